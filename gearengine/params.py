@@ -1,0 +1,243 @@
+"""The dimensionless parameter model of the gear pair, Eq. (9) of the seed paper.
+
+    x'' + 2 mu~ x' + (1 + 2 sum_r k~_pr cos(r Omega_k tau + phi_kr)) f_h(x)
+        = F~_m + sum_r F~_pr cos(r Omega_p tau + phi_pr)
+               + sum_r (r Omega_e)^2 F~_er cos(r Omega_e tau + phi_er)          (Eq. 9)
+
+x is the dynamic transmission error divided by the half backlash b, tau = omega_n t is
+dimensionless time. This module is the single definition of the parameters used by the engine,
+the HTTP API and the CLI. Every number is validated to be finite; bad input raises
+``pydantic.ValidationError`` (a ``ValueError``) naming the field.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+MAX_HARMONICS = 32
+"""Largest number of harmonics r = 1..R accepted per excitation."""
+
+PAPER_A = 0.1667
+"""Cubic backlash coefficients of the paper, f_h(x) = -0.1667 x + 0.1667 x^3 (Eq. 9)."""
+
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+class Harmonic(_Strict):
+    """One harmonic r of an excitation: amplitude times cos(r Omega tau + phase)."""
+
+    amplitude: Finite = Field(
+        0.0,
+        description="Dimensionless amplitude of this harmonic (k~_pr, F~_er or F~_pr).",
+        examples=[0.2],
+    )
+    phase: Finite = Field(
+        0.0,
+        description="Phase angle phi_r of this harmonic, radians.",
+        examples=[0.0],
+    )
+
+
+class Excitation(_Strict):
+    """A periodic excitation: fundamental frequency Omega and harmonics r = 1..R."""
+
+    frequency: Annotated[float, Field(gt=0.0, le=1.0e3, allow_inf_nan=False)] = Field(
+        description="Dimensionless fundamental frequency Omega = omega / omega_n.",
+        examples=[0.5],
+    )
+    harmonics: list[Harmonic] = Field(
+        default_factory=list,
+        max_length=MAX_HARMONICS,
+        description=(
+            "Harmonics r = 1, 2, ... in order; entry r-1 multiplies cos(r Omega tau + phase). "
+            f"At most {MAX_HARMONICS}."
+        ),
+        examples=[[{"amplitude": 0.2, "phase": 0.0}]],
+    )
+
+    def active(self) -> Iterator[tuple[int, Harmonic]]:
+        """Yield (r, harmonic) for every harmonic with a nonzero amplitude."""
+        for r, h in enumerate(self.harmonics, start=1):
+            if h.amplitude != 0.0:
+                yield r, h
+
+
+class CubicBacklash(_Strict):
+    """Cubic approximation of the backlash law, f_h(x) = -a x + c x^3 (Eq. 9)."""
+
+    model: Literal["cubic"] = Field("cubic", description="Backlash law: cubic polynomial.")
+    a: Finite = Field(
+        PAPER_A,
+        description="Linear coefficient a of f_h(x) = -a x + c x^3 (paper: 0.1667).",
+        examples=[PAPER_A],
+    )
+    c: Finite = Field(
+        PAPER_A,
+        description="Cubic coefficient c of f_h(x) = -a x + c x^3 (paper: 0.1667).",
+        examples=[PAPER_A],
+    )
+
+
+class PiecewiseBacklash(_Strict):
+    """Exact backlash law of Eq. (8): slope alpha inside the clearance |x| <= 1, 1 outside."""
+
+    model: Literal["piecewise"] = Field(
+        "piecewise", description="Backlash law: piecewise linear, Eq. (8)."
+    )
+    alpha: Annotated[float, Field(ge=0.0, lt=1.0, allow_inf_nan=False)] = Field(
+        0.0,
+        description="Stiffness ratio alpha inside the clearance, 0 <= alpha < 1 (paper: 0).",
+        examples=[0.0],
+    )
+
+
+Backlash = Annotated[CubicBacklash | PiecewiseBacklash, Field(discriminator="model")]
+
+EXCITATIONS = ("stiffness", "transmission_error", "torque")
+"""Names of the three excitations, in the order used by the kernels."""
+
+
+class GearParams(_Strict):
+    """Dimensionless parameters of Eq. (9); an omitted excitation has zero amplitude."""
+
+    damping: Annotated[float, Field(ge=0.0, le=1.0e3, allow_inf_nan=False)] = Field(
+        description="Damping ratio mu~ = c / (2 m omega_n).", examples=[0.07]
+    )
+    mean_force: Finite = Field(
+        0.0, description="Mean transmitted force F~_m = F^_m / (b k_m).", examples=[0.01]
+    )
+    backlash: Backlash = Field(
+        default_factory=CubicBacklash,
+        description="Backlash law f_h: cubic (default a = c = 0.1667) or piecewise (Eq. 8).",
+    )
+    stiffness: Excitation | None = Field(
+        None,
+        description="Mesh-stiffness variation: amplitudes k~_pr at frequency Omega_k.",
+        examples=[{"frequency": 1.0, "harmonics": [{"amplitude": 0.0, "phase": 0.0}]}],
+    )
+    transmission_error: Excitation | None = Field(
+        None,
+        description=(
+            "Static transmission error: amplitudes F~_er = e_r / b at frequency Omega_e; "
+            "the forcing is (r Omega_e)^2 F~_er cos(r Omega_e tau + phi_er)."
+        ),
+        examples=[{"frequency": 0.5, "harmonics": [{"amplitude": 0.2, "phase": 0.0}]}],
+    )
+    torque: Excitation | None = Field(
+        None,
+        description="Torque fluctuation: amplitudes F~_pr at frequency Omega_p.",
+        examples=[{"frequency": 0.1, "harmonics": [{"amplitude": 0.0, "phase": 0.0}]}],
+    )
+
+    model_config = ConfigDict(
+        extra="forbid",
+        frozen=True,
+        allow_inf_nan=False,
+        json_schema_extra={
+            "examples": [
+                {
+                    "damping": 0.07,
+                    "mean_force": 0.01,
+                    "backlash": {"model": "cubic", "a": 0.1667, "c": 0.1667},
+                    "transmission_error": {
+                        "frequency": 0.5,
+                        "harmonics": [{"amplitude": 0.2, "phase": 0.0}],
+                    },
+                }
+            ]
+        },
+    )
+
+    def excitations(self) -> Iterator[tuple[str, Excitation]]:
+        """Yield (name, excitation) for each excitation that is given."""
+        for name in EXCITATIONS:
+            exc = getattr(self, name)
+            if exc is not None:
+                yield name, exc
+
+    def active_frequencies(self) -> list[float]:
+        """Frequencies r Omega of every harmonic with nonzero amplitude (1/time units)."""
+        return [r * exc.frequency for _, exc in self.excitations() for r, _ in exc.active()]
+
+
+# --- Short aliases for first harmonics and frequencies (used by sweeps and the CLI) ---------
+
+ALIASES: dict[str, tuple[str, str]] = {
+    "mu": ("damping", ""),
+    "F_m": ("mean_force", ""),
+    "k_p1": ("stiffness", "amplitude"),
+    "F_e1": ("transmission_error", "amplitude"),
+    "F_p1": ("torque", "amplitude"),
+    "Omega_k": ("stiffness", "frequency"),
+    "Omega_e": ("transmission_error", "frequency"),
+    "Omega_p": ("torque", "frequency"),
+}
+"""alias -> (field, what): what is '' for a scalar field, else the excitation's item."""
+
+Alias = Literal["mu", "F_m", "k_p1", "F_e1", "F_p1", "Omega_k", "Omega_e", "Omega_p"]
+
+
+def get_alias(params: GearParams, name: str) -> float | None:
+    """Value of a short alias (first-harmonic amplitude, frequency, mu or F_m).
+
+    An absent excitation has amplitude 0 and frequency ``None``.
+    """
+    field, what = _alias(name)
+    if not what:
+        return float(getattr(params, field))
+    exc: Excitation | None = getattr(params, field)
+    if exc is None:
+        return 0.0 if what == "amplitude" else None
+    if what == "frequency":
+        return exc.frequency
+    return exc.harmonics[0].amplitude if exc.harmonics else 0.0
+
+
+def with_alias(params: GearParams, name: str, value: float) -> GearParams:
+    """A copy of ``params`` with the alias set to ``value``, validated.
+
+    Raises ``ValueError`` when an amplitude is set on an excitation whose frequency is unknown.
+    """
+    return with_aliases(params, {name: value})
+
+
+def with_aliases(params: GearParams, values: dict[str, float]) -> GearParams:
+    """A copy of ``params`` with several aliases set at once, validated (see ``with_alias``)."""
+    data = params.model_dump()
+    for name, value in values.items():
+        field, what = _alias(name)
+        if not what:
+            data[field] = value
+            continue
+        exc = data.get(field)
+        if exc is None:
+            if what == "amplitude" and value == 0.0:
+                continue
+            freq_alias = next(k for k, v in ALIASES.items() if v == (field, "frequency"))
+            if what == "amplitude" and freq_alias not in values:
+                raise ValueError(
+                    f"cannot set {name}: {field} has no frequency; give {field}.frequency "
+                    f"or {freq_alias}"
+                )
+            exc = data[field] = {"frequency": values.get(freq_alias, 1.0), "harmonics": []}
+        if what == "frequency":
+            exc["frequency"] = value
+        else:
+            if not exc["harmonics"]:
+                exc["harmonics"].append({"amplitude": 0.0, "phase": 0.0})
+            exc["harmonics"][0]["amplitude"] = value
+    return GearParams.model_validate(data)
+
+
+def _alias(name: str) -> tuple[str, str]:
+    try:
+        return ALIASES[name]
+    except KeyError:
+        raise ValueError(f"unknown parameter {name!r}; expected one of {sorted(ALIASES)}") from None
