@@ -15,7 +15,9 @@ MAX_DENOMINATOR = 64
 RATIO_TOLERANCE = 1e-9
 
 
-def common_frequency(frequencies: list[float], max_denominator: int = MAX_DENOMINATOR) -> float | None:
+def common_frequency(
+    frequencies: list[float], max_denominator: int = MAX_DENOMINATOR
+) -> float | None:
     """Largest Omega_0 of which every frequency is an integer multiple, or None.
 
     Args:

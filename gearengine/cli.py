@@ -1,0 +1,125 @@
+"""The ``gearengine`` command line.
+
+    gearengine melnikov FILE [--json] [--method closed_form|quadrature]
+
+FILE holds ``{"params": {...}}`` (``-`` reads standard input). ``--json`` prints exactly the body
+the HTTP API returns. Exit codes: 0 success, 2 invalid input (one line per problem, naming the
+field).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import TypeVar
+
+from pydantic import BaseModel, ValidationError
+
+from gearengine.jsonio import dumps, error_lines, load_document
+from gearengine.melnikov_analysis import MelnikovResult, ParameterThreshold, melnikov
+from gearengine.requests import MelnikovRequest
+
+EXIT_OK, EXIT_FAIL, EXIT_INVALID = 0, 1, 2
+
+R = TypeVar("R", bound=BaseModel)
+
+
+class InvalidInputError(Exception):
+    """Input that cannot be used; carries one message line per problem."""
+
+    def __init__(self, lines: list[str]) -> None:
+        super().__init__("\n".join(lines))
+        self.lines = lines
+
+
+def read_request(path: str, model: type[R]) -> R:
+    """Read and validate a request document from a file or ``-`` (stdin)."""
+    try:
+        text = sys.stdin.read() if path == "-" else Path(path).read_text()
+    except OSError as exc:
+        raise InvalidInputError([f"{path}: {exc.strerror}"]) from None
+    try:
+        return model.model_validate(load_document(text))
+    except ValueError as exc:
+        if isinstance(exc, ValidationError):
+            raise InvalidInputError(error_lines(exc)) from None
+        raise InvalidInputError([f"{path}: {exc}"]) from None
+
+
+# --- melnikov -------------------------------------------------------------------------------------
+
+
+def _fmt(v: float | None) -> str:
+    return "-" if v is None else f"{v:.6g}"
+
+
+def _threshold_row(name: str, t: ParameterThreshold) -> str:
+    crit = ", ".join(_fmt(v) for v in t.critical_values) or (t.note or "none")
+    margin = "-"
+    if t.margin is not None:
+        margin = f"{t.margin:+.4g}"
+        if t.relative_margin is not None:
+            margin += f" ({100 * t.relative_margin:+.1f}%)"
+    return f"  {name:<8} {_fmt(t.value):>10}  {crit:<36} {_fmt(t.nearest):>10}  {margin}"
+
+
+def render_melnikov(r: MelnikovResult) -> str:
+    """Readable verdict table of a Melnikov result."""
+    if not r.applicable:
+        return "Melnikov criterion not applicable\n" + "\n".join(f"  note: {n}" for n in r.notes)
+    verdict = "POSSIBLE" if r.chaos_possible else "not possible"
+    lines = [
+        f"Melnikov verdict: chaos {verdict} "
+        f"({'transverse' if r.chaos_possible else 'no transverse'} homoclinic intersection)",
+        f"  cubic law f_h = -{r.a:g} x + {r.c:g} x^3, forcing period T0 = {_fmt(r.forcing_period)}",
+        "  branch  sign change       min M         max M   extrema",
+    ]
+    for name, b in (r.branches or {}).items():
+        change = "yes" if b.sign_change else "no"
+        lines.append(f"  {name:<7} {change:<11} {b.min:>13.6g} {b.max:>13.6g}   {b.extrema}")
+    lines.append(f"  {'param':<8} {'value':>10}  {'critical values':<36} {'nearest':>10}  margin")
+    lines += [_threshold_row(name, t) for name, t in r.thresholds.items()]
+    lines += [f"  note: {n}" for n in r.notes]
+    return "\n".join(lines)
+
+
+def cmd_melnikov(args: argparse.Namespace) -> int:
+    req = read_request(args.file, MelnikovRequest)
+    result = melnikov(req.params, method=args.method or req.method)
+    print(dumps(result) if args.json else render_melnikov(result))
+    return EXIT_OK
+
+
+# --- entry point ----------------------------------------------------------------------------------
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="gearengine",
+        description="Periodic or chaotic? Melnikov and numerical verdicts for spur-gear pairs.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("melnikov", help="Melnikov verdict, thresholds and margins of a design")
+    p.add_argument("file", help='JSON file holding {"params": {...}}, or - for stdin')
+    p.add_argument("--json", action="store_true", help="print the API's JSON response")
+    p.add_argument("--method", choices=["closed_form", "quadrature"], default=None)
+    p.set_defaults(func=cmd_melnikov)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the exit code."""
+    args = build_parser().parse_args(argv)
+    func: Callable[[argparse.Namespace], int] = args.func
+    try:
+        return func(args)
+    except InvalidInputError as exc:
+        for line in exc.lines:
+            print(line, file=sys.stderr)
+        return EXIT_INVALID
+
+
+if __name__ == "__main__":
+    sys.exit(main())

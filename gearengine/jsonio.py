@@ -1,0 +1,43 @@
+"""Canonical JSON of results and readable errors, shared by the CLI and the API.
+
+The CLI's ``--json`` output and the API's response body are the same bytes: both come from
+``dumps``.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+from pydantic import BaseModel, ValidationError
+
+
+def dumps(result: BaseModel) -> str:
+    """Compact, deterministic JSON of a result model (field order as declared)."""
+    return result.model_dump_json()
+
+
+def field_path(loc: tuple[Any, ...]) -> str:
+    """Dotted JSON path of a pydantic error location: params.backlash.a, axes[0].num."""
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out or "(body)"
+
+
+def error_lines(exc: ValidationError) -> list[str]:
+    """One line per problem: 'path: message'."""
+    return [f"{field_path(e['loc'])}: {e['msg']}" for e in exc.errors(include_url=False)]
+
+
+def load_document(text: str) -> Any:
+    """Parse JSON text; raises ValueError with the line and column of a syntax error."""
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ValueError(
+            f"invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}"
+        ) from None
