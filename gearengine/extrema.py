@@ -167,7 +167,10 @@ def sublevel_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
     if period is None:
         return _supremum_interval(m0, g, active)
     taus = grid(freqs[active], period)
-    mv, gv = m0(taus), g(taus)
+    # g's own extrema join the samples: a sign of g missed by the grid still bounds p
+    g_ext = extrema(g)
+    probes = np.concatenate([taus, [e.tau0 for e in (g_ext.minimum, g_ext.maximum) if e.tau0]])
+    mv, gv = m0(probes), g(probes)
     lo, hi = _line_envelope(mv, gv)
     if lo is not None and hi is not None and lo > hi:
         return None

@@ -32,6 +32,7 @@ import numpy as np
 from scipy import integrate
 
 from gearengine.backlash import collocation_fit
+from gearengine.extrema import TrigSum
 from gearengine.params import CubicBacklash, GearParams
 
 Branch = Literal["plus", "minus"]
@@ -62,6 +63,15 @@ class MelnikovCoefficients:
     damping: float
     damping_per_unit: float
     terms: tuple[Term, ...]
+
+    def trig_sum(self) -> TrigSum:
+        """The same sum as arrays, for extrema and threshold search."""
+        return TrigSum(
+            self.damping,
+            np.array([t.coefficient for t in self.terms]),
+            np.array([t.frequency for t in self.terms]),
+            np.array([t.phase for t in self.terms]),
+        )
 
     def __call__(self, tau0: np.ndarray | float) -> np.ndarray | float:
         """Evaluate M at tau0 (array or scalar, dimensionless time)."""

@@ -1,0 +1,130 @@
+"""Result documents of the Melnikov analysis (the /v1/melnikov and /v1/thresholds contracts)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from gearengine.melnikov import Branch, Method
+
+
+class _Result(BaseModel):
+    model_config = ConfigDict(frozen=True)
+
+
+class BranchVerdict(_Result):
+    """Extrema of M over tau0 on one homoclinic branch."""
+
+    sign_change: bool = Field(description="min M < 0 < max M: M has a simple zero.")
+    min: float = Field(
+        description="Minimum of M(tau0) (infimum if the frequencies are incommensurate)."
+    )
+    max: float = Field(description="Maximum of M(tau0) (supremum if incommensurate).")
+    tau0_min: float | None = Field(
+        description="tau0 of the minimum within one period, if attained."
+    )
+    tau0_max: float | None = Field(
+        description="tau0 of the maximum within one period, if attained."
+    )
+    extrema: Literal["exact", "supremum", "constant"] = Field(
+        description="exact: commensurate frequencies, extrema over the common period; "
+        "supremum: incommensurate, sum of amplitudes; constant: no excitation."
+    )
+
+
+class TermOut(_Result):
+    """One sinusoid B sin(Omega tau0 + phi) of M."""
+
+    excitation: str = Field(description="stiffness, transmission_error or torque.")
+    r: int = Field(description="Harmonic number.")
+    frequency: float = Field(description="r Omega (dimensionless).")
+    phase: float = Field(description="Phase phi_r, radians.")
+    coefficient: float = Field(description="B, same units as M.")
+
+
+class CoefficientsOut(_Result):
+    """M(tau0) = damping + sum(terms) on one branch."""
+
+    damping: float = Field(description="Constant part A = -(8/3) mu a^(3/2) / c.")
+    terms: list[TermOut]
+
+
+class BranchThreshold(_Result):
+    """Where one branch stops changing sign as the parameter varies."""
+
+    critical_values: list[float] = Field(description="Ends of the no-sign-change intervals.")
+    no_sign_change: list[tuple[float | None, float | None]] = Field(
+        description="Closed intervals [lo, hi] of the parameter where this branch has no simple "
+        "zero; null is an unbounded end."
+    )
+
+
+class ParameterThreshold(_Result):
+    """Thresholds of one control parameter, the others fixed, and the design's margin."""
+
+    value: float | None = Field(description="The parameter's value in the given design.")
+    critical_values: list[float] = Field(
+        description="Values where the overall verdict (either branch changes sign) flips."
+    )
+    nearest: float | None = Field(description="The critical value nearest to the design.")
+    margin: float | None = Field(
+        description="value - nearest: signed distance to the nearest critical value."
+    )
+    relative_margin: float | None = Field(description="margin / |nearest| (null if nearest = 0).")
+    no_chaos: list[tuple[float | None, float | None]] = Field(
+        description="Intervals of the parameter where neither branch changes sign."
+    )
+    branches: dict[Branch, BranchThreshold] | None = Field(
+        None, description="Per-branch thresholds (null for the frequency scan)."
+    )
+    scan: tuple[float, float, int] | None = Field(
+        None, description="For a frequency: the scanned range (start, stop, points)."
+    )
+    note: str | None = Field(None, description="Why a threshold is missing, if it is.")
+
+
+class MelnikovResult(_Result):
+    """The Melnikov verdict of a design (the /v1/melnikov contract)."""
+
+    applicable: bool = Field(description="False when the unperturbed system has no saddle loop.")
+    chaos_possible: bool | None = Field(
+        description="Either branch changes sign: transverse homoclinic orbits, chaos possible. "
+        "null when not applicable."
+    )
+    branches: dict[Branch, BranchVerdict] | None = Field(
+        description="plus: x_h > 0 (Eq. 15), minus: x_h < 0."
+    )
+    thresholds: dict[str, ParameterThreshold] = Field(
+        description="Per control parameter (F_e1, mu, k_p1, F_p1, Omega_e)."
+    )
+    coefficients: dict[Branch, CoefficientsOut] | None = Field(
+        description="The sinusoids of M on each branch."
+    )
+    a: float | None = Field(description="Cubic coefficient a used (f_h = -a x + c x^3).")
+    c: float | None = Field(description="Cubic coefficient c used.")
+    forcing_period: float | None = Field(
+        description="Common period 2 pi / Omega_0 of the active excitations (null if none or "
+        "incommensurate)."
+    )
+    method: Method = Field(description="closed_form (corrected Eq. 19) or quadrature (Eq. 18).")
+    notes: list[str] = Field(description="Caveats and explanations, in plain words.")
+
+
+class ThresholdCurve(_Result):
+    """Critical values of a control parameter over a frequency range (paper Figs. 5, 12, 18)."""
+
+    parameter: str = Field(description="The control parameter: F_e1, mu, k_p1 or F_p1.")
+    frequency_parameter: str = Field(
+        description="The swept frequency: Omega_e, Omega_k or Omega_p."
+    )
+    frequencies: list[float] = Field(description="The frequency values.")
+    no_chaos: list[list[tuple[float | None, float | None]]] = Field(
+        description="Per frequency: intervals of the parameter where neither branch changes sign "
+        "(chaos is possible outside them)."
+    )
+    branches: dict[Branch, list[list[tuple[float | None, float | None]]]] = Field(
+        description="Per branch and frequency: intervals where that branch has no simple zero."
+    )
+    value: float | None = Field(description="The design's value of the parameter.")
+    notes: list[str] = Field(description="Caveats.")

@@ -1,0 +1,241 @@
+"""Thresholds of the control parameters (the paper's Eqs. 23, 24, 28-30, generalised).
+
+For each control parameter p in (F_e1, mu, k_p1, F_p1) M is affine in p, M = m0 + p g, so the
+set of p where a branch does *not* change sign is a union of at most two closed intervals
+(max M <= 0 or min M >= 0); their finite ends are the critical values, found by root finding
+for every term and harmonic. Omega_e enters M non-linearly and is scanned.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import optimize
+
+from gearengine.extrema import Interval, TrigSum, extrema, sublevel_interval
+from gearengine.melnikov import (
+    BRANCH_SIGN,
+    Branch,
+    MelnikovCoefficients,
+    coefficients,
+    cubic_coefficients,
+)
+from gearengine.melnikov_result import BranchThreshold, ParameterThreshold, ThresholdCurve
+from gearengine.params import GearParams, get_alias, with_alias
+
+CONTROL_PARAMETERS = ("F_e1", "mu", "k_p1", "F_p1")
+"""Control parameters with thresholds; the amplitudes are first harmonics."""
+
+_TERM_OF = {"F_e1": "transmission_error", "k_p1": "stiffness", "F_p1": "torque"}
+
+DOMAIN = {"mu": Interval(0.0, None)}
+"""Admissible range of a control parameter (damping is non-negative); others are unbounded."""
+
+OMEGA_SCAN = (0.05, 3.0, 60)
+"""Default Omega_e scan for critical frequencies: start, stop, number of points."""
+
+
+def sign_change_strength(params: GearParams, a: float, c: float) -> float:
+    """max over branches of min(max M, -min M): > 0 iff some branch changes sign.
+
+    Continuous in the parameters (for a fixed set of commensurate frequencies), so its roots
+    are the critical values of any parameter.
+    """
+    strengths = []
+    for br in BRANCH_SIGN:
+        ext = extrema(coefficients(params, a, c, br).trig_sum())
+        strengths.append(min(ext.maximum.value, -ext.minimum.value))
+    return max(strengths)
+
+
+def _family(coef: MelnikovCoefficients, parameter: str) -> tuple[TrigSum, TrigSum] | None:
+    """Split M = m0 + p g for the control parameter p (None if p's excitation is absent)."""
+    m = coef.trig_sum()
+    zeros = np.zeros_like(m.amplitudes)
+    if parameter == "mu":
+        return (
+            TrigSum(0.0, m.amplitudes, m.frequencies, m.phases),
+            TrigSum(coef.damping_per_unit, zeros, m.frequencies, m.phases),
+        )
+    name = _TERM_OF[parameter]
+    j = next((i for i, t in enumerate(coef.terms) if t.excitation == name and t.r == 1), None)
+    if j is None:
+        return None
+    rest = m.amplitudes.copy()
+    rest[j] = 0.0
+    unit = zeros.copy()
+    unit[j] = coef.terms[j].per_unit
+    return (
+        TrigSum(m.offset, rest, m.frequencies, m.phases),
+        TrigSum(0.0, unit, m.frequencies, m.phases),
+    )
+
+
+def _negate(m: TrigSum) -> TrigSum:
+    return TrigSum(-m.offset, -m.amplitudes, m.frequencies, m.phases)
+
+
+def no_sign_change(m0: TrigSum, g: TrigSum) -> list[Interval]:
+    """Intervals of p where m0 + p g keeps one sign: max <= 0 or min >= 0."""
+    sets = (sublevel_interval(m0, g), sublevel_interval(_negate(m0), _negate(g)))
+    return [s for s in sets if s is not None]
+
+
+def _intersect(xs: list[Interval], ys: list[Interval]) -> list[Interval]:
+    out = []
+    for x in xs:
+        for y in ys:
+            lo = _max_end(x.lo, y.lo)
+            hi = _min_end(x.hi, y.hi)
+            if lo is None or hi is None or lo <= hi:
+                out.append(Interval(lo, hi))
+    return sorted(out, key=lambda i: -np.inf if i.lo is None else i.lo)
+
+
+def _max_end(p: float | None, q: float | None) -> float | None:
+    return q if p is None else p if q is None else max(p, q)
+
+
+def _min_end(p: float | None, q: float | None) -> float | None:
+    return q if p is None else p if q is None else min(p, q)
+
+
+def _ends(intervals: list[Interval], domain: Interval) -> list[float]:
+    """Finite interval ends that are not ends of the parameter's domain."""
+    bounds = {domain.lo, domain.hi}
+    return sorted({e for i in intervals for e in (i.lo, i.hi) if e is not None and e not in bounds})
+
+
+def _margin(value: float | None, critical: list[float]) -> tuple:
+    if value is None or not critical:
+        return None, None, None
+    nearest = min(critical, key=lambda v: abs(value - v))
+    margin = value - nearest
+    return nearest, margin, (margin / abs(nearest) if nearest != 0.0 else None)
+
+
+def parameter_threshold(
+    params: GearParams, parameter: str, a: float, c: float
+) -> ParameterThreshold:
+    """Critical values of one control parameter (others fixed) and the design's margin."""
+    value = get_alias(params, parameter)
+    domain = DOMAIN.get(parameter, Interval(None, None))
+    branches: dict[Branch, BranchThreshold] = {}
+    sets: dict[Branch, list[Interval]] = {}
+    for br in BRANCH_SIGN:
+        family = _family(coefficients(params, a, c, br, include_inactive=True), parameter)
+        if family is None:
+            exc = _TERM_OF[parameter]
+            return ParameterThreshold(
+                value=value,
+                critical_values=[],
+                nearest=None,
+                margin=None,
+                relative_margin=None,
+                no_chaos=[],
+                note=f"{exc} is not given: no frequency for {parameter}",
+            )
+        sets[br] = _intersect(no_sign_change(*family), [domain])
+        branches[br] = BranchThreshold(
+            critical_values=_ends(sets[br], domain),
+            no_sign_change=[(i.lo, i.hi) for i in sets[br]],
+        )
+    overall = _intersect(sets["plus"], sets["minus"])
+    critical = _ends(overall, domain)
+    nearest, margin, rel = _margin(value, critical)
+    return ParameterThreshold(
+        value=value,
+        critical_values=critical,
+        nearest=nearest,
+        margin=margin,
+        relative_margin=rel,
+        no_chaos=[(i.lo, i.hi) for i in overall],
+        branches=branches,
+    )
+
+
+def frequency_threshold(
+    params: GearParams, a: float, c: float, scan: tuple = OMEGA_SCAN
+) -> ParameterThreshold:
+    """Critical Omega_e in a scan: where the verdict flips, located by bisection."""
+    value = get_alias(params, "Omega_e")
+    base = dict(value=value, branches=None, scan=scan)
+    if value is None:
+        return ParameterThreshold(
+            **base,
+            critical_values=[],
+            nearest=None,
+            margin=None,
+            relative_margin=None,
+            no_chaos=[],
+            note="transmission_error is not given: no Omega_e to scan",
+        )
+    start, stop, num = scan
+    exc = params.transmission_error
+
+    def strength(om: float) -> float:
+        moved = exc.model_copy(update={"frequency": float(om)})
+        return sign_change_strength(params.model_copy(update={"transmission_error": moved}), a, c)
+
+    omegas = np.linspace(start, stop, num)
+    values = [strength(om) for om in omegas]
+    critical = [
+        float(optimize.brentq(strength, lo, hi, xtol=1e-12))
+        for lo, hi, f_lo, f_hi in zip(omegas, omegas[1:], values, values[1:], strict=False)
+        if (f_lo > 0.0) != (f_hi > 0.0)
+    ]
+    edges = [float(start), *critical, float(stop)]
+    no_chaos = [
+        (edges[i], edges[i + 1])
+        for i in range(len(edges) - 1)
+        if strength(0.5 * (edges[i] + edges[i + 1])) <= 0.0
+    ]
+    nearest, margin, rel = _margin(value, critical)
+    return ParameterThreshold(
+        **base,
+        critical_values=critical,
+        nearest=nearest,
+        margin=margin,
+        relative_margin=rel,
+        no_chaos=no_chaos,
+        note="critical frequencies found by scanning; flips between scan points closer than "
+        "the grid step may be missed",
+    )
+
+
+def threshold_curve(
+    params: GearParams,
+    parameter: str,
+    frequency_parameter: str = "Omega_e",
+    start: float = 0.05,
+    stop: float = 2.5,
+    num: int = 100,
+) -> ThresholdCurve:
+    """Critical values of ``parameter`` for ``num`` values of a frequency in [start, stop].
+
+    Args:
+        params: the design; its other parameters stay fixed.
+        parameter: F_e1, mu, k_p1 or F_p1.
+        frequency_parameter: Omega_e, Omega_k or Omega_p (the excitation must be given).
+        start, stop, num: the frequency grid (dimensionless).
+    """
+    a, c, notes = cubic_coefficients(params)
+    if not (a > 0.0 and c > 0.0):
+        raise ValueError(f"the Melnikov criterion needs a > 0 and c > 0 (got a = {a}, c = {c})")
+    if get_alias(params, frequency_parameter) is None:
+        raise ValueError(f"{frequency_parameter}: its excitation is not given")
+    omegas = [float(w) for w in np.linspace(start, stop, num)]
+    rows = [
+        parameter_threshold(with_alias(params, frequency_parameter, w), parameter, a, c)
+        for w in omegas
+    ]
+    if any(r.note for r in rows):
+        raise ValueError(next(r.note for r in rows if r.note))
+    return ThresholdCurve(
+        parameter=parameter,
+        frequency_parameter=frequency_parameter,
+        frequencies=omegas,
+        no_chaos=[r.no_chaos for r in rows],
+        branches={br: [r.branches[br].no_sign_change for r in rows] for br in BRANCH_SIGN},
+        value=get_alias(params, parameter),
+        notes=notes,
+    )
