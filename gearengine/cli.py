@@ -18,7 +18,8 @@ from typing import TypeVar
 from pydantic import BaseModel, ValidationError
 
 from gearengine.jsonio import dumps, error_lines, load_document
-from gearengine.melnikov_analysis import MelnikovResult, ParameterThreshold, melnikov
+from gearengine.melnikov_analysis import melnikov
+from gearengine.melnikov_result import MelnikovResult, ParameterThreshold
 from gearengine.requests import MelnikovRequest
 
 EXIT_OK, EXIT_FAIL, EXIT_INVALID = 0, 1, 2

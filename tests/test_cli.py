@@ -1,0 +1,60 @@
+"""The gearengine CLI as a user runs it: a real subprocess."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from gearengine.jsonio import dumps
+from gearengine.melnikov_analysis import melnikov
+from gearengine.requests import MelnikovRequest
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "paper-4.1.json"
+
+
+def run(*args: str, stdin: str | None = None) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "gearengine.cli", *args],
+        input=stdin,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
+def test_melnikov_table() -> None:
+    out = run("melnikov", str(EXAMPLE))
+    assert out.returncode == 0, out.stderr
+    assert "chaos POSSIBLE" in out.stdout
+    assert "F_e1" in out.stdout and "0.19588" in out.stdout
+
+
+def test_melnikov_json_is_the_api_body() -> None:
+    out = run("melnikov", str(EXAMPLE), "--json")
+    assert out.returncode == 0, out.stderr
+    req = MelnikovRequest.model_validate_json(EXAMPLE.read_text())
+    assert out.stdout.rstrip("\n") == dumps(melnikov(req.params))
+    assert json.loads(out.stdout)["thresholds"]["F_e1"]["nearest"] > 0.195
+
+
+def test_stdin_and_invalid_input_exit_2_naming_each_field() -> None:
+    bad = {"params": {"damping": -1, "transmission_error": {"frequency": 0}, "speed": 1}}
+    out = run("melnikov", "-", stdin=json.dumps(bad))
+    assert out.returncode == 2
+    lines = out.stderr.strip().splitlines()
+    assert lines == [
+        "params.damping: Input should be greater than or equal to 0",
+        "params.transmission_error.frequency: Input should be greater than 0",
+        "params.speed: Extra inputs are not permitted",
+    ]
+
+
+def test_nan_and_broken_json_are_refused() -> None:
+    out = run("melnikov", "-", stdin='{"params": {"damping": NaN}}')
+    assert out.returncode == 2 and "params.damping" in out.stderr
+    out = run("melnikov", "-", stdin='{"params": ')
+    assert out.returncode == 2 and "invalid JSON at line 1" in out.stderr
+    out = run("melnikov", "/nonexistent.json")
+    assert out.returncode == 2 and "No such file" in out.stderr
