@@ -1,6 +1,7 @@
 """The ``gearengine`` command line.
 
     gearengine melnikov FILE [--json] [--method closed_form|quadrature]
+    gearengine serve [--host 127.0.0.1] [--port 8000] [--data-dir DIR] [--workers N]
 
 FILE holds ``{"params": {...}}`` (``-`` reads standard input). ``--json`` prints exactly the body
 the HTTP API returns. Exit codes: 0 success, 2 invalid input (one line per problem, naming the
@@ -10,6 +11,7 @@ field).
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -93,6 +95,60 @@ def cmd_melnikov(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+# --- serve ----------------------------------------------------------------------------------------
+
+
+def _is_loopback(host: str) -> bool:
+    import ipaddress
+
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def cmd_serve(args: argparse.Namespace) -> int:
+    """Start uvicorn with the API (imports the service only here: the engine has no web deps)."""
+    import uvicorn
+
+    from service.core.config import Settings
+    from service.main import create_app
+
+    flags = {
+        "host": args.host,
+        "port": args.port,
+        "data_dir": args.data_dir,
+        "workers": args.workers,
+        "dask_scheduler": args.dask,
+        "insecure": args.insecure or None,
+    }
+    settings = Settings(**{k: v for k, v in flags.items() if v is not None})
+    if not _is_loopback(settings.host) and not settings.key_list and not settings.insecure:
+        has_file = (Path(settings.data_dir) / "api_keys.sha256").exists()
+        if not has_file:
+            raise InvalidInputError(
+                [
+                    f"refusing to serve on {settings.host} without API keys: set "
+                    "GEARCHAOS_API_KEYS, or add a keys file to the data directory, or pass "
+                    "--insecure"
+                ]
+            )
+    try:
+        Path(settings.data_dir).mkdir(parents=True, exist_ok=True)
+        probe = Path(settings.data_dir) / ".write-probe"
+        probe.write_text("ok")
+        probe.unlink()
+    except OSError as exc:
+        raise InvalidInputError(
+            [f"data directory {settings.data_dir} is not writable: {exc.strerror}"]
+        ) from None
+    logging.basicConfig(level=logging.INFO, format="%(message)s")  # JSON access/job lines
+    uvicorn.run(create_app(settings), host=settings.host, port=settings.port, log_level="info")
+    return EXIT_OK
+
+
 # --- entry point ----------------------------------------------------------------------------------
 
 
@@ -107,6 +163,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
     p.add_argument("--method", choices=["closed_form", "quadrature"], default=None)
     p.set_defaults(func=cmd_melnikov)
+
+    p = sub.add_parser("serve", help="start the HTTP API and the sweep workers")
+    p.add_argument("--host", default=None, help="bind address (default 127.0.0.1)")
+    p.add_argument("--port", type=int, default=None, help="TCP port (default 8000)")
+    p.add_argument("--data-dir", default=None, help="directory holding all state (default ./data)")
+    p.add_argument("--workers", type=int, default=None, help="sweep worker processes")
+    p.add_argument("--dask", default=None, metavar="ADDRESS", help="Dask scheduler for sweeps")
+    p.add_argument(
+        "--insecure", action="store_true", help="allow a non-loopback bind without API keys"
+    )
+    p.set_defaults(func=cmd_serve)
     return parser
 
 

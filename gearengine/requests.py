@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
-from pydantic import BaseModel, ConfigDict, Field
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
 
 from gearengine.melnikov import Method
 from gearengine.params import GearParams
@@ -18,3 +20,28 @@ class MelnikovRequest(BaseModel):
         "closed_form",
         description="closed_form: corrected Eq. (19); quadrature: Eq. (18) integrated numerically.",
     )
+
+
+class ThresholdsRequest(BaseModel):
+    """Threshold curves of ``parameter`` while ``frequency_parameter`` runs over a range."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    params: GearParams = Field(description="The design; other parameters stay fixed.")
+    parameter: Literal["F_e1", "mu", "k_p1", "F_p1"] = Field(
+        "F_e1", description="Control parameter whose critical values are traced."
+    )
+    frequency_parameter: Literal["Omega_e", "Omega_k", "Omega_p"] = Field(
+        "Omega_e", description="Frequency swept along the horizontal axis."
+    )
+    start: float = Field(0.05, gt=0.0, le=1e3, description="First frequency (dimensionless).")
+    stop: float = Field(2.5, gt=0.0, le=1e3, description="Last frequency (dimensionless).")
+    num: int = Field(100, ge=2, le=100_000, description="Number of frequencies.")
+
+    @field_validator("stop")
+    @classmethod
+    def _after_start(cls, stop: float, info: ValidationInfo) -> float:
+        start = info.data.get("start")
+        if start is not None and stop <= start:
+            raise ValueError("stop must be greater than start")
+        return stop

@@ -1,0 +1,102 @@
+"""Shared dependencies: settings, API-key auth, cached computation."""
+
+from __future__ import annotations
+
+import hashlib
+import hmac
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from fastapi import Request, Response
+from starlette.concurrency import run_in_threadpool
+
+from service.cache import ResponseCache, etag_for
+from service.core.config import Settings
+from service.errors import ProblemError
+
+KEYS_FILE = "api_keys.sha256"
+"""File in the data directory: one sha256 hex digest of an API key per line (# comments)."""
+
+
+def key_id(key: str) -> str:
+    """Short, non-secret identifier of a key (first 12 hex digits of its sha256)."""
+    return hashlib.sha256(key.encode()).hexdigest()[:12]
+
+
+def load_key_hashes(settings: Settings) -> dict[str, str]:
+    """sha256 digest -> key id, from GEARCHAOS_API_KEYS and the data directory's keys file."""
+    digests = {hashlib.sha256(k.encode()).hexdigest() for k in settings.key_list}
+    path = Path(settings.data_dir) / KEYS_FILE
+    if path.exists():
+        for line in path.read_text().splitlines():
+            word = line.split("#", 1)[0].strip().lower()
+            if word:
+                digests.add(word)
+    return {d: d[:12] for d in digests}
+
+
+def presented_key(request: Request) -> str | None:
+    auth = request.headers.get("authorization", "")
+    if auth.lower().startswith("bearer "):
+        return auth[7:].strip()
+    return request.headers.get("x-api-key")
+
+
+def require_key(request: Request) -> str | None:
+    """The caller's key id, or None when auth is off. Raises 401 problem+json otherwise."""
+    hashes: dict[str, str] = request.app.state.key_hashes
+    if not hashes:
+        return None
+    key = presented_key(request)
+    if key:
+        digest = hashlib.sha256(key.encode()).hexdigest()
+        for known, kid in hashes.items():
+            if hmac.compare_digest(digest, known):
+                request.scope.setdefault("state", {})["key_id"] = kid
+                return kid
+    raise ProblemError(
+        401,
+        "unauthorized",
+        "Unauthorized",
+        "a valid API key is required: send 'Authorization: Bearer KEY' or 'X-API-Key: KEY'"
+        if not key
+        else "the API key is not valid",
+        headers={"WWW-Authenticate": "Bearer"},
+    )
+
+
+async def cached_compute(
+    request: Request,
+    route: str,
+    canonical: str,
+    compute: Callable[[], tuple[bytes, str]],
+    on_fresh: Callable[[bytes], None] | None = None,
+) -> Response:
+    """Answer from the LRU or run ``compute`` off the event loop; ETag and If-None-Match.
+
+    ``compute`` returns (body, media type); it runs in a worker thread (kernels release the GIL).
+    """
+    cache: ResponseCache = request.app.state.cache
+    tag = etag_for(route, canonical)
+    headers = {"ETag": tag, "Cache-Control": "no-cache"}
+    if tag in _if_none_match(request):
+        return Response(status_code=304, headers=headers)
+    hit = cache.get(tag)
+    if hit is not None:
+        request.app.state.metrics.cache_hits.inc()
+        body, media_type = hit
+        return Response(body, media_type=media_type, headers={**headers, "X-Cache": "hit"})
+    start = time.perf_counter()
+    body, media_type = await run_in_threadpool(compute)
+    elapsed = 1e3 * (time.perf_counter() - start)
+    cache.put(tag, body, media_type)
+    if on_fresh is not None:
+        on_fresh(body)
+    headers |= {"X-Cache": "miss", "Server-Timing": f"compute;dur={elapsed:.3f}"}
+    return Response(body, media_type=media_type, headers=headers)
+
+
+def _if_none_match(request: Request) -> set[str]:
+    value = request.headers.get("if-none-match", "")
+    return {t.strip().removeprefix("W/") for t in value.split(",") if t.strip()}

@@ -1,0 +1,22 @@
+"""Media types and the documented error responses of every route."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from service.errors import PROBLEM_JSON, Problem
+
+JSON = "application/json"
+PNG = "image/png"
+SVG = "image/svg+xml"
+
+
+def _problem(description: str) -> dict[str, Any]:
+    return {"model": Problem, "description": description, "content": {PROBLEM_JSON: {}}}
+
+
+PROBLEMS: dict[int | str, dict[str, Any]] = {
+    401: _problem("Missing or invalid API key (when keys are configured)."),
+    413: _problem("Request body over the size limit."),
+    422: _problem("Invalid input or over a limit; `errors` names each bad field."),
+}

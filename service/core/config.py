@@ -1,0 +1,47 @@
+"""The one configuration object: ``GEARCHAOS_*`` environment variables, overridden by CLI flags.
+
+Every limit of the service lives here with its default; change one with an environment variable
+(``GEARCHAOS_MAX_BODY_BYTES=2097152``) or, for the network settings, a ``gearengine serve`` flag.
+"""
+
+from __future__ import annotations
+
+import os
+from functools import cached_property
+from pathlib import Path
+
+from pydantic import Field
+from pydantic_settings import BaseSettings, SettingsConfigDict
+
+
+class Settings(BaseSettings):
+    """Service settings; field names are the environment variables without ``GEARCHAOS_``."""
+
+    model_config = SettingsConfigDict(env_prefix="GEARCHAOS_", extra="ignore", frozen=True)
+
+    host: str = Field("127.0.0.1", description="Address the API binds to.")
+    port: int = Field(8000, ge=0, le=65535, description="TCP port of the API.")
+    data_dir: Path = Field(Path("data"), description="Directory holding all state (job store).")
+    workers: int = Field(
+        max(1, os.cpu_count() or 1), ge=0, le=256, description="Sweep worker processes."
+    )
+    api_keys: str = Field(
+        "", description="Comma-separated API keys; empty = no auth (loopback only)."
+    )
+    insecure: bool = Field(False, description="Allow a non-loopback bind without API keys.")
+    dask_scheduler: str | None = Field(None, description="Dask scheduler address for sweeps.")
+
+    max_body_bytes: int = Field(1 << 20, ge=1024, description="Largest request body, bytes.")
+    max_sync_steps: int = Field(
+        5_000_000,
+        ge=1000,
+        description="Compute budget of one synchronous analysis, in RK4 steps over all starts "
+        "(the default analysis is 200 000).",
+    )
+    max_curve_points: int = Field(2000, ge=2, description="Most frequencies in a threshold curve.")
+    cache_entries: int = Field(512, ge=0, description="Responses kept in the in-memory LRU.")
+
+    @cached_property
+    def key_list(self) -> list[str]:
+        """The configured API keys, stripped, without empties."""
+        return [k.strip() for k in self.api_keys.split(",") if k.strip()]

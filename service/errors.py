@@ -1,0 +1,136 @@
+"""RFC 9457 problem details: every 4xx/5xx body is ``application/problem+json``.
+
+{"type": "https://gearchaos.dev/problems/validation", "title": "Invalid request",
+ "status": 422, "detail": "...", "errors": [{"path": "params.damping",
+ "pointer": "/params/damping", "message": "..."}]}
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import JSONResponse
+from pydantic import BaseModel, Field, ValidationError
+from starlette.exceptions import HTTPException as StarletteHTTPException
+
+from gearengine.jsonio import field_path
+
+PROBLEM_JSON = "application/problem+json"
+TYPE_BASE = "https://gearchaos.dev/problems/"
+log = logging.getLogger("gearchaos")
+
+
+class FieldError(BaseModel):
+    """One bad field of a request."""
+
+    path: str = Field(description="Dotted path of the field in the body, e.g. params.damping.")
+    pointer: str = Field(description="RFC 6901 JSON pointer of the field, e.g. /params/damping.")
+    message: str = Field(description="What is wrong with it.")
+
+
+class Problem(BaseModel):
+    """RFC 9457 problem details."""
+
+    type: str = Field(description="URI identifying the problem type.")
+    title: str = Field(description="Short summary of the problem type.")
+    status: int = Field(description="HTTP status code.")
+    detail: str = Field(description="Explanation of this occurrence.")
+    errors: list[FieldError] = Field(default_factory=list, description="The bad fields, if any.")
+
+
+class ProblemError(Exception):
+    """Raise to answer with a problem document."""
+
+    def __init__(
+        self,
+        status: int,
+        kind: str,
+        title: str,
+        detail: str,
+        errors: list[FieldError] | None = None,
+        headers: dict[str, str] | None = None,
+    ) -> None:
+        super().__init__(detail)
+        self.problem = Problem(
+            type=TYPE_BASE + kind, title=title, status=status, detail=detail, errors=errors or []
+        )
+        self.headers = headers or {}
+
+
+def problem_response(problem: Problem, headers: dict[str, str] | None = None) -> JSONResponse:
+    return JSONResponse(
+        problem.model_dump(), status_code=problem.status, media_type=PROBLEM_JSON, headers=headers
+    )
+
+
+def field_errors(errors: list[dict[str, Any]], strip_body: bool = True) -> list[FieldError]:
+    """FieldErrors from pydantic/FastAPI error dicts (dropping FastAPI's leading 'body')."""
+    out = []
+    for e in errors:
+        loc = tuple(e["loc"])
+        if strip_body and loc[:1] == ("body",):
+            loc = loc[1:]
+        pointer = "/" + "/".join(str(p).replace("~", "~0").replace("/", "~1") for p in loc)
+        out.append(FieldError(path=field_path(loc), pointer=pointer, message=e["msg"]))
+    return out
+
+
+def validation_problem(errors: list[FieldError], detail: str | None = None) -> ProblemError:
+    return ProblemError(
+        422,
+        "validation",
+        "Invalid request",
+        detail or "; ".join(f"{e.path}: {e.message}" for e in errors),
+        errors,
+    )
+
+
+_TITLES = {
+    400: "Bad request",
+    401: "Unauthorized",
+    404: "Not found",
+    405: "Method not allowed",
+    406: "Not acceptable",
+    413: "Request body too large",
+    429: "Too many requests",
+}
+
+
+def install(app: FastAPI) -> None:
+    """Register the handlers that turn every error into problem+json."""
+
+    @app.exception_handler(ProblemError)
+    async def _problem(_: Request, exc: ProblemError) -> JSONResponse:
+        return problem_response(exc.problem, exc.headers)
+
+    @app.exception_handler(RequestValidationError)
+    async def _invalid(_: Request, exc: RequestValidationError) -> JSONResponse:
+        return problem_response(validation_problem(field_errors(list(exc.errors()))).problem)
+
+    @app.exception_handler(ValidationError)
+    async def _engine_invalid(_: Request, exc: ValidationError) -> JSONResponse:
+        errors = field_errors(list(exc.errors(include_url=False)), strip_body=False)
+        return problem_response(validation_problem(errors).problem)
+
+    @app.exception_handler(StarletteHTTPException)
+    async def _http(_: Request, exc: StarletteHTTPException) -> JSONResponse:
+        title = _TITLES.get(exc.status_code, "Error")
+        slug = title.lower().replace(" ", "-")
+        problem = Problem(
+            type=TYPE_BASE + slug, title=title, status=exc.status_code, detail=str(exc.detail)
+        )
+        return problem_response(problem, getattr(exc, "headers", None))
+
+    @app.exception_handler(Exception)
+    async def _crash(request: Request, exc: Exception) -> JSONResponse:
+        log.exception("unhandled error on %s %s", request.method, request.url.path)
+        problem = Problem(
+            type=TYPE_BASE + "internal",
+            title="Internal error",
+            status=500,
+            detail=f"{type(exc).__name__}: the server failed on this request",
+        )
+        return problem_response(problem)

@@ -1,0 +1,43 @@
+"""Limits checked before any compute; each refusal is a 422 problem naming the limit."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from gearengine.requests import ThresholdsRequest
+from service.core.config import Settings
+from service.errors import FieldError, ProblemError
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The service limits of one app (from Settings)."""
+
+    settings: Settings
+
+    def check_curve(self, body: ThresholdsRequest) -> None:
+        cap = self.settings.max_curve_points
+        if body.num > cap:
+            raise over_limit("num", f"at most {cap} frequencies per curve (max_curve_points)")
+
+    def check_budget(self, steps: int, sweep_hint: bool = True) -> None:
+        cap = self.settings.max_sync_steps
+        if steps > cap:
+            hint = "; submit it as a sweep job: POST /v1/sweeps" if sweep_hint else ""
+            raise over_limit(
+                "settings",
+                f"this analysis needs {steps} RK4 steps, over the synchronous compute budget of "
+                f"{cap} steps (max_sync_steps){hint}",
+                kind="over-budget",
+            )
+
+
+def over_limit(path: str, message: str, kind: str = "limit") -> ProblemError:
+    pointer = "/" + path.replace(".", "/")
+    return ProblemError(
+        422,
+        kind,
+        "Over a limit",
+        message,
+        [FieldError(path=path, pointer=pointer, message=message)],
+    )

@@ -1,0 +1,76 @@
+"""The FastAPI application: routes under /v1, problem+json errors, offline docs."""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import AsyncIterator, Callable
+from contextlib import asynccontextmanager
+from importlib.metadata import version
+
+from fastapi import FastAPI
+from fastapi_offline import FastAPIOffline
+from starlette.concurrency import run_in_threadpool
+
+from service import errors
+from service.api.deps import load_key_hashes
+from service.api.routes import health, melnikov
+from service.cache import ResponseCache
+from service.core.config import Settings
+from service.limits import Limits
+from service.metrics import Metrics
+from service.middleware import AccessLog, BodyLimit
+
+DESCRIPTION = """
+Periodic or chaotic? Answers for a spur-gear pair with backlash, time-varying mesh stiffness,
+torque fluctuation and transmission error (Farshidianfar & Saghafi 2014, Eq. 9).
+
+* **Melnikov verdict**: whether the saddle's manifolds can intersect transversally, with the
+  threshold of each control parameter and the design's margin (`POST /v1/melnikov`).
+* **Conversions** from physical gear data (`POST /v1/conversions/physical`).
+* **Threshold curves** over a frequency range (`POST /v1/thresholds`).
+
+Every error is RFC 9457 `application/problem+json` naming the bad field. With API keys
+configured, send `Authorization: Bearer KEY` or `X-API-Key: KEY`.
+"""
+
+
+def create_app(settings: Settings | None = None) -> FastAPI:
+    """Build the app for ``settings`` (default: from GEARCHAOS_* environment variables)."""
+    settings = settings or Settings()
+    ready_checks: dict[str, Callable[[], bool]] = {}
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI) -> AsyncIterator[None]:
+        warmed = {"kernels": False}
+        ready_checks["kernels"] = lambda: warmed["kernels"]
+        await run_in_threadpool(_warm_up)
+        warmed["kernels"] = True
+        yield
+
+    app = FastAPIOffline(
+        title="gearchaos",
+        version=version("gearchaos"),
+        description=DESCRIPTION,
+        lifespan=lifespan,
+    )
+    app.state.settings = settings
+    app.state.cache = ResponseCache(settings.cache_entries)
+    app.state.metrics = Metrics()
+    app.state.limits = Limits(settings)
+    app.state.key_hashes = load_key_hashes(settings)
+    app.state.ready_checks = ready_checks
+    errors.install(app)
+    app.include_router(health.router, tags=["health"])
+    app.include_router(melnikov.router, tags=["melnikov"])
+    app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
+    app.add_middleware(AccessLog, metrics=app.state.metrics)
+    logging.getLogger("gearchaos").setLevel(logging.INFO)
+    return app
+
+
+def _warm_up() -> None:
+    """Compile or load every numba kernel once, so the first request is fast."""
+    from gearengine.melnikov_analysis import melnikov
+    from gearengine.params import GearParams
+
+    melnikov(GearParams(damping=0.1))
