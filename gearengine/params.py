@@ -116,6 +116,10 @@ class GearParams(_Strict):
     backlash: Backlash = Field(
         default_factory=CubicBacklash,
         description="Backlash law f_h: cubic (default a = c = 0.1667) or piecewise (Eq. 8).",
+        examples=[
+            {"model": "cubic", "a": 0.1667, "c": 0.1667},
+            {"model": "piecewise", "alpha": 0.0},
+        ],
     )
     stiffness: Excitation | None = Field(
         None,

@@ -7,6 +7,7 @@ import logging
 import time
 from typing import Any
 
+from starlette.exceptions import HTTPException
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from service.errors import TYPE_BASE
@@ -27,8 +28,14 @@ def _problem_413(limit: int) -> bytes:
     ).encode()
 
 
-class _TooLargeError(Exception):
-    pass
+class _TooLargeError(HTTPException):
+    """Raised from receive(): FastAPI re-raises HTTP exceptions met while reading the body, so
+    the problem handler answers 413 (other exceptions there would become a 400)."""
+
+    def __init__(self, limit: int) -> None:
+        super().__init__(
+            413, f"the request body exceeds the limit of {limit} bytes (max_body_bytes)"
+        )
 
 
 class BodyLimit:
@@ -55,7 +62,7 @@ class BodyLimit:
             if message["type"] == "http.request":
                 seen += len(message.get("body", b""))
                 if seen > self.limit:
-                    raise _TooLargeError
+                    raise _TooLargeError(self.limit)
             return message
 
         async def tracking_send(message: Message) -> None:
