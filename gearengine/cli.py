@@ -1,11 +1,13 @@
 """The ``gearengine`` command line.
 
     gearengine melnikov FILE [--json] [--method closed_form|quadrature]
+    gearengine analyze FILE [--json]
+    gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov] [--max-lle V]
     gearengine serve [--host 127.0.0.1] [--port 8000] [--data-dir DIR] [--workers N]
 
-FILE holds ``{"params": {...}}`` (``-`` reads standard input). ``--json`` prints exactly the body
-the HTTP API returns. Exit codes: 0 success, 2 invalid input (one line per problem, naming the
-field).
+FILE holds ``{"params": {...}}`` (and ``"settings"`` for analyze/check; ``-`` reads standard
+input). ``--json`` prints exactly the body the HTTP API returns. Exit codes: 0 success (check:
+pass), 1 check failed, 2 invalid input (one line per problem, naming the field).
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from typing import TypeVar
 
 from pydantic import BaseModel, ValidationError
 
+from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.jsonio import dumps, error_lines, load_document
 from gearengine.melnikov_analysis import melnikov
 from gearengine.melnikov_result import MelnikovResult, ParameterThreshold
@@ -95,6 +98,58 @@ def cmd_melnikov(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+# --- analyze and check ----------------------------------------------------------------------------
+
+SEVERITY = {"periodic": 0, "quasi_periodic": 1, "chaotic": 2, "diverged": 3}
+"""--fail-on X fails on X and on anything worse."""
+
+
+def _numerics_line(r: AnalysisResult) -> str:
+    num = r.numerics
+    kind = f"periodic {num.period}T" if num.period else num.classification
+    lle = "LLE n/a" if num.lle is None else f"LLE {num.lle:+.4g} ± {num.lle_stderr or 0.0:.2g}"
+    mel = {True: "possible", False: "not possible", None: "n/a"}[r.melnikov.chaos_possible]
+    return f"{kind} ({lle} per unit tau, {num.impact_regime}), Melnikov: chaos {mel}"
+
+
+def cmd_analyze(args: argparse.Namespace) -> int:
+    result = analyze(read_request(args.file, AnalysisRequest))
+    if args.json:
+        print(dumps(result))
+    else:
+        print(render_melnikov(result.melnikov))
+        print(f"Numerical verdict: {_numerics_line(result)}")
+        print(f"  {result.verdict.summary}")
+        print(f"  forcing period T0 = {_fmt(result.numerics.forcing_period)}")
+        for note in result.numerics.notes:
+            print(f"  note: {note}")
+    return EXIT_OK
+
+
+def failures(r: AnalysisResult, fail_on: list[str], max_lle: float | None) -> list[str]:
+    """Reasons the design fails the gate (empty: pass)."""
+    worst = r.numerics.worst_case.classification
+    reasons = [
+        f"--fail-on {f}" for f in fail_on if f != "melnikov" and SEVERITY[worst] >= SEVERITY[f]
+    ]
+    if "melnikov" in fail_on and r.melnikov.chaos_possible:
+        reasons.append("--fail-on melnikov")
+    lle = r.numerics.worst_case.lle
+    if max_lle is not None and (lle is None or lle > max_lle):
+        reasons.append(f"--max-lle {max_lle:g}")
+    return reasons
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """CI gate: exit 0 pass, 1 fail, 2 invalid input; one summary line."""
+    result = analyze(read_request(args.file, AnalysisRequest))
+    reasons = failures(result, args.fail_on or ["chaotic"], args.max_lle)
+    verdict = "FAIL" if reasons else "PASS"
+    why = f" [{', '.join(reasons)}]" if reasons else ""
+    print(f"{verdict}: {_numerics_line(result)}{why}")
+    return EXIT_FAIL if reasons else EXIT_OK
+
+
 # --- serve ----------------------------------------------------------------------------------------
 
 
@@ -163,6 +218,28 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
     p.add_argument("--method", choices=["closed_form", "quadrature"], default=None)
     p.set_defaults(func=cmd_melnikov)
+
+    p = sub.add_parser("analyze", help="Melnikov and numerical verdicts of a design")
+    p.add_argument("file", help='JSON file holding {"params": {...}, "settings": {...}}, or -')
+    p.add_argument("--json", action="store_true", help="print the API's JSON response")
+    p.set_defaults(func=cmd_analyze)
+
+    p = sub.add_parser(
+        "check",
+        help="CI gate: exit 1 when the design fails (0 pass, 2 invalid input)",
+        description="--fail-on X fails on X or anything worse "
+        "(periodic < quasi_periodic < chaotic < diverged); melnikov fails when a transverse "
+        "homoclinic tangle is possible. Default: --fail-on chaotic.",
+    )
+    p.add_argument("file", help='JSON file holding {"params": {...}, "settings": {...}}, or -')
+    p.add_argument(
+        "--fail-on",
+        action="append",
+        choices=["chaotic", "quasi_periodic", "diverged", "melnikov"],
+        help="repeatable",
+    )
+    p.add_argument("--max-lle", type=float, default=None, help="fail when the LLE exceeds V")
+    p.set_defaults(func=cmd_check)
 
     p = sub.add_parser("serve", help="start the HTTP API and the sweep workers")
     p.add_argument("--host", default=None, help="bind address (default 127.0.0.1)")

@@ -42,8 +42,9 @@ from gearengine.params import (
     PiecewiseBacklash,
 )
 
-Positive = Annotated[float, Field(gt=0.0, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+Positive = Annotated[float, Field(ge=1.0e-12, le=1.0e12, allow_inf_nan=False)]
+"""A physical quantity that must be positive, in [1e-12, 1e12] SI units (no subnormals)."""
+Finite = Annotated[float, Field(ge=-1.0e12, le=1.0e12, allow_inf_nan=False)]
 
 BALANCE_TOLERANCE = 1e-9
 """Relative mismatch of T_ma / r_a and T_mb / r_b above which the notes flag unbalanced torques."""
@@ -53,7 +54,7 @@ RATIO_TOLERANCE = 0.01
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
 class _Phase(_Strict):
@@ -115,7 +116,7 @@ class PhysicalGearData(_Strict):
         ),
         examples=[[{"amplitude": 1.0e7, "phase": 0.0}]],
     )
-    mesh_damping: Annotated[float, Field(ge=0.0, allow_inf_nan=False)] = Field(
+    mesh_damping: Annotated[float, Field(ge=0.0, le=1.0e12, allow_inf_nan=False)] = Field(
         description="Mesh damping coefficient c along the line of action [N s/m].",
         examples=[1.1e3],
     )

@@ -6,6 +6,8 @@ A branch has a simple zero (transverse homoclinic intersection) iff min M < 0 < 
 
 from __future__ import annotations
 
+import math
+
 from gearengine.extrema import Extrema, extrema
 from gearengine.frequencies import forcing_period
 from gearengine.melnikov import BRANCH_SIGN, Method, coefficients, cubic_coefficients
@@ -31,6 +33,22 @@ def branch_verdict(ext: Extrema) -> BranchVerdict:
     )
 
 
+def not_applicable(a: float, c: float, method: Method, notes: list[str]) -> MelnikovResult:
+    """A result without numbers: the criterion does not apply, and the notes say why."""
+    return MelnikovResult(
+        applicable=False,
+        chaos_possible=None,
+        branches=None,
+        thresholds={},
+        coefficients=None,
+        a=a,
+        c=c,
+        forcing_period=None,
+        method=method,
+        notes=notes,
+    )
+
+
 def melnikov(
     params: GearParams, method: Method = "closed_form", omega_scan: tuple = OMEGA_SCAN
 ) -> MelnikovResult:
@@ -43,17 +61,11 @@ def melnikov(
     """
     a, c, notes = cubic_coefficients(params)
     if not (a > 0.0 and c > 0.0):
-        return MelnikovResult(
-            applicable=False,
-            chaos_possible=None,
-            branches=None,
-            thresholds={},
-            coefficients=None,
-            a=a,
-            c=c,
-            forcing_period=None,
-            method=method,
-            notes=[
+        return not_applicable(
+            a,
+            c,
+            method,
+            [
                 *notes,
                 f"not applicable: the homoclinic orbit of x'' = a x - c x^3 needs a > 0 and "
                 f"c > 0 (got a = {a:g}, c = {c:g}); without a saddle loop there is no "
@@ -61,6 +73,18 @@ def melnikov(
             ],
         )
     coefs = {br: coefficients(params, a, c, br, method) for br in BRANCH_SIGN}
+    scale = [coefs["plus"].damping_per_unit, *(t.per_unit for t in coefs["plus"].terms)]
+    if not all(math.isfinite(v) and abs(v) < 1e150 for v in scale):
+        return not_applicable(
+            a,
+            c,
+            method,
+            [
+                *notes,
+                f"not applicable: with a = {a:g}, c = {c:g} the orbit's scale sqrt(2a/c) makes "
+                "M overflow; the Melnikov function is numerically meaningless here",
+            ],
+        )
     branches = {br: branch_verdict(extrema(coefs[br].trig_sum())) for br in BRANCH_SIGN}
     period = forcing_period(params.active_frequencies())
     if any(b.extrema == "supremum" for b in branches.values()):

@@ -23,11 +23,18 @@ MAX_HARMONICS = 32
 PAPER_A = 0.1667
 """Cubic backlash coefficients of the paper, f_h(x) = -0.1667 x + 0.1667 x^3 (Eq. 9)."""
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
+MAX_MAGNITUDE = 1.0e6
+"""Largest magnitude of an amplitude, force or coefficient; beyond it numbers overflow."""
+
+MIN_FREQUENCY = 1.0e-6
+"""Smallest dimensionless frequency (a period of 6e6 time units)."""
+
+Finite = Annotated[float, Field(allow_inf_nan=False, ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE)]
+Phase = Annotated[float, Field(allow_inf_nan=False, ge=-1.0e3, le=1.0e3)]
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
 
 class Harmonic(_Strict):
@@ -38,9 +45,9 @@ class Harmonic(_Strict):
         description="Dimensionless amplitude of this harmonic (k~_pr, F~_er or F~_pr).",
         examples=[0.2],
     )
-    phase: Finite = Field(
+    phase: Phase = Field(
         0.0,
-        description="Phase angle phi_r of this harmonic, radians.",
+        description="Phase angle phi_r of this harmonic, radians (|phi| <= 1000).",
         examples=[0.0],
     )
 
@@ -48,8 +55,8 @@ class Harmonic(_Strict):
 class Excitation(_Strict):
     """A periodic excitation: fundamental frequency Omega and harmonics r = 1..R."""
 
-    frequency: Annotated[float, Field(gt=0.0, le=1.0e3, allow_inf_nan=False)] = Field(
-        description="Dimensionless fundamental frequency Omega = omega / omega_n.",
+    frequency: Annotated[float, Field(ge=MIN_FREQUENCY, le=1.0e3, allow_inf_nan=False)] = Field(
+        description="Dimensionless fundamental frequency Omega = omega / omega_n (1e-6 to 1000).",
         examples=[0.5],
     )
     harmonics: list[Harmonic] = Field(
@@ -144,6 +151,7 @@ class GearParams(_Strict):
         extra="forbid",
         frozen=True,
         allow_inf_nan=False,
+        strict=True,
         json_schema_extra={
             "examples": [
                 {

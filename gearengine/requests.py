@@ -9,11 +9,24 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validat
 from gearengine.melnikov import Method
 from gearengine.params import GearParams
 
+PAPER_SECTION_41 = {
+    "damping": 0.07,
+    "mean_force": 0.01,
+    "backlash": {"model": "cubic", "a": 0.1667, "c": 0.1667},
+    "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 0.2, "phase": 0.0}]},
+}
+"""The paper's section 4.1 design at F~_e1 = 0.2 (Fig. 6), the documented example."""
+
 
 class MelnikovRequest(BaseModel):
     """``{"params": {...}}``: the Melnikov verdict of one design."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(
+        extra="forbid",
+        frozen=True,
+        strict=True,
+        json_schema_extra={"examples": [{"params": PAPER_SECTION_41}]},
+    )
 
     params: GearParams = Field(description="Dimensionless parameters of Eq. (9).")
     method: Method = Field(
@@ -25,7 +38,7 @@ class MelnikovRequest(BaseModel):
 class ThresholdsRequest(BaseModel):
     """Threshold curves of ``parameter`` while ``frequency_parameter`` runs over a range."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
 
     params: GearParams = Field(description="The design; other parameters stay fixed.")
     parameter: Literal["F_e1", "mu", "k_p1", "F_p1"] = Field(

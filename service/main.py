@@ -13,7 +13,7 @@ from starlette.concurrency import run_in_threadpool
 
 from service import errors
 from service.api.deps import load_key_hashes
-from service.api.routes import health, melnikov
+from service.api.routes import analyses, health, melnikov
 from service.cache import ResponseCache
 from service.core.config import Settings
 from service.limits import Limits
@@ -27,7 +27,10 @@ torque fluctuation and transmission error (Farshidianfar & Saghafi 2014, Eq. 9).
 * **Melnikov verdict**: whether the saddle's manifolds can intersect transversally, with the
   threshold of each control parameter and the design's margin (`POST /v1/melnikov`).
 * **Conversions** from physical gear data (`POST /v1/conversions/physical`).
+* **Numerical verdict**: period, largest Lyapunov exponent, classification and its agreement
+  with Melnikov (`POST /v1/analyses`).
 * **Threshold curves** over a frequency range (`POST /v1/thresholds`).
+* **Figures** as PNG or SVG (`/v1/analyses/plot`, `/v1/thresholds/plot`).
 
 Every error is RFC 9457 `application/problem+json` naming the bad field. With API keys
 configured, send `Authorization: Bearer KEY` or `X-API-Key: KEY`.
@@ -62,6 +65,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     errors.install(app)
     app.include_router(health.router, tags=["health"])
     app.include_router(melnikov.router, tags=["melnikov"])
+    app.include_router(analyses.router, tags=["analyses"])
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
     app.add_middleware(AccessLog, metrics=app.state.metrics)
     logging.getLogger("gearchaos").setLevel(logging.INFO)
@@ -72,5 +76,7 @@ def _warm_up() -> None:
     """Compile or load every numba kernel once, so the first request is fast."""
     from gearengine.melnikov_analysis import melnikov
     from gearengine.params import GearParams
+    from gearengine.simulation import warm_up
 
+    warm_up()
     melnikov(GearParams(damping=0.1))

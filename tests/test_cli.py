@@ -46,7 +46,7 @@ def test_stdin_and_invalid_input_exit_2_naming_each_field() -> None:
     lines = out.stderr.strip().splitlines()
     assert lines == [
         "params.damping: Input should be greater than or equal to 0",
-        "params.transmission_error.frequency: Input should be greater than 0",
+        "params.transmission_error.frequency: Input should be greater than or equal to 0.000001",
         "params.speed: Extra inputs are not permitted",
     ]
 

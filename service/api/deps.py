@@ -9,11 +9,12 @@ from collections.abc import Callable
 from pathlib import Path
 
 from fastapi import Request, Response
+from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
 from service.cache import ResponseCache, etag_for
 from service.core.config import Settings
-from service.errors import ProblemError
+from service.errors import FieldError, ProblemError
 
 KEYS_FILE = "api_keys.sha256"
 """File in the data directory: one sha256 hex digest of an API key per line (# comments)."""
@@ -88,13 +89,27 @@ async def cached_compute(
         body, media_type = hit
         return Response(body, media_type=media_type, headers={**headers, "X-Cache": "hit"})
     start = time.perf_counter()
-    body, media_type = await run_in_threadpool(compute)
+    try:
+        body, media_type = await run_in_threadpool(compute)
+    except ValueError as exc:
+        if isinstance(exc, ValidationError):
+            raise
+        raise engine_refusal(exc) from None
     elapsed = 1e3 * (time.perf_counter() - start)
     cache.put(tag, body, media_type)
     if on_fresh is not None:
         on_fresh(body)
     headers |= {"X-Cache": "miss", "Server-Timing": f"compute;dur={elapsed:.3f}"}
     return Response(body, media_type=media_type, headers=headers)
+
+
+def engine_refusal(exc: ValueError) -> ProblemError:
+    """422 for a ValueError of the engine; its message starts with the field when it names one."""
+    message = str(exc)
+    head = message.split(":", 1)[0]
+    path = head if head.replace(".", "").replace("_", "").isalnum() and head != message else ""
+    errors = [FieldError(path=path, pointer="/" + path.replace(".", "/"), message=message)]
+    return ProblemError(422, "refused", "Refused by the engine", message, errors if path else [])
 
 
 def _if_none_match(request: Request) -> set[str]:

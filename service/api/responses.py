@@ -16,6 +16,7 @@ def _problem(description: str) -> dict[str, Any]:
 
 
 PROBLEMS: dict[int | str, dict[str, Any]] = {
+    400: _problem("The body could not be read (not JSON, bad encoding)."),
     401: _problem("Missing or invalid API key (when keys are configured)."),
     413: _problem("Request body over the size limit."),
     422: _problem("Invalid input or over a limit; `errors` names each bad field."),

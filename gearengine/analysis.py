@@ -1,0 +1,111 @@
+"""The full answer for one design: Melnikov verdict, numerical verdict, and whether they agree.
+
+The Melnikov criterion is first order in the perturbation and only *necessary* for chaos
+(a transverse homoclinic tangle may give transient chaos and a periodic attractor). The two
+verdicts are consistent unless the numerics find chaos where Melnikov rules it out.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from gearengine.forcing import step_plan
+from gearengine.melnikov_analysis import melnikov
+from gearengine.melnikov_result import MelnikovResult
+from gearengine.params import GearParams
+from gearengine.requests import PAPER_SECTION_41
+from gearengine.simulation import NumericsResult, SimulationSettings, simulate
+
+Agreement = Literal["both_chaotic", "both_regular", "melnikov_only", "numerics_only", "undecided"]
+
+
+class AnalysisRequest(BaseModel):
+    """``{"params": {...}, "settings": {...}}``: analyse one design."""
+
+    model_config = ConfigDict(
+        extra="forbid",
+        frozen=True,
+        strict=True,
+        json_schema_extra={"examples": [{"params": PAPER_SECTION_41, "settings": {}}]},
+    )
+
+    params: GearParams = Field(description="Dimensionless parameters of Eq. (9).")
+    settings: SimulationSettings = Field(
+        default_factory=SimulationSettings,
+        description="Integration settings (defaults: 500 + 500 periods, 200 steps, x0 = "
+        "(0.01, 0.01)).",
+    )
+
+
+class Verdict(BaseModel):
+    """How the analytical and the numerical verdicts relate."""
+
+    model_config = ConfigDict(frozen=True)
+
+    agreement: Agreement = Field(
+        description="both_chaotic: tangle and chaos; both_regular: no tangle, no chaos; "
+        "melnikov_only: tangle but a regular attractor (consistent: Melnikov is necessary, not "
+        "sufficient); numerics_only: chaos without a first-order tangle; undecided: Melnikov "
+        "not applicable or the state diverged."
+    )
+    consistent: bool = Field(description="False only for numerics_only.")
+    chaotic: bool = Field(description="The numerics classify the worst start as chaotic.")
+    summary: str = Field(description="One readable line.")
+
+
+class AnalysisResult(BaseModel):
+    """The /v1/analyses contract: Melnikov, numerics, settings used, and the verdict."""
+
+    model_config = ConfigDict(frozen=True)
+
+    melnikov: MelnikovResult
+    numerics: NumericsResult
+    settings: SimulationSettings
+    verdict: Verdict
+
+
+def work(params: GearParams, settings: SimulationSettings) -> int:
+    """RK4 steps the analysis takes: (transient + record) periods x steps per T0 x starts."""
+    plan = step_plan(params, settings.steps_per_period)
+    periods = settings.transient_periods + settings.record_periods
+    return periods * plan.steps * len(settings.starts())
+
+
+def verdict(mel: MelnikovResult, num: NumericsResult) -> Verdict:
+    """Compare the Melnikov verdict with the numerical classification."""
+    chaotic = num.classification == "chaotic"
+    period = f" ({num.period}T)" if num.period else ""
+    numerics = f"numerics: {num.classification}{period}"
+    if num.classification == "diverged" or mel.chaos_possible is None:
+        why = "Melnikov not applicable" if mel.chaos_possible is None else "the state diverged"
+        return Verdict(
+            agreement="undecided", consistent=True, chaotic=chaotic, summary=f"{numerics}; {why}"
+        )
+    if mel.chaos_possible and chaotic:
+        agreement, text = "both_chaotic", "transverse homoclinic tangle and chaotic response"
+    elif mel.chaos_possible:
+        agreement = "melnikov_only"
+        text = "tangle predicted (necessary for chaos) but the attractor is regular"
+    elif chaotic:
+        agreement = "numerics_only"
+        text = "chaos found although first-order Melnikov rules it out (strong perturbation?)"
+    else:
+        agreement, text = "both_regular", "no tangle and a regular response"
+    possible = "possible" if mel.chaos_possible else "not possible"
+    return Verdict(
+        agreement=agreement,
+        consistent=agreement != "numerics_only",
+        chaotic=chaotic,
+        summary=f"{numerics}; Melnikov: chaos {possible} — {text}",
+    )
+
+
+def analyze(request: AnalysisRequest) -> AnalysisResult:
+    """Melnikov and numerical verdicts of one design."""
+    mel = melnikov(request.params)
+    num = simulate(request.params, request.settings)
+    return AnalysisResult(
+        melnikov=mel, numerics=num, settings=request.settings, verdict=verdict(mel, num)
+    )

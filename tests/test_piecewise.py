@@ -1,0 +1,101 @@
+"""Piecewise backlash law (Eq. 8): kink-splitting RK4 against step halving, scipy and gear_ref.c."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gearengine import kernels
+from gearengine.forcing import PIECEWISE, step_plan
+from gearengine.params import GearParams
+from gearengine.simulation import SimulationSettings, _packed, simulate
+from tests._gear_cases import gear_ref_binary, gear_ref_summary, paper, scipy_run
+
+
+def _kink(params: GearParams, N: int, n_trans: int, n_rec: int, x0: float = 0.01) -> tuple:
+    kc, fm, fc = _packed(params)
+    T = step_plan(params, 200).period
+    alpha = params.backlash.alpha
+    return kernels.run_kink(
+        alpha, params.damping, x0, 0.01, kc, fm, fc, T, N, n_trans, n_rec, 1, 1e6
+    )  # fmt: skip
+
+
+def _plain(params: GearParams, N: int, n_trans: int, n_rec: int, x0: float = 0.01) -> tuple:
+    kc, fm, fc = _packed(params)
+    T = step_plan(params, 200).period
+    alpha = params.backlash.alpha
+    return kernels.run_rk4(
+        PIECEWISE, 0.0, 0.0, alpha, params.damping, x0, 0.01, kc, fm, fc, True, T, N,
+        n_trans, n_rec, 1, 1e6,
+    )  # fmt: skip
+
+
+def _errors(run, params: GearParams, Ns: tuple[int, ...]) -> tuple[list[float], list[float]]:
+    """Errors of final state and log-growth sum after 10 T0 from x0 = 1.5 (starts in contact)."""
+    ref = _kink(params, 12800, 0, 10, 1.5)
+    ex, el = [], []
+    for N in Ns:
+        out = run(params, N, 0, 10, 1.5)
+        ex.append(math.hypot(out[8] - ref[8], out[9] - ref[9]))
+        el.append(abs(out[2].sum() - ref[2].sum()))
+    return ex, el
+
+
+@pytest.mark.parametrize("alpha", [0.0, 0.3])
+def test_kink_scheme_converges_at_fourth_order(alpha: float) -> None:
+    params = paper(0.25, model="piecewise", alpha=alpha)
+    out = _kink(params, 200, 0, 10, 1.5)
+    assert out[5] < 1.0 < out[6]  # the record crosses the kink at x = 1
+    ex, el = _errors(_kink, params, (200, 400, 800))
+    for errs in (ex, el):
+        orders = [math.log2(errs[i] / errs[i + 1]) for i in range(2)]
+        assert all(3.5 < q < 4.5 for q in orders), (errs, orders)
+
+
+def test_plain_rk4_across_kinks_is_much_worse() -> None:
+    params = paper(0.25, model="piecewise")
+    ex_kink, el_kink = _errors(_kink, params, (200,))
+    ex_plain, el_plain = _errors(_plain, params, (200,))
+    assert ex_plain[0] > 30.0 * ex_kink[0]
+    assert el_plain[0] > 30.0 * el_kink[0]
+
+
+@pytest.mark.parametrize(("fe", "alpha"), [(0.05, 0.0), (0.1, 0.5)])
+def test_kink_scheme_agrees_with_dop853(fe: float, alpha: float) -> None:
+    params = paper(fe, mu=0.1, model="piecewise", alpha=alpha)
+    period, lle, _ = scipy_run(params, 200, 100)
+    r = simulate(params, SimulationSettings(transient_periods=200, record_periods=100))
+    assert r.method.startswith("rk4 split at the kinks")
+    assert r.period == period == 1
+    assert r.lle == pytest.approx(lle, abs=1e-3)
+    assert r.lle < 0.0
+
+
+def test_piecewise_verdicts_are_stable_under_step_halving() -> None:
+    a, b = (
+        simulate(paper(0.25, model="piecewise"), SimulationSettings(steps_per_period=n))
+        for n in (200, 400)
+    )
+    assert a.period == b.period == 6
+    assert a.lle == pytest.approx(b.lle, abs=1e-6)
+    assert a.poincare[-1] == pytest.approx(b.poincare[-1], abs=1e-6)
+    c, d = (
+        simulate(paper(0.1, model="piecewise"), SimulationSettings(steps_per_period=n))
+        for n in (200, 400)
+    )
+    assert c.classification == d.classification == "chaotic"
+    assert c.lle == pytest.approx(d.lle, abs=0.01)
+
+
+def test_matches_gear_ref_kink_mode(tmp_path_factory: pytest.TempPathFactory) -> None:
+    exe = gear_ref_binary(tmp_path_factory.mktemp("gear_ref"))
+    if exe is None:
+        pytest.skip("gcc or gear_ref.c not available")
+    args = ["--kink", "0.07", "0.1", "0.5", "0.01", "0", "1", "0", "1", "pw", "200", "200", "200"]
+    _, lle, x, v = gear_ref_summary(exe, args)
+    out = _kink(paper(0.1, model="piecewise"), 200, 200, 200)
+    assert np.cumsum(out[2])[-1] / (200 * 4 * math.pi) == pytest.approx(lle, rel=1e-9)
+    assert (out[8], out[9]) == pytest.approx((x, v), rel=1e-10)
