@@ -1,7 +1,8 @@
 """Speed of the numba kernels against gear_ref.c and scipy, in ns per RK4 step (with tangent).
 
 Run:  .venv/bin/python benchmarks/bench_kernels.py
-Prints a markdown table and writes it, with the command, into benchmarks/README.md.
+Prints a markdown table and writes it, with the command, into its section of
+benchmarks/README.md.
 Cases: the paper's point Fe = 0.25 (cubic, 500 + 500 periods x 200 steps) for one analysis;
 a 301-point sweep Fe = 0..0.3 for the batch kernel.
 """
@@ -18,6 +19,7 @@ from pathlib import Path
 
 import numba
 import numpy as np
+from report import write_section  # benchmarks/report.py (the script's own folder)
 from scipy.integrate import solve_ivp
 
 from gearengine.params import GearParams
@@ -137,14 +139,15 @@ def main() -> None:
         lines.append(f"| {name} | {ns:.2f} | {ratio} |")
     table = "\n".join(lines)
     print(table)
-    (ROOT / "README.md").write_text(
-        "# Kernel benchmarks\n\n"
-        "Reproduce: `.venv/bin/python benchmarks/bench_kernels.py` (rewrites this file).\n\n"
+    write_section(
+        "kernels",
+        "## Kernels\n\n"
+        "Reproduce: `.venv/bin/python benchmarks/bench_kernels.py` (rewrites this section).\n\n"
         "One analysis = paper case Fe = 0.25 (cubic, chaotic), 500 transient + 500 recorded "
         "periods x 200 RK4 steps with the tangent equation; batch = 301 points Fe = 0..0.3. "
         "Ratios: single-analysis rows against gear_ref scalar, batch rows against gear_ref "
         "--simd (per point-step). Multi-thread rows are wall time x threads.\n\n"
-        f"{table}\n\nMachine: {numba.config.NUMBA_NUM_THREADS} cores, numba {numba.__version__}.\n"
+        f"{table}\n\nMachine: {numba.config.NUMBA_NUM_THREADS} cores, numba {numba.__version__}.\n",
     )
 
 
