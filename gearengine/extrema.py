@@ -20,7 +20,7 @@ import numpy as np
 
 from gearengine.frequencies import common_frequency
 
-GRID_PER_CYCLE = 48
+GRID_PER_CYCLE = 16
 MAX_GRID = 1 << 16
 NEWTON_STEPS = 5
 CANDIDATES = 4

@@ -6,6 +6,7 @@ import os
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -47,7 +48,8 @@ class Server:
         self.data_dir = data_dir
         cmd = [sys.executable, "-m", "gearengine.cli", "serve", "--port", str(self.port)]
         cmd += ["--data-dir", str(data_dir), *extra]
-        self.log = open(data_dir.parent / f"server-{self.port}.log", "w")  # noqa: SIM115
+        log_dir = Path(tempfile.mkdtemp(prefix="gearchaos-server-"))
+        self.log = open(log_dir / f"server-{self.port}.log", "w")  # noqa: SIM115
         self.proc = subprocess.Popen(
             cmd, env={**os.environ, **(env or {})}, stdout=self.log, stderr=subprocess.STDOUT
         )
@@ -65,6 +67,12 @@ class Server:
                 pass
             time.sleep(0.2)
         raise TimeoutError("server not ready")
+
+    def output(self) -> str:
+        """What the server printed so far."""
+        if not self.log.closed:
+            self.log.flush()
+        return Path(self.log.name).read_text()
 
     def stop(self) -> None:
         if self.proc.poll() is None:
