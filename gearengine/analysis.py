@@ -14,7 +14,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from gearengine.forcing import step_plan
 from gearengine.melnikov_analysis import melnikov
 from gearengine.melnikov_result import MelnikovResult
-from gearengine.params import GearParams
+from gearengine.params import GearParams, request_config
 from gearengine.requests import PAPER_SECTION_41
 from gearengine.simulation import NumericsResult, SimulationSettings, simulate
 
@@ -24,12 +24,7 @@ Agreement = Literal["both_chaotic", "both_regular", "melnikov_only", "numerics_o
 class AnalysisRequest(BaseModel):
     """``{"params": {...}, "settings": {...}}``: analyse one design."""
 
-    model_config = ConfigDict(
-        extra="forbid",
-        frozen=True,
-        strict=True,
-        json_schema_extra={"examples": [{"params": PAPER_SECTION_41, "settings": {}}]},
-    )
+    model_config = request_config({"params": PAPER_SECTION_41, "settings": {}})
 
     params: GearParams = Field(description="Dimensionless parameters of Eq. (9).")
     settings: SimulationSettings = Field(

@@ -4,6 +4,8 @@
     gearengine analyze FILE [--json]
     gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov] [--max-lle V]
     gearengine serve [--host 127.0.0.1] [--port 8000] [--data-dir DIR] [--workers N]
+    gearengine sweep FILE [--out DIR]
+    gearengine worker --data-dir DIR [--workers N] [--dask ADDRESS]
 
 FILE holds ``{"params": {...}}`` (and ``"settings"`` for analyze/check; ``-`` reads standard
 input). ``--json`` prints exactly the body the HTTP API returns. Exit codes: 0 success (check:
@@ -13,6 +15,7 @@ pass), 1 check failed, 2 invalid input (one line per problem, naming the field).
 from __future__ import annotations
 
 import argparse
+import importlib
 import logging
 import sys
 from collections.abc import Callable, Sequence
@@ -251,7 +254,27 @@ def build_parser() -> argparse.ArgumentParser:
         "--insecure", action="store_true", help="allow a non-loopback bind without API keys"
     )
     p.set_defaults(func=cmd_serve)
+
+    p = sub.add_parser("sweep", help="run a sweep here, no server: JSON, CSV and PNG")
+    p.add_argument("file", help="JSON file holding a sweep request (as POST /v1/sweeps), or -")
+    p.add_argument("--out", default=".", help="directory for the outputs (default .)")
+    p.set_defaults(func=_lazy("gearengine.sweep_cli", "cmd_sweep"))
+
+    p = sub.add_parser("worker", help="run sweep workers on a data directory's job store")
+    p.add_argument("--data-dir", default=None, help="directory holding the job store")
+    p.add_argument("--workers", type=int, default=None, help="worker processes (default: cores)")
+    p.add_argument("--dask", default=None, metavar="ADDRESS", help="Dask scheduler to run on")
+    p.set_defaults(func=_lazy("service.jobs.worker", "cmd_worker"))
     return parser
+
+
+def _lazy(module: str, name: str) -> Callable[[argparse.Namespace], int]:
+    """A command whose implementation is imported only when it runs."""
+
+    def run(args: argparse.Namespace) -> int:
+        return getattr(importlib.import_module(module), name)(args)
+
+    return run
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, Field
 
 from gearengine.params import (
     MAX_HARMONICS,
@@ -40,6 +40,7 @@ from gearengine.params import (
     GearParams,
     Harmonic,
     PiecewiseBacklash,
+    request_config,
 )
 
 Positive = Annotated[float, Field(ge=1.0e-12, le=1.0e12, allow_inf_nan=False)]
@@ -54,7 +55,7 @@ RATIO_TOLERANCE = 0.01
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+    model_config = request_config()
 
 
 class _Phase(_Strict):

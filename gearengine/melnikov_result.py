@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.melnikov import Branch, Method
+
+Bounds = Annotated[list[float | None], Field(min_length=2, max_length=2)]
+"""A closed interval [lo, hi] of a parameter; null marks an unbounded end. (A list, not a tuple:
+nested tuples give an invalid OpenAPI schema.)"""
 
 
 class _Result(BaseModel):
@@ -54,7 +58,7 @@ class BranchThreshold(_Result):
     """Where one branch stops changing sign as the parameter varies."""
 
     critical_values: list[float] = Field(description="Ends of the no-sign-change intervals.")
-    no_sign_change: list[tuple[float | None, float | None]] = Field(
+    no_sign_change: list[Bounds] = Field(
         description="Closed intervals [lo, hi] of the parameter where this branch has no simple "
         "zero; null is an unbounded end."
     )
@@ -72,13 +76,13 @@ class ParameterThreshold(_Result):
         description="value - nearest: signed distance to the nearest critical value."
     )
     relative_margin: float | None = Field(description="margin / |nearest| (null if nearest = 0).")
-    no_chaos: list[tuple[float | None, float | None]] = Field(
+    no_chaos: list[Bounds] = Field(
         description="Intervals of the parameter where neither branch changes sign."
     )
     branches: dict[Branch, BranchThreshold] | None = Field(
         None, description="Per-branch thresholds (null for the frequency scan)."
     )
-    scan: tuple[float, float, int] | None = Field(
+    scan: list[float] | None = Field(
         None, description="For a frequency: the scanned range (start, stop, points)."
     )
     note: str | None = Field(None, description="Why a threshold is missing, if it is.")
@@ -119,11 +123,11 @@ class ThresholdCurve(_Result):
         description="The swept frequency: Omega_e, Omega_k or Omega_p."
     )
     frequencies: list[float] = Field(description="The frequency values.")
-    no_chaos: list[list[tuple[float | None, float | None]]] = Field(
+    no_chaos: list[list[Bounds]] = Field(
         description="Per frequency: intervals of the parameter where neither branch changes sign "
         "(chaos is possible outside them)."
     )
-    branches: dict[Branch, list[list[tuple[float | None, float | None]]]] = Field(
+    branches: dict[Branch, list[list[Bounds]]] = Field(
         description="Per branch and frequency: intervals where that branch has no simple zero."
     )
     value: float | None = Field(description="The design's value of the parameter.")

@@ -33,8 +33,17 @@ Finite = Annotated[float, Field(allow_inf_nan=False, ge=-MAX_MAGNITUDE, le=MAX_M
 Phase = Annotated[float, Field(allow_inf_nan=False, ge=-1.0e3, le=1.0e3)]
 
 
+def request_config(*examples: object) -> ConfigDict:
+    """Config of every request model: unknown fields, NaN/inf and lax coercions (a bool or a
+    string for a number) are refused; ``examples`` document the model in the OpenAPI schema."""
+    config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+    if examples:
+        config["json_schema_extra"] = {"examples": list(examples)}
+    return config
+
+
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+    model_config = request_config()
 
 
 class Harmonic(_Strict):
@@ -147,24 +156,16 @@ class GearParams(_Strict):
         examples=[{"frequency": 0.1, "harmonics": [{"amplitude": 0.0, "phase": 0.0}]}],
     )
 
-    model_config = ConfigDict(
-        extra="forbid",
-        frozen=True,
-        allow_inf_nan=False,
-        strict=True,
-        json_schema_extra={
-            "examples": [
-                {
-                    "damping": 0.07,
-                    "mean_force": 0.01,
-                    "backlash": {"model": "cubic", "a": 0.1667, "c": 0.1667},
-                    "transmission_error": {
-                        "frequency": 0.5,
-                        "harmonics": [{"amplitude": 0.2, "phase": 0.0}],
-                    },
-                }
-            ]
-        },
+    model_config = request_config(
+        {
+            "damping": 0.07,
+            "mean_force": 0.01,
+            "backlash": {"model": "cubic", "a": 0.1667, "c": 0.1667},
+            "transmission_error": {
+                "frequency": 0.5,
+                "harmonics": [{"amplitude": 0.2, "phase": 0.0}],
+            },
+        }
     )
 
     def excitations(self) -> Iterator[tuple[str, Excitation]]:

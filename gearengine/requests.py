@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
+from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
 from gearengine.melnikov import Method
-from gearengine.params import GearParams
+from gearengine.params import GearParams, request_config
 
 PAPER_SECTION_41 = {
     "damping": 0.07,
@@ -21,12 +21,7 @@ PAPER_SECTION_41 = {
 class MelnikovRequest(BaseModel):
     """``{"params": {...}}``: the Melnikov verdict of one design."""
 
-    model_config = ConfigDict(
-        extra="forbid",
-        frozen=True,
-        strict=True,
-        json_schema_extra={"examples": [{"params": PAPER_SECTION_41}]},
-    )
+    model_config = request_config({"params": PAPER_SECTION_41})
 
     params: GearParams = Field(description="Dimensionless parameters of Eq. (9).")
     method: Method = Field(
@@ -38,7 +33,7 @@ class MelnikovRequest(BaseModel):
 class ThresholdsRequest(BaseModel):
     """Threshold curves of ``parameter`` while ``frequency_parameter`` runs over a range."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+    model_config = request_config()
 
     params: GearParams = Field(description="The design; other parameters stay fixed.")
     parameter: Literal["F_e1", "mu", "k_p1", "F_p1"] = Field(

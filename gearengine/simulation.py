@@ -29,7 +29,7 @@ from gearengine.diagnostics import (
 )
 from gearengine.forcing import CUBIC, coefficients, law, step_plan
 from gearengine.lyapunov import LyapunovEstimate, benettin
-from gearengine.params import GearParams
+from gearengine.params import GearParams, request_config
 from gearengine.periodicity import attractor_size, detect_period
 from gearengine.timeseries import NoldsResult, lyap_r_check
 
@@ -53,7 +53,7 @@ State = Annotated[list[Finite], Field(min_length=2, max_length=2)]
 class RandomStarts(BaseModel):
     """Initial states drawn uniformly from a box [xmin, xmax] x [vmin, vmax]."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False, strict=True)
+    model_config = request_config()
 
     count: int = Field(ge=1, le=MAX_STARTS, description="Number of initial states.", examples=[8])
     box: Annotated[list[State], Field(min_length=2, max_length=2)] = Field(
@@ -73,21 +73,13 @@ class RandomStarts(BaseModel):
 class SimulationSettings(BaseModel):
     """How to integrate and analyse Eq. (9). Times are in sampling intervals T0."""
 
-    model_config = ConfigDict(
-        extra="forbid",
-        frozen=True,
-        allow_inf_nan=False,
-        strict=True,
-        json_schema_extra={
-            "examples": [
-                {
-                    "transient_periods": 500,
-                    "record_periods": 500,
-                    "steps_per_period": 200,
-                    "initial_state": [0.01, 0.01],
-                }
-            ]
-        },
+    model_config = request_config(
+        {
+            "transient_periods": 500,
+            "record_periods": 500,
+            "steps_per_period": 200,
+            "initial_state": [0.01, 0.01],
+        }
     )
 
     transient_periods: int = Field(
@@ -225,6 +217,7 @@ class BatchPoint(_Result):
     lle: float | None
     lle_stderr: float | None
     final_state: list[float] | None
+    impact_regime: str | None = Field(description="no_impact | single_sided | double_sided.")
     poincare: list[list[float]] = Field(description=f"Last <= {BATCH_POINCARE} strobes.")
     start_index: int = Field(description="Index of the worst start in settings.starts().")
 
@@ -443,6 +436,7 @@ def _batch_point(runs: list[tuple[_Run, _Verdict]]) -> BatchPoint:
         lle=v.summary.lle,
         lle_stderr=v.summary.lle_stderr,
         final_state=v.summary.final_state,
+        impact_regime=v.summary.impact_regime,
         poincare=np.column_stack([run.xs[:n_ok], run.vs[:n_ok]])[-BATCH_POINCARE:].tolist(),
         start_index=idx,
     )

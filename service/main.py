@@ -13,9 +13,10 @@ from starlette.concurrency import run_in_threadpool
 
 from service import errors
 from service.api.deps import load_key_hashes
-from service.api.routes import analyses, health, melnikov
+from service.api.routes import analyses, health, melnikov, sweeps
 from service.cache import ResponseCache
 from service.core.config import Settings
+from service.jobs.runtime import SweepJobs
 from service.limits import Limits
 from service.metrics import Metrics
 from service.middleware import AccessLog, BodyLimit
@@ -31,6 +32,8 @@ torque fluctuation and transmission error (Farshidianfar & Saghafi 2014, Eq. 9).
   with Melnikov (`POST /v1/analyses`).
 * **Threshold curves** over a frequency range (`POST /v1/thresholds`).
 * **Figures** as PNG or SVG (`/v1/analyses/plot`, `/v1/thresholds/plot`).
+* **Sweeps**: bifurcation diagrams (one axis) and 2-D chaos maps (two axes) as durable jobs
+  (`POST /v1/sweeps`, then poll, fetch `/result` as JSON or CSV and `/plot`).
 
 Every error is RFC 9457 `application/problem+json` naming the bad field. With API keys
 configured, send `Authorization: Bearer KEY` or `X-API-Key: KEY`.
@@ -48,7 +51,10 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         ready_checks["kernels"] = lambda: warmed["kernels"]
         await run_in_threadpool(_warm_up)
         warmed["kernels"] = True
+        jobs = app.state.sweep_jobs = await run_in_threadpool(SweepJobs.open, settings)
+        ready_checks["job_store"] = jobs.ready
         yield
+        await run_in_threadpool(jobs.close)
 
     app = FastAPIOffline(
         title="gearchaos",
@@ -66,6 +72,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(health.router, tags=["health"])
     app.include_router(melnikov.router, tags=["melnikov"])
     app.include_router(analyses.router, tags=["analyses"])
+    app.include_router(sweeps.router, tags=["sweeps"])
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
     app.add_middleware(AccessLog, metrics=app.state.metrics)
     logging.getLogger("gearchaos").setLevel(logging.INFO)

@@ -41,6 +41,28 @@ class Settings(BaseSettings):
     max_curve_points: int = Field(2000, ge=2, description="Most frequencies in a threshold curve.")
     cache_entries: int = Field(512, ge=0, description="Responses kept in the in-memory LRU.")
 
+    max_sweep_points: int = Field(
+        40_000, ge=1, description="Most points of one sweep (every axis and branch counted)."
+    )
+    max_sweep_steps: int = Field(
+        20_000_000_000,
+        ge=1000,
+        description="Compute budget of one sweep in RK4 steps (points x periods x steps x "
+        "starts); the default is about a minute on two cores.",
+    )
+    max_queued_jobs: int = Field(
+        64, ge=1, description="Most unfinished (queued or running) sweep jobs; then 429."
+    )
+    sweep_chunk_points: int = Field(
+        64, ge=1, le=10_000, description="Points per chunk of a sweep without continuation."
+    )
+    lease_seconds: float = Field(
+        30.0, gt=0.0, le=3600.0, description="Lease of a claimed chunk, renewed every third."
+    )
+    max_retries: int = Field(
+        3, ge=0, le=100, description="Retries of a chunk whose worker died before the job fails."
+    )
+
     @cached_property
     def key_list(self) -> list[str]:
         """The configured API keys, stripped, without empties."""

@@ -1,0 +1,239 @@
+"""/v1/sweeps: the durable queue of bifurcation sweeps and chaos maps.
+
+Jobs belong to the API key that submitted them (``require_key``'s key id; None with auth off):
+another key gets 404 and does not see them in listings.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from typing import Annotated, Literal
+
+from fastapi import APIRouter, Depends, Query, Request, Response
+from fastapi.responses import StreamingResponse
+from pydantic import ValidationError
+from starlette.concurrency import run_in_threadpool
+
+from gearengine.sweep_plots import render
+from gearengine.sweeps import (
+    SweepPlan,
+    SweepPoint,
+    SweepRequest,
+    SweepResult,
+    csv_rows,
+    request_errors,
+    result_json,
+)
+from service.api.deps import require_key
+from service.api.responses import JSON, PNG, PROBLEMS, SVG
+from service.errors import ProblemError
+from service.jobs.models import UNFINISHED, Job, JobPage, JobStatus
+from service.jobs.runtime import SweepJobs
+from service.jobs.store import QueueFullError
+
+router = APIRouter(prefix="/v1/sweeps")
+
+Owner = Annotated[str | None, Depends(require_key)]
+CSV = "text/csv"
+RETRY_AFTER = {"queued": "5", "running": "2"}
+"""Seconds a client should wait before polling an unfinished job again."""
+QUEUE_FULL_RETRY = "30"
+
+_NOT_FOUND = {404: {"description": "No such job for this API key."}}
+_CONFLICT = {409: {"description": "The job has not succeeded (yet)."}}
+
+
+def _jobs(request: Request) -> SweepJobs:
+    return request.app.state.sweep_jobs
+
+
+def _job_or_404(request: Request, job_id: str, owner: str | None) -> Job:
+    job = _jobs(request).store.get(job_id, owner)
+    if job is None:
+        raise ProblemError(404, "not-found", "Not found", f"no sweep job {job_id}")
+    return job
+
+
+def _poll_headers(job: Job) -> dict[str, str]:
+    return {"Retry-After": RETRY_AFTER[job.status]} if job.status in UNFINISHED else {}
+
+
+def _succeeded(request: Request, job_id: str, owner: str | None) -> Job:
+    job = _job_or_404(request, job_id, owner)
+    if job.status != "succeeded":
+        raise ProblemError(
+            409,
+            "not-finished" if job.status in UNFINISHED else "no-result",
+            "No result",
+            f"sweep {job_id} is {job.status}: a result exists only once it has succeeded",
+            headers=_poll_headers(job),
+        )
+    return job
+
+
+@router.post(
+    "",
+    status_code=202,
+    response_model=Job,
+    responses={**PROBLEMS, 429: {"description": "Too many unfinished jobs; see Retry-After."}},
+    summary="Submit a bifurcation sweep (one axis) or a chaos map (two axes)",
+)
+def post_sweep(body: SweepRequest, request: Request, response: Response, owner: Owner) -> Job:
+    """Validate and store the sweep; it runs on the workers. Answers 202 with the job and its
+    ``Location``; poll it (``Retry-After``) and fetch ``/result`` or ``/plot`` once succeeded."""
+    settings = request.app.state.settings
+    errors = request_errors(body, settings.max_sweep_points)
+    if errors:
+        raise ValidationError.from_exception_data("SweepRequest", errors)
+    request.app.state.limits.check_sweep(body)
+    plan = SweepPlan(body, settings.sweep_chunk_points)
+    try:
+        job = _jobs(request).store.submit(
+            owner, body.model_dump_json(), plan.point_counts(), plan.chunk_points,
+            settings.max_queued_jobs,
+        )  # fmt: skip
+    except QueueFullError as exc:
+        raise ProblemError(
+            429,
+            "queue-full",
+            "Too many requests",
+            f"{exc} (max_queued_jobs); retry later",
+            headers={"Retry-After": QUEUE_FULL_RETRY},
+        ) from None
+    _jobs(request).wake()
+    response.headers["Location"] = f"/v1/sweeps/{job.id}"
+    response.headers.update(_poll_headers(job))
+    return job
+
+
+@router.get("", response_model=JobPage, responses=PROBLEMS, summary="The caller's sweep jobs")
+def list_sweeps(
+    request: Request,
+    owner: Owner,
+    status: Annotated[JobStatus | None, Query(description="Only jobs in this status.")] = None,
+    limit: Annotated[int, Query(ge=1, le=100, description="Jobs per page.")] = 20,
+    offset: Annotated[int, Query(ge=0, le=2**31, description="Jobs to skip (newest first).")] = 0,
+) -> JobPage:
+    """Newest first, paginated with ``limit`` and ``offset``."""
+    items, total = _jobs(request).store.list(owner, status, limit, offset)
+    more = offset + len(items) < total
+    return JobPage(items=items, total=total, next_offset=offset + len(items) if more else None)
+
+
+@router.get(
+    "/{job_id}",
+    response_model=Job,
+    responses={**PROBLEMS, **_NOT_FOUND},
+    summary="Status and progress of a sweep job",
+)
+def get_sweep(job_id: str, request: Request, response: Response, owner: Owner) -> Job:
+    """``Retry-After`` is set while the job is queued or running."""
+    job = _job_or_404(request, job_id, owner)
+    response.headers.update(_poll_headers(job))
+    return job
+
+
+@router.delete(
+    "/{job_id}",
+    response_model=Job,
+    responses={**PROBLEMS, **_NOT_FOUND, 409: {"description": "The job already finished."}},
+    summary="Cancel a sweep job",
+)
+def cancel_sweep(job_id: str, request: Request, owner: Owner) -> Job:
+    """No new chunk of the job starts; running chunks are dropped. Cancelling a cancelled job
+    is a no-op; a succeeded or failed job cannot be cancelled (409)."""
+    _job_or_404(request, job_id, owner)
+    job = _jobs(request).store.cancel(job_id, owner)
+    assert job is not None
+    if job.status not in ("cancelled", *UNFINISHED):
+        raise ProblemError(409, "finished", "Already finished", f"sweep {job_id} {job.status}")
+    _jobs(request).wake()
+    return job
+
+
+def _points(request: Request, job_id: str) -> Iterator[SweepPoint]:
+    for array in _jobs(request).store.chunk_results(job_id):
+        for item in json.loads(array):
+            yield SweepPoint.model_validate(item)
+
+
+@router.get(
+    "/{job_id}/result",
+    response_model=SweepResult,
+    responses={
+        **PROBLEMS,
+        **_NOT_FOUND,
+        **_CONFLICT,
+        200: {"content": {JSON: {}, CSV: {}}, "description": "The sweep's points."},
+    },
+    summary="Result of a succeeded sweep: JSON, or CSV with ?format=csv",
+)
+def get_result(
+    job_id: str,
+    request: Request,
+    owner: Owner,
+    format: Annotated[
+        Literal["json", "csv"], Query(description="json or csv (streamed).")
+    ] = "json",
+) -> Response:
+    """Every point with its axis values, classification, period, LLE, contact regime, Melnikov
+    verdict and the x of its last stroboscopic (Poincare) points."""
+    _succeeded(request, job_id, owner)
+    axes = SweepRequest.model_validate_json(_jobs(request).store.request_json(job_id)).axes
+    if format == "csv":
+        return StreamingResponse(
+            csv_rows(axes, _points(request, job_id)),
+            media_type=CSV,
+            headers={"Content-Disposition": f'attachment; filename="sweep-{job_id}.csv"'},
+        )
+    return StreamingResponse(
+        result_json(axes, _jobs(request).store.chunk_results(job_id)), media_type=JSON
+    )
+
+
+def _plot_format(fmt: str | None, accept: str) -> Literal["png", "svg"]:
+    if fmt is not None:
+        return fmt  # type: ignore[return-value]
+    types = [part.split(";")[0].strip() for part in accept.split(",") if part.strip()]
+    for t in types or ["*/*"]:
+        if t in (PNG, "image/*", "*/*"):
+            return "png"
+        if t == SVG:
+            return "svg"
+    raise ProblemError(406, "not-acceptable", "Not acceptable", f"plots are {PNG} or {SVG}")
+
+
+@router.get(
+    "/{job_id}/plot",
+    response_class=Response,
+    responses={
+        **PROBLEMS,
+        **_NOT_FOUND,
+        **_CONFLICT,
+        200: {"content": {PNG: {}, SVG: {}}, "description": "The figure."},
+        406: {"description": "Neither PNG nor SVG is acceptable."},
+    },
+    summary="Figure of a succeeded sweep: bifurcation diagram or chaos map (PNG or SVG)",
+)
+async def get_plot(
+    job_id: str,
+    request: Request,
+    owner: Owner,
+    format: Annotated[
+        Literal["png", "svg"] | None, Query(description="png or svg; else the Accept header.")
+    ] = None,
+) -> Response:
+    """One axis: Poincare x against the parameter, the LLE underneath, the Melnikov threshold
+    marked. Two axes: the map coloured by LLE, the Melnikov boundary overlaid and a table of
+    agreement between the numerical and the Melnikov verdicts."""
+    fmt = _plot_format(format, request.headers.get("accept", ""))
+    await run_in_threadpool(_succeeded, request, job_id, owner)
+
+    def draw() -> bytes:
+        store = _jobs(request).store
+        sweep = SweepRequest.model_validate_json(store.request_json(job_id))
+        return render(sweep, list(_points(request, job_id)), fmt)
+
+    body = await run_in_threadpool(draw)
+    return Response(body, media_type=PNG if fmt == "png" else SVG)

@@ -1,0 +1,134 @@
+"""Where chunks run: a local process pool or a Dask distributed cluster.
+
+Both hand back futures with ``done()``, ``result()`` and ``add_done_callback``; the dispatcher
+treats them alike. Workers only compute (``gearengine.sweeps.compute_chunk_json``); they never
+touch the store, so a worker that dies or hangs cannot corrupt it.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
+from typing import Any, Protocol
+
+from gearengine.sweeps import compute_chunk_json
+from service.jobs.store import Claim
+
+
+class Backend(Protocol):
+    """A place to run chunks."""
+
+    name: str
+
+    def capacity(self) -> int:
+        """How many chunks may run at once."""
+
+    def submit(self, claim: Claim) -> Any:
+        """Start computing a chunk; returns a future of its JSON array."""
+
+    def recover(self, error: BaseException) -> None:
+        """Called after a future failed with ``error``; repair the backend if it broke."""
+
+    def close(self) -> None:
+        """Stop every worker, dropping unfinished work."""
+
+
+def _init_worker(threads: int) -> None:
+    """Pool worker start-up: share the cores fairly and load the kernels once."""
+    import numba
+
+    from gearengine.simulation import warm_up
+
+    numba.set_num_threads(threads)
+    warm_up()
+
+
+def _ready() -> int:
+    return os.getpid()
+
+
+class LocalPool:
+    """``workers`` spawned processes on this machine (numba threads: cores / workers)."""
+
+    name = "local"
+
+    def __init__(self, workers: int) -> None:
+        self.workers = workers
+        self._pool = self._start()
+
+    def _start(self) -> ProcessPoolExecutor:
+        threads = max(1, (os.cpu_count() or 1) // self.workers)
+        pool = ProcessPoolExecutor(
+            self.workers,
+            mp_context=multiprocessing.get_context("spawn"),
+            initializer=_init_worker,
+            initargs=(threads,),
+        )
+        for f in [pool.submit(_ready) for _ in range(self.workers)]:
+            f.result()  # every worker started and warmed before the first claim
+        return pool
+
+    def capacity(self) -> int:
+        return self.workers
+
+    def submit(self, claim: Claim) -> Future[str]:
+        return self._pool.submit(
+            compute_chunk_json, claim.request_json, claim.index, claim.chunk_points
+        )
+
+    def recover(self, error: BaseException) -> None:
+        """Replace the pool once after a worker died (every chunk of the old pool fails)."""
+        if not isinstance(error, BrokenProcessPool):
+            return
+        try:
+            self._pool.submit(_ready)
+        except BrokenProcessPool:
+            self.close()
+            self._pool = self._start()
+
+    def close(self) -> None:
+        processes = list((self._pool._processes or {}).values())  # no public API before 3.14
+        self._pool.shutdown(wait=False, cancel_futures=True)
+        for p in processes:
+            p.terminate()
+        for p in processes:
+            p.join(timeout=5)
+
+
+class DaskCluster:
+    """A Dask distributed scheduler at ``address``; keeps no state the store does not have."""
+
+    name = "dask"
+
+    def __init__(self, address: str) -> None:
+        from distributed import Client
+
+        self.client = Client(address, timeout=30)
+
+    def capacity(self) -> int:
+        return max(1, sum(self.client.nthreads().values()))
+
+    def submit(self, claim: Claim) -> Any:
+        return self.client.submit(
+            compute_chunk_json,
+            claim.request_json,
+            claim.index,
+            claim.chunk_points,
+            key=f"sweep-{claim.job_id}-{claim.index}-{claim.attempt}",
+            pure=False,
+        )
+
+    def recover(self, error: BaseException) -> None:
+        """Dask reschedules lost tasks itself and reconnects on its own."""
+
+    def close(self) -> None:
+        self.client.close()
+
+
+def make_backend(workers: int, dask_address: str | None) -> Backend | None:
+    """Dask if an address is given, else a local pool of ``workers`` (None when 0)."""
+    if dask_address:
+        return DaskCluster(dask_address)
+    return LocalPool(workers) if workers > 0 else None

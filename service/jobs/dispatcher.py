@@ -1,0 +1,159 @@
+"""The dispatcher: claims chunks from the store, runs them on a backend, commits the results.
+
+One loop (``run``) does everything, so the store sees one connection per dispatcher:
+
+1. commit finished chunks (only while their lease is still held; the last one finishes the job),
+   or record a failed attempt: a ``ValueError`` from the computation is deterministic and fails
+   the job at once, anything else (a dead worker, a lost Dask task) is retried up to
+   ``max_retries`` times;
+2. renew the leases of running chunks every ``lease_seconds / 3`` (heartbeat); a chunk whose
+   job was cancelled is dropped;
+3. claim as many chunks as the backend has free slots.
+
+``stop`` is graceful: no new claims, running chunks get ``grace`` seconds to finish and be
+committed, the rest are released unfinished (without counting an attempt).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import socket
+import threading
+import time
+import uuid
+from concurrent.futures import CancelledError
+from dataclasses import dataclass, field
+from typing import Any
+
+from service.jobs.backends import Backend
+from service.jobs.store import Claim, JobStore
+
+log = logging.getLogger("gearchaos.jobs")
+
+IDLE_POLL = 0.5
+"""Seconds between looks at the store when nothing wakes the dispatcher."""
+
+
+@dataclass
+class Dispatcher:
+    """Feeds one backend from one store."""
+
+    store: JobStore
+    backend: Backend
+    lease_seconds: float = 30.0
+    max_retries: int = 3
+    owner: str = field(
+        default_factory=lambda: f"{socket.gethostname()}:{os.getpid()}:{uuid.uuid4().hex[:8]}"
+    )
+
+    def __post_init__(self) -> None:
+        self._running: dict[tuple[str, int], tuple[Claim, Any]] = {}
+        self._wake = threading.Event()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._last_beat = 0.0
+        self._grace_until = 0.0
+
+    # --- control --------------------------------------------------------------------------
+
+    def wake(self) -> None:
+        """Look at the store now (a job was submitted or a chunk finished)."""
+        self._wake.set()
+
+    def start(self) -> None:
+        """Run the loop in a daemon thread."""
+        self._thread = threading.Thread(target=self.run, name="sweep-dispatcher", daemon=True)
+        self._thread.start()
+
+    def request_stop(self, grace: float = 5.0) -> None:
+        """Ask ``run`` to stop (safe from a signal handler): no new claims, running chunks get
+        ``grace`` seconds to finish and be committed, the rest are released."""
+        self._grace_until = time.monotonic() + grace
+        self._stop.set()
+        self._wake.set()
+
+    def stop(self, grace: float = 5.0) -> None:
+        """``request_stop`` and wait for the loop's thread to end."""
+        self.request_stop(grace)
+        if self._thread is not None:
+            self._thread.join()
+
+    @property
+    def running(self) -> list[tuple[str, int]]:
+        """(job id, chunk index) of the chunks in flight."""
+        return list(self._running)
+
+    # --- the loop -------------------------------------------------------------------------
+
+    def run(self) -> None:
+        """Dispatch until ``stop``; then drain gracefully."""
+        log.info("dispatcher %s started on %s", self.owner, self.backend.name)
+        while not self._stop.is_set():
+            try:
+                self.step()
+            except Exception:
+                log.exception("dispatcher step failed; retrying")
+                time.sleep(1.0)
+            self._wake.wait(min(IDLE_POLL, self.lease_seconds / 3.0))
+            self._wake.clear()
+        self._drain()
+        self.store.close()
+        log.info("dispatcher %s stopped", self.owner)
+
+    def step(self, claim: bool = True) -> None:
+        """One round: collect finished chunks, heartbeat, claim new ones."""
+        for key, (c, future) in list(self._running.items()):
+            if future.done():
+                del self._running[key]
+                self._finish(c, future)
+        now = time.monotonic()
+        if self._running and now - self._last_beat >= self.lease_seconds / 3.0:
+            held = self.store.heartbeat(self.owner, self.lease_seconds, list(self._running))
+            for key in set(self._running) - held:
+                _, future = self._running.pop(key)
+                future.cancel()
+                log.info("chunk %s/%d dropped (job cancelled or lease lost)", *key)
+            self._last_beat = now
+        free = self.backend.capacity() - len(self._running)
+        if claim and free > 0:
+            for c in self.store.claim(self.owner, self.lease_seconds, self.max_retries, free):
+                try:
+                    future = self.backend.submit(c)
+                except Exception as exc:
+                    self._lost(c, exc)
+                    continue
+                future.add_done_callback(lambda _: self._wake.set())
+                self._running[c.key] = (c, future)
+
+    def _finish(self, c: Claim, future: Any) -> None:
+        try:
+            result = future.result()
+        except CancelledError:
+            self.store.release(self.owner, [c.key])
+            return
+        except ValueError as exc:
+            self.store.fail(self.owner, c.job_id, c.index, str(exc), False, self.max_retries)
+            log.warning("job %s chunk %d invalid: %s", c.job_id, c.index, exc)
+            return
+        except Exception as exc:
+            self._lost(c, exc)
+            return
+        if self.store.commit(self.owner, c.job_id, c.index, result):
+            log.info("job %s chunk %d committed", c.job_id, c.index)
+
+    def _lost(self, c: Claim, exc: Exception) -> None:
+        """An attempt failed for a reason outside the computation: retry (bounded)."""
+        reason = f"{type(exc).__name__}: {exc}".rstrip(": ")
+        self.store.fail(self.owner, c.job_id, c.index, reason, True, self.max_retries)
+        log.warning("job %s chunk %d attempt %d lost: %s", c.job_id, c.index, c.attempt, reason)
+        self.backend.recover(exc)
+
+    def _drain(self) -> None:
+        while self._running and time.monotonic() < self._grace_until:
+            self.step(claim=False)
+            self._wake.wait(0.05)
+            self._wake.clear()
+        self.store.release(self.owner, list(self._running))
+        self._running.clear()
+        self.backend.close()

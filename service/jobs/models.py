@@ -1,0 +1,43 @@
+"""The job object of the sweep queue, as the API shows it."""
+
+from __future__ import annotations
+
+from datetime import UTC, datetime
+from typing import Literal
+
+from pydantic import BaseModel, Field
+
+JobStatus = Literal["queued", "running", "succeeded", "failed", "cancelled"]
+UNFINISHED: tuple[JobStatus, ...] = ("queued", "running")
+
+
+class Progress(BaseModel):
+    """Points finished (committed) out of all points of the sweep."""
+
+    done: int = Field(description="Points whose chunk is committed.", examples=[128])
+    total: int = Field(description="All points, every branch counted.", examples=[301])
+
+
+class Job(BaseModel):
+    """A sweep job of the durable queue."""
+
+    id: str = Field(description="Job id (32 hex digits).")
+    status: JobStatus = Field(description="queued | running | succeeded | failed | cancelled.")
+    progress: Progress
+    created_at: datetime = Field(description="When the job was stored (UTC).")
+    started_at: datetime | None = Field(description="When its first chunk was claimed (UTC).")
+    finished_at: datetime | None = Field(description="When it succeeded, failed or was cancelled.")
+    error: str | None = Field(description="Why it failed, else null.")
+
+
+class JobPage(BaseModel):
+    """One page of the caller's jobs, newest first."""
+
+    items: list[Job]
+    total: int = Field(description="Jobs matching the filter.")
+    next_offset: int | None = Field(description="Offset of the next page, null on the last.")
+
+
+def utc(seconds: float | None) -> datetime | None:
+    """A POSIX time as an aware UTC datetime (None stays None)."""
+    return None if seconds is None else datetime.fromtimestamp(seconds, UTC)

@@ -1,0 +1,46 @@
+"""The sweep queue of one process: the store and, when there are workers, a dispatcher."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from service.core.config import Settings
+from service.jobs.backends import make_backend
+from service.jobs.dispatcher import Dispatcher
+from service.jobs.store import JobStore
+
+
+@dataclass
+class SweepJobs:
+    """The store of the data directory and this process's dispatcher (None: store only)."""
+
+    store: JobStore
+    dispatcher: Dispatcher | None
+
+    @classmethod
+    def open(cls, settings: Settings) -> SweepJobs:
+        """Open the store; start a dispatcher on Dask (``dask_scheduler``) or on a pool of
+        ``workers`` processes (none when workers == 0 and no Dask)."""
+        store = JobStore.in_dir(Path(settings.data_dir))
+        backend = make_backend(settings.workers, settings.dask_scheduler)
+        dispatcher = None
+        if backend is not None:
+            dispatcher = Dispatcher(store, backend, settings.lease_seconds, settings.max_retries)
+            dispatcher.start()
+        return cls(store, dispatcher)
+
+    def wake(self) -> None:
+        """Tell the local dispatcher that there is work."""
+        if self.dispatcher is not None:
+            self.dispatcher.wake()
+
+    def ready(self) -> bool:
+        """The store answers."""
+        return self.store.ping()
+
+    def close(self, grace: float = 5.0) -> None:
+        """Stop the dispatcher gracefully and close this thread's connection."""
+        if self.dispatcher is not None:
+            self.dispatcher.stop(grace)
+        self.store.close()

@@ -1,0 +1,400 @@
+"""The durable job store: one SQLite file (WAL) holding jobs and the results of finished chunks.
+
+Tables: ``jobs`` (one row per sweep), ``chunks`` (one row per chunk: status pending | leased |
+done | failed | cancelled, lease owner and expiry, attempts, result JSON) and ``commits`` (an
+append-only log of chunk commits, for audits and the fault tests).
+
+Every state change is one ``BEGIN IMMEDIATE`` transaction, so several dispatchers (processes
+on this machine) can share the file. A chunk is leased for ``lease_seconds`` and the lease is
+renewed by heartbeats; a chunk whose lease expired is claimed again (its attempt counts). A
+result is committed only while the committer still holds the lease, so no chunk is committed
+twice. Times are POSIX seconds (``time.time()``).
+"""
+
+from __future__ import annotations
+
+import sqlite3
+import threading
+import time
+import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+from service.jobs.models import Job, JobStatus, Progress, utc
+
+DB_FILE = "jobs.sqlite3"
+"""Name of the store in the data directory."""
+
+SCHEMA = """
+CREATE TABLE IF NOT EXISTS jobs (
+    id TEXT PRIMARY KEY,
+    owner TEXT,
+    status TEXT NOT NULL,
+    request_json TEXT NOT NULL,
+    chunk_points INTEGER NOT NULL,
+    total_chunks INTEGER NOT NULL,
+    total_points INTEGER NOT NULL,
+    created_at REAL NOT NULL,
+    started_at REAL,
+    finished_at REAL,
+    error TEXT
+);
+CREATE INDEX IF NOT EXISTS jobs_owner ON jobs(owner, created_at);
+CREATE INDEX IF NOT EXISTS jobs_status ON jobs(status, created_at);
+CREATE TABLE IF NOT EXISTS chunks (
+    job_id TEXT NOT NULL REFERENCES jobs(id),
+    idx INTEGER NOT NULL,
+    n_points INTEGER NOT NULL,
+    status TEXT NOT NULL,
+    lease_owner TEXT,
+    lease_expires REAL,
+    attempts INTEGER NOT NULL DEFAULT 0,
+    error TEXT,
+    result_json TEXT,
+    committed_at REAL,
+    PRIMARY KEY (job_id, idx)
+);
+CREATE INDEX IF NOT EXISTS chunks_status ON chunks(status, lease_expires);
+CREATE TABLE IF NOT EXISTS commits (
+    job_id TEXT NOT NULL,
+    idx INTEGER NOT NULL,
+    owner TEXT NOT NULL,
+    at REAL NOT NULL
+);
+"""
+
+
+class QueueFullError(Exception):
+    """The number of unfinished jobs reached the cap."""
+
+
+@dataclass(frozen=True)
+class Claim:
+    """A leased chunk: what a worker needs to compute it."""
+
+    job_id: str
+    index: int
+    request_json: str
+    chunk_points: int
+    attempt: int
+
+    @property
+    def key(self) -> tuple[str, int]:
+        return (self.job_id, self.index)
+
+
+class JobStore:
+    """Access to the store file; one SQLite connection per thread."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._local = threading.local()
+        self._db().executescript(SCHEMA)
+
+    @classmethod
+    def in_dir(cls, data_dir: Path) -> JobStore:
+        """The store of a data directory."""
+        return cls(Path(data_dir) / DB_FILE)
+
+    def _db(self) -> sqlite3.Connection:
+        db = getattr(self._local, "db", None)
+        if db is None:
+            db = sqlite3.connect(self.path, isolation_level=None, timeout=30.0)
+            db.row_factory = sqlite3.Row
+            db.execute("PRAGMA journal_mode=WAL")
+            db.execute("PRAGMA synchronous=FULL")
+            db.execute("PRAGMA busy_timeout=30000")
+            self._local.db = db
+        return db
+
+    @contextmanager
+    def _tx(self) -> Iterator[sqlite3.Connection]:
+        db = self._db()
+        db.execute("BEGIN IMMEDIATE")
+        try:
+            yield db
+        except BaseException:
+            db.execute("ROLLBACK")
+            raise
+        db.execute("COMMIT")
+
+    def close(self) -> None:
+        """Close this thread's connection."""
+        db = getattr(self._local, "db", None)
+        if db is not None:
+            db.close()
+            self._local.db = None
+
+    def ping(self) -> bool:
+        """The file answers a query."""
+        try:
+            self._db().execute("SELECT 1 FROM jobs LIMIT 1").fetchall()
+        except sqlite3.Error:
+            return False
+        return True
+
+    # --- the API's side -------------------------------------------------------------------
+
+    def submit(
+        self, owner: str | None, request_json: str, chunk_counts: list[int], chunk_points: int,
+        max_unfinished: int,
+    ) -> Job:  # fmt: skip
+        """Store a job and its chunks; raises ``QueueFullError`` at ``max_unfinished`` jobs."""
+        job_id, now = uuid.uuid4().hex, time.time()
+        with self._tx() as db:
+            (n,) = db.execute(
+                "SELECT COUNT(*) FROM jobs WHERE status IN ('queued', 'running')"
+            ).fetchone()
+            if n >= max_unfinished:
+                raise QueueFullError(f"{n} unfinished jobs, the limit is {max_unfinished}")
+            db.execute(
+                "INSERT INTO jobs (id, owner, status, request_json, chunk_points, total_chunks, "
+                "total_points, created_at) VALUES (?, ?, 'queued', ?, ?, ?, ?, ?)",
+                (job_id, owner, request_json, chunk_points, len(chunk_counts),
+                 sum(chunk_counts), now),
+            )  # fmt: skip
+            db.executemany(
+                "INSERT INTO chunks (job_id, idx, n_points, status) VALUES (?, ?, ?, 'pending')",
+                [(job_id, i, n) for i, n in enumerate(chunk_counts)],
+            )
+        job = self.get(job_id, owner)
+        assert job is not None
+        return job
+
+    def get(self, job_id: str, owner: str | None) -> Job | None:
+        """The job if it exists and belongs to ``owner`` (None: auth off)."""
+        row = (
+            self._db()
+            .execute(f"{_JOB_SELECT} WHERE j.id = ? AND j.owner IS ?", (job_id, owner))
+            .fetchone()
+        )
+        return None if row is None else _job(row)
+
+    def request_json(self, job_id: str) -> str:
+        """The stored request document of a job."""
+        (text,) = (
+            self._db().execute("SELECT request_json FROM jobs WHERE id = ?", (job_id,)).fetchone()
+        )
+        return text
+
+    def list(
+        self, owner: str | None, status: JobStatus | None, limit: int, offset: int
+    ) -> tuple[list[Job], int]:
+        """A page of ``owner``'s jobs, newest first, and the number matching."""
+        where, args = "j.owner IS ?", [owner]
+        if status is not None:
+            where += " AND j.status = ?"
+            args.append(status)
+        db = self._db()
+        (total,) = db.execute(f"SELECT COUNT(*) FROM jobs j WHERE {where}", args).fetchone()
+        rows = db.execute(
+            f"{_JOB_SELECT} WHERE {where} ORDER BY j.created_at DESC, j.id LIMIT ? OFFSET ?",
+            [*args, limit, offset],
+        ).fetchall()
+        return [_job(r) for r in rows], total
+
+    def cancel(self, job_id: str, owner: str | None) -> Job | None:
+        """Cancel an unfinished job: no new chunk starts. Finished jobs are left as they are."""
+        with self._tx() as db:
+            hit = db.execute(
+                "UPDATE jobs SET status = 'cancelled', finished_at = ? "
+                "WHERE id = ? AND owner IS ? AND status IN ('queued', 'running')",
+                (time.time(), job_id, owner),
+            ).rowcount
+            if hit:
+                db.execute(
+                    "UPDATE chunks SET status = 'cancelled', lease_owner = NULL "
+                    "WHERE job_id = ? AND status IN ('pending', 'leased')",
+                    (job_id,),
+                )
+        return self.get(job_id, owner)
+
+    def chunk_results(self, job_id: str) -> Iterator[str]:
+        """JSON arrays of the committed chunks, in chunk order, one query each (so the
+        iteration may move between threads, as a streamed response does)."""
+        (n,) = (
+            self._db().execute("SELECT total_chunks FROM jobs WHERE id = ?", (job_id,)).fetchone()
+        )
+        for idx in range(n):
+            row = (
+                self._db()
+                .execute(
+                    "SELECT result_json FROM chunks WHERE job_id = ? AND idx = ? "
+                    "AND status = 'done'",
+                    (job_id, idx),
+                )
+                .fetchone()
+            )
+            if row is not None:
+                yield row[0]
+
+    # --- the dispatcher's side ------------------------------------------------------------
+
+    def claim(self, owner: str, lease_seconds: float, max_retries: int, limit: int) -> list[Claim]:
+        """Lease up to ``limit`` chunks, oldest job first: pending ones, or leased ones whose
+        lease expired (their worker is gone). A chunk out of attempts fails its job."""
+        now = time.time()
+        claims: list[Claim] = []
+        with self._tx() as db:
+            rows = db.execute(
+                "SELECT c.job_id, c.idx, c.attempts, c.status, c.error, j.request_json, "
+                "j.chunk_points FROM chunks c JOIN jobs j ON j.id = c.job_id "
+                "WHERE j.status IN ('queued', 'running') AND (c.status = 'pending' "
+                "OR (c.status = 'leased' AND c.lease_expires < ?)) "
+                "ORDER BY j.created_at, j.id, c.idx LIMIT ?",
+                (now, limit),
+            ).fetchall()
+            failed: set[str] = set()
+            for r in rows:
+                if r["job_id"] in failed:
+                    continue
+                if r["attempts"] > max_retries:
+                    reason = r["error"] or "its worker stopped answering (lease expired)"
+                    _fail_job(db, r["job_id"], r["idx"], r["attempts"], reason, now)
+                    failed.add(r["job_id"])
+                    continue
+                db.execute(
+                    "UPDATE chunks SET status = 'leased', lease_owner = ?, lease_expires = ?, "
+                    "attempts = attempts + 1 WHERE job_id = ? AND idx = ?",
+                    (owner, now + lease_seconds, r["job_id"], r["idx"]),
+                )
+                db.execute(
+                    "UPDATE jobs SET status = 'running', started_at = ? "
+                    "WHERE id = ? AND status = 'queued'",
+                    (now, r["job_id"]),
+                )
+                claims.append(
+                    Claim(r["job_id"], r["idx"], r["request_json"], r["chunk_points"],
+                          r["attempts"] + 1)
+                )  # fmt: skip
+        return claims
+
+    def heartbeat(
+        self, owner: str, lease_seconds: float, keys: list[tuple[str, int]]
+    ) -> set[tuple[str, int]]:
+        """Extend the leases of ``keys``; returns those still held (not cancelled or lost)."""
+        held = set()
+        with self._tx() as db:
+            for job_id, idx in keys:
+                if db.execute(
+                    "UPDATE chunks SET lease_expires = ? WHERE job_id = ? AND idx = ? "
+                    "AND status = 'leased' AND lease_owner = ?",
+                    (time.time() + lease_seconds, job_id, idx, owner),
+                ).rowcount:
+                    held.add((job_id, idx))
+        return held
+
+    def commit(self, owner: str, job_id: str, idx: int, result_json: str) -> bool:
+        """Store a chunk's result if ``owner`` still holds its lease; the last chunk finishes
+        the job. Returns whether the result was committed."""
+        now = time.time()
+        with self._tx() as db:
+            if not db.execute(
+                "UPDATE chunks SET status = 'done', result_json = ?, committed_at = ?, "
+                "lease_owner = NULL, lease_expires = NULL, error = NULL "
+                "WHERE job_id = ? AND idx = ? AND status = 'leased' AND lease_owner = ?",
+                (result_json, now, job_id, idx, owner),
+            ).rowcount:
+                return False
+            db.execute(
+                "INSERT INTO commits (job_id, idx, owner, at) VALUES (?, ?, ?, ?)",
+                (job_id, idx, owner, now),
+            )
+            (left,) = db.execute(
+                "SELECT COUNT(*) FROM chunks WHERE job_id = ? AND status != 'done'", (job_id,)
+            ).fetchone()
+            if left == 0:
+                db.execute(
+                    "UPDATE jobs SET status = 'succeeded', finished_at = ? "
+                    "WHERE id = ? AND status = 'running'",
+                    (now, job_id),
+                )
+        return True
+
+    def fail(
+        self, owner: str, job_id: str, idx: int, reason: str, retry: bool, max_retries: int
+    ) -> None:
+        """A chunk's attempt failed: back to pending if ``retry`` and attempts remain, else the
+        job fails with ``reason``."""
+        now = time.time()
+        with self._tx() as db:
+            row = db.execute(
+                "SELECT attempts FROM chunks WHERE job_id = ? AND idx = ? "
+                "AND status = 'leased' AND lease_owner = ?",
+                (job_id, idx, owner),
+            ).fetchone()
+            if row is None:
+                return
+            if retry and row["attempts"] <= max_retries:
+                db.execute(
+                    "UPDATE chunks SET status = 'pending', lease_owner = NULL, "
+                    "lease_expires = NULL, error = ? WHERE job_id = ? AND idx = ?",
+                    (reason, job_id, idx),
+                )
+            else:
+                _fail_job(db, job_id, idx, row["attempts"], reason, now)
+
+    def release(self, owner: str, keys: list[tuple[str, int]]) -> None:
+        """Give leased chunks back unfinished (graceful stop); the attempt is not counted."""
+        with self._tx() as db:
+            db.executemany(
+                "UPDATE chunks SET status = 'pending', lease_owner = NULL, lease_expires = NULL, "
+                "attempts = MAX(attempts - 1, 0) "
+                "WHERE job_id = ? AND idx = ? AND status = 'leased' AND lease_owner = ?",
+                [(job_id, idx, owner) for job_id, idx in keys],
+            )
+
+    def commit_log(self, job_id: str) -> list[tuple[int, str]]:
+        """(chunk index, committer) of every commit of a job, in commit order."""
+        rows = self._db().execute(
+            "SELECT idx, owner FROM commits WHERE job_id = ? ORDER BY rowid", (job_id,)
+        )
+        return [(r["idx"], r["owner"]) for r in rows]
+
+    def attempts(self, job_id: str) -> list[int]:
+        """Attempts of each chunk of a job, in chunk order."""
+        rows = self._db().execute(
+            "SELECT attempts FROM chunks WHERE job_id = ? ORDER BY idx", (job_id,)
+        )
+        return [r[0] for r in rows]
+
+
+_JOB_SELECT = (
+    "SELECT j.*, (SELECT COALESCE(SUM(n_points), 0) FROM chunks c "
+    "WHERE c.job_id = j.id AND c.status = 'done') AS done_points FROM jobs j"
+)
+
+
+def _job(row: sqlite3.Row) -> Job:
+    return Job(
+        id=row["id"],
+        status=row["status"],
+        progress=Progress(done=row["done_points"], total=row["total_points"]),
+        created_at=utc(row["created_at"]),
+        started_at=utc(row["started_at"]),
+        finished_at=utc(row["finished_at"]),
+        error=row["error"],
+    )
+
+
+def _fail_job(
+    db: sqlite3.Connection, job_id: str, idx: int, attempts: int, reason: str, now: float
+) -> None:
+    db.execute(
+        "UPDATE chunks SET status = 'failed', lease_owner = NULL, error = ? "
+        "WHERE job_id = ? AND idx = ?",
+        (reason, job_id, idx),
+    )
+    db.execute(
+        "UPDATE chunks SET status = 'cancelled', lease_owner = NULL "
+        "WHERE job_id = ? AND status IN ('pending', 'leased')",
+        (job_id,),
+    )
+    db.execute(
+        "UPDATE jobs SET status = 'failed', finished_at = ?, error = ? "
+        "WHERE id = ? AND status IN ('queued', 'running')",
+        (now, f"chunk {idx} failed after {attempts} attempt(s): {reason}", job_id),
+    )

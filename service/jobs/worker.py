@@ -1,0 +1,34 @@
+"""``gearengine worker``: a dispatcher without the API, on a process pool or a Dask cluster."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+from pathlib import Path
+from types import FrameType
+
+from service.core.config import Settings
+from service.jobs.backends import make_backend
+from service.jobs.dispatcher import Dispatcher
+from service.jobs.store import JobStore
+
+
+def cmd_worker(args: argparse.Namespace) -> int:
+    """Run a dispatcher on the data directory's store until SIGTERM or SIGINT (graceful)."""
+    flags = {"data_dir": args.data_dir, "workers": args.workers, "dask_scheduler": args.dask}
+    settings = Settings(**{k: v for k, v in flags.items() if v is not None})
+    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(message)s")
+    backend = make_backend(max(1, settings.workers), settings.dask_scheduler)
+    assert backend is not None
+    store = JobStore.in_dir(Path(settings.data_dir))
+    dispatcher = Dispatcher(store, backend, settings.lease_seconds, settings.max_retries)
+
+    def on_signal(signum: int, _: FrameType | None) -> None:
+        logging.getLogger("gearchaos.jobs").info("signal %d: stopping", signum)
+        dispatcher.request_stop()
+
+    signal.signal(signal.SIGTERM, on_signal)
+    signal.signal(signal.SIGINT, on_signal)
+    dispatcher.run()
+    return 0

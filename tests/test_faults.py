@@ -1,0 +1,150 @@
+"""Fault tests with real processes: kill -9 the server mid-sweep, kill -9 a pool worker,
+cancel mid-run. Results must equal an uninterrupted run and no chunk may be committed twice."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import psutil
+import pytest
+
+from gearengine.sweeps import run_local, validated
+from service.jobs.store import JobStore
+from tests.conftest import PAPER_PARAMS, Server
+
+CHUNK_POINTS = 2
+ENV = {
+    "GEARCHAOS_WORKERS": "1",
+    "GEARCHAOS_LEASE_SECONDS": "2",
+    "GEARCHAOS_SWEEP_CHUNK_POINTS": str(CHUNK_POINTS),
+}
+SWEEP = {
+    "params": PAPER_PARAMS,
+    # long transients make each 2-point chunk take a few tenths of a second
+    "settings": {"transient_periods": 40000, "record_periods": 500, "steps_per_period": 200},
+    "axes": [{"parameter": "F_e1", "start": 0.15, "stop": 0.3, "num": 24}],
+}
+N_CHUNKS = 12
+
+
+@pytest.fixture(scope="module")
+def reference() -> dict[str, Any]:
+    """The uninterrupted run, in this process."""
+    return run_local(validated(SWEEP), chunk_points=CHUNK_POINTS).model_dump(mode="json")
+
+
+def pool_workers(server: Server) -> list[psutil.Process]:
+    """The server's spawned pool processes (not the resource tracker)."""
+    kids = psutil.Process(server.proc.pid).children(recursive=True)
+    return [p for p in kids if "spawn_main" in " ".join(p.cmdline())]
+
+
+def kill9(processes: list[psutil.Process]) -> None:
+    for p in processes:
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(p.pid, signal.SIGKILL)
+
+
+def poll(url: str, until: Any, timeout: float = 120.0) -> dict[str, Any]:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        job = httpx.get(url, timeout=10).json()
+        if until(job):
+            return job
+        time.sleep(0.05)
+    raise TimeoutError(f"{url}: {job}")
+
+
+def finished(job: dict[str, Any]) -> bool:
+    return job["status"] not in ("queued", "running")
+
+
+@pytest.fixture
+def data_dir(tmp_path: Path) -> Iterator[Path]:
+    d = tmp_path / "data"
+    d.mkdir()
+    yield d
+
+
+def assert_committed_once(data_dir: Path, job_id: str) -> list[tuple[int, str]]:
+    log = JobStore.in_dir(data_dir).commit_log(job_id)
+    assert sorted(idx for idx, _ in log) == list(range(N_CHUNKS)), log
+    return log
+
+
+def submit(srv: Server) -> tuple[dict[str, Any], str]:
+    """POST the sweep; returns the job and its URL."""
+    job = httpx.post(srv.url + "/v1/sweeps", json=SWEEP, timeout=10).json()
+    return job, f"{srv.url}/v1/sweeps/{job['id']}"
+
+
+def test_kill9_server_mid_sweep_then_restart_resumes(
+    data_dir: Path, reference: dict[str, Any]
+) -> None:
+    srv = Server(data_dir, ENV)
+    try:
+        job, url = submit(srv)
+        seen = poll(url, lambda j: j["progress"]["done"] >= 3 * CHUNK_POINTS)
+        assert seen["status"] == "running"
+        children = pool_workers(srv)
+        os.kill(srv.proc.pid, signal.SIGKILL)
+        srv.proc.wait()
+        kill9(children)
+    finally:
+        srv.stop()
+    before = JobStore.in_dir(data_dir).commit_log(job["id"])
+    assert 3 <= len(before) < N_CHUNKS
+    again = Server(data_dir, ENV)
+    try:
+        url = f"{again.url}/v1/sweeps/{job['id']}"
+        assert poll(url, finished)["status"] == "succeeded"
+        assert httpx.get(url + "/result", timeout=30).json() == reference
+    finally:
+        again.stop()
+    log = assert_committed_once(data_dir, job["id"])
+    assert log[: len(before)] == before and len({owner for _, owner in log}) == 2
+
+
+def test_kill9_a_worker_process_retries_its_chunk(
+    data_dir: Path, reference: dict[str, Any]
+) -> None:
+    srv = Server(data_dir, ENV)
+    try:
+        job, url = submit(srv)
+        poll(url, lambda j: j["progress"]["done"] >= 2 * CHUNK_POINTS)
+        (worker,) = pool_workers(srv)
+        kill9([worker])
+        assert poll(url, finished)["status"] == "succeeded"
+        assert httpx.get(url + "/result", timeout=30).json() == reference
+        assert worker.pid not in [p.pid for p in pool_workers(srv)]  # a fresh pool
+    finally:
+        srv.stop()
+    assert_committed_once(data_dir, job["id"])
+    assert max(JobStore.in_dir(data_dir).attempts(job["id"])) == 2
+
+
+def test_cancel_mid_run_stops_the_sweep(data_dir: Path) -> None:
+    srv = Server(data_dir, ENV)
+    try:
+        job, url = submit(srv)
+        poll(url, lambda j: j["progress"]["done"] >= CHUNK_POINTS)
+        r = httpx.delete(url, timeout=10)
+        assert r.status_code == 200 and r.json()["status"] == "cancelled"
+        store = JobStore.in_dir(data_dir)
+        commits = len(store.commit_log(job["id"]))
+        time.sleep(2.0)
+        after = httpx.get(url, timeout=10).json()
+        assert after["status"] == "cancelled" and len(store.commit_log(job["id"])) == commits
+        assert after["progress"]["done"] < after["progress"]["total"]
+        small = {**SWEEP, "settings": {"transient_periods": 10, "record_periods": 10}}
+        nxt = httpx.post(srv.url + "/v1/sweeps", json=small, timeout=10).json()
+        assert poll(f"{srv.url}/v1/sweeps/{nxt['id']}", finished)["status"] == "succeeded"
+    finally:
+        srv.stop()

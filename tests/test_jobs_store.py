@@ -1,0 +1,148 @@
+"""The SQLite job store: ownership, the queue cap, leases, commits, retries, cancellation."""
+
+from __future__ import annotations
+
+import multiprocessing
+import time
+from pathlib import Path
+
+import pytest
+
+from service.jobs.store import JobStore, QueueFullError
+
+LEASE = 60.0
+
+
+@pytest.fixture
+def store(tmp_path: Path) -> JobStore:
+    return JobStore.in_dir(tmp_path)
+
+
+def submit(store: JobStore, owner: str | None = None, chunks: int = 3, cap: int = 10) -> str:
+    return store.submit(owner, '{"doc": 1}', [2] * chunks, 2, cap).id
+
+
+def test_jobs_belong_to_their_owner(store: JobStore) -> None:
+    a, b = submit(store, "alice"), submit(store, "bob")
+    assert store.get(a, "alice") is not None and store.get(a, "bob") is None
+    assert store.get(a, None) is None
+    jobs, total = store.list("bob", None, 10, 0)
+    assert total == 1 and [j.id for j in jobs] == [b]
+    assert store.cancel(a, "bob") is None and store.get(a, "alice").status == "queued"
+
+
+def test_listing_pages_newest_first_and_filters(store: JobStore) -> None:
+    ids = [submit(store) for _ in range(5)]
+    page, total = store.list(None, None, 2, 0)
+    assert total == 5 and [j.id for j in page] == ids[::-1][:2]
+    store.cancel(ids[0], None)
+    page, total = store.list(None, "cancelled", 10, 0)
+    assert total == 1 and page[0].id == ids[0] and page[0].finished_at is not None
+
+
+def test_queue_cap_counts_unfinished_jobs(store: JobStore) -> None:
+    first = submit(store, cap=2)
+    submit(store, cap=2)
+    with pytest.raises(QueueFullError):
+        submit(store, cap=2)
+    store.cancel(first, None)
+    submit(store, cap=2)
+
+
+def test_claim_commit_and_progress(store: JobStore) -> None:
+    job = submit(store, chunks=3)
+    claims = store.claim("w1", LEASE, 3, 2)
+    assert [(c.job_id, c.index, c.attempt) for c in claims] == [(job, 0, 1), (job, 1, 1)]
+    assert store.get(job, None).status == "running"
+    assert [c.index for c in store.claim("w2", LEASE, 3, 5)] == [2]
+    assert store.claim("w3", LEASE, 3, 5) == []
+    assert not store.commit("w2", job, 0, "[1]")  # not w2's lease
+    for idx, owner in ((0, "w1"), (2, "w2")):
+        assert store.commit(owner, job, idx, f"[{idx}]")
+    assert not store.commit("w1", job, 0, "[9]")  # already committed
+    j = store.get(job, None)
+    assert j.status == "running" and (j.progress.done, j.progress.total) == (4, 6)
+    assert store.commit("w1", job, 1, "[1]")
+    assert store.get(job, None).status == "succeeded"
+    assert list(store.chunk_results(job)) == ["[0]", "[1]", "[2]"]
+    assert store.commit_log(job) == [(0, "w1"), (2, "w2"), (1, "w1")]
+
+
+def test_an_expired_lease_is_claimed_again_and_the_old_owner_cannot_commit(
+    store: JobStore,
+) -> None:
+    job = submit(store, chunks=1)
+    store.claim("dead", 0.05, 3, 1)
+    time.sleep(0.1)
+    (again,) = store.claim("alive", LEASE, 3, 1)
+    assert again.attempt == 2
+    assert store.heartbeat("dead", LEASE, [(job, 0)]) == set()
+    assert not store.commit("dead", job, 0, "[]")
+    assert store.commit("alive", job, 0, "[]")
+    assert store.commit_log(job) == [(0, "alive")]
+
+
+def test_retries_are_bounded_then_the_job_fails_with_the_reason(store: JobStore) -> None:
+    job = submit(store, chunks=2)
+    for attempt in (1, 2, 3):
+        c = store.claim("w", LEASE, 2, 1)[0]
+        assert (c.index, c.attempt) == (0, attempt)
+        store.fail("w", job, 0, "BrokenProcessPool: worker died", True, 2)
+    j = store.get(job, None)
+    assert j.status == "failed"
+    assert j.error == "chunk 0 failed after 3 attempt(s): BrokenProcessPool: worker died"
+    assert store.claim("w", LEASE, 2, 5) == []
+
+
+def test_a_deterministic_error_fails_at_once(store: JobStore) -> None:
+    job = submit(store, chunks=1)
+    store.claim("w", LEASE, 3, 1)
+    store.fail("w", job, 0, "steps_per_period: over the cap", False, 3)
+    assert store.get(job, None).error.endswith("steps_per_period: over the cap")
+
+
+def test_leases_lost_too_often_fail_the_job(store: JobStore) -> None:
+    job = submit(store, chunks=1)
+    for _ in range(2):
+        store.claim("w", 0.01, 1, 1)
+        time.sleep(0.03)
+    assert store.claim("w", 0.01, 1, 1) == []
+    assert "lease expired" in store.get(job, None).error
+
+
+def test_cancel_stops_claims_and_heartbeats(store: JobStore) -> None:
+    job = submit(store, chunks=3)
+    store.claim("w", LEASE, 3, 1)
+    assert store.cancel(job, None).status == "cancelled"
+    assert store.heartbeat("w", LEASE, [(job, 0)]) == set()
+    assert store.claim("w", LEASE, 3, 5) == []
+    assert not store.commit("w", job, 0, "[]")
+
+
+def test_release_gives_chunks_back_without_counting_the_attempt(store: JobStore) -> None:
+    job = submit(store, chunks=1)
+    store.claim("w", LEASE, 3, 1)
+    store.release("w", [(job, 0)])
+    (c,) = store.claim("v", LEASE, 3, 1)
+    assert c.attempt == 1 and store.attempts(job) == [1]
+
+
+def _claim_all(path: str, owner: str, out: multiprocessing.Queue) -> None:
+    store = JobStore(Path(path))
+    got = []
+    while claims := store.claim(owner, LEASE, 3, 1):
+        got += [c.key for c in claims]
+    out.put(got)
+
+
+def test_concurrent_dispatchers_never_claim_a_chunk_twice(store: JobStore) -> None:
+    job = submit(store, chunks=60, cap=10)
+    ctx = multiprocessing.get_context("spawn")
+    out = ctx.Queue()
+    procs = [ctx.Process(target=_claim_all, args=(str(store.path), f"p{i}", out)) for i in range(4)]
+    for p in procs:
+        p.start()
+    claimed = [key for _ in procs for key in out.get(timeout=60)]
+    for p in procs:
+        p.join()
+    assert sorted(claimed) == [(job, i) for i in range(60)]

@@ -1,0 +1,199 @@
+"""/v1/sweeps over the in-process client: submission, polling, listing, ownership, cancel,
+limits, results, CSV and figures (the last with a real embedded dispatcher and worker pool)."""
+
+from __future__ import annotations
+
+import csv
+import io
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from gearengine.sweeps import run_local, validated
+from service.core.config import Settings
+from service.main import create_app
+from tests.conftest import PAPER_PARAMS
+
+SHORT = {"transient_periods": 50, "record_periods": 50, "steps_per_period": 64}
+
+
+def body(num: int = 11, **extra: Any) -> dict[str, Any]:
+    return {
+        "params": PAPER_PARAMS,
+        "settings": SHORT,
+        "axes": [{"parameter": "F_e1", "start": 0.0, "stop": 0.3, "num": num}],
+        **extra,
+    }
+
+
+def test_submit_answers_202_with_location_and_the_job(client: TestClient) -> None:
+    r = client.post("/v1/sweeps", json=body())
+    assert r.status_code == 202
+    job = r.json()
+    assert r.headers["location"] == f"/v1/sweeps/{job['id']}"
+    assert job["status"] == "queued" and job["progress"] == {"done": 0, "total": 11}
+    assert job["started_at"] is None and job["error"] is None
+    r = client.get(r.headers["location"])
+    assert r.status_code == 200 and r.json() == job and r.headers["retry-after"]
+
+
+def test_listing_is_paginated_and_filtered(client: TestClient) -> None:
+    ids = [client.post("/v1/sweeps", json=body()).json()["id"] for _ in range(3)]
+    client.delete(f"/v1/sweeps/{ids[1]}")
+    page = client.get("/v1/sweeps", params={"limit": 2}).json()
+    assert page["total"] == 3 and [j["id"] for j in page["items"]] == ids[::-1][:2]
+    assert page["next_offset"] == 2
+    last = client.get("/v1/sweeps", params={"limit": 2, "offset": 2}).json()
+    assert [j["id"] for j in last["items"]] == [ids[0]] and last["next_offset"] is None
+    cancelled = client.get("/v1/sweeps", params={"status": "cancelled"}).json()
+    assert [j["id"] for j in cancelled["items"]] == [ids[1]]
+    assert client.get("/v1/sweeps", params={"status": "done"}).status_code == 422
+
+
+def test_cancel_is_immediate_and_idempotent(client: TestClient) -> None:
+    job = client.post("/v1/sweeps", json=body()).json()
+    r = client.delete(f"/v1/sweeps/{job['id']}")
+    assert r.status_code == 200 and r.json()["status"] == "cancelled"
+    assert r.json()["finished_at"] is not None and "retry-after" not in r.headers
+    assert client.delete(f"/v1/sweeps/{job['id']}").json()["status"] == "cancelled"
+    r = client.get(f"/v1/sweeps/{job['id']}/result")
+    assert r.status_code == 409 and r.headers["content-type"] == "application/problem+json"
+
+
+def test_unfinished_result_is_409_with_retry_after(client: TestClient) -> None:
+    job = client.post("/v1/sweeps", json=body()).json()
+    for path in ("result", "plot"):
+        r = client.get(f"/v1/sweeps/{job['id']}/{path}")
+        assert r.status_code == 409 and r.headers["retry-after"]
+
+
+def test_unknown_job_is_404(client: TestClient) -> None:
+    for method, path in (("GET", ""), ("GET", "/result"), ("GET", "/plot"), ("DELETE", "")):
+        r = client.request(method, f"/v1/sweeps/{'0' * 32}{path}")
+        assert r.status_code == 404 and r.json()["status"] == 404
+
+
+@pytest.mark.parametrize(
+    ("change", "path"),
+    [
+        ({"axes": [{"parameter": "F_e1", "start": 0, "stop": 0.3, "num": 0}]}, "axes[0].num"),
+        (
+            {
+                "axes": [
+                    {"parameter": "F_e1", "start": 0, "stop": 0.3, "num": 3},
+                    {"parameter": "F_e1", "start": 0, "stop": 0.3, "num": 3},
+                ]
+            },
+            "axes[1].parameter",
+        ),
+        ({"axes": [{"parameter": "mu", "start": -1, "stop": 0.3, "num": 3}]}, "axes[0].start"),
+        ({"axes": []}, "axes"),
+        ({"direction": "both"}, "direction"),
+        ({"settings": {"steps_per_period": 2}}, "settings.steps_per_period"),
+        ({"axes": [{"parameter": "F_e1", "start": 0, "stop": 0.3, "num": 50_000}]}, "axes"),
+    ],
+)
+def test_invalid_sweeps_are_422_naming_the_field(
+    client: TestClient, change: dict[str, Any], path: str
+) -> None:
+    r = client.post("/v1/sweeps", json={**body(), **change})
+    assert r.status_code == 422 and r.headers["content-type"] == "application/problem+json"
+    assert path in [e["path"] for e in r.json()["errors"]], r.json()
+    assert client.get("/v1/sweeps").json()["total"] == 0  # nothing stored
+
+
+def test_sweep_over_the_compute_budget_is_refused_before_it_is_stored(tmp_path: Path) -> None:
+    app = create_app(Settings(data_dir=tmp_path, workers=0, max_sweep_steps=1_000_000))
+    with TestClient(app) as c:
+        r = c.post("/v1/sweeps", json=body(num=200))  # 200 points x 100 periods x 64 steps
+        assert r.status_code == 422
+        assert "max_sweep_steps" in r.json()["detail"] and "1280000" in r.json()["detail"]
+        assert c.get("/v1/sweeps").json()["total"] == 0
+        assert c.post("/v1/sweeps", json=body(num=100)).status_code == 202
+
+
+def test_queue_cap_answers_429_with_retry_after(tmp_path: Path) -> None:
+    settings = Settings(data_dir=tmp_path, workers=0, max_queued_jobs=2)
+    with TestClient(create_app(settings)) as c:
+        assert all(c.post("/v1/sweeps", json=body()).status_code == 202 for _ in range(2))
+        r = c.post("/v1/sweeps", json=body())
+        assert r.status_code == 429 and int(r.headers["retry-after"]) > 0
+        assert "max_queued_jobs" in r.json()["detail"]
+
+
+def test_jobs_are_owned_by_the_api_key(tmp_path: Path) -> None:
+    settings = Settings(data_dir=tmp_path, workers=0, api_keys="key-a,key-b")
+    with TestClient(create_app(settings)) as c:
+        a, b = {"X-API-Key": "key-a"}, {"Authorization": "Bearer key-b"}
+        assert c.post("/v1/sweeps", json=body()).status_code == 401
+        job = c.post("/v1/sweeps", json=body(), headers=a).json()
+        for method, path in (("GET", ""), ("GET", "/result"), ("GET", "/plot"), ("DELETE", "")):
+            r = c.request(method, f"/v1/sweeps/{job['id']}{path}", headers=b)
+            assert r.status_code == 404, (method, path)
+        assert c.get("/v1/sweeps", headers=b).json()["total"] == 0
+        assert c.get("/v1/sweeps", headers=a).json()["items"][0]["id"] == job["id"]
+        assert c.get(f"/v1/sweeps/{job['id']}", headers=a).json()["status"] == "queued"
+
+
+def test_ready_checks_the_job_store(client: TestClient) -> None:
+    assert client.get("/v1/ready").json()["checks"]["job_store"] is True
+
+
+@pytest.fixture(scope="module")
+def working(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestClient]:
+    """An app with an embedded dispatcher and one worker process."""
+    settings = Settings(data_dir=tmp_path_factory.mktemp("jobs"), workers=1, sweep_chunk_points=4)
+    with TestClient(create_app(settings)) as c:
+        yield c
+
+
+def wait(c: TestClient, job_id: str, timeout: float = 60.0) -> dict[str, Any]:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        job = c.get(f"/v1/sweeps/{job_id}").json()
+        if job["status"] not in ("queued", "running"):
+            return job
+        time.sleep(0.05)
+    raise TimeoutError(job_id)
+
+
+def test_a_sweep_runs_to_the_same_result_as_run_local(working: TestClient) -> None:
+    doc = {
+        **body(),
+        "axes": [
+            {"parameter": "F_e1", "start": 0.0, "stop": 0.3, "num": 6},
+            {"parameter": "Omega_e", "start": 0.4, "stop": 0.8, "num": 3},
+        ],
+    }
+    job = wait(working, working.post("/v1/sweeps", json=doc).json()["id"])
+    assert job["status"] == "succeeded" and job["progress"] == {"done": 18, "total": 18}
+    assert job["started_at"] <= job["finished_at"]
+    r = working.get(f"/v1/sweeps/{job['id']}/result")
+    assert r.status_code == 200 and "retry-after" not in r.headers
+    assert r.json() == run_local(validated(doc), chunk_points=4).model_dump(mode="json")
+    r = working.get(f"/v1/sweeps/{job['id']}/result", params={"format": "csv"})
+    assert r.headers["content-type"].startswith("text/csv")
+    rows = list(csv.DictReader(io.StringIO(r.text)))
+    assert len(rows) == 18 and list(rows[0])[:2] == ["F_e1", "Omega_e"]
+
+
+def test_plots_negotiate_png_and_svg(working: TestClient) -> None:
+    job = wait(working, working.post("/v1/sweeps", json=body(num=8)).json()["id"])
+    url = f"/v1/sweeps/{job['id']}/plot"
+    r = working.get(url)
+    assert r.headers["content-type"] == "image/png" and r.content.startswith(b"\x89PNG")
+    r = working.get(url, headers={"Accept": "image/svg+xml"})
+    assert r.headers["content-type"] == "image/svg+xml" and b"<svg" in r.content[:500]
+    assert working.get(url, params={"format": "svg"}).headers["content-type"] == "image/svg+xml"
+    assert working.get(url, headers={"Accept": "text/html"}).status_code == 406
+
+
+def test_continuation_both_branches_over_http(working: TestClient) -> None:
+    doc = body(num=4, continuation=True, direction="both")
+    job = wait(working, working.post("/v1/sweeps", json=doc).json()["id"])
+    points = working.get(f"/v1/sweeps/{job['id']}/result").json()["points"]
+    assert [p["branch"] for p in points] == ["up"] * 4 + ["down"] * 4
