@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import json
 import multiprocessing
+import sqlite3
+import threading
 import time
 from pathlib import Path
 
@@ -146,3 +149,39 @@ def test_concurrent_dispatchers_never_claim_a_chunk_twice(store: JobStore) -> No
     for p in procs:
         p.join()
     assert sorted(claimed) == [(job, i) for i in range(60)]
+
+
+def test_every_job_transition_is_one_structured_log_line(
+    store: JobStore, caplog: pytest.LogCaptureFixture
+) -> None:
+    caplog.set_level("INFO", logger="gearchaos.jobs")
+    job = submit(store, owner="key-a1b2", chunks=1)
+    (claim,) = store.claim("w1", LEASE, 3, 5)
+    assert store.commit("w1", job, claim.index, "[]")
+    lines = [json.loads(r.message) for r in caplog.records if r.message.startswith("{")]
+    assert [(e["job_id"], e["key_id"], e["status"]) for e in lines] == [
+        (job, "key-a1b2", "queued"),
+        (job, "key-a1b2", "running"),
+        (job, "key-a1b2", "succeeded"),
+    ]
+    assert lines[-1]["run_s"] >= 0.0 and lines[1]["queued_s"] >= 0.0
+    other = submit(store)
+    store.cancel(other, None)
+    assert json.loads(caplog.records[-1].message)["status"] == "cancelled"
+
+
+def test_a_locked_database_makes_writers_wait_not_fail(store: JobStore, tmp_path: Path) -> None:
+    """Another process holding the write lock (concurrent writer): the submit waits for it."""
+    submit(store)
+    holder = sqlite3.connect(
+        tmp_path / "jobs.sqlite3", isolation_level=None, check_same_thread=False
+    )
+    holder.execute("BEGIN EXCLUSIVE")
+    release = threading.Timer(1.0, lambda: holder.execute("COMMIT"))
+    release.start()
+    start = time.monotonic()
+    job = submit(JobStore.in_dir(tmp_path))
+    waited = time.monotonic() - start
+    release.join()
+    holder.close()
+    assert waited >= 0.9 and store.get(job, None).status == "queued"

@@ -13,6 +13,8 @@ twice. Times are POSIX seconds (``time.time()``).
 
 from __future__ import annotations
 
+import json
+import logging
 import sqlite3
 import threading
 import time
@@ -23,6 +25,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from service.jobs.models import Job, JobStatus, Progress, utc
+
+log = logging.getLogger("gearchaos.jobs")
 
 DB_FILE = "jobs.sqlite3"
 """Name of the store in the data directory."""
@@ -63,6 +67,24 @@ CREATE TABLE IF NOT EXISTS commits (
     owner TEXT NOT NULL,
     at REAL NOT NULL
 );
+CREATE TABLE IF NOT EXISTS job_events (
+    job_id TEXT NOT NULL,
+    owner TEXT,
+    status TEXT NOT NULL,
+    created_at REAL,
+    started_at REAL,
+    finished_at REAL,
+    error TEXT
+);
+CREATE TRIGGER IF NOT EXISTS job_submitted AFTER INSERT ON jobs BEGIN
+    INSERT INTO job_events VALUES (NEW.id, NEW.owner, NEW.status, NEW.created_at,
+                                   NEW.started_at, NEW.finished_at, NEW.error);
+END;
+CREATE TRIGGER IF NOT EXISTS job_transition AFTER UPDATE OF status ON jobs
+WHEN NEW.status != OLD.status BEGIN
+    INSERT INTO job_events VALUES (NEW.id, NEW.owner, NEW.status, NEW.created_at,
+                                   NEW.started_at, NEW.finished_at, NEW.error);
+END;
 """
 
 
@@ -112,14 +134,21 @@ class JobStore:
 
     @contextmanager
     def _tx(self) -> Iterator[sqlite3.Connection]:
+        """One BEGIN IMMEDIATE transaction; the job transitions it made (recorded by triggers in
+        ``job_events``) are logged once it has committed."""
         db = self._db()
         db.execute("BEGIN IMMEDIATE")
         try:
             yield db
+            events = db.execute("SELECT * FROM job_events").fetchall()
+            if events:
+                db.execute("DELETE FROM job_events")
         except BaseException:
             db.execute("ROLLBACK")
             raise
         db.execute("COMMIT")
+        for event in events:
+            log_transition(event)
 
     def close(self) -> None:
         """Close this thread's connection."""
@@ -378,6 +407,21 @@ def _job(row: sqlite3.Row) -> Job:
         finished_at=utc(row["finished_at"]),
         error=row["error"],
     )
+
+
+def log_transition(event: sqlite3.Row) -> None:
+    """One structured line per job transition: job id, key id, status and durations (s)."""
+    created, started, finished = event["created_at"], event["started_at"], event["finished_at"]
+    line = {
+        "event": "job",
+        "job_id": event["job_id"],
+        "key_id": event["owner"],
+        "status": event["status"],
+        "queued_s": None if started is None else round(started - created, 3),
+        "run_s": None if finished is None or started is None else round(finished - started, 3),
+        "error": event["error"],
+    }
+    log.info(json.dumps(line))
 
 
 def _fail_job(
