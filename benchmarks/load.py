@@ -90,7 +90,7 @@ def percentile(values: list[float], q: float) -> float:
 async def run(clients: int, seconds: float, url: str) -> tuple[str, bool]:
     log: dict[str, list] = defaultdict(list)
     codes: dict = defaultdict(int)
-    limits = httpx.Limits(max_connections=clients)
+    limits = httpx.Limits(max_connections=clients, keepalive_expiry=2.0)
     async with httpx.AsyncClient(base_url=url, timeout=120.0, limits=limits) as http:
         deadline = time.monotonic() + seconds
         started = time.perf_counter()

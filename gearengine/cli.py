@@ -203,7 +203,13 @@ def cmd_serve(args: argparse.Namespace) -> int:
             [f"data directory {settings.data_dir} is not writable: {exc.strerror}"]
         ) from None
     logging.basicConfig(level=logging.INFO, format="%(message)s")  # JSON access/job lines
-    uvicorn.run(create_app(settings), host=settings.host, port=settings.port, log_level="info")
+    uvicorn.run(
+        create_app(settings),
+        host=settings.host,
+        port=settings.port,
+        log_level="info",
+        timeout_keep_alive=settings.keep_alive_seconds,
+    )
     return EXIT_OK
 
 

@@ -31,6 +31,13 @@ class Settings(BaseSettings):
     insecure: bool = Field(False, description="Allow a non-loopback bind without API keys.")
     dask_scheduler: str | None = Field(None, description="Dask scheduler address for sweeps.")
 
+    keep_alive_seconds: float = Field(
+        30.0,
+        gt=0.0,
+        le=3600.0,
+        description="Idle keep-alive of HTTP connections; longer than clients' (httpx: 5 s) so "
+        "the server never closes a connection a client is about to reuse.",
+    )
     max_body_bytes: int = Field(1 << 20, ge=1024, description="Largest request body, bytes.")
     max_sync_steps: int = Field(
         5_000_000,
