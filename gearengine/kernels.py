@@ -422,6 +422,8 @@ def run_kink(
     done = 0
     count = 0
     ih = 0
+    # The per-period bookkeeping below repeats run_rk4's on purpose: factoring it into
+    # inline="always" helpers returning tuples made run_rk4 45 % slower (26 vs 18 ns per step).
     for n in range(n_trans + n_rec):
         rec = n >= n_trans
         for j in range(N):
