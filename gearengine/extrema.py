@@ -75,14 +75,16 @@ def grid(frequencies: np.ndarray, period: float) -> np.ndarray:
     return np.arange(n) * (period / n)
 
 
-def maximum(m: TrigSum, period: float, taus: np.ndarray | None = None) -> Extremum:
-    """Exact max of a periodic trig sum over one period.
+def maximum(
+    m: TrigSum, period: float, taus: np.ndarray | None = None, values: np.ndarray | None = None
+) -> Extremum:
+    """Exact max of a periodic trig sum over one period (``values``: m on ``taus``, if known).
 
     The best grid peaks are polished together by Newton on M'(tau0) = 0 (quadratic convergence
     from a grid of GRID_PER_CYCLE points per cycle), each kept within one grid step.
     """
     taus = grid(m.frequencies, period) if taus is None else taus
-    values = m(taus)
+    values = m(taus) if values is None else values
     step = taus[1] - taus[0]
     peaks = np.flatnonzero((values >= np.roll(values, 1)) & (values >= np.roll(values, -1)))
     start = taus[peaks[np.argsort(values[peaks])[-CANDIDATES:]]]
@@ -122,8 +124,9 @@ def extrema(m: TrigSum) -> Extrema:
             Extremum(m.offset - spread, None), Extremum(m.offset + spread, None), "supremum"
         )
     taus = grid(m.frequencies, period)
-    top = maximum(m, period, taus)
-    bottom = maximum(_negated(m), period, taus)
+    values = m(taus)  # one grid evaluation serves both extremes
+    top = maximum(m, period, taus, values)
+    bottom = maximum(_negated(m), period, taus, -values)
     return Extrema(Extremum(-bottom.value, bottom.tau0), top, "exact")
 
 
