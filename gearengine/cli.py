@@ -171,6 +171,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     """Start uvicorn with the API (imports the service only here: the engine has no web deps)."""
     import uvicorn
 
+    from service.api.deps import load_key_hashes
     from service.core.config import Settings
     from service.main import create_app
 
@@ -183,16 +184,18 @@ def cmd_serve(args: argparse.Namespace) -> int:
         "insecure": args.insecure or None,
     }
     settings = Settings(**{k: v for k, v in flags.items() if v is not None})
-    if not _is_loopback(settings.host) and not settings.key_list and not settings.insecure:
-        has_file = (Path(settings.data_dir) / "api_keys.sha256").exists()
-        if not has_file:
-            raise InvalidInputError(
-                [
-                    f"refusing to serve on {settings.host} without API keys: set "
-                    "GEARCHAOS_API_KEYS, or add a keys file to the data directory, or pass "
-                    "--insecure"
-                ]
-            )
+    try:
+        keys = load_key_hashes(settings)
+    except ValueError as exc:
+        raise InvalidInputError([str(exc)]) from None
+    if not _is_loopback(settings.host) and not keys and not settings.insecure:
+        raise InvalidInputError(
+            [
+                f"refusing to serve on {settings.host} without API keys: set "
+                "GEARCHAOS_API_KEYS, or put key digests in the data directory's "
+                "api_keys.sha256, or pass --insecure"
+            ]
+        )
     try:
         Path(settings.data_dir).mkdir(parents=True, exist_ok=True)
         probe = Path(settings.data_dir) / ".write-probe"

@@ -71,3 +71,17 @@ def test_sigterm_shuts_down_gracefully(tmp_path: Path) -> None:
     srv.stop()
     log = srv.output()
     assert "Application shutdown complete" in log and "Traceback" not in log
+
+
+def test_keys_file_without_keys_does_not_count_as_auth(tmp_path: Path) -> None:
+    """A comment-only keys file must not let a public bind start without authentication."""
+    (tmp_path / "api_keys.sha256").write_text("# keys go here\n\n")
+    out = serve("--host", "0.0.0.0", "--data-dir", str(tmp_path))
+    assert out.returncode == 2 and "without API keys" in out.stderr
+
+
+def test_malformed_keys_file_is_refused_naming_the_line(tmp_path: Path) -> None:
+    (tmp_path / "api_keys.sha256").write_text("# team A\nmy-plain-secret\n")
+    out = serve("--data-dir", str(tmp_path))
+    assert out.returncode == 2
+    assert "api_keys.sha256:2: not a sha256 hex digest" in out.stderr

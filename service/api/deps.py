@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import hmac
+import re
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -26,14 +27,24 @@ def key_id(key: str) -> str:
 
 
 def load_key_hashes(settings: Settings) -> dict[str, str]:
-    """sha256 digest -> key id, from GEARCHAOS_API_KEYS and the data directory's keys file."""
+    """sha256 digest -> key id, from GEARCHAOS_API_KEYS and the data directory's keys file.
+
+    Raises ValueError naming the line when the keys file holds anything but 64-hex digests
+    (a typo must not silently leave a key out, or turn auth off).
+    """
     digests = {hashlib.sha256(k.encode()).hexdigest() for k in settings.key_list}
     path = Path(settings.data_dir) / KEYS_FILE
     if path.exists():
-        for line in path.read_text().splitlines():
+        for n, line in enumerate(path.read_text().splitlines(), start=1):
             word = line.split("#", 1)[0].strip().lower()
-            if word:
-                digests.add(word)
+            if not word:
+                continue
+            if not re.fullmatch(r"[0-9a-f]{64}", word):
+                raise ValueError(
+                    f"{path}:{n}: not a sha256 hex digest (make one with: printf %s KEY | "
+                    "sha256sum)"
+                )
+            digests.add(word)
     return {d: d[:12] for d in digests}
 
 
