@@ -156,7 +156,14 @@ def parameter_threshold(
 def frequency_threshold(
     params: GearParams, a: float, c: float, scan: tuple = OMEGA_SCAN
 ) -> ParameterThreshold:
-    """Critical Omega_e in a scan: where the verdict flips, located by bisection."""
+    """Critical Omega_e in a scan: where the verdict flips, located by brentq.
+
+    Every excitation frequency is scaled with Omega_e (a change of running speed, their ratios
+    fixed): the commensurability of the forcing, and so the extrema method, stays the same along
+    the scan and the sign-change strength is continuous, so each root is a real flip. (Moving
+    Omega_e alone would jump between exact extrema at rational ratios and the supremum between
+    them, and the verdict would flip at isolated points.)
+    """
     value = get_alias(params, "Omega_e")
     base = dict(value=value, branches=None, scan=scan)
     if value is None:
@@ -170,11 +177,14 @@ def frequency_threshold(
             note="transmission_error is not given: no Omega_e to scan",
         )
     start, stop, num = scan
-    exc = params.transmission_error
 
     def strength(om: float) -> float:
-        moved = exc.model_copy(update={"frequency": float(om)})
-        return sign_change_strength(params.model_copy(update={"transmission_error": moved}), a, c)
+        factor = float(om) / value
+        moved = {
+            name: exc.model_copy(update={"frequency": exc.frequency * factor})
+            for name, exc in params.excitations()
+        }
+        return sign_change_strength(params.model_copy(update=moved), a, c)
 
     omegas = np.linspace(start, stop, num)
     values = [strength(om) for om in omegas]
@@ -197,8 +207,9 @@ def frequency_threshold(
         margin=margin,
         relative_margin=rel,
         no_chaos=no_chaos,
-        note="critical frequencies found by scanning; flips between scan points closer than "
-        "the grid step may be missed",
+        note="critical Omega_e found by scanning with every excitation frequency scaled "
+        "alongside (ratios fixed, as a change of running speed); flips between scan points "
+        "closer than the grid step may be missed",
     )
 
 

@@ -10,7 +10,7 @@ from scipy import integrate
 
 from gearengine import melnikov as mk
 from gearengine.melnikov_analysis import melnikov
-from gearengine.params import GearParams, with_alias
+from gearengine.params import GearParams, with_alias, with_aliases
 
 OMEGAS = np.linspace(0.05, 3.0, 14)
 SHAPES = [(0.1667, 0.1667), (1.0, 0.5), (0.3, 2.0), (2.0, 0.2)]
@@ -248,3 +248,24 @@ def test_commensurate_extrema_are_attained_and_exact() -> None:
     assert b.max == pytest.approx(values.max(), abs=1e-9) and b.max >= values.max() - 1e-12
     assert b.min == pytest.approx(values.min(), abs=1e-9) and b.min <= values.min() + 1e-12
     assert coef(b.tau0_max) == pytest.approx(b.max, abs=1e-14)
+
+
+def test_omega_scan_with_several_excitations_finds_only_real_flips() -> None:
+    """Found in review: moving Omega_e alone jumped between exact extrema (rational ratios) and
+    the supremum, giving a false critical value at 0.25. The scan scales every frequency."""
+    params = GearParams.model_validate(
+        {
+            "damping": 0.07,
+            "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 0.2}]},
+            "stiffness": {"frequency": 1.0, "harmonics": [{"amplitude": 0.3}]},
+        }
+    )
+    crit = melnikov(params).thresholds["Omega_e"].critical_values
+    assert crit and all(abs(om - 0.25) > 1e-3 for om in crit)
+
+    def at(om: float) -> bool | None:
+        scaled = with_aliases(params, {"Omega_e": om, "Omega_k": 2.0 * om})
+        return melnikov(scaled, omega_scan=(0.5, 1.0, 2)).chaos_possible
+
+    for om in crit:
+        assert at(om - 1e-6) != at(om + 1e-6), om
