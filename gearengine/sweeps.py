@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import csv
 import io
+import itertools
 import math
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
@@ -25,6 +26,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
+from gearengine.analysis import work
 from gearengine.melnikov import cubic_coefficients
 from gearengine.params import Alias, GearParams, request_config, with_aliases
 from gearengine.requests import PAPER_SECTION_41
@@ -138,6 +140,36 @@ class SweepResult(BaseModel):
 
     axes: list[SweepAxis] = Field(description="The axes of the request.")
     points: list[SweepPoint] = Field(description="One entry per point and branch.")
+
+
+FREQUENCY_ALIASES = frozenset({"Omega_k", "Omega_e", "Omega_p"})
+
+
+def sweep_work(request: SweepRequest) -> int:
+    """RK4 steps of the whole sweep, for the compute budget.
+
+    The steps per T0 depend on how the excitation frequencies line up, so every combination of
+    swept frequencies is costed; the other axes (amplitudes, damping, mean force) only switch an
+    excitation on or off, so their corners bound them.
+    """
+    freq = [a for a in request.axes if a.parameter in FREQUENCY_ALIASES]
+    rest = [a for a in request.axes if a.parameter not in FREQUENCY_ALIASES]
+    per_combination = request.n_points() // math.prod(a.num for a in freq)
+    corners = list(itertools.product(*((a.start, a.stop) for a in rest)))
+    total = 0
+    for values in itertools.product(*(a.values() for a in freq)):
+        point = dict(zip((a.parameter for a in freq), values, strict=True))
+        total += per_combination * max(
+            work(
+                with_aliases(
+                    request.params,
+                    {**point, **dict(zip((a.parameter for a in rest), c, strict=True))},
+                ),
+                request.settings,
+            )
+            for c in corners
+        )
+    return total
 
 
 def request_errors(request: SweepRequest, max_points: int | None = None) -> list[InitErrorDetails]:

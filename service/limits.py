@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-import itertools
 from dataclasses import dataclass
 
-from gearengine.analysis import work
-from gearengine.params import with_aliases
 from gearengine.requests import ThresholdsRequest
-from gearengine.sweeps import SweepRequest
+from gearengine.sweeps import SweepRequest, sweep_work
 from service.core.config import Settings
 from service.errors import FieldError, ProblemError
 
@@ -36,19 +33,13 @@ class Limits:
             )
 
     def check_sweep(self, body: SweepRequest) -> None:
-        """Refuse a sweep whose work (points x the costliest corner design) is over budget."""
-        corners = itertools.product(*((a.start, a.stop) for a in body.axes))
-        names = [a.parameter for a in body.axes]
-        per_point = max(
-            work(with_aliases(body.params, dict(zip(names, c, strict=True))), body.settings)
-            for c in corners
-        )
-        steps = body.n_points() * per_point
+        """Refuse a sweep whose total work is over the per-sweep budget."""
+        steps = sweep_work(body)
         cap = self.settings.max_sweep_steps
         if steps > cap:
             raise over_limit(
                 "axes",
-                f"this sweep needs about {steps} RK4 steps, over the budget of {cap} steps per "
+                f"this sweep needs {steps} RK4 steps, over the budget of {cap} steps per "
                 "sweep (max_sweep_steps); use fewer points, periods or steps per period",
                 kind="over-budget",
             )

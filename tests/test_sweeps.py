@@ -11,6 +11,7 @@ from typing import Any
 import pytest
 from pydantic import ValidationError
 
+from gearengine.analysis import work
 from gearengine.cli import main
 from gearengine.jsonio import error_lines
 from gearengine.melnikov_analysis import melnikov
@@ -25,6 +26,7 @@ from gearengine.sweeps import (
     compute_chunk_json,
     melnikov_chaos_possible,
     run_local,
+    sweep_work,
     to_csv,
     validated,
 )
@@ -193,3 +195,22 @@ def test_cli_sweep_names_the_bad_field(tmp_path: Path, capsys: pytest.CaptureFix
     doc.write_text(json.dumps(sweep(("F_e1", 0.0, 0.3, 0))))
     assert main(["sweep", str(doc), "--out", str(tmp_path)]) == 2
     assert capsys.readouterr().err.startswith("axes[0].num:")
+
+
+def test_sweep_work_costs_every_frequency_combination() -> None:
+    """Found in review: the corners of an Omega_e axis cost 400k and 200k steps per point, but
+    interior ratios to Omega_k = 1 need up to 12.8M; the budget must see the real total."""
+    doc = {
+        "params": {
+            **PAPER_PARAMS,
+            "stiffness": {"frequency": 1.0, "harmonics": [{"amplitude": 0.1}]},
+        },
+        "axes": [{"parameter": "Omega_e", "start": 0.5, "stop": 1.0, "num": 65}],
+    }
+    req = validated(doc)
+    per_point = [
+        work(with_aliases(req.params, {"Omega_e": v}), req.settings) for v in req.axes[0].values()
+    ]
+    assert sweep_work(req) == sum(per_point) == 279_800_000
+    amplitude = validated(sweep(("F_e1", 0.0, 0.3, 31)))
+    assert sweep_work(amplitude) == 31 * work(amplitude.params, amplitude.settings)
