@@ -25,14 +25,18 @@ PEAK_FLOOR = 1e-3
 """Peaks below this fraction of the largest one are dropped."""
 
 
-def impact_regime(xmin: float) -> ImpactRegime:
-    """no_impact: x > 1 throughout (permanent contact, no separation); single_sided: separation
-    but never x < -1; double_sided: back-side contact x < -1 occurs."""
-    if xmin > 1.0:
+def impact_regime(xmin: float, xmax: float) -> ImpactRegime:
+    """Contact regime from the extremes of x over the record (x in units of b, Eq. 8).
+
+    no_impact: the teeth never separate, x > 1 throughout (drive-side contact) or x < -1
+    throughout (permanent back-side contact); double_sided: both flanks are hit (x > 1 and
+    x < -1 both occur); single_sided: separation with contact on at most one flank.
+    """
+    if xmin > 1.0 or xmax < -1.0:
         return "no_impact"
-    if xmin >= -1.0:
-        return "single_sided"
-    return "double_sided"
+    if xmax > 1.0 and xmin < -1.0:
+        return "double_sided"
+    return "single_sided"
 
 
 def rms(x: np.ndarray) -> float:

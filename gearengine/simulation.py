@@ -327,7 +327,7 @@ def _verdict(
         period=period,
         lle=_finite(est.lle),
         lle_stderr=_finite(est.stderr),
-        impact_regime=impact_regime(run.xmin),
+        impact_regime=impact_regime(run.xmin, run.xmax),
         final_state=None if None in final else final,
     )
     return _Verdict(verdict, period, est, summary)
@@ -403,7 +403,7 @@ def simulate(params: GearParams, settings: SimulationSettings | None = None) -> 
         lle_stderr=_finite(est.stderr),
         lle_first_half=_finite(est.first_half),
         lle_converged=est.converged,
-        impact_regime=impact_regime(worst.xmin),
+        impact_regime=impact_regime(worst.xmin, worst.xmax),
         x_rms=_finite(rms(worst.hx)),
         x_peak_to_peak=_finite(worst.xmax - worst.xmin),
         spectrum_peaks=[SpectrumPeak(**p) for p in peaks],
