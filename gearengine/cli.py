@@ -146,7 +146,8 @@ def failures(r: AnalysisResult, fail_on: list[str], max_lle: float | None) -> li
 def cmd_check(args: argparse.Namespace) -> int:
     """CI gate: exit 0 pass, 1 fail, 2 invalid input; one summary line."""
     result = analyze(read_request(args.file, AnalysisRequest))
-    reasons = failures(result, args.fail_on or ["chaotic"], args.max_lle)
+    default = [] if args.max_lle is not None else ["chaotic"]  # a bare --max-lle stands alone
+    reasons = failures(result, args.fail_on or default, args.max_lle)
     verdict = "FAIL" if reasons else "PASS"
     why = f" [{', '.join(reasons)}]" if reasons else ""
     print(f"{verdict}: {_numerics_line(result)}{why}")
@@ -241,7 +242,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="CI gate: exit 1 when the design fails (0 pass, 2 invalid input)",
         description="--fail-on X fails on X or anything worse "
         "(periodic < quasi_periodic < chaotic < diverged); melnikov fails when a transverse "
-        "homoclinic tangle is possible. Default: --fail-on chaotic.",
+        "homoclinic tangle is possible. Default: --fail-on chaotic, unless --max-lle is given.",
     )
     p.add_argument("file", help='JSON file holding {"params": {...}, "settings": {...}}, or -')
     p.add_argument(
