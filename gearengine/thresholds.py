@@ -223,6 +223,9 @@ def threshold_curve(
 ) -> ThresholdCurve:
     """Critical values of ``parameter`` for ``num`` values of a frequency in [start, stop].
 
+    Raises ValueError, its message starting with the request field at fault (``parameter``,
+    ``frequency_parameter`` or ``params.backlash``), when no curve can be drawn.
+
     Args:
         params: the design; its other parameters stay fixed.
         parameter: F_e1, mu, k_p1 or F_p1.
@@ -231,16 +234,18 @@ def threshold_curve(
     """
     a, c, notes = cubic_coefficients(params)
     if not (a > 0.0 and c > 0.0):
-        raise ValueError(f"the Melnikov criterion needs a > 0 and c > 0 (got a = {a}, c = {c})")
+        raise ValueError(
+            f"params.backlash: the Melnikov criterion needs a > 0 and c > 0 (got a = {a}, c = {c})"
+        )
     if get_alias(params, frequency_parameter) is None:
-        raise ValueError(f"{frequency_parameter}: its excitation is not given")
+        raise ValueError(f"frequency_parameter: {frequency_parameter}: its excitation is not given")
     omegas = [float(w) for w in np.linspace(start, stop, num)]
     rows = [
         parameter_threshold(with_alias(params, frequency_parameter, w), parameter, a, c)
         for w in omegas
     ]
     if any(r.note for r in rows):
-        raise ValueError(next(r.note for r in rows if r.note))
+        raise ValueError(f"parameter: {next(r.note for r in rows if r.note)}")
     return ThresholdCurve(
         parameter=parameter,
         frequency_parameter=frequency_parameter,

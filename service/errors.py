@@ -71,6 +71,10 @@ def field_errors(errors: list[dict[str, Any]], strip_body: bool = True) -> list[
     out = []
     for e in errors:
         loc = tuple(e["loc"])
+        if e.get("type") == "json_invalid":  # loc holds a character offset, not a field
+            at = loc[-1] if loc and isinstance(loc[-1], int) else "?"
+            out.append(FieldError(path="", pointer="", message=f"{e['msg']} at character {at}"))
+            continue
         if strip_body and loc[:1] == ("body",):
             loc = loc[1:]
         pointer = "/" + "/".join(str(p).replace("~", "~0").replace("/", "~1") for p in loc)
@@ -83,7 +87,7 @@ def validation_problem(errors: list[FieldError], detail: str | None = None) -> P
         422,
         "validation",
         "Invalid request",
-        detail or "; ".join(f"{e.path}: {e.message}" for e in errors),
+        detail or "; ".join(f"{e.path}: {e.message}" if e.path else e.message for e in errors),
         errors,
     )
 

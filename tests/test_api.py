@@ -79,6 +79,8 @@ def test_broken_json_and_wrong_method(client: TestClient) -> None:
         "/v1/melnikov", content=b'{"params": ', headers={"content-type": "application/json"}
     )
     assert r.status_code == 422 and r.headers["content-type"] == "application/problem+json"
+    # the location is the body, not a character offset dressed up as a path (found in review)
+    assert r.json()["errors"][0]["path"] == "" and "at character 11" in r.json()["detail"]
     r = client.get("/v1/melnikov")
     assert r.status_code == 405 and r.json()["status"] == 405
 
@@ -132,6 +134,24 @@ def test_threshold_curve_endpoint(client: TestClient) -> None:
     assert r.json()["errors"][0]["path"] == "num"
     r = client.post("/v1/thresholds", json={**body, "start": 2.0, "stop": 1.0})
     assert r.status_code == 422 and r.json()["errors"][0]["path"] == "stop"
+
+
+@pytest.mark.parametrize(
+    ("patch", "path"),
+    [
+        ({"frequency_parameter": "Omega_k"}, "frequency_parameter"),
+        (
+            {"params": {**PAPER_PARAMS, "backlash": {"model": "cubic", "a": -1.0}}},
+            "params.backlash",
+        ),
+    ],
+)
+def test_threshold_refusals_name_the_request_field(
+    client: TestClient, patch: dict, path: str
+) -> None:
+    r = client.post("/v1/thresholds", json={"params": PAPER_PARAMS, **patch})
+    assert r.status_code == 422
+    assert [e["path"] for e in r.json()["errors"]] == [path]
 
 
 def test_api_keys(tmp_path: Path) -> None:
