@@ -24,6 +24,8 @@ GRID_PER_CYCLE = 16
 MAX_GRID = 1 << 16
 NEWTON_STEPS = 5
 CANDIDATES = 4
+NEGLIGIBLE = 1e-200
+"""Coefficients smaller than this are treated as zero by the threshold search."""
 
 ExtremaMethod = Literal["exact", "supremum", "constant"]
 
@@ -161,7 +163,10 @@ def sublevel_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
     (possibly empty: None). Exact method: grid estimate by the envelope of lines, then Newton on
     phi(p) = max_tau0 (m0 + p g) = 0 with phi'(p) = g(tau*) (envelope theorem). Supremum method
     (incommensurate): phi(p) = m0.offset + p g.offset + sum_i |m0_i + p g_i|, solved exactly.
+    Coefficients below NEGLIGIBLE (e.g. sech of a huge argument, underflowing through the
+    subnormals) are taken as 0, so that -m0 / g cannot overflow.
     """
+    m0, g = _flushed(m0), _flushed(g)
     freqs = m0.frequencies
     active = (m0.amplitudes != 0.0) | (g.amplitudes != 0.0)
     period = period_of(freqs[active]) if active.any() else None
@@ -188,6 +193,15 @@ def sublevel_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
     if lo is not None and hi is not None and lo > hi:
         return None
     return Interval(lo, hi)
+
+
+def _flushed(m: TrigSum) -> TrigSum:
+    """m with every coefficient of magnitude below NEGLIGIBLE set to 0."""
+
+    def flush(v: np.ndarray | float) -> np.ndarray:
+        return np.where(np.abs(v) < NEGLIGIBLE, 0.0, v)
+
+    return TrigSum(float(flush(m.offset)), flush(m.amplitudes), m.frequencies, m.phases)
 
 
 def _line_envelope(mv: np.ndarray, gv: np.ndarray) -> tuple[float | None, float | None]:
@@ -224,40 +238,33 @@ def _affine_nonpositive(offset: float, slope: float) -> Interval | None:
 def _supremum_interval(m0: TrigSum, g: TrigSum, active: np.ndarray) -> Interval | None:
     """{p : phi(p) <= 0}, phi(p) = m0.offset + p g.offset + sum_i |m0_i + p g_i|.
 
-    phi is convex and piecewise linear with kinks at p = -m0_i / g_i; its sublevel set is found
-    from its values at the kinks and its slopes beyond them.
+    phi is convex and piecewise linear with kinks k_i = -m0_i / g_i. On the piece between two
+    sorted kinks every sign s_i of m0_i + p g_i = g_i (p - k_i) is known from the kink order, so
+    phi = alpha + beta p there exactly (no subtraction of huge kinks); the union of the pieces'
+    solutions is the interval.
     """
     a, b = m0.amplitudes[active], g.amplitudes[active]
     base = m0.offset + float(np.abs(a[b == 0.0]).sum())
     a, b = a[b != 0.0], b[b != 0.0]
     if not b.size:
         return _affine_nonpositive(base, g.offset)
-    kinks = np.sort(-a / b)
-    values = base + kinks * g.offset + np.abs(a + np.multiply.outer(kinks, b)).sum(axis=1)
-    slope_left = g.offset - float(np.abs(b).sum())
-    slope_right = g.offset + float(np.abs(b).sum())
-    if slope_left <= 0.0 <= slope_right and values.min() > 0.0:
+    order = np.argsort(-a / b)
+    a, b = a[order], b[order]
+    kinks = np.concatenate([[-np.inf], -a / b, [np.inf]])
+    lo, hi = np.inf, -np.inf
+    for j in range(b.size + 1):  # piece j lies between kinks j-1 and j (sorted)
+        signs = np.sign(b) * np.where(np.arange(b.size) < j, 1.0, -1.0)
+        alpha = base + float(signs @ a)
+        beta = g.offset + float(signs @ b)
+        left, right = kinks[j], kinks[j + 1]
+        if beta > 0.0:
+            right = min(right, -alpha / beta)
+        elif beta < 0.0:
+            left = max(left, -alpha / beta)
+        elif alpha > 0.0:
+            continue
+        if left <= right:
+            lo, hi = min(lo, left), max(hi, right)
+    if lo > hi:
         return None
-    return Interval(
-        _outer_root(kinks, values, slope_left, slope_right, left=True),
-        _outer_root(kinks[::-1], values[::-1], slope_right, slope_left, left=False),
-    )
-
-
-def _outer_root(
-    kinks: np.ndarray, values: np.ndarray, slope_out: float, slope_in: float, left: bool
-) -> float | None:
-    """Outermost root on one side of a convex piecewise-linear function (None: unbounded).
-
-    ``kinks`` run from this side inwards; ``slope_out`` is d phi / dp beyond the first kink,
-    ``slope_in`` beyond the last one.
-    """
-    if values[0] <= 0.0:
-        grows_outward = slope_out < 0.0 if left else slope_out > 0.0
-        return float(kinks[0] - values[0] / slope_out) if grows_outward else None
-    inside = np.flatnonzero(values <= 0.0)
-    if not inside.size:  # the set lies beyond the last kink, where phi has slope_in
-        return float(kinks[-1] - values[-1] / slope_in)
-    j = int(inside[0])
-    p0, p1, f0, f1 = kinks[j - 1], kinks[j], values[j - 1], values[j]
-    return float(p0 + (p1 - p0) * f0 / (f0 - f1))
+    return Interval(None if lo == -np.inf else float(lo), None if hi == np.inf else float(hi))

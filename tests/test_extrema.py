@@ -125,3 +125,28 @@ def test_thresholds_flip_the_verdict(p: GearParams) -> None:
             lo = melnikov(with_alias(p, name, crit - eps), omega_scan=(0.5, 1.0, 2))
             hi = melnikov(with_alias(p, name, crit + eps), omega_scan=(0.5, 1.0, 2))
             assert lo.chaos_possible != hi.chaos_possible, (name, crit)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.floats(-2.0, 2.0),
+    st.floats(-2.0, 2.0),
+    st.lists(st.tuples(amp, amp), min_size=1, max_size=4),
+)
+def test_supremum_interval_matches_its_piecewise_linear_function(
+    offset: float, slope: float, pairs: list[tuple[float, float]]
+) -> None:
+    """Incommensurate frequencies: phi(p) = offset + p slope + sum_i |a_i + p b_i|, with a
+    nonzero slope too (a parameter in both the constant and the sinusoids)."""
+    n = len(pairs)
+    freqs = np.sqrt(np.array([2.0, 3.0, 5.0, 7.0]))[:n]  # rationally independent
+    a = np.array([p[0] for p in pairs])
+    b = np.array([p[1] for p in pairs])
+    m0 = TrigSum(offset, a, freqs, np.zeros(n))
+    g = TrigSum(slope, b, freqs, np.zeros(n))
+    interval = sublevel_interval(m0, g)
+    for p in np.linspace(-8.0, 8.0, 161):
+        phi = offset + p * slope + float(np.abs(a + p * b).sum())
+        if abs(phi) > 1e-9:
+            inside = interval is not None and interval.contains(float(p))
+            assert inside == (phi <= 0.0), (p, phi, interval)
