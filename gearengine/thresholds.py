@@ -105,12 +105,24 @@ def _ends(intervals: list[Interval], domain: Interval) -> list[float]:
     return sorted({e for i in intervals for e in (i.lo, i.hi) if e is not None and e not in bounds})
 
 
-def _margin(value: float | None, critical: list[float]) -> tuple:
-    if value is None or not critical:
-        return None, None, None
-    nearest = min(critical, key=lambda v: abs(value - v))
-    margin = value - nearest
-    return nearest, margin, (margin / abs(nearest) if nearest != 0.0 else None)
+def _threshold(
+    value: float | None, critical: list[float], no_chaos: list, **extra: object
+) -> ParameterThreshold:
+    """The threshold document: critical values and the design's margin to the nearest one."""
+    nearest = margin = rel = None
+    if value is not None and critical:
+        nearest = min(critical, key=lambda v: abs(value - v))
+        margin = value - nearest
+        rel = margin / abs(nearest) if nearest != 0.0 else None
+    return ParameterThreshold(
+        value=value,
+        critical_values=critical,
+        nearest=nearest,
+        margin=margin,
+        relative_margin=rel,
+        no_chaos=no_chaos,
+        **extra,
+    )
 
 
 def parameter_threshold(
@@ -125,14 +137,8 @@ def parameter_threshold(
         family = _family(coefficients(params, a, c, br, include_inactive=True), parameter)
         if family is None:
             exc = _TERM_OF[parameter]
-            return ParameterThreshold(
-                value=value,
-                critical_values=[],
-                nearest=None,
-                margin=None,
-                relative_margin=None,
-                no_chaos=[],
-                note=f"{exc} is not given: no frequency for {parameter}",
+            return _threshold(
+                value, [], [], note=f"{exc} is not given: no frequency for {parameter}"
             )
         sets[br] = _intersect(no_sign_change(*family), [domain])
         branches[br] = BranchThreshold(
@@ -140,15 +146,10 @@ def parameter_threshold(
             no_sign_change=[(i.lo, i.hi) for i in sets[br]],
         )
     overall = _intersect(sets["plus"], sets["minus"])
-    critical = _ends(overall, domain)
-    nearest, margin, rel = _margin(value, critical)
-    return ParameterThreshold(
-        value=value,
-        critical_values=critical,
-        nearest=nearest,
-        margin=margin,
-        relative_margin=rel,
-        no_chaos=[(i.lo, i.hi) for i in overall],
+    return _threshold(
+        value,
+        _ends(overall, domain),
+        [(i.lo, i.hi) for i in overall],
         branches=branches,
     )
 
@@ -165,16 +166,9 @@ def frequency_threshold(
     them, and the verdict would flip at isolated points.)
     """
     value = get_alias(params, "Omega_e")
-    base = dict(value=value, branches=None, scan=scan)
     if value is None:
-        return ParameterThreshold(
-            **base,
-            critical_values=[],
-            nearest=None,
-            margin=None,
-            relative_margin=None,
-            no_chaos=[],
-            note="transmission_error is not given: no Omega_e to scan",
+        return _threshold(
+            None, [], [], scan=scan, note="transmission_error is not given: no Omega_e to scan"
         )
     start, stop, num = scan
 
@@ -199,14 +193,11 @@ def frequency_threshold(
         for i in range(len(edges) - 1)
         if strength(0.5 * (edges[i] + edges[i + 1])) <= 0.0
     ]
-    nearest, margin, rel = _margin(value, critical)
-    return ParameterThreshold(
-        **base,
-        critical_values=critical,
-        nearest=nearest,
-        margin=margin,
-        relative_margin=rel,
-        no_chaos=no_chaos,
+    return _threshold(
+        value,
+        critical,
+        no_chaos,
+        scan=scan,
         note="critical Omega_e found by scanning with every excitation frequency scaled "
         "alongside (ratios fixed, as a change of running speed); flips between scan points "
         "closer than the grid step may be missed",
