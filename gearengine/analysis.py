@@ -11,7 +11,6 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from gearengine.forcing import step_plan
 from gearengine.melnikov_analysis import melnikov
 from gearengine.melnikov_result import MelnikovResult
 from gearengine.params import GearParams, request_config
@@ -59,13 +58,6 @@ class AnalysisResult(BaseModel):
     numerics: NumericsResult
     settings: SimulationSettings
     verdict: Verdict
-
-
-def work(params: GearParams, settings: SimulationSettings) -> int:
-    """RK4 steps the analysis takes: (transient + record) periods x steps per T0 x starts."""
-    plan = step_plan(params, settings.steps_per_period)
-    periods = settings.transient_periods + settings.record_periods
-    return periods * plan.steps * len(settings.starts())
 
 
 def verdict(mel: MelnikovResult, num: NumericsResult) -> Verdict:

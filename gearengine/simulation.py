@@ -258,8 +258,18 @@ def _packed(params: GearParams) -> tuple[np.ndarray, float, np.ndarray]:
     return kc, co.mean_force, fc
 
 
+def run_steps(settings: SimulationSettings, steps: int) -> int:
+    """RK4 steps of a run: (transient + record) periods x ``steps`` per T0 x starts."""
+    return (settings.transient_periods + settings.record_periods) * steps * len(settings.starts())
+
+
+def work(params: GearParams, settings: SimulationSettings) -> int:
+    """RK4 steps ``simulate(params, settings)`` takes (for compute budgets)."""
+    return run_steps(settings, step_plan(params, settings.steps_per_period).steps)
+
+
 def _check_work(settings: SimulationSettings, steps: int) -> None:
-    work = (settings.transient_periods + settings.record_periods) * steps * len(settings.starts())
+    work = run_steps(settings, steps)
     if work > MAX_TOTAL_STEPS:
         raise ValueError(
             f"steps_per_period: the excitation frequencies need {steps} RK4 steps per T0, "

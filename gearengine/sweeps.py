@@ -26,11 +26,10 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
-from gearengine.analysis import work
 from gearengine.melnikov import cubic_coefficients
 from gearengine.params import Alias, GearParams, request_config, with_aliases
 from gearengine.requests import PAPER_SECTION_41
-from gearengine.simulation import BatchPoint, SimulationSettings, simulate_batch
+from gearengine.simulation import BatchPoint, SimulationSettings, simulate_batch, work
 from gearengine.thresholds import sign_change_strength
 
 MAX_AXIS_POINTS = 100_000

@@ -11,12 +11,11 @@ from typing import Any
 import pytest
 from pydantic import ValidationError
 
-from gearengine.analysis import work
 from gearengine.cli import main
 from gearengine.jsonio import error_lines
 from gearengine.melnikov_analysis import melnikov
 from gearengine.params import with_aliases
-from gearengine.simulation import SimulationSettings, simulate_batch
+from gearengine.simulation import SimulationSettings, simulate_batch, work
 from gearengine.sweep_plots import melnikov_crossings, render
 from gearengine.sweeps import (
     SweepPlan,

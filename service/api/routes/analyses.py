@@ -6,10 +6,11 @@ from typing import Literal
 
 from fastapi import APIRouter, Depends, Query, Request, Response
 
-from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze, work
+from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.jsonio import dumps
 from gearengine.plots import MEDIA_TYPES, ImageFormat, analysis_figure, threshold_figure
 from gearengine.requests import ThresholdsRequest
+from gearengine.simulation import work
 from service.api.deps import cached_compute, require_key
 from service.api.responses import JSON, PNG, PROBLEMS, SVG
 from service.api.routes.melnikov import curve_of
