@@ -22,10 +22,10 @@ import numpy as np
 from report import write_section  # benchmarks/report.py (the script's own folder)
 from scipy.integrate import solve_ivp
 
-from gearengine.params import GearParams
-from gearengine.simulation import (
+from gearengine.model.params import GearParams
+from gearengine.numerics.runs import integrate
+from gearengine.numerics.simulation import (
     SimulationSettings,
-    _integrate,
     simulate,
     simulate_batch,
     warm_up,
@@ -113,7 +113,7 @@ def main() -> None:
     warm_up()
     numba.set_num_threads(1)
     p = paper(0.25)
-    kernel = best_of(lambda: _integrate(p, SETTINGS, (0.01, 0.01))) * 1e9 / STEPS
+    kernel = best_of(lambda: integrate(p, SETTINGS, (0.01, 0.01))) * 1e9 / STEPS
     single = best_of(lambda: simulate(p, SETTINGS)) * 1e9 / STEPS
     points = [paper(fe) for fe in SWEEP]
     batch_1 = best_of(lambda: simulate_batch(points, SETTINGS), 3) * 1e9 / (STEPS * len(points))

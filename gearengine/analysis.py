@@ -3,6 +3,8 @@
 The Melnikov criterion is first order in the perturbation and only *necessary* for chaos
 (a transverse homoclinic tangle may give transient chaos and a periodic attractor). The two
 verdicts are consistent unless the numerics find chaos where Melnikov rules it out.
+
+This module joins the melnikov and numerics rooms; it imports nothing else of the engine.
 """
 
 from __future__ import annotations
@@ -11,11 +13,13 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from gearengine.melnikov_analysis import melnikov
-from gearengine.melnikov_result import MelnikovResult
-from gearengine.params import GearParams, request_config
-from gearengine.requests import PAPER_SECTION_41
-from gearengine.simulation import NumericsResult, SimulationSettings, simulate
+from gearengine.homoclinic.schemas import MelnikovResult
+from gearengine.homoclinic.verdict import melnikov
+from gearengine.model.examples import PAPER_SECTION_41
+from gearengine.model.params import GearParams, request_config
+from gearengine.numerics.results import NumericsResult
+from gearengine.numerics.settings import SimulationSettings
+from gearengine.numerics.simulation import simulate
 
 Agreement = Literal["both_chaotic", "both_regular", "melnikov_only", "numerics_only", "undecided"]
 

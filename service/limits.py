@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from gearengine.requests import ThresholdsRequest
+from gearengine.homoclinic.schemas import ThresholdsRequest
 from gearengine.sweeps import SweepRequest, sweep_work
 from service.core.config import Settings
 from service.errors import FieldError, ProblemError

@@ -13,7 +13,7 @@ from starlette.concurrency import run_in_threadpool
 
 from service import errors
 from service.api.deps import load_key_hashes
-from service.api.routes import analyses, health, melnikov, sweeps
+from service.api.routes import analyses, conversions, health, melnikov, sweeps, thresholds
 from service.cache import ResponseCache
 from service.core.config import Settings
 from service.jobs.runtime import SweepJobs
@@ -71,6 +71,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     errors.install(app)
     app.include_router(health.router, tags=["health"])
     app.include_router(melnikov.router, tags=["melnikov"])
+    app.include_router(conversions.router, tags=["melnikov"])
+    app.include_router(thresholds.router, tags=["melnikov"])
     app.include_router(analyses.router, tags=["analyses"])
     app.include_router(sweeps.router, tags=["sweeps"])
     app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
@@ -81,9 +83,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
 def _warm_up() -> None:
     """Compile or load every numba kernel once, so the first request is fast."""
-    from gearengine.melnikov_analysis import melnikov
-    from gearengine.params import GearParams
-    from gearengine.simulation import warm_up
+    from gearengine.homoclinic import melnikov
+    from gearengine.model.params import GearParams
+    from gearengine.numerics import warm_up
 
     warm_up()
     melnikov(GearParams(damping=0.1))

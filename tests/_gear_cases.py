@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from gearengine.forcing import coefficients, law, step_plan
-from gearengine.params import GearParams
-from gearengine.periodicity import attractor_size, detect_period
+from gearengine.model.params import GearParams
+from gearengine.numerics.forcing import forcing_coefficients, law, step_plan
+from gearengine.numerics.periodicity import attractor_size, detect_period
 
 GEAR_REF_SOURCE = Path("/work/shared/reference/gear_ref.c")
 
@@ -38,7 +38,7 @@ def scipy_run(
 
     Returns (period, LLE per unit time, final state).
     """
-    co = coefficients(params)
+    co = forcing_coefficients(params)
     lw = law(params)
     twomu = 2.0 * params.damping
 

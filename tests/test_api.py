@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 from fastapi.testclient import TestClient
 
+from gearengine.homoclinic.verdict import melnikov
 from gearengine.jsonio import dumps
-from gearengine.melnikov_analysis import melnikov
-from gearengine.params import GearParams
+from gearengine.model.params import GearParams
 from service.core.config import Settings
 from service.main import create_app
 from service.openapi import document

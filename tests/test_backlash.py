@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gearengine.backlash import (
+from gearengine.model.backlash import (
     collocation_fit,
     cubic_fit,
     fh_cubic,
@@ -15,7 +15,7 @@ from gearengine.backlash import (
     paper_cubic,
     rms_residual,
 )
-from gearengine.params import PAPER_A, CubicBacklash
+from gearengine.model.params import PAPER_A, CubicBacklash
 
 
 def test_piecewise_branches() -> None:

@@ -7,9 +7,9 @@ import subprocess
 import sys
 from pathlib import Path
 
+from gearengine.homoclinic.schemas import MelnikovRequest
+from gearengine.homoclinic.verdict import melnikov
 from gearengine.jsonio import dumps
-from gearengine.melnikov_analysis import melnikov
-from gearengine.requests import MelnikovRequest
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "paper-4.1.json"
 

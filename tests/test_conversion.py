@@ -10,14 +10,14 @@ import pytest
 from pydantic import ValidationError
 from scipy.integrate import solve_ivp
 
-from gearengine.conversion import (
+from gearengine.model.conversion import (
     Conversion,
     PhysicalGearData,
     equivalent_mass,
     mean_force,
     to_dimensionless,
 )
-from gearengine.params import (
+from gearengine.model.params import (
     MAX_HARMONICS,
     Backlash,
     CubicBacklash,

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import re
 
-from gearengine.cli import build_parser
+from gearengine.cli.main import build_parser
 from tests.conftest import ROOT
 
 DOCKERFILE = (ROOT / "Dockerfile").read_text()

@@ -22,15 +22,17 @@ def test_every_endpoint_answers(server: Server) -> None:
         assert c.get("/docs").status_code == 200 and c.get("/openapi.json").status_code == 200
 
 
-def test_melnikov_is_fast_server_side(server: Server) -> None:
-    """Server-side compute of one Melnikov verdict stays under 5 ms (Server-Timing header)."""
+def test_server_timing_header_reports_compute(server: Server) -> None:
+    """Every fresh computation says how long it took (Server-Timing); cache hits do not.
+
+    The time itself is measured in benchmarks/, never asserted here."""
     with httpx.Client(base_url=server.url, timeout=60) as c:
-        timings = []
-        for k in range(20):
-            params = {**PAPER_PARAMS, "damping": 0.05 + 0.001 * k}  # fresh: no cache hit
-            r = c.post("/v1/melnikov", json={"params": params})
-            timings.append(float(r.headers["server-timing"].split("dur=")[1]))
-        assert sorted(timings)[len(timings) // 2] < 5.0, timings
+        params = {**PAPER_PARAMS, "damping": 0.0513}
+        fresh = c.post("/v1/melnikov", json={"params": params})
+        again = c.post("/v1/melnikov", json={"params": params})
+    assert fresh.headers["x-cache"] == "miss"
+    assert float(fresh.headers["server-timing"].split("dur=")[1]) > 0.0
+    assert again.headers["x-cache"] == "hit" and "server-timing" not in again.headers
 
 
 @pytest.mark.parametrize(

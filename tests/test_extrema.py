@@ -9,10 +9,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gearengine.extrema import Interval, TrigSum, extrema, sublevel_interval
-from gearengine.melnikov import coefficients
-from gearengine.melnikov_analysis import melnikov
-from gearengine.params import GearParams, with_alias
+from gearengine.homoclinic.coefficients import melnikov_coefficients
+from gearengine.homoclinic.extrema import Interval, TrigSum, extrema, sublevel_interval
+from gearengine.homoclinic.verdict import melnikov
+from gearengine.model.aliases import with_alias
+from gearengine.model.params import GearParams
 
 amp = st.floats(-1.0, 1.0, allow_nan=False)
 phase = st.floats(0.0, 2 * math.pi)
@@ -106,7 +107,7 @@ def test_melnikov_is_affine_in_amplitudes_and_damping(p: GearParams, s: float, b
             else with_alias(p, name, 0.1 + 0.1 * s)
         )
         k = abs(s) if name == "mu" else s
-        m0, m1, ms = (coefficients(q, 0.1667, 0.1667, br)(tau) for q in (base, step, far))
+        m0, m1, ms = (melnikov_coefficients(q, 0.1667, 0.1667, br)(tau) for q in (base, step, far))
         np.testing.assert_allclose(ms, m0 + k * (m1 - m0), atol=1e-12)
 
 

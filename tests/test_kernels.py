@@ -8,11 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gearengine import kernels
-from gearengine.forcing import CUBIC, step_plan
-from gearengine.params import GearParams
-from gearengine.simulation import SimulationSettings, _packed, simulate, simulate_batch
+from gearengine.model.backlash import LAWS
+from gearengine.model.params import GearParams
+from gearengine.numerics import kernels
+from gearengine.numerics.forcing import packed_forcing, step_plan
+from gearengine.numerics.simulation import SimulationSettings, simulate, simulate_batch
 from tests._gear_cases import gear_ref_binary, gear_ref_summary, paper
+
+CUBIC = LAWS["cubic"].kernel_code
 
 MULTI = GearParams.model_validate(
     {
@@ -33,7 +36,7 @@ MULTI = GearParams.model_validate(
 
 
 def _run(params: GearParams, N: int, n_trans: int, n_rec: int, table: bool = True) -> tuple:
-    kc, fm, fc = _packed(params)
+    kc, fm, fc = packed_forcing(params)
     T = step_plan(params, 200).period
     return kernels.run_rk4(
         CUBIC, 0.1667, 0.1667, 0.0, params.damping, 0.01, 0.01, kc, fm, fc, table, T, N,
@@ -45,7 +48,7 @@ def test_forcing_table_is_eq9_at_stage_times() -> None:
     plan = step_plan(MULTI, 50)
     assert plan.omega0 == pytest.approx(0.25)
     assert plan.steps == 200  # 50 per period of the fastest excitation (Omega_k = 1), 4 per T0
-    Kt, Ft = kernels.forcing_table(plan.period, plan.steps, *_packed(MULTI))
+    Kt, Ft = kernels.forcing_table(plan.period, plan.steps, *packed_forcing(MULTI))
     t = np.arange(2 * plan.steps + 1) * plan.h / 2
     K = 1.0 + 2 * 0.05 * np.cos(t + 0.3)
     F = (

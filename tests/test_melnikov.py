@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 from scipy import integrate
 
-from gearengine import melnikov as mk
-from gearengine.melnikov_analysis import melnikov
-from gearengine.params import GearParams, with_alias, with_aliases
+from gearengine.homoclinic import coefficients as mk
+from gearengine.homoclinic.verdict import melnikov
+from gearengine.model.aliases import with_alias, with_aliases
+from gearengine.model.params import GearParams
 
 OMEGAS = np.linspace(0.05, 3.0, 14)
 SHAPES = [(0.1667, 0.1667), (1.0, 0.5), (0.3, 2.0), (2.0, 0.2)]
@@ -33,7 +34,7 @@ def te_only(fe: float, omega: float, mu: float) -> GearParams:
 def test_closed_form_matches_quadrature(a: float, c: float, kind: str, branch: str) -> None:
     """Every term of the corrected Eq. (19) equals quadrature of Eq. (18) to 1e-8 relative."""
     for omega in OMEGAS:
-        closed = mk._CLOSED_FORM[kind](omega, a, c, branch)
+        closed = mk.closed_form_coefficient(kind, omega, a, c, branch)
         quad = mk.quadrature_coefficient(kind, omega, a, c, branch)
         # the stiffness term vanishes at Omega^2 = 2a: compare against its scale there
         scale = abs(closed) if kind != "stiffness" else max(abs(closed), 1e-3 * omega**2 / c)
@@ -93,7 +94,7 @@ RICH = GearParams.model_validate(
 @pytest.mark.parametrize(("a", "c"), [(0.1667, 0.1667), (0.5, 1.5)])
 def test_full_melnikov_function_matches_eq18(branch: str, a: float, c: float) -> None:
     """All terms, several harmonics and phases, and the mean force (which integrates to 0)."""
-    coef = mk.coefficients(RICH, a, c, branch)
+    coef = mk.melnikov_coefficients(RICH, a, c, branch)
     for tau0 in (0.0, 0.9, 2.5, 7.1):
         assert coef(tau0) == pytest.approx(eq18(RICH, a, c, branch, tau0), rel=1e-8, abs=1e-12)
 
@@ -240,7 +241,7 @@ def test_piecewise_law_uses_the_paper_cubic_fit() -> None:
 
 def test_commensurate_extrema_are_attained_and_exact() -> None:
     r = melnikov(RICH)
-    coef = mk.coefficients(RICH, 0.1667, 0.1667, "plus")
+    coef = mk.melnikov_coefficients(RICH, 0.1667, 0.1667, "plus")
     taus = np.linspace(0.0, r.forcing_period, 400_001)
     values = coef(taus)
     b = r.branches["plus"]

@@ -7,8 +7,9 @@ import math
 import pytest
 from pydantic import ValidationError
 
-from gearengine.frequencies import common_frequency, forcing_period
-from gearengine.params import ALIASES, GearParams, get_alias, with_alias, with_aliases
+from gearengine.model.aliases import ALIASES, get_alias, with_alias, with_aliases
+from gearengine.model.frequencies import common_frequency, forcing_period
+from gearengine.model.params import GearParams
 
 PAPER = {
     "damping": 0.07,

@@ -7,15 +7,18 @@ import math
 import numpy as np
 import pytest
 
-from gearengine import kernels
-from gearengine.forcing import PIECEWISE, step_plan
-from gearengine.params import GearParams
-from gearengine.simulation import SimulationSettings, _packed, simulate
+from gearengine.model.backlash import LAWS
+from gearengine.model.params import GearParams
+from gearengine.numerics import kernels
+from gearengine.numerics.forcing import packed_forcing, step_plan
+from gearengine.numerics.simulation import SimulationSettings, simulate
 from tests._gear_cases import gear_ref_binary, gear_ref_summary, paper, scipy_run
+
+PIECEWISE = LAWS["piecewise"].kernel_code
 
 
 def _kink(params: GearParams, N: int, n_trans: int, n_rec: int, x0: float = 0.01) -> tuple:
-    kc, fm, fc = _packed(params)
+    kc, fm, fc = packed_forcing(params)
     T = step_plan(params, 200).period
     alpha = params.backlash.alpha
     return kernels.run_kink(
@@ -24,7 +27,7 @@ def _kink(params: GearParams, N: int, n_trans: int, n_rec: int, x0: float = 0.01
 
 
 def _plain(params: GearParams, N: int, n_trans: int, n_rec: int, x0: float = 0.01) -> tuple:
-    kc, fm, fc = _packed(params)
+    kc, fm, fc = packed_forcing(params)
     T = step_plan(params, 200).period
     alpha = params.backlash.alpha
     return kernels.run_rk4(

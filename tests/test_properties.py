@@ -9,11 +9,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from gearengine.analysis import AnalysisRequest, analyze
-from gearengine.classify import severity
+from gearengine.homoclinic.verdict import melnikov
 from gearengine.jsonio import dumps
-from gearengine.melnikov_analysis import melnikov
-from gearengine.params import GearParams
-from gearengine.simulation import SimulationSettings
+from gearengine.model.params import GearParams
+from gearengine.numerics.classify import severity
+from gearengine.numerics.simulation import SimulationSettings
 
 
 def strict_json(text: str) -> object:

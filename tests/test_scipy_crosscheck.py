@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import pytest
 
-from gearengine.params import GearParams
-from gearengine.simulation import SimulationSettings, simulate
+from gearengine.model.params import GearParams
+from gearengine.numerics.simulation import SimulationSettings, simulate
 from tests._gear_cases import paper, scipy_run
 
 SETTINGS = SimulationSettings(transient_periods=300, record_periods=200)

@@ -9,8 +9,8 @@ import math
 import pytest
 from pydantic import ValidationError
 
-from gearengine.params import GearParams
-from gearengine.simulation import (
+from gearengine.model.params import GearParams
+from gearengine.numerics.simulation import (
     NumericsResult,
     SimulationSettings,
     lyapunov,

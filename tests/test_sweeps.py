@@ -12,18 +12,19 @@ import pytest
 from pydantic import ValidationError
 
 from gearengine.cli import main
+from gearengine.homoclinic.thresholds import chaos_possible, verdict_flips
+from gearengine.homoclinic.verdict import melnikov
 from gearengine.jsonio import error_lines
-from gearengine.melnikov_analysis import melnikov
-from gearengine.params import with_aliases
-from gearengine.simulation import SimulationSettings, simulate_batch, work
-from gearengine.sweep_plots import melnikov_crossings, render
+from gearengine.model.aliases import with_aliases
+from gearengine.numerics.settings import work
+from gearengine.numerics.simulation import SimulationSettings, simulate_batch
+from gearengine.plots.sweep import sweep_figure
 from gearengine.sweeps import (
     SweepPlan,
     SweepResult,
-    agreement,
+    agreement_table,
     compute_chunk,
     compute_chunk_json,
-    melnikov_chaos_possible,
     run_local,
     sweep_work,
     to_csv,
@@ -128,7 +129,7 @@ def test_backward_branch_runs_from_stop_to_start() -> None:
 def test_melnikov_flag_equals_the_full_verdict() -> None:
     for fe in (0.0, 0.1, 0.19, 0.2, 0.3):
         params = with_aliases(validated(sweep(("F_e1", 0, 1, 2))).params, {"F_e1": fe})
-        assert melnikov_chaos_possible(params) == melnikov(params).chaos_possible
+        assert chaos_possible(params) == melnikov(params).chaos_possible
 
 
 def test_paper_fig6_period_doubling() -> None:
@@ -148,7 +149,7 @@ def test_csv_has_a_row_per_point_and_axis_columns() -> None:
     assert len(rows) == 6 and float(rows[4]["Omega_e"]) == 0.6 and float(rows[4]["F_e1"]) == 0.15
     assert rows[0]["melnikov_chaos_possible"] in ("true", "false")
     assert [float(x) for x in rows[1]["poincare_x"].split()] == result.points[1].poincare_x
-    counts = agreement(result.points)
+    counts = agreement_table(result.points)
     assert sum(counts.model_dump().values()) == 6
 
 
@@ -162,7 +163,7 @@ def test_progress_reaches_the_total() -> None:
 def test_melnikov_threshold_of_fig6() -> None:
     """The F_e1 threshold at Omega_e = 0.5, mu = 0.07 is 0.19588 (README)."""
     req = validated(sweep(("F_e1", 0.0, 0.3, 2)))
-    (v,) = melnikov_crossings(req.params, "F_e1", 0.0, 0.3)
+    (v,) = verdict_flips(req.params, "F_e1", 0.0, 0.3)
     assert v == pytest.approx(0.19588, abs=1e-4)
 
 
@@ -171,8 +172,8 @@ def test_figures_render_as_png_and_svg() -> None:
     two = validated(sweep(("F_e1", 0.0, 0.3, 4), ("Omega_e", 0.4, 0.8, 3)))
     for req in (one, two):
         points = run_local(req).points
-        assert render(req, points, "png").startswith(b"\x89PNG")
-        assert b"<svg" in render(req, points, "svg")[:500]
+        assert sweep_figure(req, points, "png").startswith(b"\x89PNG")
+        assert b"<svg" in sweep_figure(req, points, "svg")[:500]
 
 
 def test_cli_sweep_writes_json_csv_png_with_a_progress_bar(

@@ -1,4 +1,6 @@
-"""Shared dependencies: settings, API-key auth, cached computation."""
+"""Shared dependencies of the routes: settings, the job queue, API-key auth (``Owner``) and
+cached computation. The typed aliases (``Owner``, ``AppSettings``, ``Jobs``) are what routes
+declare."""
 
 from __future__ import annotations
 
@@ -8,14 +10,16 @@ import re
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Annotated
 
-from fastapi import Request, Response
+from fastapi import Depends, Request, Response
 from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
 from service.cache import ResponseCache, etag_for
 from service.core.config import Settings
 from service.errors import FieldError, ProblemError
+from service.jobs.runtime import SweepJobs
 
 KEYS_FILE = "api_keys.sha256"
 """File in the data directory: one sha256 hex digest of an API key per line (# comments)."""
@@ -76,6 +80,24 @@ def require_key(request: Request) -> str | None:
         else "the API key is not valid",
         headers={"WWW-Authenticate": "Bearer"},
     )
+
+
+Owner = Annotated[str | None, Depends(require_key)]
+"""The caller's key id (None with auth off); 401 problem+json without a valid key."""
+
+
+def app_settings(request: Request) -> Settings:
+    """The settings the app was built with."""
+    return request.app.state.settings
+
+
+def sweep_jobs(request: Request) -> SweepJobs:
+    """The app's job store and dispatcher."""
+    return request.app.state.sweep_jobs
+
+
+AppSettings = Annotated[Settings, Depends(app_settings)]
+Jobs = Annotated[SweepJobs, Depends(sweep_jobs)]
 
 
 async def cached_compute(

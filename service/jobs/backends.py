@@ -39,7 +39,7 @@ def _init_worker(threads: int) -> None:
     """Pool worker start-up: share the cores fairly and load the kernels once."""
     import numba
 
-    from gearengine.simulation import warm_up
+    from gearengine.numerics.simulation import warm_up
 
     numba.set_num_threads(threads)
     warm_up()

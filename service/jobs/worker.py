@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import argparse
 import logging
 import signal
 from pathlib import Path
@@ -14,10 +13,8 @@ from service.jobs.dispatcher import Dispatcher
 from service.jobs.store import JobStore
 
 
-def cmd_worker(args: argparse.Namespace) -> int:
+def run_worker(settings: Settings) -> int:
     """Run a dispatcher on the data directory's store until SIGTERM or SIGINT (graceful)."""
-    flags = {"data_dir": args.data_dir, "workers": args.workers, "dask_scheduler": args.dask}
-    settings = Settings(**{k: v for k, v in flags.items() if v is not None})
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(message)s")
     backend = make_backend(max(1, settings.workers), settings.dask_scheduler)
     assert backend is not None

@@ -10,22 +10,21 @@ import json
 from collections.abc import Iterator
 from typing import Annotated, Literal
 
-from fastapi import APIRouter, Depends, Query, Request, Response
+from fastapi import APIRouter, Query, Request, Response
 from fastapi.responses import StreamingResponse
-from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
-from gearengine.sweep_plots import render
+from gearengine.plots import sweep_figure
 from gearengine.sweeps import (
     SweepPlan,
     SweepPoint,
     SweepRequest,
     SweepResult,
+    checked,
     csv_rows,
-    request_errors,
     result_json,
 )
-from service.api.deps import require_key
+from service.api.deps import AppSettings, Jobs, Owner
 from service.api.responses import JSON, PNG, PROBLEMS, SVG
 from service.errors import ProblemError
 from service.jobs.models import UNFINISHED, Job, JobPage, JobStatus
@@ -34,7 +33,6 @@ from service.jobs.store import QueueFullError
 
 router = APIRouter(prefix="/v1/sweeps")
 
-Owner = Annotated[str | None, Depends(require_key)]
 CSV = "text/csv"
 RETRY_AFTER = {"queued": "5", "running": "2"}
 """Seconds a client should wait before polling an unfinished job again."""
@@ -44,12 +42,8 @@ _NOT_FOUND = {404: {"description": "No such job for this API key."}}
 _CONFLICT = {409: {"description": "The job has not succeeded (yet)."}}
 
 
-def _jobs(request: Request) -> SweepJobs:
-    return request.app.state.sweep_jobs
-
-
-def _job_or_404(request: Request, job_id: str, owner: str | None) -> Job:
-    job = _jobs(request).store.get(job_id, owner)
+def _job_or_404(jobs: SweepJobs, job_id: str, owner: str | None) -> Job:
+    job = jobs.store.get(job_id, owner)
     if job is None:
         raise ProblemError(404, "not-found", "Not found", f"no sweep job {job_id}")
     return job
@@ -59,8 +53,8 @@ def _poll_headers(job: Job) -> dict[str, str]:
     return {"Retry-After": RETRY_AFTER[job.status]} if job.status in UNFINISHED else {}
 
 
-def _succeeded(request: Request, job_id: str, owner: str | None) -> Job:
-    job = _job_or_404(request, job_id, owner)
+def _succeeded(jobs: SweepJobs, job_id: str, owner: str | None) -> Job:
+    job = _job_or_404(jobs, job_id, owner)
     if job.status != "succeeded":
         raise ProblemError(
             409,
@@ -79,17 +73,21 @@ def _succeeded(request: Request, job_id: str, owner: str | None) -> Job:
     responses={**PROBLEMS, 429: {"description": "Too many unfinished jobs; see Retry-After."}},
     summary="Submit a bifurcation sweep (one axis) or a chaos map (two axes)",
 )
-def post_sweep(body: SweepRequest, request: Request, response: Response, owner: Owner) -> Job:
+def post_sweep(
+    body: SweepRequest,
+    request: Request,
+    response: Response,
+    owner: Owner,
+    settings: AppSettings,
+    jobs: Jobs,
+) -> Job:
     """Validate and store the sweep; it runs on the workers. Answers 202 with the job and its
     ``Location``; poll it (``Retry-After``) and fetch ``/result`` or ``/plot`` once succeeded."""
-    settings = request.app.state.settings
-    errors = request_errors(body, settings.max_sweep_points)
-    if errors:
-        raise ValidationError.from_exception_data("SweepRequest", errors)
+    checked(body, settings.max_sweep_points)
     request.app.state.limits.check_sweep(body)
     plan = SweepPlan(body, settings.sweep_chunk_points)
     try:
-        job = _jobs(request).store.submit(
+        job = jobs.store.submit(
             owner, body.model_dump_json(), plan.point_counts(), plan.chunk_points,
             settings.max_queued_jobs,
         )  # fmt: skip
@@ -101,7 +99,7 @@ def post_sweep(body: SweepRequest, request: Request, response: Response, owner: 
             f"{exc} (max_queued_jobs); retry later",
             headers={"Retry-After": QUEUE_FULL_RETRY},
         ) from None
-    _jobs(request).wake()
+    jobs.wake()
     response.headers["Location"] = f"/v1/sweeps/{job.id}"
     response.headers.update(_poll_headers(job))
     return job
@@ -109,14 +107,14 @@ def post_sweep(body: SweepRequest, request: Request, response: Response, owner: 
 
 @router.get("", response_model=JobPage, responses=PROBLEMS, summary="The caller's sweep jobs")
 def list_sweeps(
-    request: Request,
     owner: Owner,
+    jobs: Jobs,
     status: Annotated[JobStatus | None, Query(description="Only jobs in this status.")] = None,
     limit: Annotated[int, Query(ge=1, le=100, description="Jobs per page.")] = 20,
     offset: Annotated[int, Query(ge=0, le=2**31, description="Jobs to skip (newest first).")] = 0,
 ) -> JobPage:
     """Newest first, paginated with ``limit`` and ``offset``."""
-    items, total = _jobs(request).store.list(owner, status, limit, offset)
+    items, total = jobs.store.list(owner, status, limit, offset)
     more = offset + len(items) < total
     return JobPage(items=items, total=total, next_offset=offset + len(items) if more else None)
 
@@ -127,9 +125,9 @@ def list_sweeps(
     responses={**PROBLEMS, **_NOT_FOUND},
     summary="Status and progress of a sweep job",
 )
-def get_sweep(job_id: str, request: Request, response: Response, owner: Owner) -> Job:
+def get_sweep(job_id: str, response: Response, owner: Owner, jobs: Jobs) -> Job:
     """``Retry-After`` is set while the job is queued or running."""
-    job = _job_or_404(request, job_id, owner)
+    job = _job_or_404(jobs, job_id, owner)
     response.headers.update(_poll_headers(job))
     return job
 
@@ -140,20 +138,20 @@ def get_sweep(job_id: str, request: Request, response: Response, owner: Owner) -
     responses={**PROBLEMS, **_NOT_FOUND, 409: {"description": "The job already finished."}},
     summary="Cancel a sweep job",
 )
-def cancel_sweep(job_id: str, request: Request, owner: Owner) -> Job:
+def cancel_sweep(job_id: str, owner: Owner, jobs: Jobs) -> Job:
     """No new chunk of the job starts; running chunks are dropped. Cancelling a cancelled job
     is a no-op; a succeeded or failed job cannot be cancelled (409)."""
-    _job_or_404(request, job_id, owner)
-    job = _jobs(request).store.cancel(job_id, owner)
+    _job_or_404(jobs, job_id, owner)
+    job = jobs.store.cancel(job_id, owner)
     assert job is not None
     if job.status not in ("cancelled", *UNFINISHED):
         raise ProblemError(409, "finished", "Already finished", f"sweep {job_id} {job.status}")
-    _jobs(request).wake()
+    jobs.wake()
     return job
 
 
-def _points(request: Request, job_id: str) -> Iterator[SweepPoint]:
-    for array in _jobs(request).store.chunk_results(job_id):
+def _points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
+    for array in jobs.store.chunk_results(job_id):
         for item in json.loads(array):
             yield SweepPoint.model_validate(item)
 
@@ -171,25 +169,23 @@ def _points(request: Request, job_id: str) -> Iterator[SweepPoint]:
 )
 def get_result(
     job_id: str,
-    request: Request,
     owner: Owner,
+    jobs: Jobs,
     format: Annotated[
         Literal["json", "csv"], Query(description="json or csv (streamed).")
     ] = "json",
 ) -> Response:
     """Every point with its axis values, classification, period, LLE, contact regime, Melnikov
     verdict and the x of its last stroboscopic (Poincare) points."""
-    _succeeded(request, job_id, owner)
-    axes = SweepRequest.model_validate_json(_jobs(request).store.request_json(job_id)).axes
+    _succeeded(jobs, job_id, owner)
+    axes = SweepRequest.model_validate_json(jobs.store.request_json(job_id)).axes
     if format == "csv":
         return StreamingResponse(
-            csv_rows(axes, _points(request, job_id)),
+            csv_rows(axes, _points(jobs, job_id)),
             media_type=CSV,
             headers={"Content-Disposition": f'attachment; filename="sweep-{job_id}.csv"'},
         )
-    return StreamingResponse(
-        result_json(axes, _jobs(request).store.chunk_results(job_id)), media_type=JSON
-    )
+    return StreamingResponse(result_json(axes, jobs.store.chunk_results(job_id)), media_type=JSON)
 
 
 def _plot_format(fmt: str | None, accept: str) -> Literal["png", "svg"]:
@@ -220,6 +216,7 @@ async def get_plot(
     job_id: str,
     request: Request,
     owner: Owner,
+    jobs: Jobs,
     format: Annotated[
         Literal["png", "svg"] | None, Query(description="png or svg; else the Accept header.")
     ] = None,
@@ -228,12 +225,11 @@ async def get_plot(
     marked. Two axes: the map coloured by LLE, the Melnikov boundary overlaid and a table of
     agreement between the numerical and the Melnikov verdicts."""
     fmt = _plot_format(format, request.headers.get("accept", ""))
-    await run_in_threadpool(_succeeded, request, job_id, owner)
+    await run_in_threadpool(_succeeded, jobs, job_id, owner)
 
     def draw() -> bytes:
-        store = _jobs(request).store
-        sweep = SweepRequest.model_validate_json(store.request_json(job_id))
-        return render(sweep, list(_points(request, job_id)), fmt)
+        sweep = SweepRequest.model_validate_json(jobs.store.request_json(job_id))
+        return sweep_figure(sweep, list(_points(jobs, job_id)), fmt)
 
     body = await run_in_threadpool(draw)
     return Response(body, media_type=PNG if fmt == "png" else SVG)

@@ -1,0 +1,6 @@
+"""The cli room: the engine's commands (melnikov, analyze, check, sweep) on top of every other
+room; ``main`` is the ``gearengine`` console script. Imports no web code."""
+
+from gearengine.cli.main import main
+
+__all__ = ["main"]

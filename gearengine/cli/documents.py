@@ -1,0 +1,55 @@
+"""What every engine command shares: reading a request document and refusing bad input.
+
+Exit codes: 0 success (check: pass), 1 check failed, 2 invalid input (one line per problem on
+standard error, naming the field).
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import TypeVar
+
+from pydantic import BaseModel, ValidationError
+
+from gearengine.jsonio import error_lines, load_document
+
+EXIT_OK, EXIT_FAIL, EXIT_INVALID = 0, 1, 2
+
+R = TypeVar("R", bound=BaseModel)
+
+
+class InvalidInputError(Exception):
+    """Input that cannot be used; carries one message line per problem."""
+
+    def __init__(self, lines: list[str]) -> None:
+        super().__init__("\n".join(lines))
+        self.lines = lines
+
+
+def read_document(path: str) -> object:
+    """The parsed JSON of a file or ``-`` (stdin); raises InvalidInputError."""
+    try:
+        text = sys.stdin.read() if path == "-" else Path(path).read_text()
+    except OSError as exc:
+        raise InvalidInputError([f"{path}: {exc.strerror}"]) from None
+    try:
+        return load_document(text)
+    except ValueError as exc:
+        raise InvalidInputError([f"{path}: {exc}"]) from None
+
+
+def validated_input(validate: Callable[[object], R], data: object, path: str) -> R:
+    """``validate(data)``, its ValueErrors (pydantic's included) as InvalidInputError lines."""
+    try:
+        return validate(data)
+    except ValidationError as exc:
+        raise InvalidInputError(error_lines(exc)) from None
+    except ValueError as exc:
+        raise InvalidInputError([f"{path}: {exc}"]) from None
+
+
+def read_request(path: str, model: type[R]) -> R:
+    """Read and validate a request document from a file or ``-`` (stdin)."""
+    return validated_input(model.model_validate, read_document(path), path)

@@ -1,0 +1,21 @@
+"""The homoclinic room, the Melnikov analysis: can the stable and unstable manifolds of the
+saddle intersect transversally?
+
+Data flow: ``coefficients`` (the sinusoids of M(tau0), Eq. 19, closed form or quadrature) ->
+``extrema`` (min and max of M over tau0) -> ``thresholds`` (critical values of each control
+parameter and the design's margin) -> ``verdict`` (``melnikov``: the whole answer), with the
+request and result documents in ``schemas``. Imports only the model room.
+"""
+
+from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult, ThresholdCurve
+from gearengine.homoclinic.thresholds import chaos_possible, threshold_curve
+from gearengine.homoclinic.verdict import melnikov
+
+__all__ = [
+    "MelnikovRequest",
+    "MelnikovResult",
+    "ThresholdCurve",
+    "chaos_possible",
+    "melnikov",
+    "threshold_curve",
+]

@@ -1,0 +1,290 @@
+"""Melnikov function of the gear model about its two homoclinic orbits (paper section 3).
+
+Unperturbed system (Eq. 11): x' = y, y' = a x - c x^3, with a > 0, c > 0. The saddle (0, 0) is
+joined to itself by two homoclinic orbits (Eq. 15), branch s = +1 (``plus``, x_h > 0) and
+s = -1 (``minus``):
+
+    x_h(t) = s sqrt(2a/c) sech(sqrt(a) t),   y_h(t) = -s sqrt(2/c) a sech(sqrt(a) t) tanh(sqrt(a) t)
+
+The Melnikov function (Eq. 17-18) is evaluated with the parameters as given (epsilon = 1, so M
+has the units of the inputs). Every term is a sinusoid in tau0 (derivation in
+``docs/melnikov-erratum.md``); with sigma = pi Omega / (2 sqrt(a)):
+
+    M(tau0) = A + sum_i B_i sin(Omega_i tau0 + phi_i)
+    A            = -(8/3) mu a^(3/2) / c                                    damping
+    B (stiffness) = k_pr pi Omega^2 (2a - Omega^2) / (3c) csch(sigma)       Omega = r Omega_k
+    B (torque)    = s sqrt(2/c) pi Omega sech(sigma) F_pr                   Omega = r Omega_p
+    B (trans. err)= s sqrt(2/c) pi Omega^3 sech(sigma) F_er                 Omega = r Omega_e
+
+The mean force F_m contributes nothing (the integral of y_h vanishes). The stiffness term differs
+from the paper's printed Eq. (19), which is wrong unless a = 1: quadrature of Eq. (18) agrees with
+the form above (tests/test_melnikov.py).
+
+Two methods give the coefficients (``METHODS``): ``closed_form`` (the corrected Eq. 19) and
+``quadrature`` (QUADPACK on Eq. 18, the check). References: Guckenheimer & Holmes, *Nonlinear
+Oscillations, Dynamical Systems, and Bifurcations of Vector Fields*, Springer 1983, section 4.5
+(the Melnikov function); Farshidianfar & Saghafi, Nonlinear Dyn. 75 (2014), Eqs. (11)-(19).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+from scipy import integrate
+
+from gearengine.homoclinic.extrema import TrigSum
+from gearengine.model.params import GearParams
+
+HomoclinicBranch = Literal["plus", "minus"]
+"""The two homoclinic orbits of Eq. (15): plus (x_h > 0) and minus (x_h < 0)."""
+BRANCH_SIGN: dict[HomoclinicBranch, float] = {"plus": 1.0, "minus": -1.0}
+Method = Literal["closed_form", "quadrature"]
+
+
+def saddle_loop(a: float, c: float) -> bool:
+    """True when x'' = a x - c x^3 has a saddle at 0 with homoclinic loops: a > 0 and c > 0.
+
+    The one domain check of the Melnikov criterion; without a saddle loop it does not apply.
+    """
+    return a > 0.0 and c > 0.0
+
+
+class Term(BaseModel):
+    """One sinusoid B sin(Omega tau0 + phase) of the Melnikov function (Eq. 19)."""
+
+    model_config = ConfigDict(frozen=True)
+
+    excitation: str = Field(description="stiffness, transmission_error or torque.")
+    r: int = Field(description="Harmonic number.")
+    frequency: float = Field(description="r Omega (dimensionless).")
+    phase: float = Field(description="Phase phi_r, radians.")
+    coefficient: float = Field(description="B, same units as M.")
+    per_unit: float = Field(
+        exclude=True, description="B per unit amplitude of the harmonic (for thresholds)."
+    )
+
+
+class BranchCoefficients(BaseModel):
+    """M(tau0) = damping + sum(term.coefficient * sin(term.frequency tau0 + term.phase)) on one
+    homoclinic branch."""
+
+    model_config = ConfigDict(frozen=True)
+
+    damping: float = Field(description="Constant part A = -(8/3) mu a^(3/2) / c.")
+    damping_per_unit: float = Field(
+        exclude=True, description="A per unit mu: -(8/3) a^(3/2) / c (for thresholds)."
+    )
+    terms: list[Term]
+
+    def trig_sum(self) -> TrigSum:
+        """The same sum as arrays, for extrema and threshold search."""
+        return TrigSum(
+            self.damping,
+            np.array([t.coefficient for t in self.terms]),
+            np.array([t.frequency for t in self.terms]),
+            np.array([t.phase for t in self.terms]),
+        )
+
+    def __call__(self, tau0: np.ndarray | float) -> np.ndarray | float:
+        """Evaluate M at tau0 (array or scalar, dimensionless time)."""
+        t = np.asarray(tau0, dtype=float)
+        m = np.full(t.shape, self.damping)
+        for term in self.terms:
+            m = m + term.coefficient * np.sin(term.frequency * t + term.phase)
+        return m if m.ndim else float(m)
+
+
+# --- Homoclinic orbit, Eq. (15) ---------------------------------------------------------------
+
+
+def homoclinic_orbit(t: np.ndarray | float, a: float, c: float, branch: HomoclinicBranch) -> tuple:
+    """(x_h, y_h) of Eq. (15) at dimensionless time t on the given branch."""
+    s = BRANCH_SIGN[branch]
+    z = math.sqrt(a) * np.asarray(t, dtype=float)
+    e = np.exp(-np.abs(z))
+    sech = 2.0 * e / (1.0 + e * e)  # overflow-free sech(z)
+    x = s * math.sqrt(2.0 * a / c) * sech
+    y = -s * math.sqrt(2.0 / c) * a * sech * np.tanh(z)
+    return x, y
+
+
+# --- Closed form, corrected Eq. (19) ----------------------------------------------------------
+
+
+def _sech(z: float) -> float:
+    e = math.exp(-abs(z))
+    return 2.0 * e / (1.0 + e * e)
+
+
+def _csch(z: float) -> float:
+    e = math.exp(-abs(z))
+    return 2.0 * e / (1.0 - e * e)
+
+
+def damping_coefficient(a: float, c: float) -> float:
+    """dA/dmu = -(8/3) a^(3/2) / c, from -2 mu * integral of y_h^2 (Eq. 19, first term)."""
+    return -8.0 / 3.0 * a**1.5 / c
+
+
+def stiffness_coefficient(omega: float, a: float, c: float) -> float:
+    """B per unit k_pr: pi Omega^2 (2a - Omega^2) / (3c) csch(pi Omega / (2 sqrt a)).
+
+    Corrected stiffness term of Eq. (19); the same for both branches.
+    """
+    return (
+        math.pi
+        * omega**2
+        * (2.0 * a - omega**2)
+        / (3.0 * c)
+        * _csch(math.pi * omega / (2.0 * math.sqrt(a)))
+    )
+
+
+def torque_coefficient(omega: float, a: float, c: float, branch: HomoclinicBranch) -> float:
+    """B per unit F_pr: s sqrt(2/c) pi Omega sech(pi Omega / (2 sqrt a)) (Eq. 19)."""
+    sigma = math.pi * omega / (2.0 * math.sqrt(a))
+    return BRANCH_SIGN[branch] * math.sqrt(2.0 / c) * math.pi * omega * _sech(sigma)
+
+
+def transmission_error_coefficient(
+    omega: float, a: float, c: float, branch: HomoclinicBranch
+) -> float:
+    """B per unit F_er: s sqrt(2/c) pi Omega^3 sech(pi Omega / (2 sqrt a)) (Eq. 19).
+
+    The forcing amplitude is Omega^2 F_er (Eq. 9), hence Omega^3.
+    """
+    return omega**2 * torque_coefficient(omega, a, c, branch)
+
+
+# --- Quadrature of Eq. (18), term by term -------------------------------------------------------
+
+
+def _weight(
+    excitation: str, a: float, c: float, branch: HomoclinicBranch
+) -> Callable[[float], float]:
+    """The odd function w(t) with term(tau0) = amplitude * integral w(t) cos(Omega(t+tau0)+phi).
+
+    Eq. (18): y_h * 2 (a x_h - c x_h^3) for stiffness, y_h for torque and transmission error
+    (whose Omega^2 factor is applied by the caller).
+    """
+
+    def w(t: float) -> float:
+        x, y = homoclinic_orbit(t, a, c, branch)
+        if excitation == "stiffness":
+            return float(2.0 * y * (a * x - c * x**3))
+        return float(y)
+
+    return w
+
+
+def _quad(f: Callable[[float], float], t_max: float, **weight: object) -> float:
+    """integral_0^t_max f(t) dt by QUADPACK to ~1e-11 relative (QAWO with a sine weight).
+
+    Raises ArithmeticError when QUADPACK's error estimate exceeds 1e-9 relative (1e-12 absolute).
+    """
+    value, abserr, *_ = integrate.quad(
+        f, 0.0, t_max, epsabs=1e-14, epsrel=1e-11, limit=1000, full_output=1, **weight
+    )
+    if abserr > max(1e-9 * abs(value), 1e-12):
+        raise ArithmeticError(f"quadrature did not converge: {value} +- {abserr}")
+    return value
+
+
+def quadrature_coefficient(
+    excitation: str, omega: float, a: float, c: float, branch: HomoclinicBranch
+) -> float:
+    """B per unit amplitude by numerical quadrature of Eq. (18) (QUADPACK QAWO).
+
+    w(t) is odd, so integral w(t) cos(Omega(t + tau0) + phi) dt = -sin(Omega tau0 + phi) *
+    2 integral_0^inf w(t) sin(Omega t) dt; B is the factor of sin(Omega tau0 + phi).
+    """
+    w = _weight(excitation, a, c, branch)
+    t_max = 80.0 / math.sqrt(a)  # w decays like exp(-sqrt(a) t); the tail is below 1e-34
+    value = _quad(w, t_max, weight="sin", wvar=omega)
+    scale = omega**2 if excitation == "transmission_error" else 1.0
+    return -2.0 * value * scale
+
+
+def quadrature_damping(a: float, c: float) -> float:
+    """dA/dmu = -2 * integral y_h^2 dt by quadrature (Eq. 18)."""
+    w = _weight("torque", a, c, "plus")
+    value = _quad(lambda t: w(t) ** 2, 80.0 / math.sqrt(a))
+    return -4.0 * value
+
+
+_CLOSED_FORM: dict[str, Callable[[float, float, float, HomoclinicBranch], float]] = {
+    "stiffness": lambda om, a, c, br: stiffness_coefficient(om, a, c),
+    "torque": torque_coefficient,
+    "transmission_error": transmission_error_coefficient,
+}
+
+
+def closed_form_coefficient(
+    excitation: str, omega: float, a: float, c: float, branch: HomoclinicBranch
+) -> float:
+    """B per unit amplitude from the corrected closed form of Eq. (19)."""
+    return _CLOSED_FORM[excitation](omega, a, c, branch)
+
+
+@dataclass(frozen=True)
+class CoefficientMethod:
+    """How the coefficients of M are obtained: the damping part and each sinusoid per unit."""
+
+    damping: Callable[[float, float], float]
+    term: Callable[[str, float, float, float, HomoclinicBranch], float]
+
+
+METHODS: dict[Method, CoefficientMethod] = {
+    "closed_form": CoefficientMethod(damping_coefficient, closed_form_coefficient),
+    "quadrature": CoefficientMethod(quadrature_damping, quadrature_coefficient),
+}
+"""Coefficient methods by name, as scipy's ``METHODS`` of solve_ivp."""
+
+
+def melnikov_coefficients(
+    params: GearParams,
+    a: float,
+    c: float,
+    branch: HomoclinicBranch,
+    method: Method = "closed_form",
+    include_inactive: bool = False,
+) -> BranchCoefficients:
+    """Coefficients of M(tau0) (Eq. 19) of ``params`` on one branch for the cubic law (a, c).
+
+    Args:
+        params: the dimensionless parameters (epsilon = 1).
+        a, c: cubic backlash coefficients, both > 0 (``saddle_loop``).
+        branch: ``plus`` (x_h > 0) or ``minus``.
+        method: a key of ``METHODS``: ``closed_form`` or ``quadrature``.
+        include_inactive: keep zero-amplitude first harmonics as terms (for threshold search).
+    """
+    how = METHODS[method]
+    per_unit_damping = how.damping(a, c)
+    terms = []
+    for name, exc in params.excitations():
+        harmonics = list(enumerate(exc.harmonics, start=1)) or [(1, None)]
+        for r, h in harmonics:
+            amplitude = 0.0 if h is None else h.amplitude
+            if amplitude == 0.0 and not (include_inactive and r == 1):
+                continue
+            omega = r * exc.frequency
+            unit = how.term(name, omega, a, c, branch)
+            phase = 0.0 if h is None else h.phase
+            terms.append(
+                Term.model_construct(
+                    excitation=name,
+                    r=r,
+                    frequency=omega,
+                    phase=phase,
+                    coefficient=unit * amplitude,
+                    per_unit=unit,
+                )
+            )
+    return BranchCoefficients.model_construct(
+        damping=per_unit_damping * params.damping, damping_per_unit=per_unit_damping, terms=terms
+    )

@@ -1,0 +1,298 @@
+"""Thresholds of the control parameters (the paper's Eqs. 23, 24, 28-30, generalised).
+
+For each control parameter p in (F_e1, mu, k_p1, F_p1) M is affine in p, M = m0 + p g, so the
+set of p where a branch does *not* change sign is a union of at most two closed intervals
+(max M <= 0 or min M >= 0); their finite ends are the critical values, found by root finding
+for every term and harmonic. Omega_e enters M non-linearly and is scanned.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy import optimize
+
+from gearengine.homoclinic.coefficients import (
+    BRANCH_SIGN,
+    BranchCoefficients,
+    HomoclinicBranch,
+    melnikov_coefficients,
+    saddle_loop,
+)
+from gearengine.homoclinic.extrema import Interval, TrigSum, extrema, sublevel_interval
+from gearengine.homoclinic.schemas import (
+    BranchThreshold,
+    ParameterThreshold,
+    ThresholdCurve,
+    ThresholdsRequest,
+)
+from gearengine.model.aliases import get_alias, with_alias, with_aliases
+from gearengine.model.backlash import melnikov_cubic
+from gearengine.model.params import GearParams
+
+CONTROL_PARAMETERS = ("F_e1", "mu", "k_p1", "F_p1")
+"""Control parameters with thresholds; the amplitudes are first harmonics."""
+
+_TERM_OF = {"F_e1": "transmission_error", "k_p1": "stiffness", "F_p1": "torque"}
+
+DOMAIN = {"mu": Interval(0.0, None)}
+"""Admissible range of a control parameter (damping is non-negative); others are unbounded."""
+
+OMEGA_SCAN = (0.05, 3.0, 60)
+"""Default Omega_e scan for critical frequencies: start, stop, number of points."""
+
+
+def sign_change_strength(params: GearParams, a: float, c: float) -> float:
+    """max over branches of min(max M, -min M): > 0 iff some branch changes sign.
+
+    Continuous in the parameters (for a fixed set of commensurate frequencies), so its roots
+    are the critical values of any parameter.
+    """
+    strengths = []
+    for br in BRANCH_SIGN:
+        ext = extrema(melnikov_coefficients(params, a, c, br).trig_sum())
+        strengths.append(min(ext.maximum.value, -ext.minimum.value))
+    return max(strengths)
+
+
+def strength_at(params: GearParams, values: dict[str, float] | None = None) -> float:
+    """``sign_change_strength`` of ``params`` with aliases set to ``values``; NaN without a
+    saddle loop (the criterion does not apply there)."""
+    design = with_aliases(params, values) if values else params
+    a, c, _ = melnikov_cubic(design.backlash)
+    return sign_change_strength(design, a, c) if saddle_loop(a, c) else math.nan
+
+
+def chaos_possible(params: GearParams) -> bool | None:
+    """The Melnikov verdict (``melnikov(params).chaos_possible``) without the thresholds.
+
+    Some branch changes sign iff ``sign_change_strength > 0``; None when the cubic law has no
+    saddle loop.
+    """
+    strength = strength_at(params)
+    return None if math.isnan(strength) else strength > 0.0
+
+
+def verdict_flips(
+    params: GearParams, alias: str, lo: float, hi: float, num: int = 160
+) -> list[float]:
+    """Values of ``alias`` in [lo, hi] where the Melnikov verdict flips: brentq on the
+    sign-change strength from a scan of ``num`` values (flips closer than a step may be missed).
+    """
+    grid = np.linspace(min(lo, hi), max(lo, hi), num)
+    s = [strength_at(params, {alias: float(v)}) for v in grid]
+    return [
+        float(optimize.brentq(lambda v: strength_at(params, {alias: v}), g0, g1, xtol=1e-10))
+        for g0, g1, s0, s1 in zip(grid, grid[1:], s, s[1:], strict=False)
+        if np.isfinite(s0) and np.isfinite(s1) and (s0 > 0.0) != (s1 > 0.0)
+    ]
+
+
+def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum] | None:
+    """Split M = m0 + p g for the control parameter p (None if p's excitation is absent)."""
+    m = coef.trig_sum()
+    zeros = np.zeros_like(m.amplitudes)
+    if parameter == "mu":
+        return (
+            TrigSum(0.0, m.amplitudes, m.frequencies, m.phases),
+            TrigSum(coef.damping_per_unit, zeros, m.frequencies, m.phases),
+        )
+    name = _TERM_OF[parameter]
+    j = next((i for i, t in enumerate(coef.terms) if t.excitation == name and t.r == 1), None)
+    if j is None:
+        return None
+    rest = m.amplitudes.copy()
+    rest[j] = 0.0
+    unit = zeros.copy()
+    unit[j] = coef.terms[j].per_unit
+    return (
+        TrigSum(m.offset, rest, m.frequencies, m.phases),
+        TrigSum(0.0, unit, m.frequencies, m.phases),
+    )
+
+
+def no_sign_change(m0: TrigSum, g: TrigSum) -> list[Interval]:
+    """Intervals of p where m0 + p g keeps one sign: max <= 0 or min >= 0."""
+    sets = (sublevel_interval(m0, g), sublevel_interval(m0.negated(), g.negated()))
+    return [s for s in sets if s is not None]
+
+
+def _intersect(xs: list[Interval], ys: list[Interval]) -> list[Interval]:
+    out = []
+    for x in xs:
+        for y in ys:
+            lo = _max_end(x.lo, y.lo)
+            hi = _min_end(x.hi, y.hi)
+            if lo is None or hi is None or lo <= hi:
+                out.append(Interval(lo, hi))
+    return sorted(out, key=lambda i: -np.inf if i.lo is None else i.lo)
+
+
+def _max_end(p: float | None, q: float | None) -> float | None:
+    return q if p is None else p if q is None else max(p, q)
+
+
+def _min_end(p: float | None, q: float | None) -> float | None:
+    return q if p is None else p if q is None else min(p, q)
+
+
+def _ends(intervals: list[Interval], domain: Interval) -> list[float]:
+    """Finite interval ends that are not ends of the parameter's domain."""
+    bounds = {domain.lo, domain.hi}
+    return sorted({e for i in intervals for e in (i.lo, i.hi) if e is not None and e not in bounds})
+
+
+def _threshold(
+    value: float | None, critical: list[float], no_chaos: list, **extra: object
+) -> ParameterThreshold:
+    """The threshold document: critical values and the design's margin to the nearest one."""
+    nearest = margin = rel = None
+    if value is not None and critical:
+        nearest = min(critical, key=lambda v: abs(value - v))
+        margin = value - nearest
+        rel = margin / abs(nearest) if nearest != 0.0 else None
+    return ParameterThreshold(
+        value=value,
+        critical_values=critical,
+        nearest=nearest,
+        margin=margin,
+        relative_margin=rel,
+        no_chaos=no_chaos,
+        **extra,
+    )
+
+
+def parameter_threshold(
+    params: GearParams, parameter: str, a: float, c: float
+) -> ParameterThreshold:
+    """Critical values of one control parameter (others fixed) and the design's margin."""
+    value = get_alias(params, parameter)
+    domain = DOMAIN.get(parameter, Interval(None, None))
+    branches: dict[HomoclinicBranch, BranchThreshold] = {}
+    sets: dict[HomoclinicBranch, list[Interval]] = {}
+    for br in BRANCH_SIGN:
+        family = _family(melnikov_coefficients(params, a, c, br, include_inactive=True), parameter)
+        if family is None:
+            exc = _TERM_OF[parameter]
+            return _threshold(
+                value, [], [], note=f"{exc} is not given: no frequency for {parameter}"
+            )
+        sets[br] = _intersect(no_sign_change(*family), [domain])
+        branches[br] = BranchThreshold(
+            critical_values=_ends(sets[br], domain),
+            no_sign_change=[(i.lo, i.hi) for i in sets[br]],
+        )
+    overall = _intersect(sets["plus"], sets["minus"])
+    return _threshold(
+        value,
+        _ends(overall, domain),
+        [(i.lo, i.hi) for i in overall],
+        branches=branches,
+    )
+
+
+def frequency_threshold(
+    params: GearParams, a: float, c: float, scan: tuple = OMEGA_SCAN
+) -> ParameterThreshold:
+    """Critical Omega_e in a scan: where the verdict flips, located by brentq.
+
+    Every excitation frequency is scaled with Omega_e (a change of running speed, their ratios
+    fixed): the commensurability of the forcing, and so the extrema method, stays the same along
+    the scan and the sign-change strength is continuous, so each root is a real flip. (Moving
+    Omega_e alone would jump between exact extrema at rational ratios and the supremum between
+    them, and the verdict would flip at isolated points.)
+    """
+    value = get_alias(params, "Omega_e")
+    if value is None:
+        return _threshold(
+            None, [], [], scan=scan, note="transmission_error is not given: no Omega_e to scan"
+        )
+    start, stop, num = scan
+
+    def strength(om: float) -> float:
+        factor = float(om) / value
+        moved = {
+            name: exc.model_copy(update={"frequency": exc.frequency * factor})
+            for name, exc in params.excitations()
+        }
+        return sign_change_strength(params.model_copy(update=moved), a, c)
+
+    omegas = np.linspace(start, stop, num)
+    values = [strength(om) for om in omegas]
+    critical = [
+        float(optimize.brentq(strength, lo, hi, xtol=1e-12))
+        for lo, hi, f_lo, f_hi in zip(omegas, omegas[1:], values, values[1:], strict=False)
+        if (f_lo > 0.0) != (f_hi > 0.0)
+    ]
+    edges = [float(start), *critical, float(stop)]
+    no_chaos = [
+        (edges[i], edges[i + 1])
+        for i in range(len(edges) - 1)
+        if strength(0.5 * (edges[i] + edges[i + 1])) <= 0.0
+    ]
+    return _threshold(
+        value,
+        critical,
+        no_chaos,
+        scan=scan,
+        note="critical Omega_e found by scanning with every excitation frequency scaled "
+        "alongside (ratios fixed, as a change of running speed); flips between scan points "
+        "closer than the grid step may be missed",
+    )
+
+
+def threshold_curve(
+    params: GearParams,
+    parameter: str,
+    frequency_parameter: str = "Omega_e",
+    start: float = 0.05,
+    stop: float = 2.5,
+    num: int = 100,
+) -> ThresholdCurve:
+    """Critical values of ``parameter`` for ``num`` values of a frequency in [start, stop].
+
+    Raises ValueError, its message starting with the request field at fault (``parameter``,
+    ``frequency_parameter`` or ``params.backlash``), when no curve can be drawn.
+
+    Args:
+        params: the design; its other parameters stay fixed.
+        parameter: F_e1, mu, k_p1 or F_p1.
+        frequency_parameter: Omega_e, Omega_k or Omega_p (the excitation must be given).
+        start, stop, num: the frequency grid (dimensionless).
+    """
+    a, c, notes = melnikov_cubic(params.backlash)
+    if not saddle_loop(a, c):
+        raise ValueError(
+            f"params.backlash: the Melnikov criterion needs a > 0 and c > 0 (got a = {a}, c = {c})"
+        )
+    if get_alias(params, frequency_parameter) is None:
+        raise ValueError(f"frequency_parameter: {frequency_parameter}: its excitation is not given")
+    omegas = [float(w) for w in np.linspace(start, stop, num)]
+    rows = [
+        parameter_threshold(with_alias(params, frequency_parameter, w), parameter, a, c)
+        for w in omegas
+    ]
+    if any(r.note for r in rows):
+        raise ValueError(f"parameter: {next(r.note for r in rows if r.note)}")
+    return ThresholdCurve(
+        parameter=parameter,
+        frequency_parameter=frequency_parameter,
+        frequencies=omegas,
+        no_chaos=[r.no_chaos for r in rows],
+        branches={br: [r.branches[br].no_sign_change for r in rows] for br in BRANCH_SIGN},
+        value=get_alias(params, parameter),
+        notes=notes,
+    )
+
+
+def curve_of(request: ThresholdsRequest) -> ThresholdCurve:
+    """``threshold_curve`` of a /v1/thresholds request document."""
+    return threshold_curve(
+        request.params,
+        request.parameter,
+        request.frequency_parameter,
+        request.start,
+        request.stop,
+        request.num,
+    )

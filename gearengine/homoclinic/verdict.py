@@ -1,0 +1,119 @@
+"""The Melnikov verdict of a design: sign change of each branch, thresholds and margins.
+
+A branch has a simple zero (transverse homoclinic intersection) iff min M < 0 < max M over tau0
+(paper section 3.2). Chaos is possible when either branch does. Guckenheimer & Holmes 1983,
+Theorem 4.5.3; Farshidianfar & Saghafi 2014, Eqs. (20)-(24).
+"""
+
+from __future__ import annotations
+
+import math
+
+from gearengine.homoclinic.coefficients import (
+    BRANCH_SIGN,
+    Method,
+    melnikov_coefficients,
+    saddle_loop,
+)
+from gearengine.homoclinic.extrema import Extrema, extrema
+from gearengine.homoclinic.schemas import BranchVerdict, MelnikovResult
+from gearengine.homoclinic.thresholds import (
+    CONTROL_PARAMETERS,
+    OMEGA_SCAN,
+    frequency_threshold,
+    parameter_threshold,
+)
+from gearengine.model.backlash import melnikov_cubic
+from gearengine.model.frequencies import forcing_period
+from gearengine.model.params import GearParams
+
+
+def branch_verdict(ext: Extrema) -> BranchVerdict:
+    """Sign-change decision of one branch from its extrema."""
+    return BranchVerdict(
+        sign_change=ext.minimum.value < 0.0 < ext.maximum.value,
+        min=ext.minimum.value,
+        max=ext.maximum.value,
+        tau0_min=ext.minimum.tau0,
+        tau0_max=ext.maximum.tau0,
+        extrema=ext.method,
+    )
+
+
+def not_applicable(a: float, c: float, method: Method, notes: list[str]) -> MelnikovResult:
+    """A result without numbers: the criterion does not apply, and the notes say why."""
+    return MelnikovResult(
+        applicable=False,
+        chaos_possible=None,
+        branches=None,
+        thresholds={},
+        coefficients=None,
+        a=a,
+        c=c,
+        forcing_period=None,
+        method=method,
+        notes=notes,
+    )
+
+
+def melnikov(
+    params: GearParams, method: Method = "closed_form", omega_scan: tuple = OMEGA_SCAN
+) -> MelnikovResult:
+    """The Melnikov verdict of ``params`` with thresholds of every control parameter.
+
+    Args:
+        params: dimensionless parameters of Eq. (9), evaluated with epsilon = 1.
+        method: ``closed_form`` or ``quadrature`` for the coefficients of M.
+        omega_scan: (start, stop, num) of the Omega_e scan for critical frequencies.
+    """
+    a, c, notes = melnikov_cubic(params.backlash)
+    if not saddle_loop(a, c):
+        return not_applicable(
+            a,
+            c,
+            method,
+            [
+                *notes,
+                f"not applicable: the homoclinic orbit of x'' = a x - c x^3 needs a > 0 and "
+                f"c > 0 (got a = {a:g}, c = {c:g}); without a saddle loop there is no "
+                "Melnikov criterion",
+            ],
+        )
+    coefs = {br: melnikov_coefficients(params, a, c, br, method) for br in BRANCH_SIGN}
+    # every per-unit coefficient the thresholds will use, inactive first harmonics included
+    scaled = melnikov_coefficients(params, a, c, "plus", method, include_inactive=True)
+    scale = [scaled.damping_per_unit, *(t.per_unit for t in scaled.terms)]
+    if not all(math.isfinite(v) and abs(v) < 1e150 for v in scale):
+        return not_applicable(
+            a,
+            c,
+            method,
+            [
+                *notes,
+                f"not applicable: with a = {a:g}, c = {c:g} the orbit's scale sqrt(2a/c) makes "
+                "M overflow; the Melnikov function is numerically meaningless here",
+            ],
+        )
+    branches = {br: branch_verdict(extrema(coefs[br].trig_sum())) for br in BRANCH_SIGN}
+    period = forcing_period(params.active_frequencies())
+    if any(b.extrema == "supremum" for b in branches.values()):
+        notes.append(
+            "the active frequencies are incommensurate (no ratio p/q with q <= 64): min and max "
+            "of M are the infimum and supremum A -/+ sum |B_i|, approached but not attained"
+        )
+    if params.mean_force != 0.0:
+        notes.append("the mean force F_m does not enter M: the integral of y_h over the orbit is 0")
+    thresholds = {p: parameter_threshold(params, p, a, c) for p in CONTROL_PARAMETERS}
+    thresholds["Omega_e"] = frequency_threshold(params, a, c, omega_scan)
+    return MelnikovResult(
+        applicable=True,
+        chaos_possible=any(b.sign_change for b in branches.values()),
+        branches=branches,
+        thresholds=thresholds,
+        coefficients=coefs,
+        a=a,
+        c=c,
+        forcing_period=period,
+        method=method,
+        notes=notes,
+    )

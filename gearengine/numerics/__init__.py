@@ -1,0 +1,26 @@
+"""The numerics room: integrate Eq. (9) and read the response.
+
+Data flow: ``settings`` (periods, steps, starts; what a run costs) -> ``forcing`` (the
+excitations as kernel arrays, the RK4 step plan) -> ``kernels`` (numba RK4 with the tangent
+equation; kink splitting for the piecewise law; a SIMD batch) -> ``runs`` (one start:
+``periodicity``, ``lyapunov``, ``classify``) -> ``simulation`` (one design: ``diagnostics``,
+``nolds_check``) and ``batch`` (many designs), with the documents in ``results``. Imports only
+the model room.
+"""
+
+from gearengine.numerics.batch import simulate_batch
+from gearengine.numerics.results import BatchPoint, NumericsResult
+from gearengine.numerics.settings import SimulationSettings, work
+from gearengine.numerics.simulation import lyapunov, poincare, simulate, warm_up
+
+__all__ = [
+    "BatchPoint",
+    "NumericsResult",
+    "SimulationSettings",
+    "lyapunov",
+    "poincare",
+    "simulate",
+    "simulate_batch",
+    "warm_up",
+    "work",
+]

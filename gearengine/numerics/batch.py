@@ -1,0 +1,94 @@
+"""Verdicts of many parameter points at once: the sweeps' path to the kernels.
+
+Cubic-law points with commensurate forcing are grouped by steps per T0 and advanced in lock-step
+by the SIMD kernel ``kernels.run_batch`` (parallel over chunks of lanes); other points run one
+by one in the single kernels (``numerics.runs``). Numbers equal those of ``simulate``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from gearengine.model.params import GearParams
+from gearengine.numerics import kernels
+from gearengine.numerics.classify import DIVERGENCE_BOUND, severity
+from gearengine.numerics.forcing import law, packed_forcing, step_plan
+from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
+from gearengine.numerics.runs import Run, StartVerdict, integrate, start_verdict
+from gearengine.numerics.settings import SimulationSettings, check_work
+
+
+def batch_point(runs: list[tuple[Run, StartVerdict]]) -> BatchPoint:
+    """The verdict of a point: its worst start's, with that start's last strobes."""
+    idx = max(
+        range(len(runs)), key=lambda i: severity(runs[i][1].classification, runs[i][1].period)
+    )
+    run, v = runs[idx]
+    n_ok = run.recorded
+    return BatchPoint(
+        classification=v.classification,
+        period=v.period,
+        lle=v.summary.lle,
+        lle_stderr=v.summary.lle_stderr,
+        final_state=v.summary.final_state,
+        impact_regime=v.summary.impact_regime,
+        poincare=np.column_stack([run.xs[:n_ok], run.vs[:n_ok]])[-BATCH_POINCARE:].tolist(),
+        start_index=idx,
+    )
+
+
+def simulate_batch(
+    points: list[GearParams], settings: SimulationSettings | None = None
+) -> list[BatchPoint]:
+    """Verdict (period, LLE, final state, last strobes) for each parameter point of a sweep.
+
+    Cubic-law points with commensurate forcing are grouped by steps per T0 and run in the
+    lock-step SIMD kernel (``kernels.run_batch``, parallel over chunks of lanes; one lane per
+    point and start). Other points (piecewise law, incommensurate forcing) run one by one in the
+    single kernels. Numbers equal those of ``simulate`` for the same point and start.
+    """
+    settings = settings or SimulationSettings()
+    starts = settings.starts()
+    n_trans, n_rec = settings.transient_periods, settings.record_periods
+    results: dict[int, BatchPoint] = {}
+    groups: dict[int, list[int]] = {}
+    plans = [step_plan(p, settings.steps_per_period) for p in points]
+    for i, (p, plan) in enumerate(zip(points, plans, strict=True)):
+        check_work(settings, plan.steps)
+        if p.backlash.model == "cubic" and plan.omega0 is not None:
+            groups.setdefault(plan.steps, []).append(i)
+        else:
+            runs = []
+            for s in starts:
+                run = integrate(p, settings, s)
+                runs.append((run, start_verdict(run, s, plan.period, plan.omega0 is not None)))
+            results[i] = batch_point(runs)
+    for N, members in groups.items():
+        lanes = [(i, s) for i in members for s in starts]
+        tables = [
+            kernels.forcing_table(plans[i].period, N, *packed_forcing(points[i])) for i in members
+        ]
+        rows = {i: k for k, i in enumerate(members)}
+        Kt = np.array([tables[rows[i]][0] for i, _ in lanes])
+        Ft = np.array([tables[rows[i]][1] for i, _ in lanes])
+        per = np.array([plans[i].period for i, _ in lanes])
+        a = np.array([law(points[i]).a for i, _ in lanes])
+        c = np.array([law(points[i]).c for i, _ in lanes])
+        mu = np.array([points[i].damping for i, _ in lanes])
+        x0 = np.array([s[0] for _, s in lanes])
+        v0 = np.array([s[1] for _, s in lanes])
+        xs, vs, logs, xmin, xmax, done, xf, vf = kernels.run_batch(
+            a, c, mu, x0, v0, Kt, Ft, per, N, n_trans, n_rec, DIVERGENCE_BOUND
+        )
+        per_point: dict[int, list[tuple[Run, StartVerdict]]] = {i: [] for i in members}
+        empty = np.zeros(0)
+        for lane, (i, s) in enumerate(lanes):
+            run = Run(
+                xs[lane], vs[lane], logs[lane], empty, empty, float(xmin[lane]),
+                float(xmax[lane]), int(done[lane]), (float(xf[lane]), float(vf[lane])),
+                bool(done[lane] < n_trans + n_rec), max(0, int(done[lane]) - n_trans),
+            )  # fmt: skip
+            per_point[i].append((run, start_verdict(run, s, plans[i].period, True)))
+        for i, runs in per_point.items():
+            results[i] = batch_point(runs)
+    return [results[i] for i in range(len(points))]

@@ -1,0 +1,153 @@
+"""Forcing terms of Eq. (9) as flat coefficient arrays, and the RK4 step plan.
+
+    K(t) = 1  + sum_i k_amp_i cos(k_omega_i t + k_phase_i)     (Eq. 9)
+    F(t) = Fm + sum_i f_amp_i cos(f_omega_i t + f_phase_i)
+
+with stiffness terms k_amp = 2 k~_pr at r Omega_k, torque terms F~_pr at r Omega_p and
+transmission-error terms (r Omega_e)^2 F~_er at r Omega_e (torque terms first, as gear_ref.c).
+
+Only harmonics with a nonzero amplitude are kept. The step plan aligns the fixed RK4 steps to the
+Poincare period T0 = 2 pi / Omega_0 so stroboscopic samples fall on step boundaries.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from gearengine.model.backlash import LAWS
+from gearengine.model.frequencies import common_frequency
+from gearengine.model.params import CubicBacklash, GearParams
+
+
+@dataclass(frozen=True)
+class ForcingCoefficients:
+    """Flat arrays of the cosine terms of K(t) and F(t) (Eq. 9), each of shape (n_terms,)."""
+
+    k_amp: np.ndarray
+    k_omega: np.ndarray
+    k_phase: np.ndarray
+    mean_force: float
+    f_amp: np.ndarray
+    f_omega: np.ndarray
+    f_phase: np.ndarray
+
+
+@dataclass(frozen=True)
+class Law:
+    """Backlash law f_h as kernel arguments: its name and code in ``model.backlash.LAWS``, the
+    cubic's (a, c) and the piecewise law's alpha (the unused ones are 0)."""
+
+    name: str
+    code: int
+    a: float
+    c: float
+    alpha: float
+
+
+@dataclass(frozen=True)
+class StepPlan:
+    """Fixed-step RK4 grid.
+
+    Attributes:
+        omega0: common frequency Omega_0 of the forcing, or None when incommensurate.
+        period: sampling interval T0 (time units): 2 pi / Omega_0, or the period of the fastest
+            excitation when there is no common period.
+        steps: RK4 steps N per sampling interval; step h = period / steps.
+        omega_ref: frequency the spectrum orders refer to, 2 pi / period.
+        notes: human-readable remarks on the choices made.
+    """
+
+    omega0: float | None
+    period: float
+    steps: int
+    omega_ref: float
+    notes: tuple[str, ...]
+
+    @property
+    def h(self) -> float:
+        """RK4 step h = T0 / N (time units)."""
+        return self.period / self.steps
+
+
+def forcing_coefficients(params: GearParams) -> ForcingCoefficients:
+    """Cosine terms of K(t) and F(t) of Eq. (9) for every harmonic with nonzero amplitude."""
+    k_terms: list[tuple[float, float, float]] = []
+    f_terms: list[tuple[float, float, float]] = []
+    if params.stiffness is not None:
+        w = params.stiffness.frequency
+        k_terms += [(2.0 * h.amplitude, r * w, h.phase) for r, h in params.stiffness.active()]
+    if params.torque is not None:
+        w = params.torque.frequency
+        f_terms += [(h.amplitude, r * w, h.phase) for r, h in params.torque.active()]
+    if params.transmission_error is not None:
+        w = params.transmission_error.frequency
+        f_terms += [
+            ((r * w) * (r * w) * h.amplitude, r * w, h.phase)
+            for r, h in params.transmission_error.active()
+        ]
+    k = np.array(k_terms, dtype=np.float64).reshape(-1, 3)
+    f = np.array(f_terms, dtype=np.float64).reshape(-1, 3)
+    return ForcingCoefficients(
+        k_amp=np.ascontiguousarray(k[:, 0]),
+        k_omega=np.ascontiguousarray(k[:, 1]),
+        k_phase=np.ascontiguousarray(k[:, 2]),
+        mean_force=float(params.mean_force),
+        f_amp=np.ascontiguousarray(f[:, 0]),
+        f_omega=np.ascontiguousarray(f[:, 1]),
+        f_phase=np.ascontiguousarray(f[:, 2]),
+    )
+
+
+def law(params: GearParams) -> Law:
+    """Kernel arguments of the backlash law f_h."""
+    b = params.backlash
+    code = LAWS[b.model].kernel_code
+    if isinstance(b, CubicBacklash):
+        return Law(b.model, code, float(b.a), float(b.c), 0.0)
+    return Law(b.model, code, 0.0, 0.0, float(b.alpha))
+
+
+def packed_forcing(params: GearParams) -> tuple[np.ndarray, float, np.ndarray]:
+    """(kc, fm, fc): the forcing as the kernels take it, kc and fc of shape (3, n_terms) with
+    rows amplitude, omega, phase, and fm the mean force F~_m."""
+    co = forcing_coefficients(params)
+    kc = np.ascontiguousarray(np.vstack([co.k_amp, co.k_omega, co.k_phase]))
+    fc = np.ascontiguousarray(np.vstack([co.f_amp, co.f_omega, co.f_phase]))
+    return kc, co.mean_force, fc
+
+
+def fastest_excitation(params: GearParams) -> float | None:
+    """Largest fundamental frequency Omega among excitations with a nonzero harmonic."""
+    freqs = [exc.frequency for _, exc in params.excitations() if any(True for _ in exc.active())]
+    return max(freqs) if freqs else None
+
+
+def step_plan(params: GearParams, steps_per_period: int) -> StepPlan:
+    """RK4 grid with ``steps_per_period`` steps per period of the fastest active excitation.
+
+    Commensurate forcing: T0 = 2 pi / Omega_0 and N = round(steps_per_period Omega_fast / Omega_0)
+    (= steps_per_period * Omega_fast / Omega_0 exactly when that ratio is an integer).
+    Incommensurate: sampling interval 2 pi / Omega_fast, N = steps_per_period, no period.
+    No active excitation: T0 = 2 pi (Omega_0 = 1), N = steps_per_period.
+    """
+    fast = fastest_excitation(params)
+    if fast is None:
+        note = "no active excitation: constant forcing, sampling interval T0 = 2 pi (Omega_0 = 1)"
+        return StepPlan(1.0, 2.0 * math.pi, steps_per_period, 1.0, (note,))
+    omega0 = common_frequency(params.active_frequencies())
+    if omega0 is None:
+        note = (
+            f"active frequencies {sorted(set(params.active_frequencies()))} are incommensurate "
+            "(no common Omega_0): the forcing is quasi-periodic and has no Poincare period; "
+            f"strobes are taken every 2 pi / {fast:g} (fastest excitation) and the forcing is "
+            "evaluated at absolute time"
+        )
+        return StepPlan(None, 2.0 * math.pi / fast, steps_per_period, fast, (note,))
+    steps = max(1, round(steps_per_period * fast / omega0))
+    notes: tuple[str, ...] = ()
+    if not math.isclose(fast / omega0, round(fast / omega0), rel_tol=1e-9):
+        notes = (f"T0 is shorter than the fastest excitation period; N = {steps} steps per T0",)
+    return StepPlan(omega0, 2.0 * math.pi / omega0, steps, omega0, notes)

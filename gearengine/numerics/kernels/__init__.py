@@ -1,0 +1,52 @@
+"""Numba kernels: fixed-step RK4 of Eq. (9) with its tangent equation.
+
+    x' = v,    v' = -2 mu v - K(t) f_h(x) + F(t)                       (Eq. 9)
+    dx' = dv,  dv' = -2 mu dv - K(t) f_h'(x) dx                        (tangent equation)
+
+Three kernels share one output layout (see ``run_rk4``):
+
+* ``run_rk4``: classical RK4 with N steps per sampling interval T0, forcing either tabulated once
+  at the 2N+1 stage times of a period (commensurate forcing) or evaluated at absolute time
+  t = n T0 + j h (no drift). Cubic law, or the piecewise law of Eq. (8) stepped straight across
+  the kinks (first-order accurate there; kept for comparison with ``run_kink``).
+* ``run_kink``: piecewise law of Eq. (8) with every RK4 step split at the switching times
+  |x| = 1 (port of ``gear_ref.c --kink``, general alpha): a crossing is detected from a cubic
+  Hermite interpolant of x over the substep, located by Illinois regula falsi on RK4 substeps to
+  ~1e-13 h, and integration restarts there with the new region's field. The field is continuous
+  across |x| = 1, so the tangent vector needs no saltation jump. Forcing at absolute time.
+* ``run_batch``: cubic law only; many parameter points ("lanes") in lock-step, struct of arrays,
+  inner loops over ``LANES`` lanes so LLVM vectorises, ``prange`` over chunks of lanes. Same
+  arithmetic as ``run_rk4`` with a forcing table.
+
+Benettin et al. (Meccanica 15, 1980): the tangent vector starts at (1, 1)/sqrt(2) and is
+renormalised at the end of every interval T0; the log of its norm is recorded over the n_rec
+recorded intervals. A run stops early (diverged) when |x| or |v| is not below ``bound`` at an
+interval end (this also catches NaN).
+
+Forcing coefficients are packed as kc, fc of shape (3, n_terms): rows amplitude, omega, phase
+(see ``gearengine.numerics.forcing``); K(t) = 1 + sum kc0 cos(kc1 t + kc2),
+F(t) = fm + sum fc0 cos(fc1 t + fc2).
+"""
+
+from gearengine.numerics.kernels.kink import run_kink
+from gearengine.numerics.kernels.lockstep import LANES, run_batch
+from gearengine.numerics.kernels.smooth import (
+    SQRT1_2,
+    forcing_at,
+    forcing_table,
+    law_force,
+    region_force,
+    run_rk4,
+)
+
+__all__ = [
+    "LANES",
+    "SQRT1_2",
+    "forcing_at",
+    "forcing_table",
+    "law_force",
+    "region_force",
+    "run_batch",
+    "run_kink",
+    "run_rk4",
+]

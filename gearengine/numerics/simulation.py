@@ -1,0 +1,165 @@
+"""Numerical verdict on Eq. (9): integrate, detect the period, estimate the largest Lyapunov
+exponent, classify, and describe the response.
+
+Public entry points: ``simulate`` (one parameter point, one or several initial states),
+``lyapunov`` and ``poincare`` (short verbs), ``warm_up`` (compile/load every kernel);
+``numerics.batch.simulate_batch`` runs a sweep's points.
+
+Integrators (``numerics.kernels``, chosen in ``numerics.runs.INTEGRATORS``): classical fixed-step
+RK4 with the tangent equation for the cubic law; for the piecewise law of Eq. (8) the
+kink-splitting RK4 (steps split at |x| = 1). The largest Lyapunov exponent is the tangent-space
+estimate of Benettin, Galgani, Giorgilli & Strelcyn (Meccanica 15, 1980); the period is read from
+the Poincare (stroboscopic) section; see Parker & Chua, *Practical Numerical Algorithms for
+Chaotic Systems* (Springer 1989), ch. 6.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from gearengine.model.params import GearParams
+from gearengine.numerics.batch import simulate_batch
+from gearengine.numerics.classify import DIVERGENCE_BOUND, severity
+from gearengine.numerics.diagnostics import (
+    impact_regime,
+    poincare_points,
+    rms,
+    spectrum_peaks,
+    time_history,
+)
+from gearengine.numerics.forcing import StepPlan, step_plan
+from gearengine.numerics.nolds_check import lyap_r_check
+from gearengine.numerics.results import NumericsResult, SpectrumPeak, TimeHistory
+from gearengine.numerics.runs import (
+    Run,
+    StartVerdict,
+    finite_or_none,
+    history_stride,
+    integrate,
+    method_of,
+    start_verdict,
+)
+from gearengine.numerics.settings import SimulationSettings, check_work
+
+
+def simulate(params: GearParams, settings: SimulationSettings | None = None) -> NumericsResult:
+    """Integrate Eq. (9) from every start of ``settings`` and return the numerical verdict.
+
+    The detailed fields (LLE statistics, spectrum, Poincare points, time history, nolds) describe
+    the worst start; ``starts`` holds a summary per start.
+    """
+    settings = settings or SimulationSettings()
+    plan = step_plan(params, settings.steps_per_period)
+    check_work(settings, plan.steps)
+    commensurate = plan.omega0 is not None
+    notes = list(plan.notes)
+    runs: list[tuple[Run, StartVerdict]] = []
+    for start in settings.starts():
+        run = integrate(params, settings, start)
+        runs.append((run, start_verdict(run, start, plan.period, commensurate)))
+    worst, wv = max(runs, key=lambda rv: severity(rv[1].classification, rv[1].period))
+    base: dict[str, Any] = {
+        "classification": wv.classification,
+        "period": wv.period,
+        "forcing_period": plan.period if commensurate else None,
+        "sampling_interval": plan.period,
+        "steps_per_forcing_period": plan.steps,
+        "method": method_of(params, plan),
+        "starts": [v.summary for _, v in runs],
+        "worst_case": wv.summary,
+    }
+    if worst.diverged:
+        return _diverged(base, worst, plan, notes)
+    return _detailed(base, worst, wv, plan, settings, notes)
+
+
+def _diverged(base: dict[str, Any], worst: Run, plan: StepPlan, notes: list[str]) -> NumericsResult:
+    """The result of a run that left the divergence bound: no statistics, the strobes so far."""
+    t_div = (worst.done + 1) * plan.period
+    notes.append(f"|x| or |v| exceeded {DIVERGENCE_BOUND:g} by tau = {t_div:g}; stopped")
+    return NumericsResult(
+        **base,
+        lle=None,
+        lle_stderr=None,
+        lle_first_half=None,
+        lle_converged=False,
+        impact_regime=None,
+        x_rms=None,
+        x_peak_to_peak=None,
+        spectrum_peaks=[],
+        poincare=poincare_points(worst.xs[: worst.recorded], worst.vs[: worst.recorded]),
+        time_history=None,
+        nolds=None,
+        notes=notes,
+    )
+
+
+def _detailed(
+    base: dict[str, Any],
+    worst: Run,
+    wv: StartVerdict,
+    plan: StepPlan,
+    settings: SimulationSettings,
+    notes: list[str],
+) -> NumericsResult:
+    """The full result of the worst start: LLE statistics, spectrum, strobes, history, nolds."""
+    dt = history_stride(settings, plan.steps) * plan.h
+    t0 = settings.transient_periods * plan.period + dt
+    commensurate = plan.omega0 is not None
+    est = wv.lle
+    peaks = spectrum_peaks(worst.hx, dt, plan.omega_ref)
+    assert est is not None
+    negative = est.lle < -3.0 * (est.stderr or 0.0)
+    if commensurate and wv.classification == "quasi_periodic" and negative:
+        notes.append(
+            "LLE clearly negative but no period <= 64 found: longer period or unfinished "
+            "transient; try more transient_periods"
+        )
+    if not est.converged:
+        notes.append("LLE not converged: first half and whole record disagree")
+    nolds_result = None
+    if settings.lyapunov_nolds:
+        if peaks:
+            nolds_result = lyap_r_check(worst.hx, dt, peaks[0]["frequency"])
+        else:
+            notes.append("nolds skipped: x(t) is constant")
+    return NumericsResult(
+        **base,
+        lle=finite_or_none(est.lle),
+        lle_stderr=finite_or_none(est.stderr),
+        lle_first_half=finite_or_none(est.first_half),
+        lle_converged=est.converged,
+        impact_regime=impact_regime(worst.xmin, worst.xmax),
+        x_rms=finite_or_none(rms(worst.hx)),
+        x_peak_to_peak=finite_or_none(worst.xmax - worst.xmin),
+        spectrum_peaks=[SpectrumPeak(**p) for p in peaks],
+        poincare=poincare_points(worst.xs, worst.vs),
+        time_history=TimeHistory(**time_history(t0, dt, worst.hx, worst.hv, plan.period)),
+        nolds=nolds_result,
+        notes=notes,
+    )
+
+
+def lyapunov(params: GearParams, settings: SimulationSettings | None = None) -> float | None:
+    """Largest Lyapunov exponent per unit tau of the worst start (None if diverged)."""
+    return simulate(params, settings).lle
+
+
+def poincare(params: GearParams, settings: SimulationSettings | None = None) -> list[list[float]]:
+    """Last (<= 256) stroboscopic points [[x, v], ...] of the worst start."""
+    return simulate(params, settings).poincare
+
+
+def warm_up() -> None:
+    """Compile or load from cache every kernel on a tiny problem (call once at start-up)."""
+    tiny = SimulationSettings(transient_periods=1, record_periods=4, steps_per_period=8)
+    base = {
+        "damping": 0.07,
+        "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 0.1}]},
+    }
+    torque = {"frequency": math.sqrt(2.0), "harmonics": [{"amplitude": 0.01}]}
+    cubic = GearParams.model_validate(base)
+    for extra in ({}, {"torque": torque}, {"backlash": {"model": "piecewise"}}):
+        simulate(GearParams.model_validate({**base, **extra}), tiny)
+    simulate_batch([cubic, cubic], tiny)

@@ -1,0 +1,161 @@
+"""Figures of a sweep (matplotlib, Agg): PNG or SVG bytes.
+
+* One axis, the bifurcation diagram: x of the stroboscopic (Poincare) points against the
+  parameter, the largest Lyapunov exponent underneath, the Melnikov threshold marked and the
+  range where the Melnikov function changes sign shaded (paper Figs. 6, 13).
+* Two axes, the chaos map: each point coloured by its LLE, the Melnikov boundary (zero of the
+  sign-change strength, ``thresholds.sign_change_strength``) overlaid with the chaos-possible
+  side hatched, and a table of agreement between the numerical and the Melnikov verdicts.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+
+import numpy as np
+from matplotlib.colors import TwoSlopeNorm
+from matplotlib.figure import Figure
+
+from gearengine.homoclinic.thresholds import strength_at, verdict_flips
+from gearengine.model.aliases import ALIASES, get_alias
+from gearengine.plots.style import LLE_LABEL, SYMBOLS, ImageFormat, figure_bytes
+from gearengine.sweeps.export import agreement_table
+from gearengine.sweeps.request import SweepRequest
+from gearengine.sweeps.results import SweepPoint
+
+BOUNDARY_GRID = 160
+"""Samples per axis of the sign-change strength for the Melnikov boundary."""
+
+
+def sweep_figure(request: SweepRequest, points: Sequence[SweepPoint], fmt: ImageFormat) -> bytes:
+    """The sweep's figure, bifurcation diagram or chaos map, as PNG or SVG bytes."""
+    fig = bifurcation(request, points) if len(request.axes) == 1 else chaos_map(request, points)
+    return figure_bytes(fig, fmt)
+
+
+def _fixed(request: SweepRequest) -> str:
+    """The design's other parameters, for the title."""
+    swept = {a.parameter for a in request.axes}
+    parts = []
+    for alias in ALIASES:
+        value = get_alias(request.params, alias)
+        if alias not in swept and value:
+            parts.append(f"{SYMBOLS[alias]} = {value:g}")
+    return ", ".join(parts)
+
+
+def _settings_note(request: SweepRequest) -> str:
+    s = request.settings
+    x0 = ", ".join(f"{v:g}" for v in s.initial_state)
+    how = "continuation" if request.continuation else f"$(x, \\dot x)_0$ = ({x0})"
+    return (
+        f"RK4, {s.steps_per_period} steps per $T_0$, {s.transient_periods} + "
+        f"{s.record_periods} periods, {how}"
+    )
+
+
+def bifurcation(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
+    """Poincare x against the parameter, the LLE underneath, the Melnikov threshold marked."""
+    axis = request.axes[0]
+    name = axis.parameter
+    fig = Figure(figsize=(8.0, 6.4), layout="constrained")
+    top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=[2.2, 1.0])
+    colours = {None: "black", "up": "tab:blue", "down": "tab:orange"}
+    branches = sorted({p.branch for p in points}, key=lambda b: b or "")
+    for branch in branches:
+        mine = [p for p in points if p.branch == branch]
+        xs = [p.values[name] for p in mine for _ in p.poincare_x]
+        ys = [x for p in mine for x in p.poincare_x]
+        suffix = f", branch {branch}" if branch else ""
+        top.scatter(xs, ys, s=0.6, c=colours[branch], marker=".", linewidths=0,
+                    label="Poincaré points" + suffix)  # fmt: skip
+        lle = sorted((p.values[name], p.lle) for p in mine if p.lle is not None)
+        bottom.plot(*zip(*lle, strict=True), lw=0.9, c=colours[branch],
+                    label=r"$\lambda_{\max}$" + suffix)  # fmt: skip
+    lo, hi = sorted((axis.start, axis.stop))
+    crossings = verdict_flips(request.params, name, lo, hi, BOUNDARY_GRID)
+    edges = [lo, *crossings, hi]
+    for ax in (top, bottom):
+        for e0, e1 in itertools.pairwise(edges):
+            mid = strength_at(request.params, {name: 0.5 * (e0 + e1)})
+            if mid > 0.0:
+                ax.axvspan(e0, e1, color="tab:red", alpha=0.08, lw=0)
+        for k, v in enumerate(crossings):
+            label = f"Melnikov threshold {SYMBOLS[name]} = {v:.4g}" if k == 0 else None
+            ax.axvline(v, c="tab:red", ls="--", lw=1.0, label=label)
+    bottom.axhline(0.0, c="grey", lw=0.6)
+    top.set_ylabel(r"$x$ at $\tau = n T_0$ (units of $b$)")
+    bottom.set_ylabel(LLE_LABEL)
+    bottom.set_xlabel(f"{SYMBOLS[name]} (dimensionless)")
+    bottom.set_xlim(lo, hi)
+    top.legend(loc="best", markerscale=12, fontsize=8, framealpha=0.9)
+    bottom.legend(loc="best", fontsize=8, framealpha=0.9)
+    top.set_title(
+        f"Bifurcation diagram in {SYMBOLS[name]}: {_fixed(request)}\n"
+        f"{_settings_note(request)}; shaded: Melnikov function changes sign",
+        fontsize=10,
+    )
+    return fig
+
+
+def chaos_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
+    """The (axis 0, axis 1) plane coloured by LLE, the Melnikov boundary and an agreement
+    table. With both branches a cell shows the larger LLE of the two."""
+    ax0, ax1 = request.axes
+    v0, v1 = np.array(ax0.values()), np.array(ax1.values())
+    lle = np.full((ax1.num, ax0.num), np.nan)
+    index0 = {v: i for i, v in enumerate(ax0.values())}
+    index1 = {v: i for i, v in enumerate(ax1.values())}
+    for p in points:
+        if p.lle is None:
+            continue
+        i, j = index0[p.values[ax0.parameter]], index1[p.values[ax1.parameter]]
+        lle[j, i] = p.lle if np.isnan(lle[j, i]) else max(lle[j, i], p.lle)
+    fig = Figure(figsize=(8.4, 7.2), layout="constrained")
+    ax, tab = fig.subplots(2, 1, height_ratios=[5.0, 1.0])
+    finite = lle[np.isfinite(lle)]
+    span = float(np.max(np.abs(finite))) if finite.size else 1.0
+    norm = TwoSlopeNorm(0.0, -span or -1.0, span or 1.0)
+    mesh = ax.pcolormesh(v0, v1, np.ma.masked_invalid(lle), cmap="RdBu_r", norm=norm,
+                         shading="nearest")  # fmt: skip
+    ax.set_facecolor("0.7")
+    fig.colorbar(mesh, ax=ax, label=LLE_LABEL + "; grey: diverged", shrink=0.9)
+    g0 = np.linspace(v0.min(), v0.max(), BOUNDARY_GRID)
+    g1 = np.linspace(v1.min(), v1.max(), BOUNDARY_GRID)
+    strength = np.array(
+        [
+            [strength_at(request.params, {ax0.parameter: a, ax1.parameter: b}) for a in g0]
+            for b in g1
+        ]
+    )
+    if np.nanmin(strength) < 0.0 < np.nanmax(strength):
+        ax.contourf(g0, g1, strength, levels=[0.0, np.inf], colors="none", hatches=["//"])
+        ax.contour(g0, g1, strength, levels=[0.0], colors="black", linewidths=1.6)
+    ax.plot([], [], c="black", lw=1.6, label="Melnikov boundary (hatched: chaos possible)")
+    ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
+    ax.set_xlabel(f"{SYMBOLS[ax0.parameter]} (dimensionless)")
+    ax.set_ylabel(f"{SYMBOLS[ax1.parameter]} (dimensionless)")
+    ax.set_title(
+        f"Chaos map, colour = largest Lyapunov exponent: {_fixed(request)}\n"
+        f"{_settings_note(request)}",
+        fontsize=10,
+    )
+    agree = agreement_table(points)
+    tab.axis("off")
+    tab.table(
+        cellText=[
+            ["numerically chaotic", agree.chaotic_inside, agree.chaotic_outside],
+            [
+                "not chaotic (periodic, quasi-periodic, diverged)",
+                agree.regular_inside,
+                agree.regular_outside,
+            ],
+        ],
+        colLabels=["points", "inside Melnikov region", "outside Melnikov region"],
+        colWidths=[0.5, 0.25, 0.25],
+        cellLoc="center",
+        bbox=[0.0, 0.0, 1.0, 1.0],
+    )
+    tab.set_title("Agreement of the numerical and the Melnikov verdicts", fontsize=9)
+    return fig

@@ -1,0 +1,105 @@
+"""The plan of a sweep: its points split into chunks (the unit of work of the job queue), and
+its cost in RK4 steps.
+
+Chunk i depends only on (request, i, chunk size), so a chunk computed twice gives the same bytes
+and an interrupted sweep resumes exactly.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from gearengine.model.aliases import with_aliases
+from gearengine.numerics.settings import work
+from gearengine.sweeps.request import SweepBranch, SweepRequest
+
+DEFAULT_CHUNK_POINTS = 64
+"""Points per chunk without continuation (the service's sweep_chunk_points default)."""
+
+
+FREQUENCY_ALIASES = frozenset({"Omega_k", "Omega_e", "Omega_p"})
+
+
+def sweep_work(request: SweepRequest) -> int:
+    """RK4 steps of the whole sweep, for the compute budget.
+
+    The steps per T0 depend on how the excitation frequencies line up, so every combination of
+    swept frequencies is costed; the other axes (amplitudes, damping, mean force) only switch an
+    excitation on or off, so their corners bound them.
+    """
+    freq = [a for a in request.axes if a.parameter in FREQUENCY_ALIASES]
+    rest = [a for a in request.axes if a.parameter not in FREQUENCY_ALIASES]
+    per_combination = request.n_points() // math.prod(a.num for a in freq)
+    corners = list(itertools.product(*((a.start, a.stop) for a in rest)))
+    total = 0
+    for values in itertools.product(*(a.values() for a in freq)):
+        point = dict(zip((a.parameter for a in freq), values, strict=True))
+        total += per_combination * max(
+            work(
+                with_aliases(
+                    request.params,
+                    {**point, **dict(zip((a.parameter for a in rest), c, strict=True))},
+                ),
+                request.settings,
+            )
+            for c in corners
+        )
+    return total
+
+
+@dataclass(frozen=True)
+class Chunk:
+    """A unit of work: grid points in the order computed, and how."""
+
+    index: int
+    points: list[tuple[int, ...]]
+    """Grid indices (i0, i1?) per point, in computation order."""
+    branch: SweepBranch | None
+    """With continuation: the branch of this line; None without continuation."""
+
+
+@dataclass(frozen=True)
+class SweepPlan:
+    """Deterministic split of a request's points into chunks.
+
+    Without continuation: ``chunk_points`` consecutive grid points per chunk (first axis
+    fastest). With continuation: one line along the first axis per chunk, for each value of the
+    second axis and each branch (up lines first).
+    """
+
+    request: SweepRequest
+    chunk_points: int = DEFAULT_CHUNK_POINTS
+
+    def _grid(self) -> list[tuple[int, ...]]:
+        shape = [a.num for a in self.request.axes]
+        return [tuple(reversed(ix)) for ix in np.ndindex(*reversed(shape))]
+
+    def n_chunks(self) -> int:
+        """Number of chunks."""
+        req = self.request
+        if req.continuation:
+            lines = req.axes[1].num if len(req.axes) == 2 else 1
+            return lines * len(req.branches())
+        return math.ceil(req.n_points() / self.chunk_points)
+
+    def chunk(self, index: int) -> Chunk:
+        """Chunk ``index`` (0 <= index < n_chunks())."""
+        req = self.request
+        if not 0 <= index < self.n_chunks():
+            raise IndexError(f"chunk {index} out of range 0..{self.n_chunks() - 1}")
+        if req.continuation:
+            lines = req.axes[1].num if len(req.axes) == 2 else 1
+            branch = req.branches()[index // lines]
+            rest = () if len(req.axes) == 1 else (index % lines,)
+            line = [(i0, *rest) for i0 in range(req.axes[0].num)]
+            return Chunk(index, line if branch == "up" else line[::-1], branch)
+        lo = index * self.chunk_points
+        return Chunk(index, self._grid()[lo : lo + self.chunk_points], None)
+
+    def point_counts(self) -> list[int]:
+        """Number of points of each chunk."""
+        return [len(self.chunk(i).points) for i in range(self.n_chunks())]

@@ -1,0 +1,58 @@
+"""POST /v1/thresholds and /v1/thresholds/plot: Melnikov threshold curves over a frequency."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from fastapi import APIRouter, Depends, Request, Response
+
+from gearengine.homoclinic import ThresholdCurve
+from gearengine.homoclinic.schemas import ThresholdsRequest
+from gearengine.homoclinic.thresholds import curve_of
+from gearengine.jsonio import dumps
+from gearengine.plots import MEDIA_TYPES, threshold_figure
+from service.api.deps import cached_compute, require_key
+from service.api.responses import IMAGE_RESPONSES, JSON, PROBLEMS, FormatQuery, image_format
+
+router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
+
+
+@router.post(
+    "/thresholds",
+    response_model=ThresholdCurve,
+    responses=PROBLEMS,
+    summary="Threshold curves of a control parameter over a frequency range",
+)
+async def post_thresholds(body: ThresholdsRequest, request: Request) -> Response:
+    """Where each Melnikov branch starts or stops changing sign as a frequency is swept
+    (paper Figs. 5, 12, 18): per frequency, the intervals of the parameter without chaos."""
+    request.app.state.limits.check_curve(body)
+    return await cached_compute(
+        request,
+        "thresholds",
+        body.model_dump_json(),
+        lambda: (dumps(curve_of(body)).encode(), JSON),
+    )
+
+
+@router.post(
+    "/thresholds/plot",
+    response_class=Response,
+    responses=IMAGE_RESPONSES,
+    summary="Melnikov threshold curves as a figure",
+)
+async def post_threshold_plot(
+    body: ThresholdsRequest,
+    request: Request,
+    format: Literal["png", "svg"] | None = FormatQuery,
+) -> Response:
+    """The paper's Figs. 5, 12, 18: critical values of the parameter against the frequency,
+    the band without chaos shaded, the design's value marked."""
+    fmt = image_format(request, format)
+    request.app.state.limits.check_curve(body)
+    return await cached_compute(
+        request,
+        f"thresholds/plot.{fmt}",
+        body.model_dump_json(),
+        lambda: (threshold_figure(curve_of(body), fmt), MEDIA_TYPES[fmt]),
+    )
