@@ -4,8 +4,9 @@ Data flow: ``settings`` (periods, steps, starts; what a run costs) -> ``forcing`
 excitations as kernel arrays, the RK4 step plan) -> ``kernels`` (numba RK4 with the tangent
 equation; kink splitting for the piecewise law; a SIMD batch) -> ``runs`` (one start:
 ``periodicity``, ``lyapunov``, ``classify``) -> ``simulation`` (one design: ``diagnostics``,
-``nolds_check``) and ``batch`` (many designs), with the documents in ``results``. Imports only
-the model room.
+``nolds_check``, ``floquet``: multipliers and stability margin of a periodic response) and
+``batch`` (many designs), with the documents in ``results``; ``bifurcations`` locates the
+bifurcation points along a line of parameter values. Imports only the model room.
 """
 
 from gearengine.numerics.batch import simulate_batch

@@ -14,7 +14,7 @@ from gearengine.numerics import kernels
 from gearengine.numerics.classify import DIVERGENCE_BOUND, severity
 from gearengine.numerics.forcing import law, packed_forcing, step_plan
 from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
-from gearengine.numerics.runs import Run, StartVerdict, integrate, start_verdict
+from gearengine.numerics.runs import Run, StartVerdict, finite_or_none, integrate, start_verdict
 from gearengine.numerics.settings import SimulationSettings, check_work
 
 
@@ -34,6 +34,7 @@ def batch_point(runs: list[tuple[Run, StartVerdict]]) -> BatchPoint:
         impact_regime=v.summary.impact_regime,
         poincare=np.column_stack([run.xs[:n_ok], run.vs[:n_ok]])[-BATCH_POINCARE:].tolist(),
         start_index=idx,
+        x_peak_to_peak=None if run.diverged else finite_or_none(run.xmax - run.xmin),
     )
 
 

@@ -3,6 +3,8 @@ points of a sweep)."""
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.numerics.nolds_check import NoldsResult
@@ -45,6 +47,39 @@ class StartSummary(_Result):
     final_state: list[float] | None
 
 
+Bifurcation = Literal["period_doubling", "fold", "neimark_sacker"]
+"""How a Floquet multiplier leaves the unit circle: through -1, through +1, or as a complex pair."""
+
+
+class FloquetResult(_Result):
+    """Floquet analysis of one periodic orbit of period n T0, Newton-refined by shooting
+    (``numerics.floquet``; docs/floquet.md)."""
+
+    period: int = Field(description="Period n of the orbit, in sampling intervals T0.")
+    steps_per_period: int = Field(description="RK4 steps N per T0 used for the flow and Phi.")
+    multipliers: list[list[float]] = Field(
+        description="Floquet multipliers (eigenvalues of the monodromy matrix Phi) "
+        "[[re, im], [re, im]], largest modulus first."
+    )
+    stability_margin: float = Field(
+        description="1 - max |lambda|: > 0 stable, < 0 unstable; distance to the unit circle."
+    )
+    nearest_bifurcation: Bifurcation = Field(
+        description="Where the dominant multiplier points now (not a prediction along a "
+        "parameter path): period_doubling (real, negative: would leave through -1), fold "
+        "(real, positive: through +1), neimark_sacker (complex pair; impossible for Eq. 9 with "
+        "constant damping, see notes)."
+    )
+    orbit_state: list[float] = Field(description="Refined orbit state [x, v] at t = 0 mod T0.")
+    orbit_residual: float = Field(description="|phi_{n T0}(X) - X| at the refined state X.")
+    newton_steps: int = Field(description="Newton updates applied to the initial state.")
+    converged: bool = Field(description="orbit_residual < 1e-11 max(1, |X|).")
+    liouville_error: float = Field(
+        description="|det Phi - exp(-2 mu n T0)| / exp(-2 mu n T0): the RK4 error of Phi."
+    )
+    notes: list[str] = Field(description="Remarks on the result.")
+
+
 class NumericsResult(_Result):
     """Numerical verdict. Detailed fields describe the worst-case start (``worst_case``)."""
 
@@ -68,6 +103,13 @@ class NumericsResult(_Result):
     starts: list[StartSummary] = Field(description="One verdict per initial state.")
     worst_case: StartSummary = Field(description="The worst start.")
     notes: list[str] = Field(description="Remarks on choices and limitations.")
+    floquet: FloquetResult | None = Field(
+        None,
+        description="Floquet multipliers and stability margin of the worst start's periodic "
+        "orbit; null when the response is not periodic, the forcing has no common period or "
+        "Newton shooting did not converge (floquet_note says which).",
+    )
+    floquet_note: str | None = Field(None, description="Why floquet is null; else null.")
 
 
 class BatchPoint(_Result):
@@ -81,3 +123,6 @@ class BatchPoint(_Result):
     impact_regime: str | None = Field(description="no_impact | single_sided | double_sided.")
     poincare: list[list[float]] = Field(description=f"Last <= {BATCH_POINCARE} strobes.")
     start_index: int = Field(description="Index of the worst start in settings.starts().")
+    x_peak_to_peak: float | None = Field(
+        None, description="max x - min x over the record (units of b), null if diverged."
+    )

@@ -28,6 +28,7 @@ from gearengine.numerics.diagnostics import (
     spectrum_peaks,
     time_history,
 )
+from gearengine.numerics.floquet import floquet_of
 from gearengine.numerics.forcing import StepPlan, step_plan
 from gearengine.numerics.nolds_check import lyap_r_check
 from gearengine.numerics.results import NumericsResult, SpectrumPeak, TimeHistory
@@ -47,7 +48,10 @@ def simulate(params: GearParams, settings: SimulationSettings | None = None) -> 
     """Integrate Eq. (9) from every start of ``settings`` and return the numerical verdict.
 
     The detailed fields (LLE statistics, spectrum, Poincare points, time history, nolds) describe
-    the worst start; ``starts`` holds a summary per start.
+    the worst start; ``starts`` holds a summary per start. A periodic worst start under
+    commensurate forcing also gets its Floquet multipliers and stability margin (``floquet``:
+    Newton shooting from its last strobe, ``numerics.floquet``); otherwise ``floquet_note``
+    says why there are none.
     """
     settings = settings or SimulationSettings()
     plan = step_plan(params, settings.steps_per_period)
@@ -70,8 +74,11 @@ def simulate(params: GearParams, settings: SimulationSettings | None = None) -> 
         "worst_case": wv.summary,
     }
     if worst.diverged:
-        return _diverged(base, worst, plan, notes)
-    return _detailed(base, worst, wv, plan, settings, notes)
+        result = _diverged(base, worst, plan, notes)
+    else:
+        result = _detailed(base, worst, wv, plan, settings, notes)
+    orbit, why = floquet_of(params, settings, result)
+    return result.model_copy(update={"floquet": orbit, "floquet_note": why})
 
 
 def _diverged(base: dict[str, Any], worst: Run, plan: StepPlan, notes: list[str]) -> NumericsResult:

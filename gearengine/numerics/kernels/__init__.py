@@ -3,7 +3,7 @@
     x' = v,    v' = -2 mu v - K(t) f_h(x) + F(t)                       (Eq. 9)
     dx' = dv,  dv' = -2 mu dv - K(t) f_h'(x) dx                        (tangent equation)
 
-Three kernels share one output layout (see ``run_rk4``):
+The three run kernels share one output layout (see ``run_rk4``); ``monodromy`` is the fourth:
 
 * ``run_rk4``: classical RK4 with N steps per sampling interval T0, forcing either tabulated once
   at the 2N+1 stage times of a period (commensurate forcing) or evaluated at absolute time
@@ -14,6 +14,8 @@ Three kernels share one output layout (see ``run_rk4``):
   Hermite interpolant of x over the substep, located by Illinois regula falsi on RK4 substeps to
   ~1e-13 h, and integration restarts there with the new region's field. The field is continuous
   across |x| = 1, so the tangent vector needs no saltation jump. Forcing at absolute time.
+* ``monodromy``: the flow over n intervals T0 and its 2x2 Jacobian (the monodromy matrix), for
+  Newton shooting and Floquet multipliers (``numerics.floquet``); both laws, same RK4 arithmetic.
 * ``run_batch``: cubic law only; many parameter points ("lanes") in lock-step, struct of arrays,
   inner loops over ``LANES`` lanes so LLVM vectorises, ``prange`` over chunks of lanes. Same
   arithmetic as ``run_rk4`` with a forcing table.
@@ -30,6 +32,7 @@ F(t) = fm + sum fc0 cos(fc1 t + fc2).
 
 from gearengine.numerics.kernels.kink import run_kink
 from gearengine.numerics.kernels.lockstep import LANES, run_batch
+from gearengine.numerics.kernels.monodromy import monodromy
 from gearengine.numerics.kernels.smooth import (
     SQRT1_2,
     forcing_at,
@@ -45,6 +48,7 @@ __all__ = [
     "forcing_at",
     "forcing_table",
     "law_force",
+    "monodromy",
     "region_force",
     "run_batch",
     "run_kink",

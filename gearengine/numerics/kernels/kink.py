@@ -74,7 +74,7 @@ def _rk4_region(
 
 
 @njit(**JIT_OPTIONS)
-def _kink_step(
+def kink_step(
     reg: int,
     alpha: float,
     twomu: float,
@@ -88,7 +88,10 @@ def _kink_step(
     dx: float,
     dv: float,
 ) -> tuple[float, float, float, float, int]:  # pragma: no cover - compiled
-    """Advance (x, v, dx, dv) from t by h, splitting at every switching time |x| = 1."""
+    """Advance (x, v, dx, dv) from t by h, splitting at every switching time |x| = 1.
+
+    Returns the new (x, v, dx, dv) and region; public because ``kernels.monodromy`` steps the
+    two columns of the monodromy matrix with it."""
     rem = h
     tc = t
     for _ in range(16):
@@ -198,7 +201,7 @@ def run_kink(
     for n in range(n_trans + n_rec):
         rec = n >= n_trans
         for j in range(N):
-            x, v, dx, dv, reg = _kink_step(
+            x, v, dx, dv, reg = kink_step(
                 reg, alpha, twomu, kc, fm, fc, n * T + j * h, h, x, v, dx, dv
             )
             xmin = min(xmin, x)
