@@ -4,18 +4,24 @@ saddle intersect transversally?
 Data flow: ``coefficients`` (the sinusoids of M(tau0), Eq. 19, closed form or quadrature) ->
 ``extrema`` (min and max of M over tau0) -> ``thresholds`` (critical values of each control
 parameter and the design's margin) -> ``verdict`` (``melnikov``: the whole answer), with the
-request and result documents in ``schemas``. Imports only the model room.
+request and result documents in ``schemas``; ``batch`` (``melnikov_batch``) gives verdicts and
+margins of many designs at once; ``kernels`` holds the compiled inner loops. Imports only the
+model room.
 """
 
+from gearengine.homoclinic.batch import MelnikovBatchRequest, MelnikovBatchResult, melnikov_batch
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult, ThresholdCurve
 from gearengine.homoclinic.thresholds import chaos_possible, threshold_curve
 from gearengine.homoclinic.verdict import melnikov
 
 __all__ = [
+    "MelnikovBatchRequest",
+    "MelnikovBatchResult",
     "MelnikovRequest",
     "MelnikovResult",
     "ThresholdCurve",
     "chaos_possible",
     "melnikov",
+    "melnikov_batch",
     "threshold_curve",
 ]

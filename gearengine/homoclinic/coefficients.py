@@ -288,3 +288,20 @@ def melnikov_coefficients(
     return BranchCoefficients.model_construct(
         damping=per_unit_damping * params.damping, damping_per_unit=per_unit_damping, terms=terms
     )
+
+
+def active_only(coef: BranchCoefficients, params: GearParams) -> BranchCoefficients:
+    """``melnikov_coefficients(params, ...)`` from the same call with ``include_inactive``: the
+    zero-amplitude first harmonics dropped, so one evaluation per branch (one quadrature per
+    term with ``method="quadrature"``) serves both the verdict and the thresholds."""
+    amplitudes = [
+        0.0 if h is None else h.amplitude
+        for _, exc in params.excitations()
+        for r, h in (list(enumerate(exc.harmonics, start=1)) or [(1, None)])
+        if r == 1 or h.amplitude != 0.0
+    ]
+    return BranchCoefficients.model_construct(
+        damping=coef.damping,
+        damping_per_unit=coef.damping_per_unit,
+        terms=[t for t, amp in zip(coef.terms, amplitudes, strict=True) if amp != 0.0],
+    )

@@ -12,18 +12,17 @@ the building block of the thresholds (Eqs. 23, 24, 28-30 generalised).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 
+from gearengine.homoclinic import kernels
+from gearengine.homoclinic.kernels import CANDIDATES, GRID_PER_CYCLE, MAX_GRID, NEWTON_STEPS
 from gearengine.model.frequencies import forcing_period
 
-GRID_PER_CYCLE = 16
-MAX_GRID = 1 << 16
-NEWTON_STEPS = 5
-CANDIDATES = 4
 NEGLIGIBLE = 1e-200
 """Coefficients smaller than this are treated as zero by the threshold search."""
 
@@ -113,7 +112,7 @@ def extrema(m: TrigSum) -> Extrema:
     m = TrigSum(m.offset, m.amplitudes[active], m.frequencies[active], m.phases[active])
     if m.amplitudes.size == 1:
         return _single(m)
-    period = forcing_period(m.frequencies.tolist())
+    period = _period(tuple(m.frequencies.tolist()))
     if period is None:
         spread = float(np.abs(m.amplitudes).sum())
         return Extrema(
@@ -155,17 +154,21 @@ def sublevel_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
     m0 and g must share frequencies and phases (g holds the per-unit coefficients of p, m0 the
     rest). The max over tau0 of an affine family is convex in p, so the set is an interval
     (possibly empty: None). Exact method: grid estimate by the envelope of lines, then Newton on
-    phi(p) = max_tau0 (m0 + p g) = 0 with phi'(p) = g(tau*) (envelope theorem). Supremum method
-    (incommensurate): phi(p) = m0.offset + p g.offset + sum_i |m0_i + p g_i|, solved exactly.
-    Coefficients below NEGLIGIBLE (e.g. sech of a huge argument, underflowing through the
-    subnormals) are taken as 0, so that -m0 / g cannot overflow.
+    phi(p) = max_tau0 (m0 + p g) = 0 with phi'(p) = g(tau*) (envelope theorem, compiled in
+    ``kernels.sublevel_root``). Supremum method (incommensurate), and the closed form of a single
+    sinusoid, whose maximum is attained: phi(p) = m0.offset + p g.offset + sum_i |m0_i + p g_i|,
+    solved exactly (Eqs. 23-24 are this case). Coefficients below NEGLIGIBLE (e.g. sech of a huge
+    argument, underflowing through the subnormals) are taken as 0, so that -m0 / g cannot
+    overflow.
     """
+    if m0.amplitudes.size <= 1:
+        return _one_sinusoid_interval(m0, g)
     m0, g = _flushed(m0), _flushed(g)
     freqs = m0.frequencies
     active = (m0.amplitudes != 0.0) | (g.amplitudes != 0.0)
-    period = forcing_period(freqs[active].tolist()) if active.any() else None
     if not active.any():
         return _affine_nonpositive(m0.offset, g.offset)
+    period = None if active.sum() == 1 else _period(tuple(freqs[active].tolist()))
     if period is None:
         return _supremum_interval(m0, g, active)
     taus = grid(freqs[active], period)
@@ -180,17 +183,55 @@ def sublevel_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
     hi = None if hi is not None and hi == np.inf else hi
     if lo is not None and hi is not None and lo > hi:
         return None
-
-    def phi(p: float) -> tuple[float, float]:
-        fam = TrigSum(m0.offset + p * g.offset, m0.amplitudes + p * g.amplitudes, freqs, m0.phases)
-        top = maximum(fam, period, taus)
-        return top.value, float(g(np.array([top.tau0]))[0])
-
-    lo = None if lo is None else _newton_root(phi, lo)
-    hi = None if hi is None else _newton_root(phi, hi)
+    args = (m0.offset, m0.amplitudes, g.offset, g.amplitudes, freqs, m0.phases, period, taus)
+    lo = None if lo is None else float(kernels.sublevel_root(*args, lo))
+    hi = None if hi is None else float(kernels.sublevel_root(*args, hi))
     if lo is not None and hi is not None and lo > hi:
         return None
     return Interval(lo, hi)
+
+
+@functools.lru_cache(maxsize=4096)
+def _period(frequencies: tuple[float, ...]) -> float | None:
+    """``forcing_period`` of a set of frequencies, remembered (thresholds ask for the same sets)."""
+    return forcing_period(list(frequencies))
+
+
+def _flush(v: float) -> float:
+    return 0.0 if abs(v) < NEGLIGIBLE else v
+
+
+def _one_sinusoid_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
+    """``sublevel_interval`` of sums with at most one sinusoid, on Python floats.
+
+    phi(p) = (m0.offset + p g.offset) + |a + p b| is convex piecewise linear with one kink
+    k = -a / b (Eqs. 23-24 are its roots); the steps and roundings are those of
+    ``_supremum_interval`` for one term, without arrays.
+    """
+    off0, offg = _flush(float(m0.offset)), _flush(float(g.offset))
+    a = _flush(float(m0.amplitudes[0])) if m0.amplitudes.size else 0.0
+    b = _flush(float(g.amplitudes[0])) if g.amplitudes.size else 0.0
+    if b == 0.0:
+        return _affine_nonpositive(off0 + abs(a) if a != 0.0 else off0, offg)
+    base = off0 + 0.0
+    kinks = (-math.inf, -a / b, math.inf)
+    sign = 1.0 if b > 0.0 else -1.0
+    lo, hi = math.inf, -math.inf
+    for j in (0, 1):  # piece j lies between kinks j-1 and j
+        s = sign if j else -sign
+        alpha, beta = base + s * a, offg + s * b
+        left, right = kinks[j], kinks[j + 1]
+        if beta > 0.0:
+            right = min(right, -alpha / beta)
+        elif beta < 0.0:
+            left = max(left, -alpha / beta)
+        elif alpha > 0.0:
+            continue
+        if left <= right:
+            lo, hi = min(lo, left), max(hi, right)
+    if lo > hi:
+        return None
+    return Interval(None if lo == -math.inf else lo, None if hi == math.inf else hi)
 
 
 def _flushed(m: TrigSum) -> TrigSum:
@@ -210,19 +251,6 @@ def _line_envelope(mv: np.ndarray, gv: np.ndarray) -> tuple[float | None, float 
     lo = float(np.max(-mv[neg] / gv[neg])) if neg.any() else None
     hi = float(np.min(-mv[pos] / gv[pos])) if pos.any() else None
     return lo, hi
-
-
-def _newton_root(phi, p: float) -> float:
-    """Root of the convex phi near p: Newton, which is monotone from outside the sublevel set."""
-    for _ in range(30):
-        value, slope = phi(p)
-        if slope == 0.0:
-            break
-        step = value / slope
-        p -= step
-        if abs(step) <= 1e-14 * max(1.0, abs(p)):
-            break
-    return p
 
 
 def _affine_nonpositive(offset: float, slope: float) -> Interval | None:

@@ -5,11 +5,17 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
 
 from gearengine.homoclinic.coefficients import BranchCoefficients, HomoclinicBranch, Method
+from gearengine.model.design import ParamsOrDesign
 from gearengine.model.examples import PAPER_SECTION_41
-from gearengine.model.params import GearParams, request_config
+from gearengine.model.params import MIN_FREQUENCY, request_config
+
+WholeNumber = Annotated[
+    int, BeforeValidator(lambda v: int(v) if isinstance(v, float) and v.is_integer() else v)
+]
+"""An integer as JSON Schema counts them: 2.0 is the integer 2 (strict mode refuses floats)."""
 
 Bounds = Annotated[list[float | None], Field(min_length=2, max_length=2)]
 """A closed interval [lo, hi] of a parameter; null marks an unbounded end. (A list, not a tuple:
@@ -123,38 +129,52 @@ class ThresholdCurve(_Result):
 # --- requests ---------------------------------------------------------------------------
 
 
-class MelnikovRequest(BaseModel):
+class MelnikovRequest(ParamsOrDesign):
     """``{"params": {...}}``: the Melnikov verdict of one design."""
 
     model_config = request_config({"params": PAPER_SECTION_41})
 
-    params: GearParams = Field(description="Dimensionless parameters of Eq. (9).")
     method: Method = Field(
         "closed_form",
         description="closed_form: corrected Eq. (19); quadrature: Eq. (18) integrated numerically.",
     )
 
 
-class ThresholdsRequest(BaseModel):
+class ThresholdsRequest(ParamsOrDesign):
     """Threshold curves of ``parameter`` while ``frequency_parameter`` runs over a range."""
 
     model_config = request_config()
 
-    params: GearParams = Field(description="The design; other parameters stay fixed.")
     parameter: Literal["F_e1", "mu", "k_p1", "F_p1"] = Field(
         "F_e1", description="Control parameter whose critical values are traced."
     )
     frequency_parameter: Literal["Omega_e", "Omega_k", "Omega_p"] = Field(
-        "Omega_e", description="Frequency swept along the horizontal axis."
+        "Omega_e",
+        description="Frequency swept along the horizontal axis; its excitation (Omega_e: "
+        "transmission_error, Omega_k: stiffness, Omega_p: torque) must be given in params.",
     )
-    start: float = Field(0.05, gt=0.0, le=1e3, description="First frequency (dimensionless).")
-    stop: float = Field(2.5, gt=0.0, le=1e3, description="Last frequency (dimensionless).")
-    num: int = Field(100, ge=2, le=100_000, description="Number of frequencies.")
-
-    @field_validator("stop")
-    @classmethod
-    def _after_start(cls, stop: float, info: ValidationInfo) -> float:
-        start = info.data.get("start")
-        if start is not None and stop <= start:
-            raise ValueError("stop must be greater than start")
-        return stop
+    start: float = Field(
+        0.05,
+        ge=MIN_FREQUENCY,
+        le=1e3,
+        description="First frequency (dimensionless, 1e-6 to 1000).",
+        examples=[0.05],
+    )
+    stop: float = Field(
+        2.5,
+        ge=MIN_FREQUENCY,
+        le=1e3,
+        description="Last frequency (dimensionless, 1e-6 to 1000); below start the "
+        "frequencies run downwards.",
+        examples=[2.5],
+    )
+    num: WholeNumber = Field(
+        100,
+        ge=2,
+        le=100_000,
+        description="Number of frequencies, start and stop included (the service caps it at "
+        "max_curve_points, default 2000).",
+        examples=[100],
+    )
+    # No rule joins start and stop (JSON Schema could not state it): the grid is
+    # numpy.linspace(start, stop, num) in either direction, as a sweep axis is.

@@ -9,14 +9,17 @@ for every term and harmonic. Omega_e enters M non-linearly and is scanned.
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 
 import numpy as np
 from scipy import optimize
 
+from gearengine.homoclinic import kernels
 from gearengine.homoclinic.coefficients import (
     BRANCH_SIGN,
     BranchCoefficients,
     HomoclinicBranch,
+    Method,
     melnikov_coefficients,
     saddle_loop,
 )
@@ -29,6 +32,7 @@ from gearengine.homoclinic.schemas import (
 )
 from gearengine.model.aliases import get_alias, with_alias, with_aliases
 from gearengine.model.backlash import melnikov_cubic
+from gearengine.model.frequencies import MAX_DENOMINATOR, RATIO_TOLERANCE
 from gearengine.model.params import GearParams
 
 CONTROL_PARAMETERS = ("F_e1", "mu", "k_p1", "F_p1")
@@ -42,16 +46,21 @@ DOMAIN = {"mu": Interval(0.0, None)}
 OMEGA_SCAN = (0.05, 3.0, 60)
 """Default Omega_e scan for critical frequencies: start, stop, number of points."""
 
+Coefficients = dict[HomoclinicBranch, BranchCoefficients]
+"""Per-unit coefficients of both branches, inactive first harmonics included."""
 
-def sign_change_strength(params: GearParams, a: float, c: float) -> float:
+
+def sign_change_strength(
+    params: GearParams, a: float, c: float, method: Method = "closed_form"
+) -> float:
     """max over branches of min(max M, -min M): > 0 iff some branch changes sign.
 
     Continuous in the parameters (for a fixed set of commensurate frequencies), so its roots
-    are the critical values of any parameter.
+    are the critical values of any parameter. ``method`` names the coefficients (``METHODS``).
     """
     strengths = []
     for br in BRANCH_SIGN:
-        ext = extrema(melnikov_coefficients(params, a, c, br).trig_sum())
+        ext = extrema(melnikov_coefficients(params, a, c, br, method).trig_sum())
         strengths.append(min(ext.maximum.value, -ext.minimum.value))
     return max(strengths)
 
@@ -163,16 +172,35 @@ def _threshold(
     )
 
 
+def unit_coefficients(params: GearParams, a: float, c: float, method: Method) -> Coefficients:
+    """Coefficients of both branches with the inactive first harmonics (for thresholds): built
+    once per branch, then split per control parameter by ``_family``."""
+    return {
+        br: melnikov_coefficients(params, a, c, br, method, include_inactive=True)
+        for br in BRANCH_SIGN
+    }
+
+
 def parameter_threshold(
-    params: GearParams, parameter: str, a: float, c: float
+    params: GearParams,
+    parameter: str,
+    a: float,
+    c: float,
+    method: Method = "closed_form",
+    coefs: Coefficients | None = None,
 ) -> ParameterThreshold:
-    """Critical values of one control parameter (others fixed) and the design's margin."""
+    """Critical values of one control parameter (others fixed) and the design's margin.
+
+    ``coefs`` are the branches' ``unit_coefficients`` if already known (else computed with
+    ``method``).
+    """
     value = get_alias(params, parameter)
     domain = DOMAIN.get(parameter, Interval(None, None))
+    coefs = unit_coefficients(params, a, c, method) if coefs is None else coefs
     branches: dict[HomoclinicBranch, BranchThreshold] = {}
     sets: dict[HomoclinicBranch, list[Interval]] = {}
     for br in BRANCH_SIGN:
-        family = _family(melnikov_coefficients(params, a, c, br, include_inactive=True), parameter)
+        family = _family(coefs[br], parameter)
         if family is None:
             exc = _TERM_OF[parameter]
             return _threshold(
@@ -193,7 +221,11 @@ def parameter_threshold(
 
 
 def frequency_threshold(
-    params: GearParams, a: float, c: float, scan: tuple = OMEGA_SCAN
+    params: GearParams,
+    a: float,
+    c: float,
+    scan: tuple = OMEGA_SCAN,
+    method: Method = "closed_form",
 ) -> ParameterThreshold:
     """Critical Omega_e in a scan: where the verdict flips, located by brentq.
 
@@ -201,13 +233,78 @@ def frequency_threshold(
     fixed): the commensurability of the forcing, and so the extrema method, stays the same along
     the scan and the sign-change strength is continuous, so each root is a real flip. (Moving
     Omega_e alone would jump between exact extrema at rational ratios and the supremum between
-    them, and the verdict would flip at isolated points.)
+    them, and the verdict would flip at isolated points.) The closed form runs compiled
+    (``kernels.scan_roots``); quadrature, and the rare scan on which a coefficient underflows to
+    0, take ``_scan_python``, the same algorithm on the pydantic documents.
     """
     value = get_alias(params, "Omega_e")
     if value is None:
         return _threshold(
             None, [], [], scan=scan, note="transmission_error is not given: no Omega_e to scan"
         )
+    found = _scan_compiled(params, a, c, scan, value) if method == "closed_form" else None
+    critical, no_chaos = found or _scan_python(params, a, c, scan, value, method)
+    return _threshold(
+        value,
+        critical,
+        no_chaos,
+        scan=scan,
+        note="critical Omega_e found by scanning with every excitation frequency scaled "
+        "alongside (ratios fixed, as a change of running speed); flips between scan points "
+        "closer than the grid step may be missed",
+    )
+
+
+def scan_terms(params: GearParams) -> tuple[np.ndarray, ...]:
+    """The active harmonics as arrays (fundamental, r, kind, amplitude, phase), in the order of
+    ``melnikov_coefficients``: the per-unit coefficients are functions of r Omega alone."""
+    rows = [
+        (exc.frequency, r, kernels.KIND[name], h.amplitude, h.phase)
+        for name, exc in params.excitations()
+        for r, h in exc.active()
+    ]
+    table = np.array(rows, dtype=float).reshape(len(rows), 5).T
+    return table[0], table[1], table[2].astype(np.int64), table[3], table[4]
+
+
+def commensurability(frequencies: list[float]) -> tuple[float, float]:
+    """(gcd, lcm) with Omega_0 = top * gcd / lcm (``model.frequencies.common_frequency``, whose
+    steps these are); (0, 1) when incommensurate or empty. Scaling every frequency by one factor
+    keeps the ratios, so one answer serves a whole running-speed scan."""
+    freqs = sorted({f for f in frequencies if f > 0.0})
+    if not freqs:
+        return 0.0, 1.0
+    top = freqs[-1]
+    ratios = []
+    for f in freqs:
+        q = Fraction(f / top).limit_denominator(MAX_DENOMINATOR)
+        if abs(float(q) - f / top) > RATIO_TOLERANCE * (f / top):
+            return 0.0, 1.0
+        ratios.append(q)
+    lcm = math.lcm(*(q.denominator for q in ratios))
+    return float(math.gcd(*(q.numerator * (lcm // q.denominator) for q in ratios))), float(lcm)
+
+
+def _scan_compiled(
+    params: GearParams, a: float, c: float, scan: tuple, value: float
+) -> tuple[list[float], list[tuple[float, float]]] | None:
+    """Critical Omega_e and no-chaos pieces by ``kernels.scan_roots``; None to fall back."""
+    start, stop, num = scan
+    base, r, kind, amp, phase = scan_terms(params)
+    gcd, lcm = commensurability((r * base).tolist())
+    omegas = np.linspace(start, stop, num)
+    args = (value, base, r, kind, amp, phase, float(params.damping), a, c, gcd, lcm)
+    critical, flags, ok = kernels.scan_roots(omegas, 1e-12, *args)
+    if not ok:
+        return None
+    edges = [float(start), *critical.tolist(), float(stop)]
+    return critical.tolist(), [(edges[i], edges[i + 1]) for i in np.flatnonzero(flags)]
+
+
+def _scan_python(
+    params: GearParams, a: float, c: float, scan: tuple, value: float, method: Method
+) -> tuple[list[float], list[tuple[float, float]]]:
+    """The running-speed scan on the documents: ``sign_change_strength`` with ``method``."""
     start, stop, num = scan
 
     def strength(om: float) -> float:
@@ -216,7 +313,7 @@ def frequency_threshold(
             name: exc.model_copy(update={"frequency": exc.frequency * factor})
             for name, exc in params.excitations()
         }
-        return sign_change_strength(params.model_copy(update=moved), a, c)
+        return sign_change_strength(params.model_copy(update=moved), a, c, method)
 
     omegas = np.linspace(start, stop, num)
     values = [strength(om) for om in omegas]
@@ -231,15 +328,7 @@ def frequency_threshold(
         for i in range(len(edges) - 1)
         if strength(0.5 * (edges[i] + edges[i + 1])) <= 0.0
     ]
-    return _threshold(
-        value,
-        critical,
-        no_chaos,
-        scan=scan,
-        note="critical Omega_e found by scanning with every excitation frequency scaled "
-        "alongside (ratios fixed, as a change of running speed); flips between scan points "
-        "closer than the grid step may be missed",
-    )
+    return critical, no_chaos
 
 
 def threshold_curve(

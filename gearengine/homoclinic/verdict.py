@@ -9,19 +9,16 @@ from __future__ import annotations
 
 import math
 
-from gearengine.homoclinic.coefficients import (
-    BRANCH_SIGN,
-    Method,
-    melnikov_coefficients,
-    saddle_loop,
-)
+from gearengine.homoclinic.coefficients import BRANCH_SIGN, Method, active_only, saddle_loop
 from gearengine.homoclinic.extrema import Extrema, extrema
 from gearengine.homoclinic.schemas import BranchVerdict, MelnikovResult
 from gearengine.homoclinic.thresholds import (
     CONTROL_PARAMETERS,
     OMEGA_SCAN,
+    Coefficients,
     frequency_threshold,
     parameter_threshold,
+    unit_coefficients,
 )
 from gearengine.model.backlash import melnikov_cubic
 from gearengine.model.frequencies import forcing_period
@@ -56,6 +53,32 @@ def not_applicable(a: float, c: float, method: Method, notes: list[str]) -> Meln
     )
 
 
+def applicability(
+    params: GearParams, method: Method = "closed_form"
+) -> tuple[float, float, list[str], Coefficients | None]:
+    """(a, c, notes, units) of a design: the cubic law, its notes, and the per-unit coefficients
+    of both branches (``unit_coefficients``); units is None when the criterion does not apply
+    (no saddle loop, or M overflows), and the last note says why."""
+    a, c, notes = melnikov_cubic(params.backlash)
+    if not saddle_loop(a, c):
+        notes.append(
+            f"not applicable: the homoclinic orbit of x'' = a x - c x^3 needs a > 0 and "
+            f"c > 0 (got a = {a:g}, c = {c:g}); without a saddle loop there is no "
+            "Melnikov criterion"
+        )
+        return a, c, notes, None
+    # every per-unit coefficient the thresholds will use, inactive first harmonics included
+    units = unit_coefficients(params, a, c, method)
+    scale = [units["plus"].damping_per_unit, *(t.per_unit for t in units["plus"].terms)]
+    if not all(math.isfinite(v) and abs(v) < 1e150 for v in scale):
+        notes.append(
+            f"not applicable: with a = {a:g}, c = {c:g} the orbit's scale sqrt(2a/c) makes "
+            "M overflow; the Melnikov function is numerically meaningless here"
+        )
+        return a, c, notes, None
+    return a, c, notes, units
+
+
 def melnikov(
     params: GearParams, method: Method = "closed_form", omega_scan: tuple = OMEGA_SCAN
 ) -> MelnikovResult:
@@ -63,37 +86,14 @@ def melnikov(
 
     Args:
         params: dimensionless parameters of Eq. (9), evaluated with epsilon = 1.
-        method: ``closed_form`` or ``quadrature`` for the coefficients of M.
+        method: ``closed_form`` or ``quadrature`` for the coefficients of M, used everywhere:
+            the branch extrema, the thresholds and the Omega_e scan.
         omega_scan: (start, stop, num) of the Omega_e scan for critical frequencies.
     """
-    a, c, notes = melnikov_cubic(params.backlash)
-    if not saddle_loop(a, c):
-        return not_applicable(
-            a,
-            c,
-            method,
-            [
-                *notes,
-                f"not applicable: the homoclinic orbit of x'' = a x - c x^3 needs a > 0 and "
-                f"c > 0 (got a = {a:g}, c = {c:g}); without a saddle loop there is no "
-                "Melnikov criterion",
-            ],
-        )
-    coefs = {br: melnikov_coefficients(params, a, c, br, method) for br in BRANCH_SIGN}
-    # every per-unit coefficient the thresholds will use, inactive first harmonics included
-    scaled = melnikov_coefficients(params, a, c, "plus", method, include_inactive=True)
-    scale = [scaled.damping_per_unit, *(t.per_unit for t in scaled.terms)]
-    if not all(math.isfinite(v) and abs(v) < 1e150 for v in scale):
-        return not_applicable(
-            a,
-            c,
-            method,
-            [
-                *notes,
-                f"not applicable: with a = {a:g}, c = {c:g} the orbit's scale sqrt(2a/c) makes "
-                "M overflow; the Melnikov function is numerically meaningless here",
-            ],
-        )
+    a, c, notes, units = applicability(params, method)
+    if units is None:
+        return not_applicable(a, c, method, notes)
+    coefs = {br: active_only(units[br], params) for br in BRANCH_SIGN}
     branches = {br: branch_verdict(extrema(coefs[br].trig_sum())) for br in BRANCH_SIGN}
     period = forcing_period(params.active_frequencies())
     if any(b.extrema == "supremum" for b in branches.values()):
@@ -103,8 +103,15 @@ def melnikov(
         )
     if params.mean_force != 0.0:
         notes.append("the mean force F_m does not enter M: the integral of y_h over the orbit is 0")
-    thresholds = {p: parameter_threshold(params, p, a, c) for p in CONTROL_PARAMETERS}
-    thresholds["Omega_e"] = frequency_threshold(params, a, c, omega_scan)
+    if method != "closed_form":
+        notes.append(
+            f"method {method}: the verdict, the thresholds and the Omega_e scan all use "
+            f"{method} coefficients"
+        )
+    thresholds = {
+        p: parameter_threshold(params, p, a, c, method, units) for p in CONTROL_PARAMETERS
+    }
+    thresholds["Omega_e"] = frequency_threshold(params, a, c, omega_scan, method)
     return MelnikovResult(
         applicable=True,
         chaos_possible=any(b.sign_change for b in branches.values()),

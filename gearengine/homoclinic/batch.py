@@ -1,0 +1,213 @@
+"""Melnikov verdicts and threshold margins of many designs at once (for optimisers).
+
+``melnikov_batch(designs)`` gives, per design, what an optimiser needs from ``melnikov``:
+``chaos_possible`` and the margin of each control parameter (F_e1, mu, k_p1, F_p1) to its
+nearest critical value, the same numbers as the full verdict's thresholds (no Omega_e scan).
+
+Designs with one excitation and at most its first harmonic (the paper's section 4.1 case) are
+evaluated together on arrays (``_simple``): with one sinusoid M = A + B sin(Omega tau0 + phi), the
+thresholds are the closed forms of Eqs. (23)-(24),
+
+    F_1 critical  = -/+ (-A / |B_unit|)                      (Eq. 23, any excitation's amplitude)
+    mu critical   = -|B| / A_unit,  A_unit = -(8/3) a^(3/2) / c          (Eq. 24)
+
+computed with the same operations as the single verdict (``extrema._one_sinusoid_interval``), so
+the numbers are the same to the last bit. Every other design (several excitations or harmonics,
+no saddle loop, zero damping, coefficients at the edge of the float range) takes the per-design
+path, ``melnikov``'s thresholds without the scan.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numba
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+from typing_extensions import TypedDict  # pydantic needs it on Python < 3.12
+
+from gearengine.homoclinic.coefficients import BRANCH_SIGN, active_only, saddle_loop
+from gearengine.homoclinic.extrema import NEGLIGIBLE, extrema
+from gearengine.homoclinic.kernels import KIND, damping_unit, unit_coefficient
+from gearengine.homoclinic.thresholds import CONTROL_PARAMETERS, parameter_threshold
+from gearengine.homoclinic.verdict import applicability
+from gearengine.model.backlash import melnikov_cubic
+from gearengine.model.examples import PAPER_SECTION_41
+from gearengine.model.params import GearParams, request_config
+
+MAX_DESIGNS = 10_000
+"""Largest number of designs in one POST /v1/melnikov/batch."""
+
+_PARAMETER_OF = {"transmission_error": "F_e1", "stiffness": "k_p1", "torque": "F_p1"}
+
+
+class Margin(TypedDict):
+    """Signed distance of a control parameter to its nearest critical value (null if none)."""
+
+    margin: float | None
+    relative_margin: float | None
+
+
+class BatchVerdict(TypedDict):
+    """One design's verdict: chaos possible (null: criterion not applicable) and margins."""
+
+    chaos_possible: bool | None
+    margins: dict[str, Margin]
+
+
+class MelnikovBatchRequest(BaseModel):
+    """``{"designs": [params, ...]}``: verdicts and margins of up to MAX_DESIGNS designs."""
+
+    model_config = request_config({"designs": [PAPER_SECTION_41]})
+
+    designs: list[GearParams] = Field(
+        min_length=1,
+        max_length=MAX_DESIGNS,
+        description=f"Dimensionless parameters of Eq. (9), one per design (1 to {MAX_DESIGNS}).",
+        examples=[[PAPER_SECTION_41]],
+    )
+
+
+class MelnikovBatchResult(BaseModel):
+    """Per design, in request order: chaos possible and the margin of F_e1, mu, k_p1, F_p1."""
+
+    model_config = ConfigDict(frozen=True)
+
+    results: list[BatchVerdict] = Field(
+        description="chaos_possible (null: criterion not applicable) and margins[parameter] = "
+        "{margin, relative_margin} as in the thresholds of POST /v1/melnikov (null: no critical "
+        "value)."
+    )
+
+
+def _margin(value: float, critical: Sequence[float]) -> Margin:
+    """``thresholds._threshold``'s margin: value - nearest, and over |nearest| (null if 0)."""
+    if not critical:
+        return {"margin": None, "relative_margin": None}
+    nearest = min(critical, key=lambda v: abs(value - v))
+    margin = value - nearest
+    return {"margin": margin, "relative_margin": margin / abs(nearest) if nearest != 0.0 else None}
+
+
+@numba.njit(cache=True, nogil=True)
+def _simple(kind, freq, amp, mu, a, c):  # pragma: no cover - compiled
+    """Per design: (status, chaos, amplitude critical H, mu critical R).
+
+    status 0: closed forms valid (critical F_1 = -/+H unless H is NaN, mu critical R unless NaN);
+    1: not applicable (M overflows, as ``verdict.applicability``); 2: take the per-design path.
+    """
+    n = kind.size
+    status = np.zeros(n, dtype=np.int8)
+    chaos = np.zeros(n, dtype=np.bool_)
+    h, r = np.full(n, np.nan), np.full(n, np.nan)
+    for j in range(n):
+        au = damping_unit(a[j], c[j])
+        bu = unit_coefficient(kind[j], freq[j], a[j], c[j], 1.0)
+        if not (math.isfinite(au) and abs(au) < 1e150 and math.isfinite(bu) and abs(bu) < 1e150):
+            status[j] = 1
+            continue
+        big_a, big_b = au * mu[j], bu * amp[j]
+        chaos[j] = big_a - abs(big_b) < 0.0 < big_a + abs(big_b)
+        if abs(big_a) < NEGLIGIBLE or abs(au) < NEGLIGIBLE or abs(bu) < NEGLIGIBLE:
+            status[j] = 2
+            continue
+        hj = -big_a / abs(bu)
+        if not (math.isfinite(hj) and hj != 0.0):
+            status[j] = 2
+            continue
+        h[j] = hj
+        if abs(big_b) >= NEGLIGIBLE:
+            rj = -(0.0 + abs(big_b)) / au
+            if not math.isfinite(rj):
+                status[j] = 2
+                continue
+            if rj != 0.0:
+                r[j] = rj
+    return status, chaos, h, r
+
+
+def _simple_row(p: GearParams) -> tuple[str, float, float] | None:
+    """(excitation, Omega, F_1) when ``p`` has one excitation with at most one harmonic."""
+    given = [(name, exc) for name, exc in p.excitations()]
+    if len(given) != 1 or len(given[0][1].harmonics) > 1 or p.damping == 0.0:
+        return None
+    name, exc = given[0]
+    return name, exc.frequency, exc.harmonics[0].amplitude if exc.harmonics else 0.0
+
+
+def design_verdict(p: GearParams) -> BatchVerdict:
+    """One design on the full path: ``melnikov``'s verdict and parameter thresholds."""
+    a, c, _, units = applicability(p)
+    if units is None:
+        return {
+            "chaos_possible": None,
+            "margins": {q: _margin(0.0, []) for q in CONTROL_PARAMETERS},
+        }
+    chaos = False
+    for br in BRANCH_SIGN:
+        ext = extrema(active_only(units[br], p).trig_sum())
+        chaos = chaos or ext.minimum.value < 0.0 < ext.maximum.value
+    margins: dict[str, Margin] = {}
+    for q in CONTROL_PARAMETERS:
+        t = parameter_threshold(p, q, a, c, coefs=units)
+        margins[q] = {"margin": t.margin, "relative_margin": t.relative_margin}
+    return {"chaos_possible": chaos, "margins": margins}
+
+
+def melnikov_batch(designs: Sequence[GearParams]) -> list[BatchVerdict]:
+    """Verdict and control-parameter margins of every design, in order.
+
+    Equal to ``melnikov(p).chaos_possible`` and ``melnikov(p).thresholds[q].margin`` /
+    ``relative_margin`` for q in F_e1, mu, k_p1, F_p1 (closed-form coefficients). Single-excitation
+    designs run together in one compiled pass; the others one by one (see the module docstring).
+    """
+    out: list[BatchVerdict | None] = [None] * len(designs)
+    rows, where = [], []
+    for i, p in enumerate(designs):
+        simple = _simple_row(p)
+        a, c, _ = melnikov_cubic(p.backlash)
+        if simple is None or not saddle_loop(a, c):
+            out[i] = design_verdict(p)
+            continue
+        name, omega, amplitude = simple
+        rows.append((KIND[name], omega, amplitude, p.damping, a, c))
+        where.append((i, _PARAMETER_OF[name]))
+    if rows:
+        table = np.array(rows, dtype=float)
+        status, chaos, h, r = _simple(table[:, 0].astype(np.int64), *table[:, 1:].T)
+        for k, (i, own) in enumerate(where):
+            out[i] = _simple_verdict(designs[i], own, status[k], chaos[k], h[k], r[k], table[k])
+    return out  # type: ignore[return-value]
+
+
+def _simple_verdict(p, own, status, chaos, h, r, row) -> BatchVerdict:
+    """The verdict of a one-excitation design from the compiled closed forms."""
+    if status == 2:
+        return design_verdict(p)
+    if status == 1:
+        return {
+            "chaos_possible": None,
+            "margins": {q: _margin(0.0, []) for q in CONTROL_PARAMETERS},
+        }
+    amplitude, mu = float(row[2]), float(row[3])
+    margins: dict[str, Margin] = {
+        q: {"margin": None, "relative_margin": None} for q in CONTROL_PARAMETERS
+    }
+    margins[own] = _margin(amplitude, [] if math.isnan(h) else [-float(h), float(h)])
+    margins["mu"] = _margin(mu, [] if math.isnan(r) else [float(r)])
+    return {"chaos_possible": bool(chaos), "margins": margins}
+
+
+def warm_up() -> None:
+    """Load (or compile) every Melnikov kernel once: a two-excitation verdict and a batch."""
+    from gearengine.homoclinic.verdict import melnikov
+
+    two = GearParams.model_validate(
+        {
+            **PAPER_SECTION_41,
+            "stiffness": {"frequency": 1.0, "harmonics": [{"amplitude": 0.1}]},
+        }
+    )
+    melnikov(two)
+    melnikov_batch([GearParams.model_validate(PAPER_SECTION_41), two])

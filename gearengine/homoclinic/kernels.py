@@ -1,0 +1,330 @@
+"""Compiled inner loops of the Melnikov thresholds (numba, ``cache=True``).
+
+The same arithmetic as ``coefficients`` (corrected Eq. 19) and ``extrema`` (grid + Newton extrema
+of M(tau0) = A + sum_i B_i sin(Omega_i tau0 + phi_i)), written on plain arrays so that the
+Omega_e scan and the threshold root finding run without Python objects in their loops:
+
+- ``unit_coefficient`` / ``damping_unit``: B per unit amplitude and A per unit mu, Eq. (19), with
+  the same operations in the same order as the scalar functions of ``coefficients`` (libm
+  ``exp``, ``sqrt`` and ``pow``), so the numbers are bit for bit the same;
+- ``trig_max`` / ``trig_extrema``: the port of ``extrema.maximum`` / ``extrema.extrema``;
+- ``scan_strength`` / ``scan_roots``: the sign-change strength max_s min(max M_s, -min M_s) along
+  a running-speed scan (every frequency scaled with Omega_e) and its roots by Brent's method
+  (a port of scipy's ``brentq``, Brent 1973, *Algorithms for Minimization without Derivatives*,
+  ch. 4).
+
+Excitation kinds are coded as integers: ``STIFFNESS``, ``TRANSMISSION_ERROR``, ``TORQUE``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+STIFFNESS, TRANSMISSION_ERROR, TORQUE = 0, 1, 2
+KIND = {"stiffness": STIFFNESS, "transmission_error": TRANSMISSION_ERROR, "torque": TORQUE}
+
+GRID_PER_CYCLE = 16
+MAX_GRID = 1 << 16
+NEWTON_STEPS = 5
+CANDIDATES = 4
+BRENT_RTOL = 4.0 * np.finfo(float).eps
+"""scipy's default relative tolerance of brentq."""
+BRENT_MAXITER = 100
+FALLBACK = np.nan
+"""Strength returned when the active set of terms changes along a scan (see ``scan_strength``)."""
+
+jit = numba.njit(cache=True, nogil=True)
+
+
+@jit
+def _sech(z: float) -> float:
+    e = math.exp(-abs(z))
+    return 2.0 * e / (1.0 + e * e)
+
+
+@jit
+def _csch(z: float) -> float:
+    e = math.exp(-abs(z))
+    return 2.0 * e / (1.0 - e * e)
+
+
+@jit
+def damping_unit(a: float, c: float) -> float:
+    """dA/dmu = -(8/3) a^(3/2) / c (Eq. 19, first term)."""
+    return -8.0 / 3.0 * a**1.5 / c
+
+
+@jit
+def unit_coefficient(kind: int, omega: float, a: float, c: float, s: float) -> float:
+    """B per unit amplitude at frequency omega = r Omega on branch s = +-1 (corrected Eq. 19).
+
+    stiffness: pi Omega^2 (2a - Omega^2) / (3c) csch(sigma); torque: s sqrt(2/c) pi Omega
+    sech(sigma); transmission error: Omega^2 times torque; sigma = pi Omega / (2 sqrt a).
+    """
+    if kind == STIFFNESS:
+        w2 = omega**2
+        return (
+            math.pi
+            * w2
+            * (2.0 * a - w2)
+            / (3.0 * c)
+            * _csch(math.pi * omega / (2.0 * math.sqrt(a)))
+        )
+    sigma = math.pi * omega / (2.0 * math.sqrt(a))
+    torque = s * math.sqrt(2.0 / c) * math.pi * omega * _sech(sigma)
+    if kind == TORQUE:
+        return torque
+    return omega**2 * torque
+
+
+@jit
+def trig_eval(offset: float, amps, freqs, phases, tau: float) -> float:
+    """M(tau) = offset + sum_i amps_i sin(freqs_i tau + phases_i)."""
+    total = 0.0
+    for i in range(amps.size):
+        total += amps[i] * math.sin(freqs[i] * tau + phases[i])
+    return offset + total
+
+
+@jit
+def grid_size(freqs, period: float) -> int:
+    """GRID_PER_CYCLE points per fastest cycle over one period (as ``extrema.grid``)."""
+    cycles = period * freqs.max() / (2.0 * math.pi)
+    return int(min(MAX_GRID, max(64, math.ceil(GRID_PER_CYCLE * cycles))))
+
+
+@jit
+def grid_sines(freqs, phases, period: float):
+    """(taus, S) on the uniform grid of one common period, S[k, i] = sin(freqs_i taus_k +
+    phases_i): the table is shared by both branches and by every amplitude of a Newton search."""
+    n = grid_size(freqs, period)
+    taus = np.arange(n) * (period / n)
+    table = np.empty((n, freqs.size))
+    for k in range(n):
+        for i in range(freqs.size):
+            table[k, i] = math.sin(freqs[i] * taus[k] + phases[i])
+    return taus, table
+
+
+@jit
+def grid_values(offset: float, amps, table, values):
+    """values[k] = offset + sum_i amps_i table[k, i] (M on the grid, ``trig_eval``'s order)."""
+    for k in range(values.size):
+        total = 0.0
+        for i in range(amps.size):
+            total += amps[i] * table[k, i]
+        values[k] = offset + total
+
+
+@jit
+def trig_max(offset: float, amps, freqs, phases, period: float, taus, values, sign: float):
+    """(max, tau*) of sign * M over one period from its grid values (``extrema.maximum``).
+
+    The CANDIDATES best grid peaks are polished by NEWTON_STEPS Newton steps on M'(tau) = 0,
+    each kept within one grid step of its start.
+    """
+    n = taus.size
+    step = taus[1] - taus[0]
+    cand_v = np.full(CANDIDATES, -np.inf)  # the best peaks so far, ascending
+    cand_k = np.full(CANDIDATES, -1)
+    best = 0
+    for k in range(n):
+        v = sign * values[k]
+        if v > sign * values[best]:
+            best = k
+        if v >= sign * values[k - 1] and v >= sign * values[(k + 1) % n] and v > cand_v[0]:
+            j = 0
+            while j + 1 < CANDIDATES and cand_v[j + 1] < v:
+                cand_v[j], cand_k[j] = cand_v[j + 1], cand_k[j + 1]
+                j += 1
+            cand_v[j], cand_k[j] = v, k
+    top, at = -np.inf, 0.0
+    for q in range(CANDIDATES):
+        if cand_k[q] < 0:
+            continue
+        start = taus[cand_k[q]]
+        tau = start
+        for _ in range(NEWTON_STEPS):
+            d1, d2 = 0.0, 0.0
+            for i in range(amps.size):
+                arg = freqs[i] * tau + phases[i]
+                wa = sign * amps[i] * freqs[i]
+                d1 += math.cos(arg) * wa
+                d2 -= math.sin(arg) * (wa * freqs[i])
+            newton = d1 / d2 if d2 < 0.0 else 0.0
+            tau = min(max(tau - newton, start - step), start + step)
+        v = sign * trig_eval(offset, amps, freqs, phases, tau)
+        if v > top:
+            top, at = v, tau
+    if sign * values[best] > top:
+        return sign * values[best], taus[best]
+    return top, at % period
+
+
+@jit
+def trig_extrema(offset: float, amps, freqs, phases, period: float, taus, table, values):
+    """(min, max) of M over tau0 (``extrema.extrema``): constant, one sinusoid in closed form,
+    supremum A -/+ sum |B_i| when ``period`` <= 0 (incommensurate), else exact on one period
+    (``taus``, ``table`` from ``grid_sines``; ``values`` is scratch of the grid's size)."""
+    nact, spread, only = 0, 0.0, 0.0
+    for i in range(amps.size):
+        if amps[i] != 0.0:
+            nact += 1
+            spread += abs(amps[i])
+            only = amps[i]
+    if nact == 0:
+        return offset, offset
+    if nact == 1:
+        return offset - abs(only), offset + abs(only)
+    if period <= 0.0:
+        return offset - spread, offset + spread
+    grid_values(offset, amps, table, values)
+    top, _ = trig_max(offset, amps, freqs, phases, period, taus, values, 1.0)
+    bottom, _ = trig_max(offset, amps, freqs, phases, period, taus, values, -1.0)
+    return -bottom, top
+
+
+@jit
+def scan_strength(om, value, base, r, kind, amp, phase, mu, a, c, gcd, lcm) -> float:
+    """Sign-change strength max_s min(max M_s, -min M_s) at Omega_e = om, every frequency
+    scaled by om / value (``thresholds.sign_change_strength`` along a running-speed scan).
+
+    Terms are the active harmonics: fundamental ``base``, harmonic number ``r``, excitation
+    ``kind``, amplitude ``amp`` and ``phase``. The common frequency is Omega_0 = top * gcd / lcm,
+    as ``model.frequencies.common_frequency`` computes it (gcd = 0: incommensurate). Returns
+    FALLBACK (NaN) when a coefficient underflows to 0 and the active set (and so its period) is
+    no longer the given one.
+    """
+    n = base.size
+    factor = om / value
+    freqs = np.empty(n)
+    for i in range(n):
+        freqs[i] = r[i] * (base[i] * factor)
+    exact = n >= 2 and gcd > 0.0
+    period = 2.0 * math.pi / (freqs.max() * gcd / lcm) if exact else 0.0
+    if exact:
+        taus, table = grid_sines(freqs, phase, period)
+    else:
+        taus, table = np.zeros(2), np.zeros((2, n))
+    values = np.empty(taus.size)
+    damping = damping_unit(a, c) * mu
+    best = -np.inf
+    amps = np.empty(n)
+    for s in (1.0, -1.0):
+        nact = 0
+        for i in range(n):
+            amps[i] = unit_coefficient(kind[i], freqs[i], a, c, s) * amp[i]
+            nact += amps[i] != 0.0
+        if 2 <= nact < n:
+            return FALLBACK
+        lo, hi = trig_extrema(damping, amps, freqs, phase, period, taus, table, values)
+        best = max(best, min(hi, -lo))
+    return best
+
+
+@jit
+def _brentq(args, xa: float, xb: float, xtol: float) -> float:
+    """Root of ``scan_strength`` in [xa, xb]: scipy's brentq (Zeros/brentq.c), step for step."""
+    xpre, xcur = xa, xb
+    xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
+    fpre, fcur = scan_strength(xpre, *args), scan_strength(xcur, *args)
+    if fpre == 0.0:
+        return xpre
+    if fcur == 0.0:
+        return xcur
+    for _ in range(BRENT_MAXITER):
+        if fpre != 0.0 and fcur != 0.0 and (fpre < 0.0) != (fcur < 0.0):
+            xblk, fblk = xpre, fpre
+            spre = scur = xcur - xpre
+        if abs(fblk) < abs(fcur):
+            xpre, xcur, xblk = xcur, xblk, xcur
+            fpre, fcur, fblk = fcur, fblk, fcur
+        delta = (xtol + BRENT_RTOL * abs(xcur)) / 2
+        sbis = (xblk - xcur) / 2
+        if fcur == 0.0 or abs(sbis) < delta:
+            return xcur
+        if abs(spre) > delta and abs(fcur) < abs(fpre):
+            if xpre == xblk:
+                stry = -fcur * (xcur - xpre) / (fcur - fpre)
+            else:
+                dpre = (fpre - fcur) / (xpre - xcur)
+                dblk = (fblk - fcur) / (xblk - xcur)
+                stry = -fcur * (fblk * dblk - fpre * dpre) / (dblk * dpre * (fblk - fpre))
+            if 2 * abs(stry) < min(abs(spre), 3 * abs(sbis) - delta):
+                spre, scur = scur, stry
+            else:
+                spre, scur = sbis, sbis
+        else:
+            spre, scur = sbis, sbis
+        xpre, fpre = xcur, fcur
+        xcur += scur if abs(scur) > delta else (delta if sbis > 0 else -delta)
+        fcur = scan_strength(xcur, *args)
+        if math.isnan(fcur):
+            return np.nan
+    return np.nan
+
+
+@jit
+def scan_roots(omegas, xtol, value, base, r, kind, amp, phase, mu, a, c, gcd, lcm):
+    """Critical Omega_e of a running-speed scan and the no-chaos flag of each piece between them.
+
+    Returns (critical, no_chaos, ok): ``no_chaos[j]`` says the strength is <= 0 in the middle of
+    piece j of [start, *critical, stop]; ``ok`` is False when the scan met a FALLBACK point.
+    """
+    args = (value, base, r, kind, amp, phase, mu, a, c, gcd, lcm)
+    m = omegas.size
+    vals = np.empty(m)
+    for k in range(m):
+        vals[k] = scan_strength(omegas[k], *args)
+    critical = [0.0 for _ in range(0)]
+    if np.isnan(vals).any():
+        return np.empty(0), np.zeros(0, dtype=np.bool_), False
+    for k in range(m - 1):
+        if (vals[k] > 0.0) != (vals[k + 1] > 0.0):
+            root = _brentq(args, omegas[k], omegas[k + 1], xtol)
+            if math.isnan(root):
+                return np.empty(0), np.zeros(0, dtype=np.bool_), False
+            critical.append(root)
+    edges = np.empty(len(critical) + 2)
+    edges[0], edges[-1] = omegas[0], omegas[m - 1]
+    for j in range(len(critical)):
+        edges[j + 1] = critical[j]
+    no_chaos = np.zeros(edges.size - 1, dtype=np.bool_)
+    for j in range(edges.size - 1):
+        mid = scan_strength(0.5 * (edges[j] + edges[j + 1]), *args)
+        if math.isnan(mid):
+            return np.empty(0), np.zeros(0, dtype=np.bool_), False
+        no_chaos[j] = mid <= 0.0
+    return edges[1:-1].copy(), no_chaos, True
+
+
+@jit
+def sublevel_root(m0off, m0amps, goff, gamps, freqs, phases, period, taus, p):
+    """Root near p of the convex phi(p) = max_tau0 (m0 + p g) (``extrema._newton_root``).
+
+    Newton with phi'(p) = g(tau*) (envelope theorem), monotone from outside the sublevel set;
+    at most 30 steps, stopping at a relative step of 1e-14.
+    """
+    amps = np.empty(m0amps.size)
+    values = np.empty(taus.size)
+    table = np.empty((taus.size, freqs.size))
+    for k in range(taus.size):
+        for i in range(freqs.size):
+            table[k, i] = math.sin(freqs[i] * taus[k] + phases[i])
+    for _ in range(30):
+        off = m0off + p * goff
+        for i in range(amps.size):
+            amps[i] = m0amps[i] + p * gamps[i]
+        grid_values(off, amps, table, values)
+        value, tau = trig_max(off, amps, freqs, phases, period, taus, values, 1.0)
+        slope = trig_eval(goff, gamps, freqs, phases, tau)
+        if slope == 0.0:
+            break
+        step = value / slope
+        p -= step
+        if abs(step) <= 1e-14 * max(1.0, abs(p)):
+            break
+    return p
