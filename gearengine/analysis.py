@@ -13,8 +13,10 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from gearengine.homoclinic.schemas import MelnikovResult
+from gearengine.engineering import Engineering, engineering
+from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
 from gearengine.homoclinic.verdict import melnikov
+from gearengine.model.design import EXAMPLE_DESIGN, DesignConversion, ParamsOrDesign
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.numerics.results import NumericsResult
@@ -24,12 +26,11 @@ from gearengine.numerics.simulation import simulate
 Agreement = Literal["both_chaotic", "both_regular", "melnikov_only", "numerics_only", "undecided"]
 
 
-class AnalysisRequest(BaseModel):
+class AnalysisRequest(ParamsOrDesign):
     """``{"params": {...}, "settings": {...}}``: analyse one design."""
 
     model_config = request_config({"params": PAPER_SECTION_41, "settings": {}})
 
-    params: GearParams = Field(description="Dimensionless parameters of Eq. (9).")
     settings: SimulationSettings = Field(
         default_factory=SimulationSettings,
         description="Integration settings (defaults: 500 + 500 periods, 200 steps, x0 = "
@@ -62,6 +63,23 @@ class AnalysisResult(BaseModel):
     numerics: NumericsResult
     settings: SimulationSettings
     verdict: Verdict
+    params: GearParams | None = Field(
+        None, description="With a design: the dimensionless parameters used (reproducible)."
+    )
+    engineering: Engineering | None = Field(
+        None, description="With a design: the answer in gear-design units."
+    )
+
+
+class MelnikovAnswer(MelnikovResult):
+    """The /v1/melnikov contract: the verdict, and with a design its params and engineering."""
+
+    params: GearParams | None = Field(
+        None, description="With a design: the dimensionless parameters used (reproducible)."
+    )
+    engineering: Engineering | None = Field(
+        None, description="With a design: the answer in gear-design units."
+    )
 
 
 def verdict(mel: MelnikovResult, num: NumericsResult) -> Verdict:
@@ -94,9 +112,51 @@ def verdict(mel: MelnikovResult, num: NumericsResult) -> Verdict:
 
 
 def analyze(request: AnalysisRequest) -> AnalysisResult:
-    """Melnikov and numerical verdicts of one design."""
+    """Melnikov and numerical verdicts of one design (with a design, in its units too)."""
     mel = melnikov(request.params)
     num = simulate(request.params, request.settings)
-    return AnalysisResult(
+    result = AnalysisResult(
         melnikov=mel, numerics=num, settings=request.settings, verdict=verdict(mel, num)
+    )
+    conv = request.conversion
+    if conv is None:
+        return result
+    eng = engineering(conv, request.speed_rpm_range(), mel, num)
+    return result.model_copy(update={"params": conv.params, "engineering": eng})
+
+
+def answer_melnikov(request: MelnikovRequest) -> MelnikovResult:
+    """The Melnikov verdict of a request; with a design, its params and engineering block."""
+    mel = melnikov(request.params, method=request.method)
+    conv = request.conversion
+    if conv is None:
+        return mel
+    eng = engineering(conv, request.speed_rpm_range(), mel)
+    return MelnikovAnswer(**dict(mel), params=conv.params, engineering=eng)
+
+
+class DesignRequest(ParamsOrDesign):
+    """``{"design": {...}}``: the design's conversion and its engineering block."""
+
+    model_config = request_config({"design": EXAMPLE_DESIGN})
+
+
+class DesignReport(BaseModel):
+    """The /v1/conversions/design contract: Eq. (9)'s parameters of a design, what was derived
+    from it, and the Melnikov answer in its units."""
+
+    model_config = ConfigDict(frozen=True)
+
+    conversion: DesignConversion
+    engineering: Engineering
+
+
+def convert(request: DesignRequest) -> DesignReport:
+    """The conversion of a design with its engineering block (Melnikov windows, thresholds)."""
+    conv = request.conversion
+    if conv is None:
+        raise ValueError("design: give a design (physical units) to convert")
+    mel = melnikov(conv.params)
+    return DesignReport(
+        conversion=conv, engineering=engineering(conv, request.speed_rpm_range(), mel)
     )

@@ -282,7 +282,7 @@ N_SAMPLES = 1500
 X0, V0 = 0.0, -1.0  # x~(0) / b and dx~/dt(0) / (b w_n): start inside the clearance
 
 
-def _physical_response(data: PhysicalGearData, w_n: float) -> tuple[np.ndarray, np.ndarray]:
+def physical_response(data: PhysicalGearData, w_n: float) -> tuple[np.ndarray, np.ndarray]:
     """x~(t) / b from Eq. (2a)-(2b), sampled at t; returns (t, x~ / b)."""
     b, ra = data.half_backlash, data.base_radius_a
     w_e = data.teeth_a * data.shaft_speed_a
@@ -299,7 +299,7 @@ def _physical_response(data: PhysicalGearData, w_n: float) -> tuple[np.ndarray, 
     return t, (ra * sol.y[0] - data.base_radius_b * sol.y[1] - e) / b
 
 
-def _dimensionless_response(p: GearParams, tau: np.ndarray) -> np.ndarray:
+def dimensionless_response(p: GearParams, tau: np.ndarray) -> np.ndarray:
     sol = solve_ivp(
         _dimensionless_rhs(p),
         (0.0, tau[-1]),
@@ -324,8 +324,8 @@ BACKLASH_LAWS = [
 def test_dimensionless_equation_reproduces_two_dof_model(backlash: dict[str, object]) -> None:
     data = gear(backlash=backlash)
     conv = to_dimensionless(data)
-    t, x_phys = _physical_response(data, conv.natural_frequency)
-    x_dim = _dimensionless_response(conv.params, conv.natural_frequency * t)
+    t, x_phys = physical_response(data, conv.natural_frequency)
+    x_dim = dimensionless_response(conv.params, conv.natural_frequency * t)
     scale = np.max(np.abs(x_phys))
     assert np.max(np.abs(x_dim - x_phys)) / scale < 1e-6
     if backlash["model"] == "piecewise":
@@ -347,8 +347,8 @@ def test_printed_mean_force_does_not_reproduce_two_dof_model() -> None:
     printed = _printed_mean_force(data) / (data.half_backlash * data.mesh_stiffness)
     assert abs(printed / conv.params.mean_force - 1.0) > 1.0
     wrong = conv.params.model_copy(update={"mean_force": printed})
-    t, x_phys = _physical_response(data, conv.natural_frequency)
-    x_wrong = _dimensionless_response(wrong, conv.natural_frequency * t)
+    t, x_phys = physical_response(data, conv.natural_frequency)
+    x_wrong = dimensionless_response(wrong, conv.natural_frequency * t)
     assert np.max(np.abs(x_wrong - x_phys)) / np.max(np.abs(x_phys)) > 0.1
 
 

@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import argparse
 
+from gearengine.analysis import MelnikovAnswer, answer_melnikov
 from gearengine.cli.documents import EXIT_OK, read_request
+from gearengine.engineering import Engineering
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult, ParameterThreshold
-from gearengine.homoclinic.verdict import melnikov
 from gearengine.jsonio import dumps
 
 
@@ -47,8 +48,35 @@ def render_melnikov(r: MelnikovResult) -> str:
     return "\n".join(lines)
 
 
+def render_engineering(eng: Engineering) -> str:
+    """The engineering block of a design as readable lines (gear units)."""
+    windows = ", ".join(f"{a:,.0f}-{b:,.0f}" for a, b in eng.speed_windows_rpm) or "none"
+    lo, hi = eng.speed_range_rpm
+    lines = [
+        f"In gear units (f_n = {eng.natural_frequency_hz:.6g} Hz, mesh "
+        f"{eng.mesh_frequency_hz:.6g} Hz at {eng.speed_rpm:,.0f} rpm):",
+        f"  Melnikov speed windows [rpm] (scanned {lo:,.0f}-{hi:,.0f}): {windows}",
+        f"  {'parameter':<36} {'value':>12} {'nearest critical':>17} {'margin to chaos':>16}",
+    ]
+    for name, c in eng.critical.items():
+        lines.append(
+            f"  {name + ' [' + c.unit + ']':<36} {fmt_value(c.value):>12} "
+            f"{fmt_value(c.nearest):>17} {fmt_value(c.margin_to_chaos):>16}"
+        )
+    lines.append(f"  {eng.summary}")
+    return "\n".join(lines)
+
+
 def cmd_melnikov(args: argparse.Namespace) -> int:
+    """Print the Melnikov verdict of a request file (with a design, in gear units too)."""
     req = read_request(args.file, MelnikovRequest)
-    result = melnikov(req.params, method=args.method or req.method)
-    print(dumps(result) if args.json else render_melnikov(result))
+    if args.method:
+        req = req.model_copy(update={"method": args.method})
+    result = answer_melnikov(req)
+    if args.json:
+        print(dumps(result))
+        return EXIT_OK
+    print(render_melnikov(result))
+    if isinstance(result, MelnikovAnswer) and result.engineering is not None:
+        print(render_engineering(result.engineering))
     return EXIT_OK

@@ -82,3 +82,14 @@ def _alias(name: str) -> tuple[str, str]:
         return ALIASES[name]
     except KeyError:
         raise ValueError(f"unknown parameter {name!r}; expected one of {sorted(ALIASES)}") from None
+
+
+def with_speed_factor(params: GearParams, factor: float) -> GearParams:
+    """A copy of ``params`` with every excitation frequency times ``factor`` (> 0): a change of
+    running speed, which moves the mesh, transmission-error and torque frequencies together and
+    leaves the dimensionless amplitudes unchanged (F~_er = e_r / b; the forcing (r Omega)^2 F~_er
+    grows with speed by itself)."""
+    data = params.model_dump()
+    for name, _ in params.excitations():
+        data[name]["frequency"] *= factor
+    return GearParams.model_validate(data)

@@ -1,32 +1,61 @@
-"""POST /v1/melnikov: the Melnikov verdict of one design."""
+"""POST /v1/melnikov: the Melnikov verdict of one design; POST /v1/melnikov/batch: verdicts and
+margins of many."""
 
 from __future__ import annotations
 
 from fastapi import APIRouter, Depends, Request, Response
+from starlette.concurrency import run_in_threadpool
 
-from gearengine.homoclinic import MelnikovRequest, MelnikovResult, melnikov
+from gearengine.analysis import MelnikovAnswer, answer_melnikov
+from gearengine.homoclinic import (
+    MelnikovBatchRequest,
+    MelnikovBatchResult,
+    MelnikovRequest,
+    melnikov_batch,
+)
 from gearengine.jsonio import dumps
 from service.api.deps import cached_compute, require_key
-from service.api.responses import JSON, PROBLEMS
+from service.api.responses import CACHED, JSON, PROBLEMS
 
 router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 
 
 @router.post(
     "/melnikov",
-    response_model=MelnikovResult,
-    responses=PROBLEMS,
+    response_model=MelnikovAnswer,
+    responses=CACHED,
     summary="Melnikov verdict, thresholds and margins of one design",
 )
 async def post_melnikov(body: MelnikovRequest, request: Request) -> Response:
     """Can the stable and unstable manifolds of the saddle intersect transversally?
 
     Returns both branches' extrema of M(tau0), the threshold of each control parameter with the
-    design's margin, and the corrected closed-form (or quadrature) coefficients.
+    design's margin, and the corrected closed-form (or quadrature) coefficients. With a
+    ``design`` in physical units, also the ``params`` used and the ``engineering`` block: the
+    driver speeds [rpm] where chaos is possible and the thresholds in gear units.
     """
     return await cached_compute(
         request,
         "melnikov",
         body.model_dump_json(),
-        lambda: (dumps(melnikov(body.params, method=body.method)).encode(), JSON),
+        lambda: (dumps(answer_melnikov(body)).encode(), JSON),
     )
+
+
+@router.post(
+    "/melnikov/batch",
+    response_model=MelnikovBatchResult,
+    responses=PROBLEMS,
+    summary="Melnikov verdicts and parameter margins of up to 10,000 designs (for optimisers)",
+)
+async def post_melnikov_batch(body: MelnikovBatchRequest) -> Response:
+    """Per design, in order: chaos possible, and the margin of F_e1, mu, k_p1 and F_p1 to their
+    nearest critical values (the thresholds of POST /v1/melnikov without the Omega_e scan).
+    More designs than the cap are refused with 422 naming ``designs``.
+    """
+
+    def compute() -> bytes:
+        result = MelnikovBatchResult.model_construct(results=melnikov_batch(body.designs))
+        return result.model_dump_json().encode()
+
+    return Response(await run_in_threadpool(compute), media_type=JSON)

@@ -1,0 +1,255 @@
+"""Answers in gear-design units: the engineering block of every response to a ``design``.
+
+From the design's conversion (``model.design``) and the dimensionless verdicts this module
+gives what a gearbox engineer asks:
+
+* ``speed_windows_rpm``: the driver speeds at which the Melnikov criterion allows chaos at the
+  design's torque. A change of running speed scales every excitation frequency together (their
+  ratios fixed; amplitudes F~_er = e_r / b and F~_pr do not depend on speed), so the windows are
+  the sign changes of the sign-change strength along that scaling, located by brentq;
+* the critical value of each control parameter in its unit, and ``margin_to_chaos``: positive
+  on the safe side, negative inside the chaos-possible region (Eqs. 23, 24 generalised);
+* for analyses, the response: dynamic transmission error b (x_max - x_min), the dynamic mesh
+  force b k_m [K(t) f_h(x) + 2 mu~ x'] and the dynamic factor (max force / static force F^_m),
+  the fractions of time with the teeth apart (|x| <= 1) and on the back flank (x < -1), the
+  response period and the dominant response frequency;
+* ``summary``: plain sentences for a design review.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from gearengine.homoclinic.boundary import chaos_intervals
+from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
+from gearengine.model.aliases import with_speed_factor
+from gearengine.model.backlash import LAWS
+from gearengine.model.design import Derived, DesignConversion
+from gearengine.model.params import GearParams
+from gearengine.numerics.forcing import forcing_coefficients
+from gearengine.numerics.results import NumericsResult
+
+WINDOW_SCAN = 240
+"""Speeds sampled in the Melnikov window scan before brentq refines each edge."""
+
+
+class _Doc(BaseModel):
+    model_config = ConfigDict(frozen=True)
+
+
+class Critical(_Doc):
+    """The threshold of one control parameter in its physical unit."""
+
+    unit: str = Field(description="Unit of value, critical_values and margin_to_chaos.")
+    value: float | None = Field(description="The design's value.")
+    critical_values: list[float] = Field(description="Where the Melnikov verdict flips.")
+    nearest: float | None = Field(description="The critical value nearest to the design.")
+    margin_to_chaos: float | None = Field(
+        description="|value - nearest|, positive on the safe side, negative inside the "
+        "chaos-possible region."
+    )
+    relative_margin: float | None = Field(description="margin_to_chaos / |nearest|.")
+
+
+class Contact(_Doc):
+    """How the teeth meet over the recorded response (x in units of the half backlash b)."""
+
+    regime: str | None = Field(description="no_impact | single_sided | double_sided.")
+    separation_fraction: float = Field(description="Fraction of time with |x| <= 1 (apart).")
+    back_flank_fraction: float = Field(description="Fraction of time with x < -1 (back flank).")
+
+
+class Response(_Doc):
+    """The numerical response in physical units (last recorded periods)."""
+
+    dte_peak_to_peak_um: float | None = Field(description="Dynamic transmission error p-p [µm].")
+    dynamic_mesh_force_max_n: float | None = Field(description="Largest mesh force [N].")
+    dynamic_mesh_force_min_n: float | None = Field(description="Smallest mesh force [N].")
+    static_force_n: float = Field(description="Mean mesh force F^_m [N].")
+    dynamic_factor: float | None = Field(description="max force / static force.")
+    contact: Contact | None
+    period_ms: float | None = Field(description="Response period [ms], null if not periodic.")
+    period_mesh_periods: float | None = Field(description="Response period / mesh period.")
+    dominant_frequency_hz: float | None = Field(description="Largest spectral peak [Hz].")
+    dominant_shaft_order: float | None = Field(description="That frequency / driver speed.")
+
+
+class Engineering(_Doc):
+    """The answer in gear-design units."""
+
+    natural_frequency_hz: float
+    time_scale_s: float
+    mesh_frequency_hz: float
+    speed_rpm: float
+    speed_range_rpm: list[float] = Field(description="Driver speeds scanned [rpm].")
+    speed_windows_rpm: list[list[float]] = Field(
+        description="[low, high] driver speeds [rpm] where the Melnikov criterion allows chaos "
+        "at this torque (every excitation frequency scales with speed)."
+    )
+    critical: dict[str, Critical] = Field(description="Thresholds in physical units.")
+    derived: dict[str, Derived]
+    response: Response | None = Field(None, description="For analyses: the response.")
+    summary: str = Field(description="Plain sentences for a design review.")
+    notes: list[str]
+
+
+def speed_windows(params: GearParams, speed_rpm: float, lo: float, hi: float) -> list[list[float]]:
+    """Driver speeds [rpm] in [lo, hi] where some Melnikov branch changes sign: the design at
+    ``speed_rpm`` moved to each speed by scaling every excitation frequency together."""
+    return chaos_intervals(lambda rpm: with_speed_factor(params, rpm / speed_rpm), lo, hi,
+                           WINDOW_SCAN)  # fmt: skip
+
+
+IMPACT_WORDS = {
+    "no_impact": "the teeth always in contact",
+    "single_sided": "tooth separation and impacts on the drive flank",
+    "double_sided": "impacts on both flanks (back-flank contact)",
+}
+
+SCALES = {
+    "F_e1": ("transmission_error_amplitude", "um"),
+    "F_p1": ("torque_fluctuation_amplitude", "N*m"),
+    "mu": ("damping_ratio", "1"),
+    "k_p1": ("stiffness_variation_amplitude", "N/m"),
+}
+"""Control parameter -> (engineering name, unit)."""
+
+
+def _to_physical(name: str, value: float, conv: DesignConversion) -> float:
+    """A dimensionless control parameter in its physical unit (Eq. 8 inverted)."""
+    if name == "F_e1":
+        return value * conv.half_backlash_m * 1e6  # e_1 = F~_e1 b, in µm
+    if name == "F_p1":
+        return value / conv.torque_gain  # T_p1 = F~_p1 / (m r_a / (I_a b k_m))
+    if name == "k_p1":
+        return 2.0 * value * conv.mesh_stiffness_n_per_m  # k_1 = 2 k_m k~_p1
+    return value  # mu~ = zeta
+
+
+def critical(name: str, t: ParameterThreshold, conv: DesignConversion) -> Critical:
+    """One threshold in physical units with its signed margin to chaos."""
+    unit = SCALES[name][1]
+    crit = [_to_physical(name, v, conv) for v in t.critical_values]
+    value = None if t.value is None else _to_physical(name, t.value, conv)
+    nearest = None if t.nearest is None else _to_physical(name, t.nearest, conv)
+    margin = rel = None
+    if value is not None and nearest is not None:
+        safe = any(
+            (lo is None or t.value >= lo) and (hi is None or t.value <= hi)  # type: ignore[operator]
+            for lo, hi in t.no_chaos
+        )
+        margin = (1.0 if safe else -1.0) * abs(value - nearest)
+        rel = margin / abs(nearest) if nearest else None
+    return Critical(unit=unit, value=value, critical_values=crit, nearest=nearest,
+                    margin_to_chaos=margin, relative_margin=rel)  # fmt: skip
+
+
+def mesh_force(params: GearParams, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Dimensionless mesh force K(tau) f_h(x) + 2 mu~ x' at the samples (Eq. 9's left side)."""
+    co = forcing_coefficients(params)
+    stiffness = 1.0 + np.cos(np.multiply.outer(t, co.k_omega) + co.k_phase) @ co.k_amp
+    f_h = LAWS[params.backlash.model].f_h(params.backlash, x)
+    return stiffness * f_h + 2.0 * params.damping * v
+
+
+def response(params: GearParams, num: NumericsResult, conv: DesignConversion) -> Response:
+    """The response of an analysis in physical units (from its recorded time history)."""
+    static = conv.static_force_n
+    hist = num.time_history
+    contact = force_max = force_min = factor = None
+    if hist is not None and hist.x:
+        t, x, v = (np.asarray(a) for a in (hist.t, hist.x, hist.v))
+        force = mesh_force(params, t, x, v) * conv.half_backlash_m * conv.mesh_stiffness_n_per_m
+        force_max, force_min = float(force.max()), float(force.min())
+        factor = force_max / static if static > 0.0 else None
+        contact = Contact(
+            regime=num.impact_regime,
+            separation_fraction=float(np.mean(np.abs(x) <= 1.0)),
+            back_flank_fraction=float(np.mean(x < -1.0)),
+        )
+    omega_n = 1.0 / conv.time_scale_s
+    period_s = None if num.period is None else num.period * num.sampling_interval / omega_n
+    peak = num.spectrum_peaks[0].frequency * omega_n / (2 * math.pi) if num.spectrum_peaks else None
+    shaft_hz = conv.speed_rpm / 60.0
+    dte = num.x_peak_to_peak
+    return Response(
+        dte_peak_to_peak_um=None if dte is None else dte * conv.half_backlash_m * 1e6,
+        dynamic_mesh_force_max_n=force_max,
+        dynamic_mesh_force_min_n=force_min,
+        static_force_n=static,
+        dynamic_factor=factor,
+        contact=contact,
+        period_ms=None if period_s is None else 1e3 * period_s,
+        period_mesh_periods=None if period_s is None else period_s * conv.mesh_frequency_hz,
+        dominant_frequency_hz=peak,
+        dominant_shaft_order=None if peak is None else peak / shaft_hz,
+    )
+
+
+def _windows_text(windows: list[list[float]], rng: tuple[float, float]) -> str:
+    if not windows:
+        return f"allows no chaos at any speed from {rng[0]:,.0f} to {rng[1]:,.0f} rpm"
+    spans = ", ".join(f"{a:,.0f}-{b:,.0f} rpm" for a, b in windows)
+    return f"allows chaos at {spans} (scanned {rng[0]:,.0f} to {rng[1]:,.0f} rpm)"
+
+
+def summary(
+    conv: DesignConversion,
+    mel: MelnikovResult,
+    windows: list[list[float]],
+    rng: tuple[float, float],
+    resp: Response | None,
+    num: NumericsResult | None,
+) -> str:
+    """Two or three sentences an engineer can paste into a design review."""
+    here = "allows chaos" if mel.chaos_possible else "rules chaos out"
+    text = (
+        f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion {here}; at this torque it "
+        f"{_windows_text(windows, rng)}."
+    )
+    if num is not None and resp is not None:
+        kind = f"periodic ({num.period}T)" if num.period else num.classification.replace("_", "-")
+        text += f" The simulated response is {kind}"
+        if resp.contact is not None:
+            text += f" with {IMPACT_WORDS.get(resp.contact.regime or '', 'no verdict on impacts')}"
+            if resp.contact.separation_fraction > 0.0:
+                text += f" (teeth apart {100 * resp.contact.separation_fraction:.0f} % of the time)"
+        if resp.dte_peak_to_peak_um is not None:
+            text += f", dynamic transmission error {resp.dte_peak_to_peak_um:.3g} µm peak to peak"
+        if resp.dynamic_factor is not None:
+            text += f", dynamic factor {resp.dynamic_factor:.3g}"
+        text += "."
+    return text
+
+
+def engineering(
+    conv: DesignConversion,
+    rpm_range: tuple[float, float],
+    mel: MelnikovResult,
+    num: NumericsResult | None = None,
+) -> Engineering:
+    """The engineering block of a design's Melnikov verdict (and analysis, given ``num``)."""
+    params = conv.params
+    windows = speed_windows(params, conv.speed_rpm, *rpm_range)
+    crit = {
+        SCALES[name][0]: critical(name, t, conv)
+        for name, t in mel.thresholds.items()
+        if name in SCALES and t.value is not None and (t.critical_values or t.note is None)
+    }
+    resp = None if num is None else response(params, num, conv)
+    return Engineering(
+        natural_frequency_hz=conv.natural_frequency_hz,
+        time_scale_s=conv.time_scale_s,
+        mesh_frequency_hz=conv.mesh_frequency_hz,
+        speed_rpm=conv.speed_rpm,
+        speed_range_rpm=list(rpm_range),
+        speed_windows_rpm=windows,
+        critical=crit,
+        derived=conv.derived,
+        response=resp,
+        summary=summary(conv, mel, windows, rpm_range, resp, num),
+        notes=conv.notes,
+    )
