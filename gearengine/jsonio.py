@@ -7,6 +7,7 @@ The CLI's ``--json`` output and the API's response body are the same bytes: both
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from typing import Any
 
 from pydantic import BaseModel, ValidationError
@@ -30,11 +31,20 @@ def field_path(loc: tuple[Any, ...]) -> str:
 
 def error_lines(exc: ValidationError) -> list[str]:
     """One line per problem: 'path: message'."""
-    return [f"{field_path(e['loc'])}: {e['msg']}" for e in exc.errors(include_url=False)]
+    return [f"{field_path(e['loc'])}: {message(e)}" for e in exc.errors(include_url=False)]
+
+
+def message(error: Mapping[str, Any]) -> str:
+    """A pydantic error's message without the "Value error, " that pydantic puts before the
+    engine's own sentences."""
+    return str(error["msg"]).removeprefix("Value error, ")
 
 
 def load_document(text: str) -> Any:
-    """Parse JSON text; raises ValueError with the line and column of a syntax error."""
+    """Parse JSON text; raises ValueError with the line and column of a syntax error, or
+    'empty input' when there is nothing but whitespace (an empty file or stdin)."""
+    if not text.strip():
+        raise ValueError("empty input")
     try:
         return json.loads(text)
     except json.JSONDecodeError as exc:

@@ -32,6 +32,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
     from service.api.deps import load_key_hashes
     from service.main import create_app
+    from service.server import EXIT_STARTUP_FAILURE, AnnouncingServer
 
     flags = {
         "host": args.host,
@@ -64,14 +65,17 @@ def cmd_serve(args: argparse.Namespace) -> int:
             [f"data directory {settings.data_dir} is not writable: {exc.strerror}"]
         ) from None
     logging.basicConfig(level=logging.INFO, format="%(message)s")  # JSON access/job lines
-    uvicorn.run(
+    config = uvicorn.Config(
         create_app(settings),
         host=settings.host,
         port=settings.port,
         log_level="info",
+        access_log=False,  # the app logs each request once, as a JSON line (AccessLog)
         timeout_keep_alive=settings.keep_alive_seconds,
     )
-    return EXIT_OK
+    server = AnnouncingServer(config, settings)  # prints the one "ready on ..." line
+    server.run()
+    return EXIT_OK if server.started else EXIT_STARTUP_FAILURE
 
 
 def cmd_worker(args: argparse.Namespace) -> int:

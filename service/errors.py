@@ -16,7 +16,7 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, Field, ValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from gearengine.jsonio import field_path
+from gearengine.jsonio import field_path, message
 
 PROBLEM_JSON = "application/problem+json"
 TYPE_BASE = "https://gearchaos.dev/problems/"
@@ -78,7 +78,7 @@ def field_errors(errors: list[dict[str, Any]], strip_body: bool = True) -> list[
         if strip_body and loc[:1] == ("body",):
             loc = loc[1:]
         pointer = "/" + "/".join(str(p).replace("~", "~0").replace("/", "~1") for p in loc)
-        out.append(FieldError(path=field_path(loc), pointer=pointer, message=e["msg"]))
+        out.append(FieldError(path=field_path(loc), pointer=pointer, message=message(e)))
     return out
 
 
@@ -89,6 +89,23 @@ def validation_problem(errors: list[FieldError], detail: str | None = None) -> P
         "Invalid request",
         detail or "; ".join(f"{e.path}: {e.message}" if e.path else e.message for e in errors),
         errors,
+    )
+
+
+def _is_json(media: str) -> bool:
+    return media == "application/json" or media.endswith("+json")
+
+
+def unsupported_media_type(media: str) -> ProblemError:
+    """415: a JSON body sent without a JSON media type (curl -d sends form data; FastAPI reads
+    a body as JSON only under application/json or +json)."""
+    sent = f"not {media}" if media else "and the request has no Content-Type"
+    return ProblemError(
+        415,
+        "unsupported-media-type",
+        "Unsupported media type",
+        f"the body must be JSON, {sent}: send Content-Type: application/json "
+        "(curl: -H content-type:application/json, or --json)",
     )
 
 
@@ -111,8 +128,12 @@ def install(app: FastAPI) -> None:
         return problem_response(exc.problem, exc.headers)
 
     @app.exception_handler(RequestValidationError)
-    async def _invalid(_: Request, exc: RequestValidationError) -> JSONResponse:
-        return problem_response(validation_problem(field_errors(list(exc.errors()))).problem)
+    async def _invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
+        errors = list(exc.errors())
+        media = request.headers.get("content-type", "").split(";")[0].strip().lower()
+        if not _is_json(media) and any(tuple(e["loc"]) == ("body",) for e in errors):
+            return problem_response(unsupported_media_type(media).problem)
+        return problem_response(validation_problem(field_errors(errors)).problem)
 
     @app.exception_handler(ValidationError)
     async def _engine_invalid(_: Request, exc: ValidationError) -> JSONResponse:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from gearengine.homoclinic.schemas import ThresholdsRequest
 from gearengine.sweeps import SweepRequest, sweep_work
@@ -15,6 +16,20 @@ class Limits:
     """The service limits of one app (from Settings)."""
 
     settings: Settings
+
+    def document(self, spec: dict[str, Any]) -> None:
+        """Write the limits that bound one field into the OpenAPI document, so that its schema
+        refuses what these checks refuse: the ``num`` of a threshold curve (max_curve_points)
+        and of a sweep axis (max_sweep_points: one axis can hold no more)."""
+        schemas = spec.get("components", {}).get("schemas", {})
+        caps = {
+            "ThresholdsRequest": self.settings.max_curve_points,
+            "SweepAxis": self.settings.max_sweep_points,
+        }
+        for name, cap in caps.items():
+            num = schemas.get(name, {}).get("properties", {}).get("num")
+            if num is not None:
+                num["maximum"] = min(num.get("maximum", cap), cap)
 
     def check_curve(self, body: ThresholdsRequest) -> None:
         cap = self.settings.max_curve_points

@@ -6,6 +6,7 @@ import logging
 from collections.abc import AsyncIterator, Callable
 from contextlib import asynccontextmanager
 from importlib.metadata import version
+from typing import Any
 
 from fastapi import FastAPI
 from fastapi_offline import FastAPIOffline
@@ -13,7 +14,15 @@ from starlette.concurrency import run_in_threadpool
 
 from service import errors
 from service.api.deps import load_key_hashes
-from service.api.routes import analyses, conversions, health, melnikov, sweeps, thresholds
+from service.api.routes import (
+    analyses,
+    conversions,
+    explorer,
+    health,
+    melnikov,
+    sweeps,
+    thresholds,
+)
 from service.cache import ResponseCache
 from service.core.config import Settings
 from service.jobs.runtime import SweepJobs
@@ -66,6 +75,14 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.cache = ResponseCache(settings.cache_entries)
     app.state.metrics = Metrics()
     app.state.limits = Limits(settings)
+    base_openapi = app.openapi
+
+    def openapi() -> dict[str, Any]:  # the schema states this app's limits (Limits.document)
+        if app.openapi_schema is None:
+            app.state.limits.document(base_openapi())
+        return app.openapi_schema
+
+    app.openapi = openapi  # type: ignore[method-assign]
     app.state.key_hashes = load_key_hashes(settings)
     app.state.ready_checks = ready_checks
     errors.install(app)
@@ -75,7 +92,12 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(thresholds.router, tags=["melnikov"])
     app.include_router(analyses.router, tags=["analyses"])
     app.include_router(sweeps.router, tags=["sweeps"])
-    app.add_middleware(BodyLimit, limit=settings.max_body_bytes)
+    app.include_router(explorer.router)
+    app.add_middleware(
+        BodyLimit,
+        limit=settings.max_body_bytes,
+        per_path={"/v1/melnikov/batch": settings.max_batch_body_bytes},
+    )
     app.add_middleware(AccessLog, metrics=app.state.metrics)
     logging.getLogger("gearchaos").setLevel(logging.INFO)
     return app
@@ -83,9 +105,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
 def _warm_up() -> None:
     """Compile or load every numba kernel once, so the first request is fast."""
-    from gearengine.homoclinic import melnikov
-    from gearengine.model.params import GearParams
+    from gearengine.homoclinic.batch import warm_up as warm_up_melnikov
     from gearengine.numerics import warm_up
 
     warm_up()
-    melnikov(GearParams(damping=0.1))
+    warm_up_melnikov()

@@ -119,8 +119,10 @@ def test_check_gate_exit_codes(tmp_path: Path) -> None:
     assert gate(tmp_path, fe(0.2), "--fail-on", "melnikov").returncode == 1
     assert gate(tmp_path, fe(0.2), "--max-lle", "-0.1").returncode == 1
     assert gate(tmp_path, fe(0.2), "--max-lle", "0").returncode == 0
-    # a bare --max-lle replaces the default --fail-on chaotic (found in review)
-    assert gate(tmp_path, fe(0.28), "--max-lle", "0.1").returncode == 0
+    # a bare limit adds to the default --fail-on chaotic: a chaotic design fails even when its
+    # LLE is below the limit (it used to replace the rule, and a chaotic design passed)
+    assert gate(tmp_path, fe(0.28), "--max-lle", "0.1").returncode == 1
+    assert gate(tmp_path, fe(0.28), "--fail-on", "diverged", "--max-lle", "0.1").returncode == 0
     assert gate(tmp_path, fe(0.28), "--max-lle", "0.01").returncode == 1
     bad = gate(tmp_path, {**PAPER_PARAMS, "damping": "x"})
     assert bad.returncode == 2 and "params.damping" in bad.stderr

@@ -85,6 +85,23 @@ def test_broken_json_and_wrong_method(client: TestClient) -> None:
     assert r.status_code == 405 and r.json()["status"] == 405
 
 
+@pytest.mark.parametrize(
+    "headers",
+    [{"content-type": "application/x-www-form-urlencoded"}, {}, {"content-type": "text/plain"}],
+)
+def test_json_body_without_json_content_type_is_415_with_a_hint(
+    client: TestClient, headers: dict[str, str]
+) -> None:
+    body = json.dumps({"params": PAPER_PARAMS})  # what `curl -d` sends as form data
+    r = client.post("/v1/melnikov", content=body, headers=headers)
+    assert r.status_code == 415 and r.headers["content-type"] == "application/problem+json"
+    assert "send Content-Type: application/json" in r.json()["detail"]
+    assert "valid dictionary" not in r.text
+    # JSON that is not an object, sent as JSON, is still a validation problem
+    r = client.post("/v1/melnikov", content=b"[1]", headers={"content-type": "application/json"})
+    assert r.status_code == 422
+
+
 def test_body_limit_counts_streamed_bytes(tmp_path: Path) -> None:
     app = create_app(Settings(data_dir=tmp_path, max_body_bytes=4096))
     with TestClient(app) as c:
@@ -132,8 +149,15 @@ def test_threshold_curve_endpoint(client: TestClient) -> None:
     r = client.post("/v1/thresholds", json={**body, "num": 10_000})
     assert r.status_code == 422 and "max_curve_points" in r.json()["detail"]
     assert r.json()["errors"][0]["path"] == "num"
-    r = client.post("/v1/thresholds", json={**body, "start": 2.0, "stop": 1.0})
-    assert r.status_code == 422 and r.json()["errors"][0]["path"] == "stop"
+    # no rule joins start and stop (the schema could not say it): downwards is the same curve
+    down = client.post("/v1/thresholds", json={**body, "start": 2.0, "stop": 0.1}).json()
+    assert down["frequencies"] == pytest.approx(curve["frequencies"][::-1])
+    assert down["no_chaos"][0] == curve["no_chaos"][-1]  # the ends are exact
+    assert down["no_chaos"][-1] == curve["no_chaos"][0]
+    # the schema's bounds are validation's: below the engine's lowest frequency, and 2.0 as num
+    r = client.post("/v1/thresholds", json={**body, "start": 1e-9})
+    assert r.status_code == 422 and r.json()["errors"][0]["path"] == "start"
+    assert client.post("/v1/thresholds", json={**body, "num": 20.0}).json() == curve
 
 
 @pytest.mark.parametrize(

@@ -58,3 +58,28 @@ def test_nan_and_broken_json_are_refused() -> None:
     assert out.returncode == 2 and "invalid JSON at line 1" in out.stderr
     out = run("melnikov", "/nonexistent.json")
     assert out.returncode == 2 and "No such file" in out.stderr
+
+
+def test_empty_input_says_so() -> None:
+    for stdin in ("", "  \n"):
+        out = run("melnikov", "-", stdin=stdin)
+        assert out.returncode == 2 and out.stderr.strip() == "-: empty input"
+
+
+def pipe(command: str) -> subprocess.CompletedProcess[str]:
+    """``command`` run by bash with ``gearengine`` being this interpreter's CLI; prints the CLI's
+    exit status (PIPESTATUS[0]) last."""
+    cli = f"{sys.executable} -m gearengine.cli"
+    script = command.replace("gearengine", cli, 1) + '; echo "status=${PIPESTATUS[0]}"'
+    return subprocess.run(
+        ["bash", "-c", script], capture_output=True, text=True, timeout=120, cwd=EXAMPLE.parents[1]
+    )
+
+
+def test_a_closed_pipe_ends_quietly() -> None:
+    out = pipe("gearengine melnikov examples/paper-4.1.json | head -1")
+    assert out.stdout.startswith("Melnikov verdict:") and "Traceback" not in out.stderr
+    assert out.stdout.strip().splitlines()[-1] in ("status=0", "status=141")
+    # `true` reads nothing and exits at once, long before the CLI has computed: every write fails
+    out = pipe("gearengine melnikov examples/paper-4.1.json --json | true")
+    assert out.stderr == "" and out.stdout.strip() == "status=141"

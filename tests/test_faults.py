@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
+import sqlite3
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -148,3 +149,46 @@ def test_cancel_mid_run_stops_the_sweep(data_dir: Path) -> None:
         assert poll(f"{srv.url}/v1/sweeps/{nxt['id']}", finished)["status"] == "succeeded"
     finally:
         srv.stop()
+
+
+def test_restart_after_kill9_reclaims_the_dead_servers_leases_at_once(
+    data_dir: Path, reference: dict[str, Any]
+) -> None:
+    """The restarted server knows the crashed one is dead (same host, its pid gone): it takes
+    the interrupted chunks at once, long before their 600 s leases would have expired."""
+    env = {**ENV, "GEARCHAOS_LEASE_SECONDS": "600"}
+    srv = Server(data_dir, env)
+    try:
+        job, url = submit(srv)
+        poll(url, lambda j: j["progress"]["done"] >= 2 * CHUNK_POINTS)
+        children = pool_workers(srv)
+        os.kill(srv.proc.pid, signal.SIGKILL)
+        srv.proc.wait()
+        kill9(children)
+    finally:
+        srv.stop()
+    with sqlite3.connect(data_dir / "jobs.sqlite3") as db:
+        leased = dict(
+            db.execute(
+                "SELECT idx, lease_expires FROM chunks WHERE job_id = ? AND status = 'leased'",
+                (job["id"],),
+            ).fetchall()
+        )
+    assert leased, "no chunk was in flight at the crash"
+    again = Server(data_dir, env)
+    try:
+        url = f"{again.url}/v1/sweeps/{job['id']}"
+        assert poll(url, finished)["status"] == "succeeded"
+        assert httpx.get(url + "/result", timeout=30).json() == reference
+        assert "reclaimed" in again.output()
+    finally:
+        again.stop()
+    with sqlite3.connect(data_dir / "jobs.sqlite3") as db:
+        committed = dict(
+            db.execute(
+                "SELECT idx, committed_at FROM chunks WHERE job_id = ?", (job["id"],)
+            ).fetchall()
+        )
+    # every interrupted chunk was done while the dead server's lease on it was still valid
+    assert all(committed[idx] < expires for idx, expires in leased.items()), (leased, committed)
+    assert_committed_once(data_dir, job["id"])

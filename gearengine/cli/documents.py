@@ -16,6 +16,11 @@ from pydantic import BaseModel, ValidationError
 from gearengine.jsonio import error_lines, load_document
 
 EXIT_OK, EXIT_FAIL, EXIT_INVALID = 0, 1, 2
+EXIT_PIPE = 141
+"""Standard output's reader went away (``| head``): 128 + SIGPIPE, as the shell reports a
+Unix tool that the signal stopped; distinct from a failed check (1)."""
+EXIT_INTERNAL = 70
+"""An unexpected error, a bug (EX_SOFTWARE of sysexits.h): never confused with a failed check."""
 
 R = TypeVar("R", bound=BaseModel)
 

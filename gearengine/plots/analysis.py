@@ -11,13 +11,14 @@ from matplotlib import pyplot as plt
 
 from gearengine.analysis import AnalysisResult
 from gearengine.homoclinic.schemas import ThresholdCurve
+from gearengine.numerics.results import SpectrumPeak
 from gearengine.plots.style import ImageFormat, figure_bytes, symbol
 
 
 def analysis_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
     """(a) time history, (b) phase plane, (c) Poincare section, (d) amplitude spectrum."""
     num = result.numerics
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7.5))
+    fig, axes = plt.subplots(2, 2, figsize=(10, 7.5), layout="constrained")
     (ax_t, ax_p), (ax_s, ax_f) = axes
     hist = num.time_history
     period = f"{num.period}T-periodic" if num.period else num.classification.replace("_", "-")
@@ -32,60 +33,100 @@ def analysis_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
         t, x, v = (np.asarray(a) for a in (hist.t, hist.x, hist.v))
         ax_t.plot(t, x, lw=0.8, color="C0")
         ax_p.plot(x, v, lw=0.6, color="C0")
-        _spectrum(ax_f, t, x, num.sampling_interval)
     if num.poincare:
         pts = np.asarray(num.poincare)
         ax_p.plot(pts[:, 0], pts[:, 1], "o", ms=3, color="C3", label="Poincaré points")
-        ax_p.legend(loc="upper right", fontsize=8)
         ax_s.plot(pts[:, 0], pts[:, 1], "o", ms=2.5, color="C3")
     for ax in (ax_t, ax_p, ax_s):
         for edge in (-1.0, 1.0):  # clearance edges |x| = 1 (Eq. 8)
-            (ax.axhline if ax is ax_t else ax.axvline)(edge, color="0.6", lw=0.6, ls=":")
-    ax_t.set(title="(a) time history", xlabel=r"$\tau$", ylabel=r"$x$")
-    ax_p.set(title="(b) phase plane", xlabel=r"$x$", ylabel=r"$\dot x$")
-    ax_s.set(title="(c) Poincaré section", xlabel=r"$x$", ylabel=r"$\dot x$")
-    ax_f.set(
-        title="(d) amplitude spectrum of x",
-        xlabel=r"frequency / $\Omega_0$ (fundamental of the forcing)",
-        ylabel="amplitude of x",
+            (ax.axhline if ax is ax_t else ax.axvline)(
+                edge, color="0.45", lw=0.7, ls=":", label=CLEARANCE if edge > 0 else None
+            )
+    # one legend for panels (a)-(c), under them, where it hides no data
+    fig.legend(*ax_p.get_legend_handles_labels(), loc="outside lower center", ncols=2, fontsize=8.5)
+    x_label, v_label = (
+        r"$x$ (units of the half backlash $b$)",
+        r"$\dot x = dx/d\tau$ ($b$ per unit $\tau$)",
     )
+    ax_t.set(title="(a) time history", xlabel=r"$\tau$ (dimensionless time)", ylabel=x_label)
+    ax_p.set(title="(b) phase plane", xlabel=x_label, ylabel=v_label)
+    ax_s.set(title="(c) Poincaré section (one point per $T_0$)", xlabel=x_label, ylabel=v_label)
+    _spectrum(ax_f, num.spectrum_peaks, result.settings.record_periods)
     for ax in axes.flat:
         ax.grid(alpha=0.3)
-    fig.tight_layout()
     return figure_bytes(fig, fmt)
 
 
-def _spectrum(ax: plt.Axes, t: np.ndarray, x: np.ndarray, interval: float) -> None:
-    """One-sided amplitude spectrum of the displayed history (Hann window, amplitude-corrected)."""
-    n = x.size
-    if n < 8:
+CLEARANCE = "|x| = 1: clearance edges"
+
+
+def _spectrum(ax: plt.Axes, peaks: list[SpectrumPeak], record_periods: int) -> None:
+    """The spectrum the JSON reports (``numerics.spectrum_peaks``): its largest peaks as stems,
+    so the figure and the numbers agree; computed over the whole record (``record_periods``
+    sampling intervals), Hann window, amplitude-corrected (a sinusoid A cos wt peaks at A)."""
+    ax.set(
+        title="(d) amplitude spectrum of x: largest peaks",
+        xlabel=r"order: frequency / $\Omega_0$ (fundamental of the forcing)",
+        ylabel="amplitude of x (units of b)",
+    )
+    ax.text(
+        0.98, 0.97,
+        f"x over the last {record_periods} periods $T_0$,\nHann window, amplitude-corrected\n"
+        "(numerics.spectrum_peaks)",
+        transform=ax.transAxes, ha="right", va="top", fontsize=7.5,
+        bbox={"boxstyle": "round", "fc": "white", "ec": "0.8", "alpha": 0.85},
+    )  # fmt: skip
+    if not peaks:
         return
-    window = np.hanning(n)
-    amp = 2.0 * np.abs(np.fft.rfft((x - x.mean()) * window)) / window.sum()
-    omega = 2.0 * np.pi * np.fft.rfftfreq(n, d=float(t[1] - t[0]))
-    order = omega * interval / (2.0 * np.pi)
-    keep = order <= 4.0
-    ax.plot(order[keep], amp[keep], lw=0.9, color="C0")
+    order = np.array([p.order for p in peaks])
+    amp = np.array([p.amplitude for p in peaks])
+    ax.vlines(order, 0.0, amp, color="C0", lw=1.6)
+    ax.plot(order, amp, "o", color="C0", ms=4)
+    top = int(np.argmax(amp))
+    ax.annotate(
+        f"{amp[top]:.3g} at order {order[top]:.3g}",
+        (order[top], amp[top]), xytext=(6, -2), textcoords="offset points", fontsize=8,
+    )  # fmt: skip
+    ax.set_xlim(0.0, max(1.05 * order.max(), 1.0))
+    ax.set_ylim(0.0, 1.35 * amp.max())
 
 
-def threshold_figure(curve: ThresholdCurve, fmt: ImageFormat = "png") -> bytes:
-    """Critical values of the parameter against the frequency, the no-chaos band shaded."""
-    fig, ax = plt.subplots(figsize=(8, 5.5))
+def threshold_figure(
+    curve: ThresholdCurve, fmt: ImageFormat = "png", design_frequency: float | None = None
+) -> bytes:
+    """Critical values of the parameter against the frequency, the no-chaos band shaded, and
+    the design as a point at (``design_frequency``, ``curve.value``) when both are known."""
+    fig, ax = plt.subplots(figsize=(8, 5.5), layout="constrained")
     w = np.asarray(curve.frequencies)
     lo, hi = _band(curve.no_chaos)
+    sym, fsym = symbol(curve.parameter), symbol(curve.frequency_parameter)
+    bands = {branch: _band(intervals) for branch, intervals in curve.branches.items()}
     styles = {"plus": ("C3", "-", "+"), "minus": ("C2", "--", "-")}
-    for branch, intervals in curve.branches.items():
-        blo, bhi = _band(intervals)
+    if len(bands) == 2 and all(
+        np.array_equal(a, b, equal_nan=True) for a, b in zip(*bands.values(), strict=True)
+    ):  # one line drawn: one legend entry
+        bands = {"both": next(iter(bands.values()))}
+        styles["both"] = ("C3", "-", "\\pm")
+    for branch, (blo, bhi) in bands.items():
         color, ls, sign = styles[branch]
-        ax.plot(w, blo, color=color, ls=ls, lw=1.3, label=f"threshold of $M^{sign}$ ({branch})")
+        label = (
+            "threshold of $M^+$ and $M^-$ (the branches coincide)"
+            if branch == "both"
+            else f"threshold of $M^{sign}$ ({branch} branch)"
+        )
+        ax.plot(w, blo, color=color, ls=ls, lw=1.3, label=label)
         ax.plot(w, bhi, color=color, ls=ls, lw=1.3)
     if curve.value is not None:
-        ax.axhline(curve.value, color="k", lw=0.8, ls=":", label="design value")
-    sym = symbol(curve.parameter)
+        ax.axhline(curve.value, color="k", lw=0.8, ls=":", label=f"design value of {sym}")
+        if design_frequency is not None:
+            ax.plot(
+                design_frequency, curve.value, "*", ms=13, color="k", mfc="gold", zorder=5,
+                label=f"design: {fsym} = {design_frequency:.4g}, {sym} = {curve.value:.4g}",
+            )  # fmt: skip
     ax.set(
-        xlabel=symbol(curve.frequency_parameter),
+        xlabel=f"{fsym} (dimensionless frequency)",
         ylabel=sym,
-        title=f"Melnikov threshold curves of {sym}: chaos possible outside the shaded band",
+        title=f"Melnikov thresholds of {sym} over {fsym}\nchaos possible outside the shaded band",
     )
     finite = np.abs(np.concatenate([lo, hi]))
     finite = finite[np.isfinite(finite) & (finite > 0.0)]
@@ -106,8 +147,7 @@ def threshold_figure(curve: ThresholdCurve, fmt: ImageFormat = "png") -> bytes:
         label="no sign change: no chaos",
     )  # fmt: skip
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="best")
-    fig.tight_layout()
+    ax.legend(fontsize=8, loc="best", framealpha=0.9)
     return figure_bytes(fig, fmt)
 
 

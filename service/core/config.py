@@ -39,6 +39,9 @@ class Settings(BaseSettings):
         "the server never closes a connection a client is about to reuse.",
     )
     max_body_bytes: int = Field(1 << 20, ge=1024, description="Largest request body, bytes.")
+    max_batch_body_bytes: int = Field(
+        16 << 20, ge=1024, description="Largest body of POST /v1/melnikov/batch, bytes."
+    )
     max_sync_steps: int = Field(
         5_000_000,
         ge=1000,

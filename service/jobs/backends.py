@@ -66,11 +66,22 @@ class LocalPool:
             initializer=_init_worker,
             initargs=(threads,),
         )
-        for f in [pool.submit(_ready) for _ in range(self.workers)]:
-            f.result()  # every worker started and warmed before the first claim
+        # the workers start and warm up in the background (the server is ready meanwhile);
+        # capacity() stays 0, so no chunk is claimed, until every one of them has answered
+        self._warming = [pool.submit(_ready) for _ in range(self.workers)]
         return pool
 
     def capacity(self) -> int:
+        if self._warming:
+            if not all(f.done() for f in self._warming):
+                return 0
+            warming, self._warming = self._warming, []
+            try:
+                for f in warming:
+                    f.result()
+            except BrokenProcessPool as exc:  # a worker died while starting: a fresh pool
+                self.recover(exc)
+                return 0
         return self.workers
 
     def submit(self, claim: Claim) -> Future[str]:

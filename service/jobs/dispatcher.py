@@ -10,6 +10,16 @@ One loop (``run``) does everything, so the store sees one connection per dispatc
    job was cancelled is dropped;
 3. claim as many chunks as the backend has free slots.
 
+Leases name their holder, the dispatcher's ``owner``: ``host:pid:random``. A lease of a holder
+that is known to be dead is ended at once instead of after ``lease_seconds`` (so a server
+restarted after a crash resumes its chunks immediately), at start and then with every heartbeat.
+Known dead (``holder_is_dead``): same host name, and either this process's pid but not one of its
+live dispatchers (a restart that got the same pid, as PID 1 in a container does), or a pid with
+no process (``os.kill(pid, 0)`` raises ProcessLookupError). Every other holder (another host, a
+live or reused pid, an owner string of another form) keeps its lease until it expires. Should the
+rule ever misjudge (two machines with one host name sharing a data directory), no result is
+committed twice: a commit needs the lease, and the old holder's next heartbeat drops the chunk.
+
 ``stop`` is graceful: no new claims, running chunks get ``grace`` seconds to finish and be
 committed, the rest are released unfinished (without counting an attempt).
 """
@@ -34,6 +44,33 @@ log = logging.getLogger("gearchaos.jobs")
 IDLE_POLL = 0.5
 """Seconds between looks at the store when nothing wakes the dispatcher."""
 
+HOST = socket.gethostname()
+_LIVE_OWNERS: set[str] = set()
+"""Owners of this process's dispatchers that have not finished running."""
+
+
+def new_owner() -> str:
+    """A dispatcher's instance id: ``host:pid:random``."""
+    return f"{HOST}:{os.getpid()}:{uuid.uuid4().hex[:8]}"
+
+
+def holder_is_dead(owner: str) -> bool:
+    """Whether the dispatcher ``owner`` is known to have died (see the module's docstring)."""
+    host, _, rest = owner.rpartition(":")
+    host, _, pid_text = host.rpartition(":")
+    if host != HOST or not pid_text.isdigit() or not rest:
+        return False
+    pid = int(pid_text)
+    if pid == os.getpid():
+        return owner not in _LIVE_OWNERS
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except OSError:  # PermissionError: the pid exists, owned by someone else
+        return False
+    return False
+
 
 @dataclass
 class Dispatcher:
@@ -43,9 +80,7 @@ class Dispatcher:
     backend: Backend
     lease_seconds: float = 30.0
     max_retries: int = 3
-    owner: str = field(
-        default_factory=lambda: f"{socket.gethostname()}:{os.getpid()}:{uuid.uuid4().hex[:8]}"
-    )
+    owner: str = field(default_factory=new_owner)
 
     def __post_init__(self) -> None:
         self._running: dict[tuple[str, int], tuple[Claim, Any]] = {}
@@ -53,7 +88,9 @@ class Dispatcher:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._last_beat = 0.0
+        self._last_reclaim = -float("inf")
         self._grace_until = 0.0
+        _LIVE_OWNERS.add(self.owner)
 
     # --- control --------------------------------------------------------------------------
 
@@ -99,6 +136,7 @@ class Dispatcher:
             self._wake.clear()
         self._drain()
         self.store.close()
+        _LIVE_OWNERS.discard(self.owner)
         log.info("dispatcher %s stopped", self.owner)
 
     def step(self, claim: bool = True) -> None:
@@ -115,6 +153,9 @@ class Dispatcher:
                 future.cancel()
                 log.info("chunk %s/%d dropped (job cancelled or lease lost)", *key)
             self._last_beat = now
+        if claim and now - self._last_reclaim >= self.lease_seconds / 3.0:
+            self.reclaim_dead_leases()
+            self._last_reclaim = now
         free = self.backend.capacity() - len(self._running)
         if claim and free > 0:
             for c in self.store.claim(self.owner, self.lease_seconds, self.max_retries, free):
@@ -125,6 +166,14 @@ class Dispatcher:
                     continue
                 future.add_done_callback(lambda _: self._wake.set())
                 self._running[c.key] = (c, future)
+
+    def reclaim_dead_leases(self) -> int:
+        """End the leases of dispatchers known to be dead; returns the chunks freed."""
+        dead = {o for o in self.store.lease_holders() if holder_is_dead(o)}
+        freed = self.store.expire_leases(dead)
+        if freed:
+            log.info("reclaimed %d chunk(s) leased by dead dispatcher(s) %s", freed, sorted(dead))
+        return freed
 
     def _finish(self, c: Claim, future: Any) -> None:
         try:

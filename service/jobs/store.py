@@ -24,7 +24,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from service.jobs.models import Job, JobStatus, Progress, utc
+from service.jobs.models import Job, JobAxis, JobStatus, Progress, utc
 
 log = logging.getLogger("gearchaos.jobs")
 
@@ -376,6 +376,29 @@ class JobStore:
                 [(job_id, idx, owner) for job_id, idx in keys],
             )
 
+    def lease_holders(self) -> set[str]:
+        """Owners of the leases that have not expired."""
+        rows = self._db().execute(
+            "SELECT DISTINCT lease_owner FROM chunks WHERE status = 'leased' "
+            "AND lease_owner IS NOT NULL AND lease_expires >= ?",
+            (time.time(),),
+        )
+        return {r[0] for r in rows}
+
+    def expire_leases(self, owners: set[str]) -> int:
+        """End the leases of ``owners`` now (their holders are known to be dead), so the next
+        claim takes those chunks at once, as after an expiry (the attempt counts). Returns how
+        many chunks were freed."""
+        if not owners:
+            return 0
+        marks = ", ".join("?" * len(owners))
+        with self._tx() as db:
+            return db.execute(
+                f"UPDATE chunks SET lease_expires = ? WHERE status = 'leased' "
+                f"AND lease_owner IN ({marks})",
+                (time.time(), *sorted(owners)),
+            ).rowcount
+
     def commit_log(self, job_id: str) -> list[tuple[int, str]]:
         """(chunk index, committer) of every commit of a job, in commit order."""
         rows = self._db().execute(
@@ -398,10 +421,16 @@ _JOB_SELECT = (
 
 
 def _job(row: sqlite3.Row) -> Job:
+    request = json.loads(row["request_json"])
     return Job(
         id=row["id"],
+        label=request.get("label"),
         status=row["status"],
         progress=Progress(done=row["done_points"], total=row["total_points"]),
+        axes=[
+            JobAxis(**{k: a[k] for k in ("parameter", "start", "stop", "num")})
+            for a in request.get("axes", [])
+        ],
         created_at=utc(row["created_at"]),
         started_at=utc(row["started_at"]),
         finished_at=utc(row["finished_at"]),

@@ -11,7 +11,7 @@ from gearengine.jsonio import dumps
 from gearengine.numerics import work
 from gearengine.plots import MEDIA_TYPES, analysis_figure
 from service.api.deps import cached_compute, require_key
-from service.api.responses import IMAGE_RESPONSES, JSON, PROBLEMS, FormatQuery, image_format
+from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
 
 router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 
@@ -25,7 +25,7 @@ def _analysis(request: Request, body: AnalysisRequest) -> AnalysisResult:
 @router.post(
     "/analyses",
     response_model=AnalysisResult,
-    responses=PROBLEMS,
+    responses=CACHED,
     summary="Melnikov and numerical verdicts of one design",
 )
 async def post_analysis(body: AnalysisRequest, request: Request) -> Response:

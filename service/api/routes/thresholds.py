@@ -10,17 +10,23 @@ from gearengine.homoclinic import ThresholdCurve
 from gearengine.homoclinic.schemas import ThresholdsRequest
 from gearengine.homoclinic.thresholds import curve_of
 from gearengine.jsonio import dumps
+from gearengine.model.aliases import get_alias
 from gearengine.plots import MEDIA_TYPES, threshold_figure
 from service.api.deps import cached_compute, require_key
-from service.api.responses import IMAGE_RESPONSES, JSON, PROBLEMS, FormatQuery, image_format
+from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
 
 router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
+
+
+def _design_frequency(body: ThresholdsRequest) -> float | None:
+    """The design's value of the swept frequency: where the figure marks the design."""
+    return None if body.params is None else get_alias(body.params, body.frequency_parameter)
 
 
 @router.post(
     "/thresholds",
     response_model=ThresholdCurve,
-    responses=PROBLEMS,
+    responses=CACHED,
     summary="Threshold curves of a control parameter over a frequency range",
 )
 async def post_thresholds(body: ThresholdsRequest, request: Request) -> Response:
@@ -54,5 +60,5 @@ async def post_threshold_plot(
         request,
         f"thresholds/plot.{fmt}",
         body.model_dump_json(),
-        lambda: (threshold_figure(curve_of(body), fmt), MEDIA_TYPES[fmt]),
+        lambda: (threshold_figure(curve_of(body), fmt, _design_frequency(body)), MEDIA_TYPES[fmt]),
     )

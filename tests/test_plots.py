@@ -1,0 +1,92 @@
+"""What the figures draw: the spectrum panel shows the JSON's spectrum, the lines and axes say
+what they are, the design is a point, one legend entry per drawn threshold line."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+import gearengine.plots.analysis as plots
+from gearengine.analysis import AnalysisRequest, analyze
+from gearengine.homoclinic.thresholds import threshold_curve
+from gearengine.model.params import GearParams
+from tests.conftest import PAPER_PARAMS
+
+
+@pytest.fixture
+def drawn(monkeypatch: pytest.MonkeyPatch) -> list[Figure]:
+    """The figures the plot functions render, kept instead of turned into bytes."""
+    figures: list[Figure] = []
+
+    def keep(fig: Figure, fmt: str) -> bytes:
+        figures.append(fig)
+        return b""
+
+    monkeypatch.setattr(plots, "figure_bytes", keep)
+    return figures
+
+
+def chaotic() -> Any:
+    te = {"frequency": 0.5, "harmonics": [{"amplitude": 0.28}]}
+    params = {**PAPER_PARAMS, "transmission_error": te}
+    return analyze(AnalysisRequest.model_validate({"params": params}))
+
+
+def test_the_spectrum_panel_draws_the_reported_peaks(drawn: list[Figure]) -> None:
+    result = chaotic()
+    plots.analysis_figure(result)
+    (fig,) = drawn
+    ax_f = fig.axes[3]
+    (stems,) = ax_f.collections
+    segments = stems.get_segments()
+    peaks = result.numerics.spectrum_peaks
+    assert [(s[1][0], s[1][1]) for s in segments] == [(p.order, p.amplitude) for p in peaks]
+    top = max(peaks, key=lambda p: p.amplitude)
+    assert top.amplitude == pytest.approx(max(s[1][1] for s in segments))
+    # the panel says what is plotted
+    words = ax_f.get_title() + " ".join(t.get_text() for t in ax_f.texts)
+    for needed in ("amplitude spectrum of x", "Hann window", "amplitude-corrected", "500"):
+        assert needed in words, needed
+    # |x| = 1 lines are labelled and x, x' carry their units
+    assert "|x| = 1: clearance edges" in [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "half backlash" in fig.axes[0].get_ylabel()
+    assert "per unit" in fig.axes[1].get_ylabel()
+
+
+def curve_figure(drawn: list[Figure], params: dict[str, Any], frequency: float) -> Figure:
+    curve = threshold_curve(GearParams.model_validate(params), "F_e1", "Omega_e", 0.2, 2.0, 40)
+    plots.threshold_figure(curve, "png", design_frequency=frequency)
+    return drawn[-1]
+
+
+def legend_labels(fig: Figure) -> list[str]:
+    return [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+
+
+def test_threshold_figure_marks_the_design_and_labels_each_line(drawn: list[Figure]) -> None:
+    fig = curve_figure(drawn, PAPER_PARAMS, 0.5)
+    labels = legend_labels(fig)
+    design = [line for line in fig.axes[0].lines if line.get_label().startswith("design:")]
+    assert len(design) == 1 and list(design[0].get_xydata()[0]) == [0.5, 0.2]
+    # symmetric forcing: the two branches are one line, so one entry
+    assert sum("threshold" in label for label in labels) == 1
+    # a mean force with a second harmonic splits the branches: two lines, two entries
+    split = {
+        **PAPER_PARAMS,
+        "mean_force": 0.05,
+        "transmission_error": {
+            "frequency": 0.5,
+            "harmonics": [{"amplitude": 0.2}, {"amplitude": 0.05, "phase": 1.0}],
+        },
+    }
+    fig = curve_figure(drawn, split, 0.5)
+    thresholds = [label for label in legend_labels(fig) if "threshold" in label]
+    lines = {
+        tuple(np.round(line.get_ydata(), 9))
+        for line in fig.axes[0].lines
+        if line.get_label() in thresholds
+    }
+    assert len(thresholds) == len(lines) == 2, (thresholds, lines)
