@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
-from gearengine.sweeps import run_local, validated
+from gearengine.sweeps import compute_chunk_json, run_local, validated
 from service.core.config import Settings
 from service.main import create_app
 from tests.conftest import PAPER_PARAMS
@@ -197,3 +197,56 @@ def test_continuation_both_branches_over_http(working: TestClient) -> None:
     job = wait(working, working.post("/v1/sweeps", json=doc).json()["id"])
     points = working.get(f"/v1/sweeps/{job['id']}/result").json()["points"]
     assert [p["branch"] for p in points] == ["up"] * 4 + ["down"] * 4
+
+
+def test_jobs_show_their_axes_and_label(client: TestClient) -> None:
+    job = client.post("/v1/sweeps", json=body(label="stage 1: F_e1")).json()
+    assert job["label"] == "stage 1: F_e1"
+    assert job["axes"] == [{"parameter": "F_e1", "start": 0.0, "stop": 0.3, "num": 11}]
+    (listed,) = client.get("/v1/sweeps").json()["items"]
+    assert listed["label"] == "stage 1: F_e1" and listed["axes"] == job["axes"]
+    assert client.post("/v1/sweeps", json=body()).json()["label"] is None
+    r = client.post("/v1/sweeps", json=body(label="x" * 201))
+    assert r.status_code == 422 and r.json()["errors"][0]["path"] == "label"
+
+
+def test_a_cancelled_jobs_finished_chunks_are_a_partial_result(tmp_path: Path) -> None:
+    """Chunk 51 of 4 points holds F_e1 = 0.204, which numpy.linspace makes 0.20400000000000001:
+    the CSV writes the decimal."""
+    app = create_app(Settings(data_dir=tmp_path, workers=0, sweep_chunk_points=4))
+    with TestClient(app) as c:
+        job = c.post("/v1/sweeps", json=body(num=301)).json()
+        store = app.state.sweep_jobs.store
+        url = f"/v1/sweeps/{job['id']}"
+        assert c.get(url + "/result", params={"partial": True}).json()["points"] == []
+        # a worker leases chunks 0..51 and finishes only chunk 51; then the job is cancelled
+        claims = store.claim("test-worker", 60.0, 3, 52)
+        assert [cl.index for cl in claims] == list(range(52))
+        done = compute_chunk_json(claims[51].request_json, 51, 4)
+        assert store.commit("test-worker", job["id"], 51, done)
+        assert c.delete(url).json()["status"] == "cancelled"
+        assert c.get(url + "/result").status_code == 409
+        r = c.get(url + "/result", params={"partial": True})
+        assert r.status_code == 200 and r.headers["x-partial-result"] == "true"
+        result = r.json()
+        assert result["partial"] is True
+        assert [p["values"]["F_e1"] for p in result["points"]] == pytest.approx(
+            [0.204, 0.205, 0.206, 0.207]
+        )
+        r = c.get(url + "/result", params={"partial": True, "format": "csv"})
+        assert r.headers["x-partial-result"] == "true"
+        rows = list(csv.DictReader(io.StringIO(r.text)))
+        assert [row["F_e1"] for row in rows] == ["0.204", "0.205", "0.206", "0.207"]
+
+
+def test_openapi_declares_the_headers_it_sends(client: TestClient) -> None:
+    paths = client.get("/openapi.json").json()["paths"]
+    submit = paths["/v1/sweeps"]["post"]["responses"]["202"]["headers"]
+    assert {"Location", "Retry-After"} <= set(submit)
+    assert "Retry-After" in paths["/v1/sweeps/{job_id}"]["get"]["responses"]["200"]["headers"]
+    result = paths["/v1/sweeps/{job_id}/result"]["get"]["responses"]
+    assert "Retry-After" in result["409"]["headers"]
+    assert "X-Partial-Result" in result["200"]["headers"]
+    for path in ("/v1/melnikov", "/v1/analyses", "/v1/thresholds", "/v1/analyses/plot"):
+        responses = paths[path]["post"]["responses"]
+        assert "ETag" in responses["200"]["headers"] and "304" in responses, path

@@ -3,11 +3,16 @@
     gearengine melnikov FILE [--json] [--method closed_form|quadrature]
     gearengine analyze FILE [--json]
     gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov] [--max-lle V]
+        [--min-stability-margin X]
     gearengine sweep FILE [--out DIR]
+    gearengine convert FILE [--json]
 
-FILE holds ``{"params": {...}}`` (and ``"settings"`` for analyze/check; ``-`` reads standard
-input). ``--json`` prints exactly the body the HTTP API returns. Exit codes: 0 success (check:
-pass), 1 check failed, 2 invalid input (one line per problem, naming the field).
+FILE holds ``{"params": {...}}`` or ``{"design": {...}}`` (physical units), and ``"settings"``
+for analyze/check; ``-`` reads standard input. ``--json`` prints exactly the body the HTTP API
+returns. Exit codes: 0 success (check: pass), 1 check failed, 2 invalid input (one line per
+problem, naming the field), 141 the reader of standard output went away (``| head``): no
+traceback, and the shell's code of a process that SIGPIPE stopped (128 + 13), so a closed pipe
+is never mistaken for a failed check.
 
 More commands come from installed plugins: every entry point of the group ``gearengine.commands``
 is a function ``register(subparsers)``; the service registers ``serve`` and ``worker`` this way,
@@ -18,16 +23,34 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
+import traceback
 from collections.abc import Callable, Sequence
 from importlib.metadata import entry_points
 
 from gearengine.cli.analyze import cmd_analyze, cmd_check
-from gearengine.cli.documents import EXIT_INVALID, InvalidInputError
+from gearengine.cli.convert import cmd_convert
+from gearengine.cli.documents import EXIT_INTERNAL, EXIT_INVALID, EXIT_PIPE, InvalidInputError
 from gearengine.cli.melnikov import cmd_melnikov
 from gearengine.cli.sweep import cmd_sweep
+from gearengine.model.units import QUANTITIES, parse_quantity
 
 PLUGIN_GROUP = "gearengine.commands"
+
+
+def micrometres(text: str) -> float:
+    """A length option in µm: a bare number is µm, "0.02 mm" is read with its unit."""
+    try:
+        return float(text)
+    except ValueError:
+        pass
+    try:
+        return parse_quantity(text, QUANTITIES["error"]) * 1e6
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
 """Entry-point group of command plugins: each is a ``register(subparsers)`` function."""
 
 
@@ -54,22 +77,48 @@ def build_parser() -> argparse.ArgumentParser:
         help="CI gate: exit 1 when the design fails (0 pass, 2 invalid input)",
         description="--fail-on X fails on X or anything worse "
         "(periodic < quasi_periodic < chaotic < diverged); melnikov fails when a transverse "
-        "homoclinic tangle is possible. Default: --fail-on chaotic, unless --max-lle is given.",
+        "homoclinic tangle is possible; impacts on back-flank contact. Default: --fail-on "
+        "chaotic; the limits (--max-lle, --max-dte, --min-stability-margin) add to it. With "
+        "--speed and/or --torque the whole operating envelope of a design is checked.",
     )
     p.add_argument("file", help='JSON file holding {"params": {...}, "settings": {...}}, or -')
     p.add_argument(
         "--fail-on",
         action="append",
-        choices=["chaotic", "quasi_periodic", "diverged", "melnikov"],
+        choices=["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts"],
         help="repeatable",
     )
+    p.add_argument("--speed", metavar="LOW:HIGH", help="driver speeds: rpm, or with units")
+    p.add_argument("--torque", metavar="LOW:HIGH", help="mean driver torques: N m, or with units")
+    p.add_argument("--speed-points", type=int, default=23, metavar="N", help="default 23")
+    p.add_argument("--torque-points", type=int, default=5, metavar="N", help="default 5")
+    p.add_argument("--max-dte", type=micrometres, default=None, metavar="E",
+                   help="fail where the dynamic transmission error (peak to peak) exceeds E "
+                   "(µm, or with a unit: 20um, 0.02mm)")  # fmt: skip
+    p.add_argument("--json", metavar="FILE", help="write the envelope report (JSON)")
+    p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
+    p.add_argument("--server", metavar="URL", help="run the envelope on a running service "
+                   "(API key from GEARCHAOS_API_KEY)")  # fmt: skip
     p.add_argument("--max-lle", type=float, default=None, help="fail when the LLE exceeds V")
+    p.add_argument(
+        "--min-stability-margin",
+        type=float,
+        default=None,
+        metavar="X",
+        help="fail when the response is periodic and its Floquet stability margin "
+        "1 - max |lambda| is below X (or unavailable)",
+    )
     p.set_defaults(func=cmd_check)
 
     p = sub.add_parser("sweep", help="run a sweep here, no server: JSON, CSV and PNG")
     p.add_argument("file", help="JSON file holding a sweep request (as POST /v1/sweeps), or -")
     p.add_argument("--out", default=".", help="directory for the outputs (default .)")
     p.set_defaults(func=cmd_sweep)
+
+    p = sub.add_parser("convert", help="a design in physical units: parameters, derivations, rpm")
+    p.add_argument("file", help='JSON file holding {"design": {...}}, or - for stdin')
+    p.add_argument("--json", action="store_true", help="print the API's JSON response")
+    p.set_defaults(func=cmd_convert)
 
     for plugin in entry_points(group=PLUGIN_GROUP):
         try:
@@ -84,8 +133,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     func: Callable[[argparse.Namespace], int] = args.func
     try:
-        return func(args)
+        code = func(args)
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit
     except InvalidInputError as exc:
         for line in exc.lines:
             print(line, file=sys.stderr)
         return EXIT_INVALID
+    except BrokenPipeError:
+        # the reader went away (``| head``): stop quietly, as Unix tools do. Point stdout at
+        # /dev/null so the interpreter's final flush does not fail again.
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_PIPE
+    except Exception:  # a bug: never mistaken for a failed check (exit 1)
+        traceback.print_exc()
+        print("gearengine: internal error (please report it)", file=sys.stderr)
+        return EXIT_INTERNAL
+    return code

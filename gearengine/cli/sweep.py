@@ -49,7 +49,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     result = run_local(request, progress_bar(time.monotonic()))
     (out / f"{stem}.json").write_text(dumps(result))
     (out / f"{stem}.csv").write_text("".join(to_csv(result)))
-    (out / f"{stem}.png").write_bytes(sweep_figure(request, result.points, "png"))
+    (out / f"{stem}.png").write_bytes(
+        sweep_figure(request, result.points, "png", result.bifurcations)
+    )
     for ext in ("json", "csv", "png"):
         print(out / f"{stem}.{ext}")
     return EXIT_OK

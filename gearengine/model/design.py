@@ -22,11 +22,14 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
+    GetJsonSchemaHandler,
     PrivateAttr,
     ValidationInfo,
     field_validator,
     model_validator,
 )
+from pydantic.json_schema import JsonSchemaValue
+from pydantic_core import CoreSchema
 
 from gearengine.model import geometry
 from gearengine.model.backlash import collocation_fit
@@ -37,6 +40,7 @@ from gearengine.model.conversion import (
     TransmissionErrorHarmonic,
     to_dimensionless,
 )
+from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import (
     MAX_HARMONICS,
     CubicBacklash,
@@ -426,12 +430,15 @@ class ParamsOrDesign(BaseModel):
     """
 
     design: Design | None = Field(
-        None, description="The pair in physical units (see docs/units.md). Give this or params."
+        None,
+        description="The pair in physical units (see docs/units.md). Give this or params.",
+        examples=[EXAMPLE_DESIGN],
     )
     params: GearParams | None = Field(
         None,
         validate_default=True,
         description="Dimensionless parameters of Eq. (9). Give this or design.",
+        examples=[PAPER_SECTION_41],
     )
     _conversion: DesignConversion | None = PrivateAttr(None)
 
@@ -454,6 +461,15 @@ class ParamsOrDesign(BaseModel):
         object.__setattr__(self, "params", conversion.params)
         self._conversion = conversion
         return self
+
+    @classmethod
+    def __get_pydantic_json_schema__(
+        cls, core_schema: CoreSchema, handler: GetJsonSchemaHandler
+    ) -> JsonSchemaValue:
+        """The schema says what validation does: exactly one of params and design."""
+        schema = handler.resolve_ref_schema(handler(core_schema))
+        schema["oneOf"] = [{"required": ["params"]}, {"required": ["design"]}]
+        return schema
 
     @property
     def conversion(self) -> DesignConversion | None:

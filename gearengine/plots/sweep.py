@@ -10,28 +10,65 @@
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Sequence
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.colors import TwoSlopeNorm
 from matplotlib.figure import Figure
 
-from gearengine.homoclinic.thresholds import strength_at, verdict_flips
+from gearengine.homoclinic.boundary import chaos_intervals_from, flips
+from gearengine.homoclinic.thresholds import strength_at
 from gearengine.model.aliases import ALIASES, get_alias
+from gearengine.model.params import GearParams
+from gearengine.plots.envelope import axis_label, envelope_map
 from gearengine.plots.style import LLE_LABEL, SYMBOLS, ImageFormat, figure_bytes
+from gearengine.sweeps.axes import display_unit, is_dimensionless
 from gearengine.sweeps.export import agreement_table
 from gearengine.sweeps.request import SweepRequest
-from gearengine.sweeps.results import SweepPoint
+from gearengine.sweeps.results import SweepBifurcation, SweepPoint
 
 BOUNDARY_GRID = 160
 """Samples per axis of the sign-change strength for the Melnikov boundary."""
+PHYSICAL_BOUNDARY_GRID = 60
+"""Samples along a physical axis (each one converts the design)."""
 
 
-def sweep_figure(request: SweepRequest, points: Sequence[SweepPoint], fmt: ImageFormat) -> bytes:
-    """The sweep's figure, bifurcation diagram or chaos map, as PNG or SVG bytes."""
-    fig = bifurcation(request, points) if len(request.axes) == 1 else chaos_map(request, points)
+def sweep_figure(
+    request: SweepRequest,
+    points: Sequence[SweepPoint],
+    fmt: ImageFormat,
+    bifurcations: Sequence[SweepBifurcation] | None = None,
+) -> bytes:
+    """The sweep's figure, bifurcation diagram or chaos map, as PNG or SVG bytes; the located
+    ``bifurcations`` (``SweepResult.bifurcations``) are marked on a bifurcation diagram."""
+    if len(request.axes) == 1:
+        fig = bifurcation(request, points, bifurcations)
+    elif all(is_dimensionless(a.parameter) for a in request.axes):
+        fig = chaos_map(request, points)
+    else:
+        fig = envelope_map(request, points)
     return figure_bytes(fig, fmt)
+
+
+def bifurcation_label(b: SweepBifurcation) -> str:
+    """E.g. "1T→2T at F_e1 = 0.21194" (the period after is "?" when none was found)."""
+    after = f"{b.period_after}T" if b.period_after is not None else "?"
+    return f"{b.period_before}T→{after} at {b.parameter} = {b.value:.5f}"
+
+
+def _mark_bifurcations(top: Axes, bottom: Axes, bifurcations: Sequence[SweepBifurcation]) -> None:
+    """Vertical lines at the located points, labelled on the diagram (``bifurcation_label``)."""
+    for b in bifurcations:
+        if b.value is None:
+            continue
+        colour = "tab:green" if b.branch == "up" else "tab:purple"
+        for ax in (top, bottom):
+            ax.axvline(b.value, c=colour, ls=":", lw=0.9)
+        top.annotate(
+            bifurcation_label(b), (b.value, 0.98), xycoords=("data", "axes fraction"),
+            rotation=90, ha="right", va="top", fontsize=7, color=colour,
+        )  # fmt: skip
 
 
 def _fixed(request: SweepRequest) -> str:
@@ -55,44 +92,57 @@ def _settings_note(request: SweepRequest) -> str:
     )
 
 
-def bifurcation(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
-    """Poincare x against the parameter, the LLE underneath, the Melnikov threshold marked."""
+def bifurcation(
+    request: SweepRequest,
+    points: Sequence[SweepPoint],
+    bifurcations: Sequence[SweepBifurcation] | None = None,
+) -> Figure:
+    """Poincare x against the parameter, the LLE underneath, the Melnikov threshold marked, and
+    the located bifurcation points (continuation sweeps) as labelled vertical lines."""
     axis = request.axes[0]
     name = axis.parameter
+    physical = not is_dimensionless(name)
+    factor = display_unit(name)[1] if physical else 1.0
     fig = Figure(figsize=(8.0, 6.4), layout="constrained")
     top, bottom = fig.subplots(2, 1, sharex=True, height_ratios=[2.2, 1.0])
     colours = {None: "black", "up": "tab:blue", "down": "tab:orange"}
     branches = sorted({p.branch for p in points}, key=lambda b: b or "")
     for branch in branches:
         mine = [p for p in points if p.branch == branch]
-        xs = [p.values[name] for p in mine for _ in p.poincare_x]
+        xs = [p.values[name] * factor for p in mine for _ in p.poincare_x]
         ys = [x for p in mine for x in p.poincare_x]
         suffix = f", branch {branch}" if branch else ""
         top.scatter(xs, ys, s=0.6, c=colours[branch], marker=".", linewidths=0,
                     label="Poincaré points" + suffix)  # fmt: skip
-        lle = sorted((p.values[name], p.lle) for p in mine if p.lle is not None)
+        lle = sorted((p.values[name] * factor, p.lle) for p in mine if p.lle is not None)
         bottom.plot(*zip(*lle, strict=True), lw=0.9, c=colours[branch],
                     label=r"$\lambda_{\max}$" + suffix)  # fmt: skip
-    lo, hi = sorted((axis.start, axis.stop))
-    crossings = verdict_flips(request.params, name, lo, hi, BOUNDARY_GRID)
-    edges = [lo, *crossings, hi]
+    grid = request.grids()[0]
+    lo, hi = min(grid), max(grid)
+
+    def path(v: float) -> GearParams:
+        return request.point({name: v})
+
+    # the boundary of the points themselves: each point's verdict is /v1/melnikov's for it
+    crossings = flips(path, lo, hi, PHYSICAL_BOUNDARY_GRID if physical else BOUNDARY_GRID)
+    chaos = chaos_intervals_from(path, [lo, *crossings, hi])
+    symbol = axis_label(name) if physical else SYMBOLS[name]
     for ax in (top, bottom):
-        for e0, e1 in itertools.pairwise(edges):
-            mid = strength_at(request.params, {name: 0.5 * (e0 + e1)})
-            if mid > 0.0:
-                ax.axvspan(e0, e1, color="tab:red", alpha=0.08, lw=0)
+        for e0, e1 in chaos:
+            ax.axvspan(e0 * factor, e1 * factor, color="tab:red", alpha=0.08, lw=0)
         for k, v in enumerate(crossings):
-            label = f"Melnikov threshold {SYMBOLS[name]} = {v:.4g}" if k == 0 else None
-            ax.axvline(v, c="tab:red", ls="--", lw=1.0, label=label)
+            label = f"Melnikov threshold {symbol} = {v * factor:.4g}" if k == 0 else None
+            ax.axvline(v * factor, c="tab:red", ls="--", lw=1.0, label=label)
+    _mark_bifurcations(top, bottom, bifurcations or [])
     bottom.axhline(0.0, c="grey", lw=0.6)
     top.set_ylabel(r"$x$ at $\tau = n T_0$ (units of $b$)")
     bottom.set_ylabel(LLE_LABEL)
-    bottom.set_xlabel(f"{SYMBOLS[name]} (dimensionless)")
-    bottom.set_xlim(lo, hi)
+    bottom.set_xlabel(symbol if physical else f"{symbol} (dimensionless)")
+    bottom.set_xlim(lo * factor, hi * factor)
     top.legend(loc="best", markerscale=12, fontsize=8, framealpha=0.9)
     bottom.legend(loc="best", fontsize=8, framealpha=0.9)
     top.set_title(
-        f"Bifurcation diagram in {SYMBOLS[name]}: {_fixed(request)}\n"
+        f"Bifurcation diagram in {symbol}: {_fixed(request)}\n"
         f"{_settings_note(request)}; shaded: Melnikov function changes sign",
         fontsize=10,
     )
@@ -103,10 +153,11 @@ def chaos_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
     """The (axis 0, axis 1) plane coloured by LLE, the Melnikov boundary and an agreement
     table. With both branches a cell shows the larger LLE of the two."""
     ax0, ax1 = request.axes
-    v0, v1 = np.array(ax0.values()), np.array(ax1.values())
+    s0, s1 = request.grids()
+    v0, v1 = np.array(s0), np.array(s1)
     lle = np.full((ax1.num, ax0.num), np.nan)
-    index0 = {v: i for i, v in enumerate(ax0.values())}
-    index1 = {v: i for i, v in enumerate(ax1.values())}
+    index0 = {v: i for i, v in enumerate(s0)}
+    index1 = {v: i for i, v in enumerate(s1)}
     for p in points:
         if p.lle is None:
             continue
@@ -124,10 +175,7 @@ def chaos_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
     g0 = np.linspace(v0.min(), v0.max(), BOUNDARY_GRID)
     g1 = np.linspace(v1.min(), v1.max(), BOUNDARY_GRID)
     strength = np.array(
-        [
-            [strength_at(request.params, {ax0.parameter: a, ax1.parameter: b}) for a in g0]
-            for b in g1
-        ]
+        [[strength_at(request.point({ax0.parameter: a, ax1.parameter: b})) for a in g0] for b in g1]
     )
     if np.nanmin(strength) < 0.0 < np.nanmax(strength):
         ax.contourf(g0, g1, strength, levels=[0.0, np.inf], colors="none", hatches=["//"])

@@ -7,7 +7,15 @@ numerics rooms.
 """
 
 from gearengine.sweeps.compute import compute_chunk, compute_chunk_json, run_local
-from gearengine.sweeps.export import agreement_table, csv_rows, result_json, to_csv
+from gearengine.sweeps.export import (
+    agreement_table,
+    chunk_bifurcations,
+    chunk_json,
+    chunk_points,
+    csv_rows,
+    result_json,
+    to_csv,
+)
 from gearengine.sweeps.plan import DEFAULT_CHUNK_POINTS, SweepPlan, sweep_work
 from gearengine.sweeps.request import (
     SweepAxis,
@@ -16,17 +24,21 @@ from gearengine.sweeps.request import (
     request_errors,
     validated,
 )
-from gearengine.sweeps.results import SweepPoint, SweepResult
+from gearengine.sweeps.results import SweepBifurcation, SweepPoint, SweepResult
 
 __all__ = [
     "DEFAULT_CHUNK_POINTS",
     "SweepAxis",
+    "SweepBifurcation",
     "SweepPlan",
     "SweepPoint",
     "SweepRequest",
     "SweepResult",
     "agreement_table",
     "checked",
+    "chunk_bifurcations",
+    "chunk_json",
+    "chunk_points",
     "compute_chunk",
     "compute_chunk_json",
     "csv_rows",

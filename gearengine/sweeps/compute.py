@@ -1,26 +1,57 @@
 """Computing a sweep's chunks: the numerical verdict of each point (``numerics.batch``) with the
-Melnikov verdict beside it; continuation carries the final state along a line.
+Melnikov verdict beside it; continuation carries the final state along a line, and on a
+one-axis sweep locates the line's bifurcation points, carried in the chunk's output.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any
 
 from gearengine.homoclinic.thresholds import chaos_possible
-from gearengine.model.aliases import with_aliases
+from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
 from gearengine.numerics.batch import simulate_batch
+from gearengine.numerics.bifurcations import Response, locate_bifurcations
+from gearengine.numerics.forcing import step_plan
 from gearengine.numerics.results import BatchPoint
 from gearengine.numerics.settings import SimulationSettings
-from gearengine.sweeps.export import result_json
+from gearengine.sweeps.axes import display_unit, is_dimensionless
+from gearengine.sweeps.axes import shown as rounded
+from gearengine.sweeps.export import chunk_json, result_json
+from gearengine.sweeps.export import chunk_points as points_of_chunk
 from gearengine.sweeps.plan import DEFAULT_CHUNK_POINTS, SweepPlan
 from gearengine.sweeps.request import SweepBranch, SweepRequest
-from gearengine.sweeps.results import SweepPoint, SweepResult
+from gearengine.sweeps.results import PhysicalValue, SweepBifurcation, SweepPoint, SweepResult
+from gearengine.sweeps.windows import speed_windows
+
+
+def _physical(
+    request: SweepRequest, values: dict[str, float], params: GearParams, bp: BatchPoint
+) -> dict[str, Any]:
+    """With a design: the axes in display units, the DTE in µm and the point's aliases."""
+    if request.design is None:
+        return {}
+    shown = {}
+    for name, si in values.items():
+        if not is_dimensionless(name):
+            unit, factor = display_unit(name)
+            shown[name] = PhysicalValue(value=rounded(si * factor), unit=unit)
+    b = values.get("mesh.half_backlash", request.design.mesh.half_backlash)
+    if bp.x_peak_to_peak is not None:
+        shown["dte"] = PhysicalValue(value=rounded(bp.x_peak_to_peak * b * 1e6), unit="um")
+    aliases = {a: get_alias(params, a) for a in ALIASES}
+    return {"physical": shown, "dimensionless": {k: v for k, v in aliases.items() if v is not None}}
 
 
 def _point(
-    values: dict[str, float], branch: SweepBranch | None, params: GearParams, bp: BatchPoint
-):
+    request: SweepRequest,
+    values: dict[str, float],
+    branch: SweepBranch | None,
+    params: GearParams,
+    bp: BatchPoint,
+) -> SweepPoint:
     return SweepPoint(
         values=values,
         branch=branch,
@@ -31,6 +62,8 @@ def _point(
         impact_regime=bp.impact_regime,
         melnikov_chaos_possible=chaos_possible(params),
         poincare_x=[s[0] for s in bp.poincare],
+        x_peak_to_peak=bp.x_peak_to_peak,
+        **_physical(request, values, params, bp),
     )
 
 
@@ -38,11 +71,19 @@ def compute_chunk(
     request: SweepRequest, chunk_index: int, chunk_points: int = DEFAULT_CHUNK_POINTS
 ) -> list[SweepPoint]:
     """Verdicts of the points of one chunk, in the chunk's order (deterministic)."""
+    return _compute(request, chunk_index, chunk_points)[0]
+
+
+def _compute(
+    request: SweepRequest, chunk_index: int, chunk_points: int
+) -> tuple[list[SweepPoint], list[SweepBifurcation] | None]:
+    """A chunk's points and, for a line of a one-axis continuation sweep, the bifurcation
+    points located on it (``numerics.bifurcations``; None for other chunks)."""
     chunk = SweepPlan(request, chunk_points).chunk(chunk_index)
     axes = request.axes
-    grids = [a.values() for a in axes]
+    grids = request.grids()
     values = [{a.parameter: grids[k][ix[k]] for k, a in enumerate(axes)} for ix in chunk.points]
-    designs = [with_aliases(request.params, v) for v in values]
+    designs = [request.point(v) for v in values]
     if not request.continuation:
         verdicts = simulate_batch(designs, request.settings)
     else:
@@ -52,9 +93,42 @@ def compute_chunk(
             (bp,) = simulate_batch([design], settings)
             verdicts.append(bp)
             settings = _carried(request.settings, bp)
-    return [
-        _point(v, chunk.branch, d, bp) for v, d, bp in zip(values, designs, verdicts, strict=True)
+    points = [
+        _point(request, v, chunk.branch, d, bp)
+        for v, d, bp in zip(values, designs, verdicts, strict=True)
     ]
+    if not request.continuation or len(axes) != 1 or len(values) < 2:
+        return points, None
+    if axes[0].parameter not in ALIASES:  # located by shooting in an alias of Eq. (9) only
+        return points, []
+    line = [v[axes[0].parameter] for v in values]
+    return points, _line_bifurcations(request, line, designs, verdicts)
+
+
+def _line_bifurcations(
+    request: SweepRequest, line: list[float], designs: list[GearParams], verdicts: list[BatchPoint]
+) -> list[SweepBifurcation]:
+    """Bifurcation points of one continuation line, followed from its computed responses.
+
+    The line's points are reused (``Response``), so only Newton shooting, the location of each
+    crossing and one simulation per crossing (the branch switch) are added. Incommensurate
+    forcing has no Poincare period and so no multipliers: no points then.
+    """
+    responses = [
+        Response(
+            bp.classification,
+            bp.period,
+            bp.poincare[-1] if bp.poincare else None,
+            None if bp.final_state is None else (bp.final_state[0], bp.final_state[1]),
+        )
+        for bp in verdicts
+    ]
+    alias = request.axes[0].parameter
+    steps = request.settings.steps_per_period
+    if any(step_plan(d, steps).omega0 is None for d in designs):
+        return []
+    events = locate_bifurcations(request.params, alias, line, request.settings, responses=responses)
+    return [SweepBifurcation.model_validate(e) for e in events]
 
 
 def _carried(settings: SimulationSettings, bp: BatchPoint) -> SimulationSettings:
@@ -71,24 +145,36 @@ def _carried(settings: SimulationSettings, bp: BatchPoint) -> SimulationSettings
 
 
 def compute_chunk_json(request_json: str, chunk_index: int, chunk_points: int) -> str:
-    """``compute_chunk`` on JSON text, returning a JSON array (what workers exchange)."""
+    """``compute_chunk`` on JSON text, returning the chunk's output (what workers exchange):
+    a JSON array of points, or for a continuation line also its bifurcations (``chunk_json``)."""
     request = SweepRequest.model_validate_json(request_json)
-    points = compute_chunk(request, chunk_index, chunk_points)
-    return "[" + ",".join(p.model_dump_json() for p in points) + "]"
+    return chunk_json(*_compute(request, chunk_index, chunk_points))
 
 
 def run_local(
     request: SweepRequest,
     progress_callback: Callable[[int, int], None] | None = None,
     chunk_points: int = DEFAULT_CHUNK_POINTS,
+    workers: int = 1,
 ) -> SweepResult:
-    """Compute every chunk in this process; ``progress_callback(done, total)`` in points."""
+    """Compute every chunk in this process; ``progress_callback(done, total)`` in points.
+
+    ``workers`` > 1 computes chunks on that many threads: the kernels release the GIL
+    (``nogil``), so the integration runs on every core. The result does not depend on it.
+    """
     plan = SweepPlan(request, chunk_points)
     total, done = request.n_points(), 0
-    arrays = []
-    for i in range(plan.n_chunks()):
-        arrays.append(compute_chunk_json(request.model_dump_json(), i, chunk_points))
-        done += len(plan.chunk(i).points)
-        if progress_callback is not None:
-            progress_callback(done, total)
-    return SweepResult.model_validate_json("".join(result_json(request.axes, arrays)))
+    text = request.model_dump_json()
+    with ThreadPoolExecutor(max(1, workers)) as pool:
+        futures = [pool.submit(compute_chunk_json, text, i, chunk_points)
+                   for i in range(plan.n_chunks())]  # fmt: skip
+        arrays = []
+        for i, future in enumerate(futures):
+            arrays.append(future.result())
+            done += len(plan.chunk(i).points)
+            if progress_callback is not None:
+                progress_callback(done, total)
+    points = [SweepPoint.model_validate(p) for text in arrays for p in points_of_chunk(text)]
+    windows = speed_windows(request, points)
+    text = "".join(result_json(request.axes, arrays, windows=windows))
+    return SweepResult.model_validate_json(text)

@@ -6,24 +6,77 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 from collections.abc import Iterable, Iterator
 
 from pydantic import BaseModel, Field
 
 from gearengine.sweeps.request import SweepAxis
-from gearengine.sweeps.results import SweepPoint, SweepResult
+from gearengine.sweeps.results import SweepBifurcation, SweepPoint, SweepResult
+
+_LINE_HEAD = '{"bifurcations":'
+_LINE_POINTS = ',"points":['
 
 
-def result_json(axes: list[SweepAxis], chunk_arrays: Iterable[str]) -> Iterator[str]:
-    """The JSON text of a ``SweepResult`` from the chunks' JSON arrays (in chunk order)."""
+def chunk_json(points: Iterable[SweepPoint], bifurcations: list[SweepBifurcation] | None) -> str:
+    """A chunk's output (what workers exchange): the JSON array of its points, or, for a line
+    of a one-axis continuation sweep, ``{"bifurcations": [...], "points": [...]}``."""
+    array = ",".join(p.model_dump_json() for p in points)
+    if bifurcations is None:
+        return "[" + array + "]"
+    located = ",".join(b.model_dump_json() for b in bifurcations)
+    return _LINE_HEAD + "[" + located + "]" + _LINE_POINTS + array + "]}"
+
+
+def _chunk_parts(text: str) -> tuple[str, list[dict[str, object]] | None]:
+    """The inner text of a chunk's points array and its bifurcations (None if it has none)."""
+    text = text.strip()
+    if not text.startswith(_LINE_HEAD):
+        return text[1:-1], None
+    cut = text.index(_LINE_POINTS)
+    return text[cut + len(_LINE_POINTS) : -2], json.loads(text[len(_LINE_HEAD) : cut])
+
+
+def chunk_points(text: str) -> list[dict[str, object]]:
+    """The points of a chunk's output, as JSON objects."""
+    return json.loads("[" + _chunk_parts(text)[0] + "]")
+
+
+def chunk_bifurcations(chunk_outputs: Iterable[str]) -> list[SweepBifurcation] | None:
+    """The bifurcations of all chunks, in chunk order; None when no chunk located any."""
+    found = [_chunk_parts(text)[1] for text in chunk_outputs]
+    if all(f is None for f in found):
+        return None
+    return [SweepBifurcation.model_validate(b) for f in found for b in f or []]
+
+
+def result_json(
+    axes: list[SweepAxis],
+    chunk_arrays: Iterable[str],
+    partial: bool = False,
+    windows: list[BaseModel] | None = None,
+) -> Iterator[str]:
+    """The JSON text of a ``SweepResult`` from the chunks' outputs (``chunk_json``, in chunk
+    order): the points streamed as they are, the lines' bifurcations gathered at the end.
+    ``partial``: some chunks are missing (a job that did not succeed); ``windows``: the speed
+    windows (``sweeps.windows``) of a sweep over the driver speed."""
     yield '{"axes":[' + ",".join(a.model_dump_json() for a in axes) + '],"points":['
     first = True
+    located: list[dict[str, object]] | None = None
     for array in chunk_arrays:
-        inner = array.strip()[1:-1]
+        inner, bifurcations = _chunk_parts(array)
+        if bifurcations is not None:
+            located = (located or []) + bifurcations
         if inner:
             yield ("" if first else ",") + inner
             first = False
-    yield "]}"
+    shown = (
+        "null" if windows is None else "[" + ",".join(w.model_dump_json() for w in windows) + "]"
+    )
+    yield (
+        '],"bifurcations":' + json.dumps(located) + ',"partial":' + json.dumps(partial)
+        + ',"windows":' + shown + "}"
+    )  # fmt: skip
 
 
 CSV_FIELDS = (
@@ -49,10 +102,17 @@ def csv_rows(axes: list[SweepAxis], points: Iterable[SweepPoint]) -> Iterator[st
     names = [a.parameter for a in axes]
     yield _csv_row([*names, *CSV_FIELDS])
     for p in points:
-        cells = [p.values[n] for n in names]
+        cells = [_grid_value(p.values[n]) for n in names]
         cells += [getattr(p, f) for f in CSV_FIELDS[:-1]]
         cells.append(" ".join(repr(x) for x in p.poincare_x))
         yield _csv_row(cells)
+
+
+def _grid_value(x: float) -> float:
+    """An axis value as the decimal it stands for: ``numpy.linspace`` computes 0.204 as
+    0.20400000000000001 (an ulp away); 15 significant digits snap it back, so the cell reads
+    0.204 (every float is written in repr's shortest form)."""
+    return float(f"{x:.15g}")
 
 
 def _csv_row(cells: list[object]) -> str:

@@ -13,7 +13,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gearengine.model.aliases import with_aliases
 from gearengine.numerics.settings import work
 from gearengine.sweeps.request import SweepBranch, SweepRequest
 
@@ -24,26 +23,32 @@ DEFAULT_CHUNK_POINTS = 64
 FREQUENCY_ALIASES = frozenset({"Omega_k", "Omega_e", "Omega_p"})
 
 
+def moves_frequency_ratios(parameter: str) -> bool:
+    """True for an axis that changes the ratios of the excitation frequencies (and so the steps
+    per T0): one excitation's frequency, an order or a tooth count. ``speed`` and ``Omega`` scale
+    every frequency together and keep the ratios."""
+    return parameter in FREQUENCY_ALIASES or parameter.endswith((".order", ".teeth"))
+
+
 def sweep_work(request: SweepRequest) -> int:
     """RK4 steps of the whole sweep, for the compute budget.
 
     The steps per T0 depend on how the excitation frequencies line up, so every combination of
-    swept frequencies is costed; the other axes (amplitudes, damping, mean force) only switch an
-    excitation on or off, so their corners bound them.
+    values of the axes that move their ratios is costed; the other axes (amplitudes, damping,
+    mean force, running speed) only switch an excitation on or off, so their corners bound them.
     """
-    freq = [a for a in request.axes if a.parameter in FREQUENCY_ALIASES]
-    rest = [a for a in request.axes if a.parameter not in FREQUENCY_ALIASES]
-    per_combination = request.n_points() // math.prod(a.num for a in freq)
-    corners = list(itertools.product(*((a.start, a.stop) for a in rest)))
+    grids = request.grids()
+    freq = [k for k, a in enumerate(request.axes) if moves_frequency_ratios(a.parameter)]
+    rest = [k for k, a in enumerate(request.axes) if not moves_frequency_ratios(a.parameter)]
+    per_combination = request.n_points() // math.prod(request.axes[k].num for k in freq)
+    corners = list(itertools.product(*((grids[k][0], grids[k][-1]) for k in rest)))
+    names = [a.parameter for a in request.axes]
     total = 0
-    for values in itertools.product(*(a.values() for a in freq)):
-        point = dict(zip((a.parameter for a in freq), values, strict=True))
+    for values in itertools.product(*(grids[k] for k in freq)):
+        point = {names[k]: v for k, v in zip(freq, values, strict=True)}
         total += per_combination * max(
             work(
-                with_aliases(
-                    request.params,
-                    {**point, **dict(zip((a.parameter for a in rest), c, strict=True))},
-                ),
+                request.point({**point, **{names[k]: v for k, v in zip(rest, c, strict=True)}}),
                 request.settings,
             )
             for c in corners

@@ -15,19 +15,43 @@ settings' initial states and points of a chunk run together in ``simulate_batch`
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Annotated, Literal
 
 import numpy as np
-from pydantic import BaseModel, Field, ValidationError
+from pydantic import BaseModel, Field, PlainValidator, ValidationError, WithJsonSchema
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
-from gearengine.model.aliases import Alias, with_aliases
+from gearengine.model.design import Design, ParamsOrDesign
 from gearengine.model.examples import PAPER_SECTION_41
-from gearengine.model.params import Finite, GearParams, request_config
+from gearengine.model.params import GearParams, request_config
 from gearengine.numerics.settings import SimulationSettings
+from gearengine.sweeps.axes import (
+    axis_problem,
+    changes_nothing,
+    is_dimensionless,
+    point_params,
+    si_value,
+)
 
 MAX_AXIS_POINTS = 100_000
 """Upper cap of ``num`` of one axis (the service caps the product lower, max_sweep_points)."""
+
+
+def _axis_value(value: object) -> float | str:
+    """A finite number, or a string (a quantity with a unit, parsed against the design)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        raise ValueError("give a number, or a string with a unit such as '500 rpm'")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise ValueError("Input should be a finite number")
+    return value if isinstance(value, str) else float(value)
+
+
+AxisValue = Annotated[
+    float | str,
+    PlainValidator(_axis_value),
+    WithJsonSchema({"anyOf": [{"type": "number"}, {"type": "string", "examples": ["500 rpm"]}]}),
+]
+"""An axis end: a number (dimensionless, or SI for a physical field) or a string with a unit."""
 
 SweepBranch = Literal["up", "down"]
 """A line of a continuation sweep: up (run start -> stop) or down (stop -> start)."""
@@ -35,17 +59,26 @@ Direction = Literal["forward", "backward", "both"]
 
 
 class SweepAxis(BaseModel):
-    """One axis: ``num`` equally spaced values of a parameter alias from ``start`` to ``stop``."""
+    """One axis: ``num`` equally spaced values of a parameter from ``start`` to ``stop``."""
 
     model_config = request_config()
 
-    parameter: Alias = Field(
-        description="Parameter alias: mu, F_m, k_p1, F_e1, F_p1, Omega_k, Omega_e or Omega_p "
-        "(first-harmonic amplitudes and excitation frequencies, dimensionless).",
-        examples=["F_e1"],
+    parameter: str = Field(
+        min_length=1,
+        max_length=100,
+        pattern=r"^[A-Za-z_][A-Za-z0-9_.]*$",
+        description="A dimensionless alias of Eq. (9) (mu, F_m, k_p1, F_e1, F_p1, Omega_k, "
+        "Omega_e, Omega_p), Omega (every excitation frequency scaled together), or with a "
+        "design a physical field: speed, torque, mesh.half_backlash, mesh.damping_ratio, "
+        "transmission_error.harmonics.0.amplitude, ... (see gearengine.sweeps.axes).",
+        examples=["F_e1", "speed"],
     )
-    start: Finite = Field(description="First value (dimensionless).", examples=[0.0])
-    stop: Finite = Field(description="Last value (dimensionless).", examples=[0.3])
+    start: AxisValue = Field(
+        description="First value: a number (dimensionless, or SI for a physical field) or a "
+        "string with a unit ('500 rpm').",
+        examples=[0.0, "500 rpm"],
+    )
+    stop: AxisValue = Field(description="Last value, as start.", examples=[0.3, "6000 rpm"])
     num: int = Field(
         ge=1,
         le=MAX_AXIS_POINTS,
@@ -53,12 +86,17 @@ class SweepAxis(BaseModel):
         examples=[301],
     )
 
-    def values(self) -> list[float]:
-        """The ``num`` values, start to stop (``numpy.linspace``)."""
-        return [float(v) for v in np.linspace(self.start, self.stop, self.num)]
+    def values(self, design: Design | None = None) -> list[float]:
+        """The ``num`` values, start to stop (``numpy.linspace``), in SI units for a physical
+        field of ``design``."""
+        lo, hi = self.start, self.stop
+        if not is_dimensionless(self.parameter):
+            assert design is not None
+            lo, hi = (si_value(design, self.parameter, v) for v in (lo, hi))
+        return [float(v) for v in np.linspace(float(lo), float(hi), self.num)]
 
 
-class SweepRequest(BaseModel):
+class SweepRequest(ParamsOrDesign):
     """A bifurcation diagram (one axis) or a chaos map (two axes) of the design ``params``."""
 
     model_config = request_config(
@@ -71,7 +109,6 @@ class SweepRequest(BaseModel):
         }
     )
 
-    params: GearParams = Field(description="The design; the axes' parameters are overwritten.")
     settings: SimulationSettings = Field(
         default_factory=SimulationSettings,
         description="Integration settings of every point (periods, steps, initial states).",
@@ -83,12 +120,19 @@ class SweepRequest(BaseModel):
     )
     continuation: bool = Field(
         False,
-        description="Carry the final state [x, v] from point to point along the first axis.",
+        description="Carry the final state [x, v] from point to point along the first axis; "
+        "on a one-axis sweep also locate the bifurcation points (result: bifurcations).",
     )
     direction: Direction = Field(
         "forward",
         description="With continuation: forward (start -> stop), backward, or both (exposes "
         "hysteresis; points carry branch up or down).",
+    )
+    label: str | None = Field(
+        None,
+        max_length=200,
+        description="The client's name for the sweep, shown in job listings; not computed on.",
+        examples=["stage 1: F_e1 at 1500 rpm"],
     )
 
     def branches(self) -> list[SweepBranch]:
@@ -98,6 +142,15 @@ class SweepRequest(BaseModel):
     def n_points(self) -> int:
         """Number of computed points, every branch counted."""
         return math.prod(a.num for a in self.axes) * len(self.branches())
+
+    def grids(self) -> list[list[float]]:
+        """Each axis' values (SI units for physical fields)."""
+        return [a.values(self.design) for a in self.axes]
+
+    def point(self, values: dict[str, float]) -> GearParams:
+        """The dimensionless parameters at one grid point (``sweeps.axes.point_params``)."""
+        assert self.params is not None
+        return point_params(self.params, self.design, values)
 
 
 def request_errors(request: SweepRequest, max_points: int | None = None) -> list[InitErrorDetails]:
@@ -128,20 +181,43 @@ def request_errors(request: SweepRequest, max_points: int | None = None) -> list
         )
     if errors:
         return errors
-    base = {a.parameter: a.start for a in request.axes}
     for i, axis in enumerate(request.axes):
-        for end in ("start", "stop"):
-            value = getattr(axis, end)
+        problem = axis_problem(request.params, request.design, axis.parameter, axis.start,
+                               axis.stop, {})  # fmt: skip
+        if problem is not None:
+            add(("axes", i, problem[0]), problem[1], getattr(axis, problem[0]))
+    if errors:
+        return errors
+    grids = request.grids()
+    base = {a.parameter: g[0] for a, g in zip(request.axes, grids, strict=True)}
+    for i, (axis, grid) in enumerate(zip(request.axes, grids, strict=True)):
+        for end, value in (("start", grid[0]), ("stop", grid[-1])):
             try:
-                with_aliases(request.params, {**base, axis.parameter: value})
+                request.point({**base, axis.parameter: value})
             except ValidationError as exc:
                 e = exc.errors(include_url=False)[0]
                 where = ".".join(map(str, e["loc"]))
                 add(("axes", i, end), f"gives an invalid design: {where}: {e['msg']}", value)
-            except ValueError as exc:
+            except ValueError as exc:  # the parameter cannot be set on this design at all
                 add(("axes", i, "parameter"), str(exc), axis.parameter)
                 break
+        if axis.num > 1 and not errors and _changes_nothing(request, i, grids):
+            add(("axes", i, "parameter"), f"{axis.parameter} changes nothing in Eq. (9) for this "
+                "design (its excitation has no nonzero harmonic?)", axis.parameter)  # fmt: skip
     return errors
+
+
+def _changes_nothing(request: SweepRequest, i: int, grids: list[list[float]]) -> bool:
+    """Axis ``i`` leaves Eq. (9) unchanged at both ends of the other axis (if any)."""
+    others = [(a.parameter, g) for k, (a, g) in enumerate(zip(request.axes, grids, strict=True))
+              if k != i]  # fmt: skip
+    ends = [{}] if not others else [{others[0][0]: v} for v in (others[0][1][0], others[0][1][-1])]
+    name, grid = request.axes[i].parameter, grids[i]
+    assert request.params is not None
+    return all(
+        changes_nothing(request.params, request.design, name, grid[0], grid[-1], base)
+        for base in ends
+    )
 
 
 def checked(request: SweepRequest, max_points: int | None = None) -> SweepRequest:

@@ -3,9 +3,20 @@
 
 from __future__ import annotations
 
+from typing import Literal
+
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.sweeps.request import SweepAxis, SweepBranch
+
+
+class PhysicalValue(BaseModel):
+    """A value with its unit."""
+
+    model_config = ConfigDict(frozen=True, allow_inf_nan=False)
+
+    value: float
+    unit: str
 
 
 class SweepPoint(BaseModel):
@@ -30,6 +41,70 @@ class SweepPoint(BaseModel):
         description="Melnikov verdict at this point; null when not applicable (a or c <= 0)."
     )
     poincare_x: list[float] = Field(description="x of the last stroboscopic points (units of b).")
+    x_peak_to_peak: float | None = Field(
+        None, description="max x - min x over the record (units of b); null if diverged."
+    )
+    physical: dict[str, PhysicalValue] | None = Field(
+        None,
+        description="With a design: the physical axes' values in display units (rpm, N*m, "
+        "µm, ...) and the dynamic transmission error dte (µm peak to peak).",
+        examples=[{"speed": {"value": 1500.0, "unit": "rpm"}, "torque": {"value": 40.0,
+                   "unit": "N*m"}, "dte": {"value": 3.4, "unit": "um"}}],
+    )  # fmt: skip
+    dimensionless: dict[str, float] | None = Field(
+        None,
+        description="With physical axes: the point's dimensionless aliases (mu, F_m, F_e1, "
+        "Omega_e, ...) after conversion.",
+    )
+
+
+class SweepBifurcation(BaseModel):
+    """A bifurcation point located on a line of a continuation sweep (``numerics.bifurcations``):
+    where the followed periodic orbit's largest Floquet multiplier crosses the unit circle."""
+
+    model_config = ConfigDict(frozen=True, allow_inf_nan=False)
+
+    parameter: str = Field(description="The swept parameter alias.", examples=["F_e1"])
+    value: float | None = Field(
+        description="Located parameter value (to 1e-10); null for orbit_lost.",
+        examples=[0.2119437371],
+    )
+    type: Literal["period_doubling", "fold", "neimark_sacker", "orbit_lost"] = Field(
+        description="period_doubling (multiplier through -1), fold (+1), neimark_sacker "
+        "(complex pair), or orbit_lost (Newton lost the branch without a crossing, e.g. past "
+        "a fold; value null)."
+    )
+    period_before: int = Field(description="Period of the orbit before the point, units of T0.")
+    period_after: int | None = Field(
+        description="Period of the stable orbit found beyond it; null if none (e.g. chaos)."
+    )
+    branch: SweepBranch = Field(description="up (start -> stop) or down (stop -> start).")
+    bracket: list[float] = Field(description="The two grid values around the point.")
+    critical_multiplier: list[float] | None = Field(
+        description="The dominant multiplier [re, im] at the point (about [-1, 0] for a "
+        "period doubling); null for orbit_lost."
+    )
+
+
+class SpeedWindows(BaseModel):
+    """Speed intervals [rpm] at one level of the other axis (or of the whole one-axis sweep)."""
+
+    model_config = ConfigDict(frozen=True)
+
+    level: dict[str, PhysicalValue] = Field(
+        description='The other axis at this row, e.g. {"torque": {"value": 40, '
+        '"unit": "N*m"}}; empty for a one-axis speed sweep.'
+    )
+    response: dict[str, list[list[float]]] = Field(
+        description="Per response (periodic 1T, periodic 2T, ..., quasi-periodic, chaotic, "
+        "diverged): [first, last] speeds [rpm] of each run of grid points."
+    )
+    impacts: dict[str, list[list[float]]] = Field(
+        description="single_sided (teeth separate) and double_sided (back-flank contact) runs."
+    )
+    melnikov: list[list[float]] = Field(
+        description="Runs of grid speeds where the Melnikov criterion allows chaos."
+    )
 
 
 class SweepResult(BaseModel):
@@ -39,3 +114,18 @@ class SweepResult(BaseModel):
 
     axes: list[SweepAxis] = Field(description="The axes of the request.")
     points: list[SweepPoint] = Field(description="One entry per point and branch.")
+    bifurcations: list[SweepBifurcation] | None = Field(
+        None,
+        description="One-axis continuation sweeps: the bifurcation points located on each "
+        "branch, in sweep order; null for other sweeps.",
+    )
+    partial: bool = Field(
+        False,
+        description="True when points are missing: the finished chunks of a job that did not "
+        "succeed (cancelled, failed or still running), fetched with ?partial=true.",
+    )
+    windows: list[SpeedWindows] | None = Field(
+        None,
+        description="Sweeps over the driver speed: per level of the other axis, the speed "
+        "intervals [rpm] of each response, of impacts and of Melnikov chaos; null otherwise.",
+    )

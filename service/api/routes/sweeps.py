@@ -6,7 +6,6 @@ another key gets 404 and does not see them in listings.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Iterator
 from typing import Annotated, Literal
 
@@ -21,11 +20,14 @@ from gearengine.sweeps import (
     SweepRequest,
     SweepResult,
     checked,
+    chunk_bifurcations,
+    chunk_points,
     csv_rows,
     result_json,
 )
+from gearengine.sweeps.windows import speed_windows
 from service.api.deps import AppSettings, Jobs, Owner
-from service.api.responses import JSON, PNG, PROBLEMS, SVG
+from service.api.responses import JSON, PNG, PROBLEMS, RETRY_AFTER_HEADER, SVG, header
 from service.errors import ProblemError
 from service.jobs.models import UNFINISHED, Job, JobPage, JobStatus
 from service.jobs.runtime import SweepJobs
@@ -39,7 +41,16 @@ RETRY_AFTER = {"queued": "5", "running": "2"}
 QUEUE_FULL_RETRY = "30"
 
 _NOT_FOUND = {404: {"description": "No such job for this API key."}}
-_CONFLICT = {409: {"description": "The job has not succeeded (yet)."}}
+_RETRY = {"Retry-After": RETRY_AFTER_HEADER}
+_CONFLICT = {
+    409: {
+        "description": "The job has not succeeded (yet); ?partial=true gives its finished "
+        "chunks. Retry-After while it is queued or running.",
+        "headers": _RETRY,
+    }
+}
+PARTIAL_HEADER = "X-Partial-Result"
+"""Set to true on a result with points missing (?partial=true on a job that did not succeed)."""
 
 
 def _job_or_404(jobs: SweepJobs, job_id: str, owner: str | None) -> Job:
@@ -60,7 +71,8 @@ def _succeeded(jobs: SweepJobs, job_id: str, owner: str | None) -> Job:
             409,
             "not-finished" if job.status in UNFINISHED else "no-result",
             "No result",
-            f"sweep {job_id} is {job.status}: a result exists only once it has succeeded",
+            f"sweep {job_id} is {job.status}: the full result exists only once it has "
+            "succeeded; ?partial=true gives the points of its finished chunks",
             headers=_poll_headers(job),
         )
     return job
@@ -70,7 +82,17 @@ def _succeeded(jobs: SweepJobs, job_id: str, owner: str | None) -> Job:
     "",
     status_code=202,
     response_model=Job,
-    responses={**PROBLEMS, 429: {"description": "Too many unfinished jobs; see Retry-After."}},
+    responses={
+        **PROBLEMS,
+        202: {
+            "description": "Stored and queued.",
+            "headers": {
+                "Location": header("URL of the job: poll it."),
+                "Retry-After": RETRY_AFTER_HEADER,
+            },
+        },
+        429: {"description": "Too many unfinished jobs; see Retry-After.", "headers": _RETRY},
+    },
     summary="Submit a bifurcation sweep (one axis) or a chaos map (two axes)",
 )
 def post_sweep(
@@ -122,7 +144,11 @@ def list_sweeps(
 @router.get(
     "/{job_id}",
     response_model=Job,
-    responses={**PROBLEMS, **_NOT_FOUND},
+    responses={
+        **PROBLEMS,
+        **_NOT_FOUND,
+        200: {"description": "The job.", "headers": _RETRY},
+    },
     summary="Status and progress of a sweep job",
 )
 def get_sweep(job_id: str, response: Response, owner: Owner, jobs: Jobs) -> Job:
@@ -152,7 +178,7 @@ def cancel_sweep(job_id: str, owner: Owner, jobs: Jobs) -> Job:
 
 def _points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
     for array in jobs.store.chunk_results(job_id):
-        for item in json.loads(array):
+        for item in chunk_points(array):
             yield SweepPoint.model_validate(item)
 
 
@@ -163,7 +189,14 @@ def _points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
         **PROBLEMS,
         **_NOT_FOUND,
         **_CONFLICT,
-        200: {"content": {JSON: {}, CSV: {}}, "description": "The sweep's points."},
+        200: {
+            "content": {JSON: {}, CSV: {}},
+            "description": "The sweep's points.",
+            "headers": {
+                PARTIAL_HEADER: header("true when points are missing (?partial=true)."),
+                "Retry-After": RETRY_AFTER_HEADER,
+            },
+        },
     },
     summary="Result of a succeeded sweep: JSON, or CSV with ?format=csv",
 )
@@ -174,18 +207,40 @@ def get_result(
     format: Annotated[
         Literal["json", "csv"], Query(description="json or csv (streamed).")
     ] = "json",
+    partial: Annotated[
+        bool,
+        Query(
+            description="Also answer for a job that did not succeed (cancelled, failed, or "
+            'still running): the points of its finished chunks, marked "partial": true and '
+            f"{PARTIAL_HEADER}: true."
+        ),
+    ] = False,
 ) -> Response:
     """Every point with its axis values, classification, period, LLE, contact regime, Melnikov
-    verdict and the x of its last stroboscopic (Poincare) points."""
-    _succeeded(jobs, job_id, owner)
-    axes = SweepRequest.model_validate_json(jobs.store.request_json(job_id)).axes
+    verdict and the x of its last stroboscopic (Poincare) points; a one-axis continuation
+    sweep also its located bifurcation points (``bifurcations``)."""
+    job = _job_or_404(jobs, job_id, owner) if partial else _succeeded(jobs, job_id, owner)
+    missing = job.status != "succeeded"
+    headers = {PARTIAL_HEADER: "true", **_poll_headers(job)} if missing else {}
+    sweep = SweepRequest.model_validate_json(jobs.store.request_json(job_id))
+    axes = sweep.axes
     if format == "csv":
+        name = f"sweep-{job_id}{'-partial' if missing else ''}.csv"
         return StreamingResponse(
             csv_rows(axes, _points(jobs, job_id)),
             media_type=CSV,
-            headers={"Content-Disposition": f'attachment; filename="sweep-{job_id}.csv"'},
+            headers={"Content-Disposition": f'attachment; filename="{name}"', **headers},
         )
-    return StreamingResponse(result_json(axes, jobs.store.chunk_results(job_id)), media_type=JSON)
+    return StreamingResponse(
+        result_json(
+            axes,
+            jobs.store.chunk_results(job_id),
+            partial=missing,
+            windows=speed_windows(sweep, list(_points(jobs, job_id))),
+        ),
+        media_type=JSON,
+        headers=headers,
+    )
 
 
 def _plot_format(fmt: str | None, accept: str) -> Literal["png", "svg"]:
@@ -229,7 +284,8 @@ async def get_plot(
 
     def draw() -> bytes:
         sweep = SweepRequest.model_validate_json(jobs.store.request_json(job_id))
-        return sweep_figure(sweep, list(_points(jobs, job_id)), fmt)
+        located = chunk_bifurcations(jobs.store.chunk_results(job_id))
+        return sweep_figure(sweep, list(_points(jobs, job_id)), fmt, located)
 
     body = await run_in_threadpool(draw)
     return Response(body, media_type=PNG if fmt == "png" else SVG)

@@ -1,0 +1,134 @@
+"""The default envelope check (``gearengine check --speed 500:6000 --torque 20:200``) against
+``gear_ref --simd --batch`` on the same points, wall time.
+
+Run:  .venv/bin/python benchmarks/bench_envelope.py
+The design is the README's pair with the transmission error as its only excitation and the
+paper's cubic law (``backlash_law: cubic_fit``), so that a change of speed moves one frequency
+and gear_ref's one-parameter batch can run the same grid: per torque level one
+``gear_ref --simd --batch We`` over the 23 speeds (Omega_e and F~_m from the engine's own
+conversion), 60 + 60 periods of 128 RK4 steps, the check's default settings. The engine is
+timed twice: the whole command (a fresh process: imports, cached kernels, conversion of every
+point, Melnikov verdicts, report) and the sweep alone in this process. A second row times the
+command on the README design as it is (piecewise law, three excitations), which gear_ref's
+batch cannot run. Best of 3; writes its section of benchmarks/README.md.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from report import write_section  # benchmarks/report.py (the script's own folder)
+
+from gearengine.cli.envelope import ENVELOPE_SETTINGS
+from gearengine.model.design import EXAMPLE_DESIGN
+from gearengine.sweeps import run_local, validated
+
+ROOT = Path(__file__).resolve().parents[1]
+GEAR_REF = Path("/work/shared/reference/gear_ref.c")
+REPEATS = 3
+SPEEDS, TORQUES = (500.0, 6000.0, 23), (20.0, 200.0, 5)
+
+
+def cubic_te_design() -> dict:
+    d = copy.deepcopy(EXAMPLE_DESIGN)
+    d["mesh"].pop("stiffness_harmonics")
+    d.pop("torque_fluctuation")
+    d["backlash_law"] = "cubic_fit"
+    return d
+
+
+def sweep_doc(design: dict) -> dict:
+    axes = [
+        {"parameter": "speed", "start": f"{SPEEDS[0]} rpm", "stop": f"{SPEEDS[1]} rpm",
+         "num": SPEEDS[2]},
+        {"parameter": "torque", "start": f"{TORQUES[0]} N*m", "stop": f"{TORQUES[1]} N*m",
+         "num": TORQUES[2]},
+    ]  # fmt: skip
+    return {"design": design, "settings": ENVELOPE_SETTINGS, "axes": axes}
+
+
+def best(run: object) -> float:
+    times = []
+    for _ in range(REPEATS):
+        t = time.perf_counter()
+        run()  # type: ignore[operator]
+        times.append(time.perf_counter() - t)
+    return min(times)
+
+
+def command_seconds(design: dict, tmp: Path) -> float:
+    path = tmp / "design.json"
+    path.write_text(json.dumps({"design": design}))
+    speed, torque = f"{SPEEDS[0]:g}:{SPEEDS[1]:g}", f"{TORQUES[0]:g}:{TORQUES[1]:g}"
+    args = [sys.executable, "-m", "gearengine.cli", "check", str(path), "--speed", speed,
+            "--torque", torque]  # fmt: skip
+    return best(lambda: subprocess.run(args, capture_output=True, check=False))
+
+
+def gear_ref_seconds(tmp: Path) -> float:
+    """Wall time of one ``gear_ref --simd --batch We`` per torque level, summed."""
+    exe = tmp / "gear_ref"
+    gcc = shutil.which("gcc") or sys.exit("gcc is needed to build gear_ref")
+    subprocess.run([gcc, "-O3", "-march=native", "-o", exe, GEAR_REF, "-lm"], check=True)
+    req = validated(sweep_doc(cubic_te_design()))
+    speeds, torques = req.grids()
+    calls = []
+    for torque in torques:
+        lo, hi = (req.point({"speed": s, "torque": torque}) for s in (speeds[0], speeds[-1]))
+        we_lo, we_hi = lo.transmission_error.frequency, hi.transmission_error.frequency
+        fe = lo.transmission_error.harmonics[0].amplitude
+        s = ENVELOPE_SETTINGS
+        calls.append([exe, "--simd", "--batch", "We", f"{we_lo!r}", f"{we_hi!r}", str(SPEEDS[2]),
+                      f"{lo.damping!r}", f"{fe!r}", f"{we_lo!r}", f"{lo.mean_force!r}", "0", "1",
+                      "0", "1", "cubic", str(s["steps_per_period"]), str(s["transient_periods"]),
+                      str(s["record_periods"])])  # fmt: skip
+
+    def run() -> None:
+        for call in calls:
+            subprocess.run(call, check=True, capture_output=True)
+
+    return best(run)
+
+
+def main() -> None:
+    with tempfile.TemporaryDirectory() as tmp_dir:
+        tmp = Path(tmp_dir)
+        ref = gear_ref_seconds(tmp)
+        req = validated(sweep_doc(cubic_te_design()))
+        cores = os.cpu_count() or 1
+        chunk = max(1, req.n_points() // (4 * cores))
+        run_local(req, chunk_points=chunk, workers=cores)  # warm
+        sweep = best(lambda: run_local(req, chunk_points=chunk, workers=cores))
+        command = command_seconds(cubic_te_design(), tmp)
+        readme = command_seconds(copy.deepcopy(EXAMPLE_DESIGN), tmp)
+    n = SPEEDS[2] * TORQUES[2]
+    rows = [
+        f"| sweep of the {n} points in process, {cores} threads | {sweep:.2f} s | "
+        f"{ref:.2f} s | {sweep / ref:.1f}x |",
+        f"| whole `gearengine check` command (new process) | {command:.2f} s | {ref:.2f} s | "
+        f"{command / ref:.1f}x |",
+        f"| whole command, README design (piecewise law, 3 excitations) | {readme:.2f} s | – | – |",
+    ]
+    write_section(
+        "envelope",
+        "## Envelope check (`gearengine check --speed 500:6000 --torque 20:200`)\n\n"
+        f"Default grid {SPEEDS[2]} speeds x {TORQUES[2]} torques, 60 + 60 periods of 128 RK4 "
+        "steps; the README design with its transmission error only and the cubic law, so that "
+        "gear_ref --simd --batch (one call per torque level over the speeds) runs the same "
+        "points. Best of 3, `benchmarks/bench_envelope.py`.\n\n"
+        "| what | gearengine | gear_ref --simd --batch | ratio |\n|---|---:|---:|---:|\n"
+        + "\n".join(rows),
+    )
+    print("\n".join(rows))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,166 @@
+"""``gearengine check DESIGN --speed 500:6000 --torque 20:200``: the CI gate over an operating
+envelope.
+
+Sweeps the design over a grid of driver speeds (rpm unless a unit is given) and mean torques
+(N m unless a unit is given), checks every point against the rules (``sweeps.gate``), prints
+the failing windows, and exits 1 when any point fails, 0 when none does, 2 on invalid input.
+``--json FILE`` writes the report (with the API's sweep result in it), ``--junit FILE`` a
+JUnit XML report, ``--server URL`` runs the sweep on a running service (its queue, its
+workers) instead of in this process, with the same report.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Callable
+from pathlib import Path
+
+from gearengine.cli.documents import (
+    EXIT_FAIL,
+    EXIT_OK,
+    InvalidInputError,
+    read_document,
+    validated_input,
+)
+from gearengine.cli.sweep import progress_bar
+from gearengine.jsonio import dumps
+from gearengine.sweeps.compute import run_local
+from gearengine.sweeps.gate import EnvelopeReport, Rules, envelope_report, junit_xml, window_text
+from gearengine.sweeps.request import SweepRequest, validated
+from gearengine.sweeps.results import SweepResult
+
+ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
+"""Integration settings of an envelope check unless the design file gives ``settings``."""
+POLL_SECONDS = 1.0
+
+
+def axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
+    """A sweep axis from "A:B" (bare numbers in ``unit``) or "52rad/s:628rad/s"."""
+    ends = text.split(":")
+    if len(ends) != 2 or not all(e.strip() for e in ends):
+        raise InvalidInputError([f"--{name}: give a range as LOW:HIGH, e.g. --{name} 500:6000"])
+    lo, hi = (e.strip() if any(c.isalpha() for c in e) else f"{e.strip()} {unit}" for e in ends)
+    return {"parameter": name, "start": lo, "stop": hi, "num": num}
+
+
+def envelope_request(args: argparse.Namespace) -> SweepRequest:
+    """The speed x torque sweep of the design file under ``args``."""
+    doc = read_document(args.file)
+    if not isinstance(doc, dict) or "design" not in doc:
+        raise InvalidInputError([f'{args.file}: an envelope check needs {{"design": {{...}}}}'])
+    design = doc["design"]
+    axes = [
+        axis("speed", args.speed, "rpm", args.speed_points)
+        if args.speed
+        else axis("speed", _here(design, "speed"), "rpm", 1)
+    ]
+    if args.torque:
+        axes.append(axis("torque", args.torque, "N*m", args.torque_points))
+    sweep = {"design": design, "settings": doc.get("settings", ENVELOPE_SETTINGS), "axes": axes,
+             "label": f"envelope check of {Path(args.file).name}"}  # fmt: skip
+    return validated_input(validated, sweep, args.file)
+
+
+def _here(design: dict, name: str) -> str:
+    """The design's own value as a one-point range (when only the other axis is given)."""
+    value = design.get(name)
+    if value is None:
+        raise InvalidInputError([f"--{name}: give a range, the design has no {name}"])
+    return f"{value}:{value}"
+
+
+def progress(start: float) -> Callable[[int, int], None]:
+    """A bar on a terminal, plain lines (every 10 %) in a CI log."""
+    if sys.stderr.isatty():
+        return progress_bar(start)
+    shown = [-1]
+
+    def line(done: int, total: int) -> None:
+        tenth = 10 * done // max(total, 1)
+        if tenth > shown[0]:
+            shown[0] = tenth
+            elapsed = time.monotonic() - start
+            print(f"envelope: {done}/{total} points, {elapsed:.1f} s", file=sys.stderr)
+
+    return line
+
+
+def run_on_server(url: str, request: SweepRequest, key: str | None,
+                  report: Callable[[int, int], None]) -> SweepResult:  # fmt: skip
+    """Submit the sweep to a running service, follow its progress, fetch the result."""
+    base = url.rstrip("/")
+    job = _call(f"{base}/v1/sweeps", key, request.model_dump_json().encode())
+    while job["status"] in ("queued", "running"):
+        time.sleep(POLL_SECONDS)
+        job = _call(f"{base}/v1/sweeps/{job['id']}", key)
+        report(job["progress"]["done"], job["progress"]["total"])
+    if job["status"] != "succeeded":
+        raise InvalidInputError([f"{base}: sweep {job['id']} {job['status']}"])
+    return SweepResult.model_validate(_call(f"{base}/v1/sweeps/{job['id']}/result", key))
+
+
+def _call(url: str, key: str | None, body: bytes | None = None) -> dict:
+    headers = {"content-type": "application/json", "accept": "application/json"}
+    if key:
+        headers["authorization"] = f"Bearer {key}"
+    req = urllib.request.Request(url, data=body, headers=headers)
+    try:
+        with urllib.request.urlopen(req, timeout=60) as response:
+            return json.loads(response.read())
+    except urllib.error.HTTPError as exc:
+        detail = exc.read().decode(errors="replace")
+        raise InvalidInputError([f"{url}: {exc.code} {detail}"]) from None
+    except urllib.error.URLError as exc:
+        raise InvalidInputError([f"{url}: {exc.reason}"]) from None
+
+
+def rules_of(args: argparse.Namespace) -> Rules:
+    """--fail-on classes (default chaotic; limits add to them, never replace them)."""
+    return Rules(fail_on=args.fail_on or ["chaotic"], max_lle=args.max_lle,
+                 max_dte_um=args.max_dte)  # fmt: skip
+
+
+def rules_text(rules: Rules) -> str:
+    """The rules as options: "--fail-on chaotic, --max-dte 20 µm"."""
+    parts = [f"--fail-on {f}" for f in rules.fail_on]
+    if rules.max_lle is not None:
+        parts.append(f"--max-lle {rules.max_lle:g}")
+    if rules.max_dte_um is not None:
+        parts.append(f"--max-dte {rules.max_dte_um:g} µm")
+    return ", ".join(parts)
+
+
+def print_report(report: EnvelopeReport) -> None:
+    """PASS or FAIL, then one line per failing window (rpm and N m)."""
+    verdict = "PASS" if report.passed else "FAIL"
+    print(f"{verdict}: {report.failing_points} of {report.points} operating points break "
+          f"the rules ({rules_text(report.rules)})")  # fmt: skip
+    for w in report.failures:
+        print(f"  {window_text(w)}")
+
+
+def cmd_envelope(args: argparse.Namespace) -> int:
+    """The envelope gate; exit 0 pass, 1 fail, 2 invalid input."""
+    request = envelope_request(args)
+    rules = rules_of(args)
+    tick = progress(time.monotonic())
+    if args.server:
+        key = os.environ.get("GEARCHAOS_API_KEY")
+        result = run_on_server(args.server, request, key, tick)
+    else:
+        chunk = max(1, request.n_points() // (4 * (os.cpu_count() or 1)))
+        result = run_local(request, tick, chunk_points=chunk, workers=os.cpu_count() or 1)
+    report = envelope_report(result, rules)
+    print_report(report)
+    if args.json:
+        Path(args.json).write_text(dumps(report))
+    if args.junit:
+        levels = [w.level for w in report.windows] or [{}]
+        Path(args.junit).write_text(junit_xml(report, f"operating envelope of {args.file}", levels))
+    return EXIT_OK if report.passed else EXIT_FAIL

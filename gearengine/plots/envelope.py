@@ -1,0 +1,113 @@
+"""The operating envelope of a design: a map over two physical axes (driver speed in rpm and
+mean torque in N m, say), each grid cell coloured by its response, impacts marked, and the
+Melnikov boundary drawn, with a legend an engineer reads without the paper.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from matplotlib.colors import BoundaryNorm, ListedColormap
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+
+from gearengine.sweeps.axes import display_unit, is_dimensionless
+from gearengine.sweeps.request import SweepRequest
+from gearengine.sweeps.results import SweepPoint
+
+CLASSES: list[tuple[str, str]] = [
+    ("periodic 1T", "#c6dbef"),
+    ("periodic 2T", "#6baed6"),
+    ("periodic 4T", "#2171b5"),
+    ("periodic, longer period", "#08306b"),
+    ("quasi-periodic", "#fdae6b"),
+    ("chaotic", "#d62728"),
+    ("diverged", "#636363"),
+]
+"""Response classes of the map, in legend order, with their colours."""
+
+AXIS_NAMES = {"speed": "driver speed", "torque": "mean driver torque"}
+
+
+def response_class(p: SweepPoint) -> int:
+    """Index in ``CLASSES`` of a point's response."""
+    if p.classification == "periodic":
+        return {1: 0, 2: 1, 4: 2}.get(p.period or 0, 3)
+    return {"quasi_periodic": 4, "chaotic": 5}.get(p.classification, 6)
+
+
+def axis_label(name: str) -> str:
+    """ "driver speed [rpm]", "mesh.half_backlash [um]", or the alias for a dimensionless axis."""
+    if is_dimensionless(name):
+        return f"{name} (dimensionless)"
+    unit, _ = display_unit(name)
+    return f"{AXIS_NAMES.get(name, name)} [{unit.replace('um', 'µm').replace('*', '·')}]"
+
+
+def _grid(request: SweepRequest) -> tuple[np.ndarray, np.ndarray]:
+    """Both axes' grids in display units."""
+    out = []
+    for axis, values in zip(request.axes, request.grids(), strict=True):
+        factor = 1.0 if is_dimensionless(axis.parameter) else display_unit(axis.parameter)[1]
+        out.append(np.asarray(values) * factor)
+    return out[0], out[1]
+
+
+def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
+    """The map: response classes as colours, tooth separation and back-flank impacts as
+    markers, the Melnikov boundary (where the criterion starts allowing chaos) as a black line
+    with the chaos-possible side hatched."""
+    ax0, ax1 = request.axes
+    g0, g1 = _grid(request)
+    s0, s1 = request.grids()
+    i0 = {v: i for i, v in enumerate(s0)}
+    i1 = {v: i for i, v in enumerate(s1)}
+    cls = np.full((len(g1), len(g0)), np.nan)
+    mel = np.zeros((len(g1), len(g0)))
+    marks: dict[str, list[tuple[float, float]]] = {"single_sided": [], "double_sided": []}
+    for p in points:
+        if p.branch == "down":
+            continue
+        i, j = i0[p.values[ax0.parameter]], i1[p.values[ax1.parameter]]
+        cls[j, i] = response_class(p)
+        mel[j, i] = 1.0 if p.melnikov_chaos_possible else 0.0
+        if p.impact_regime in marks:
+            marks[p.impact_regime].append((g0[i], g1[j]))
+    fig = Figure(figsize=(10.0, 6.4), layout="constrained")
+    ax = fig.subplots()
+    cmap = ListedColormap([c for _, c in CLASSES])
+    norm = BoundaryNorm(np.arange(len(CLASSES) + 1) - 0.5, cmap.N)
+    ax.pcolormesh(g0, g1, np.ma.masked_invalid(cls), cmap=cmap, norm=norm, shading="nearest")
+    for regime, style in (("single_sided", ("o", "white", 9)), ("double_sided", ("x", "k", 22))):
+        if marks[regime]:
+            xs, ys = zip(*marks[regime], strict=True)
+            ax.scatter(xs, ys, marker=style[0], c=style[1], s=style[2], linewidths=0.8,
+                       edgecolors="k" if style[0] == "o" else None, zorder=3)  # fmt: skip
+    if len(g0) > 1 and len(g1) > 1 and 0.0 < mel.mean() < 1.0:
+        ax.contourf(g0, g1, mel, levels=[0.5, 1.5], colors="none", hatches=["//"])
+        ax.contour(g0, g1, mel, levels=[0.5], colors="black", linewidths=1.6)
+    ax.set_xlabel(axis_label(ax0.parameter))
+    ax.set_ylabel(axis_label(ax1.parameter))
+    s = request.settings
+    ax.set_title(
+        "Operating envelope: response of the gear pair at each operating point\n"
+        f"RK4, {s.steps_per_period} steps per excitation period, {s.transient_periods} + "
+        f"{s.record_periods} periods per point",
+        fontsize=10,
+    )
+    present = sorted({int(c) for c in cls[np.isfinite(cls)]})
+    handles = [
+        Patch(facecolor=CLASSES[k][1], edgecolor="0.4", label=CLASSES[k][0]) for k in present
+    ]
+    handles += [
+        Line2D([], [], ls="", marker="o", mfc="white", mec="k", ms=4,
+               label="teeth separate (impacts on the drive flank)"),
+        Line2D([], [], ls="", marker="x", c="k", ms=5, label="back-flank impacts"),
+        Patch(facecolor="none", edgecolor="k", hatch="//",
+              label="Melnikov criterion: chaos possible\n(black line: its boundary)"),
+    ]  # fmt: skip
+    ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
+              title="response", title_fontsize=9, frameon=False)  # fmt: skip
+    return fig

@@ -1,0 +1,172 @@
+"""What a sweep axis moves, and the parameters of each grid point.
+
+An axis names one of:
+
+* a dimensionless alias of Eq. (9) (``F_e1``, ``mu``, ``Omega_e``, ...; ``model.aliases``), set on
+  the request's ``params`` (for a design: on its conversion);
+* ``Omega``: every excitation frequency scaled together, as a change of running speed; its value
+  is the fundamental of the fastest excitation, the others keep their ratios to it;
+* with a ``design``, a physical field by its path: ``speed`` (every excitation frequency moves
+  with it), ``torque``, ``mesh.half_backlash``, ``mesh.damping_ratio``,
+  ``transmission_error.harmonics.0.amplitude``, ... with start and stop as unit strings
+  ("500 rpm") or SI numbers. The design is re-validated and converted at every point, so each
+  point is exactly the design a single ``/v1/analyses`` call at that value would analyse.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from pydantic import ValidationError
+
+from gearengine.model.aliases import ALIASES, with_aliases, with_speed_factor
+from gearengine.model.design import Design, convert_design
+from gearengine.model.params import GearParams
+from gearengine.model.units import RPM
+from gearengine.numerics.forcing import packed_forcing
+
+OMEGA = "Omega"
+"""The axis that scales every excitation frequency together (dimensionless)."""
+
+DISPLAY_UNITS: dict[str, tuple[str, float]] = {
+    "speed": ("rpm", 1.0 / RPM),
+    "torque": ("N*m", 1.0),
+    "braking_torque": ("N*m", 1.0),
+    "half_backlash": ("um", 1e6),
+    "transmission_error": ("um", 1e6),
+    "torque_fluctuation": ("N*m", 1.0),
+    "stiffness_harmonics": ("N/m", 1.0),
+    "stiffness": ("N/m", 1.0),
+    "damping_ratio": ("1", 1.0),
+    "damping": ("N*s/m", 1.0),
+    "inertia": ("kg*m^2", 1.0),
+    "base_radius": ("mm", 1e3),
+    "module": ("mm", 1e3),
+    "face_width": ("mm", 1e3),
+    "bore": ("mm", 1e3),
+    "pressure_angle": ("deg", 180.0 / math.pi),
+    "order": ("1", 1.0),
+    "profile_shift": ("1", 1.0),
+}
+"""Display unit and factor from SI of a physical field, by the most specific name in its path
+(``transmission_error.harmonics.0.amplitude`` is shown in µm)."""
+
+
+def is_dimensionless(parameter: str) -> bool:
+    """True for an alias of Eq. (9) or ``Omega``; False for a field of a design."""
+    return parameter in ALIASES or parameter == OMEGA
+
+
+def shown(value: float) -> float:
+    """A value converted to display units, rounded to 12 significant digits (6000 rpm, not
+    6000.000000000001)."""
+    return float(f"{value:.12g}")
+
+
+def display_unit(path: str) -> tuple[str, float]:
+    """(unit, factor from SI) of a physical field path."""
+    for part in (path, *reversed(path.split("."))):
+        if part in DISPLAY_UNITS:
+            return DISPLAY_UNITS[part]
+    return ("SI", 1.0)
+
+
+def _set(tree: dict[str, Any], path: str, value: object) -> None:
+    *head, last = path.split(".")
+    node: Any = tree
+    for key in head:
+        node = node[int(key)] if key.isdigit() else node[key]
+    if last.isdigit():
+        node[int(last)] = value
+    elif isinstance(node, dict) and last in node:
+        node[last] = value
+    else:
+        raise KeyError(last)
+
+
+def _get(tree: Any, path: str) -> Any:
+    for key in path.split("."):
+        tree = tree[int(key)] if key.isdigit() else tree[key]
+    return tree
+
+
+def design_with(design: Design, values: dict[str, object]) -> Design:
+    """``design`` with physical fields set (unit strings or SI numbers), re-validated.
+
+    Raises KeyError for a path the design does not have, ValidationError for a bad value.
+    """
+    tree = design.model_dump()
+    for path, value in values.items():
+        _set(tree, path, value)
+    return Design.model_validate(tree)
+
+
+def si_value(design: Design, path: str, value: object) -> float:
+    """The SI number of ``value`` (a unit string or a number) for the field at ``path``."""
+    return float(_get(design_with(design, {path: value}).model_dump(), path))
+
+
+def fastest_frequency(params: GearParams) -> float | None:
+    """The largest fundamental frequency among the given excitations (the ``Omega`` axis)."""
+    freqs = [exc.frequency for _, exc in params.excitations()]
+    return max(freqs) if freqs else None
+
+
+def point_params(params: GearParams, design: Design | None, values: dict[str, float]) -> GearParams:
+    """The dimensionless parameters of one grid point.
+
+    Physical fields are set on the design first (then converted), aliases and ``Omega`` on the
+    resulting parameters.
+    """
+    physical = {k: v for k, v in values.items() if not is_dimensionless(k)}
+    if physical:
+        assert design is not None
+        params = convert_design(design_with(design, physical)).params
+    aliases = {k: v for k, v in values.items() if k in ALIASES}
+    if aliases:
+        params = with_aliases(params, aliases)
+    if OMEGA in values:
+        ref = fastest_frequency(params)
+        assert ref is not None
+        params = with_speed_factor(params, values[OMEGA] / ref)
+    return params
+
+
+def dynamics_key(params: GearParams) -> tuple:
+    """What Eq. (9) actually integrates: two designs with equal keys have equal dynamics."""
+    kc, fm, fc = packed_forcing(params)
+    return (params.damping, params.backlash, fm, kc.tobytes(), fc.tobytes())
+
+
+def axis_problem(params: GearParams, design: Design | None, parameter: str, start: object,
+                 stop: object, base: dict[str, float]) -> tuple[str, str] | None:  # fmt: skip
+    """Why an axis cannot be swept, as (field, message), or None when it can."""
+    if not is_dimensionless(parameter):
+        if design is None:
+            return "parameter", (
+                f"{parameter} is not an alias of Eq. (9) ({', '.join(sorted(ALIASES))}, Omega); "
+                "physical axes (speed, torque, mesh.half_backlash, ...) need a design"
+            )
+        for end, value in (("start", start), ("stop", stop)):
+            try:
+                si_value(design, parameter, value)
+            except (KeyError, IndexError, TypeError):
+                return "parameter", f"the design has no field {parameter}"
+            except ValidationError as exc:
+                return end, "; ".join(e["msg"] for e in exc.errors(include_url=False))
+    elif not all(isinstance(v, (int, float)) for v in (start, stop)):
+        return "start", f"{parameter} is dimensionless: give start and stop as numbers"
+    if parameter == OMEGA and fastest_frequency(params) is None:
+        return "parameter", "Omega scales the excitation frequencies, and no excitation is given"
+    return None
+
+
+def changes_nothing(
+    params: GearParams, design: Design | None, parameter: str, lo: float, hi: float,
+    base: dict[str, float],
+) -> bool:  # fmt: skip
+    """True when moving ``parameter`` from ``lo`` to ``hi`` leaves Eq. (9) unchanged (an
+    ``Omega_e`` axis with no transmission-error harmonic, say)."""
+    ends = [point_params(params, design, {**base, parameter: v}) for v in (lo, hi)]
+    return dynamics_key(ends[0]) == dynamics_key(ends[1])

@@ -1,0 +1,146 @@
+"""The CI gate over an operating envelope: which grid points of a speed x torque sweep break
+which rule, gathered into failing speed windows per torque level, and the JUnit XML report
+that GitHub, GitLab and Jenkins show.
+
+Rules (``Rules``): ``fail_on`` classes (``chaotic`` fails chaotic and diverged points, ordered
+periodic < quasi_periodic < chaotic < diverged as in ``numerics.classify.SEVERITY``),
+``melnikov`` (the criterion allows chaos), ``impacts`` (back-flank contact); and numeric limits,
+which add to the classes instead of replacing them: ``max_lle`` (per unit tau), ``max_dte_um``
+(dynamic transmission error peak to peak, µm).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Literal
+from xml.etree import ElementTree
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from gearengine.numerics.classify import SEVERITY
+from gearengine.sweeps.results import PhysicalValue, SpeedWindows, SweepPoint, SweepResult
+from gearengine.sweeps.windows import SPEED, runs
+
+FailOn = Literal["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts"]
+
+
+class Rules(BaseModel):
+    """What fails the gate at a grid point."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    fail_on: list[FailOn] = Field(
+        default_factory=lambda: ["chaotic"],
+        description="Classes that fail (and anything worse), melnikov, impacts.",
+    )
+    max_lle: float | None = Field(None, description="Largest LLE allowed, per unit tau.")
+    max_dte_um: float | None = Field(None, description="Largest DTE peak to peak [µm].")
+
+
+def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
+    """The rules one point breaks, as short labels ("chaotic", "DTE > 20 µm", ...)."""
+    out = []
+    for name in rules.fail_on:
+        if name in SEVERITY and SEVERITY[p.classification] >= SEVERITY[name]:
+            out.append(p.classification.replace("_", "-"))
+            break
+    if "melnikov" in rules.fail_on and p.melnikov_chaos_possible:
+        out.append("Melnikov: chaos possible")
+    if "impacts" in rules.fail_on and p.impact_regime == "double_sided":
+        out.append("back-flank impacts")
+    if rules.max_lle is not None and (p.lle is None or p.lle > rules.max_lle):
+        out.append(f"LLE > {rules.max_lle:g}")
+    dte = (p.physical or {}).get("dte")
+    if rules.max_dte_um is not None and (dte is None or dte.value > rules.max_dte_um):
+        out.append(f"DTE > {rules.max_dte_um:g} µm")
+    return out
+
+
+class FailingWindow(BaseModel):
+    """A run of grid speeds at one torque level that breaks one rule."""
+
+    model_config = ConfigDict(frozen=True)
+
+    level: dict[str, PhysicalValue] = Field(description="The torque level (other axis).")
+    rule: str = Field(description="The rule broken, e.g. 'chaotic', 'DTE > 20 µm'.")
+    speeds_rpm: list[float] = Field(description="[first, last] failing grid speed [rpm].")
+
+
+class EnvelopeReport(BaseModel):
+    """The verdict of the gate over an envelope (``gearengine check --speed --torque``)."""
+
+    model_config = ConfigDict(frozen=True)
+
+    passed: bool
+    rules: Rules
+    points: int = Field(description="Grid points checked.")
+    failing_points: int
+    failures: list[FailingWindow]
+    windows: list[SpeedWindows] = Field(description="All response windows, failing or not.")
+    sweep: SweepResult = Field(description="The sweep result (the API's document).")
+
+
+def _level_key(p: SweepPoint) -> tuple:
+    return tuple(sorted((k, v.value) for k, v in (p.physical or {}).items() if k not in
+                        (SPEED, "dte")))  # fmt: skip
+
+
+def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
+    """Failing windows of a sweep over the driver speed (and another axis) under ``rules``."""
+    rows: dict[tuple, list[SweepPoint]] = {}
+    for p in result.points:
+        if p.branch != "down":
+            rows.setdefault(_level_key(p), []).append(p)
+    failures: list[FailingWindow] = []
+    failing = 0
+    for row in rows.values():
+        row.sort(key=lambda p: p.values[SPEED])
+        level = {k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, "dte")}
+        speeds = [p.physical[SPEED].value for p in row]  # type: ignore[index]
+        broken = [point_failures(p, rules) for p in row]
+        failing += sum(1 for b in broken if b)
+        for rule in dict.fromkeys(r for b in broken for r in b):
+            for span in runs(speeds, [rule if rule in b else None for b in broken]).get(rule, []):
+                failures.append(FailingWindow(level=level, rule=rule, speeds_rpm=span))
+    return EnvelopeReport(
+        passed=not failures,
+        rules=rules,
+        points=sum(len(r) for r in rows.values()),
+        failing_points=failing,
+        failures=failures,
+        windows=result.windows or [],
+        sweep=result,
+    )
+
+
+def level_text(level: dict[str, PhysicalValue]) -> str:
+    """"torque 40 N*m", or "all" for a one-axis sweep."""
+    return ", ".join(f"{k} {v.value:g} {v.unit}" for k, v in level.items()) or "all"
+
+
+def window_text(w: FailingWindow) -> str:
+    """One failing window in words: "torque 20 N*m: chaotic at 3000-3500 rpm"."""
+    lo, hi = w.speeds_rpm
+    span = f"{lo:g} rpm" if lo == hi else f"{lo:g}-{hi:g} rpm"
+    return f"{level_text(w.level)}: {w.rule} at {span}"
+
+
+def junit_xml(report: EnvelopeReport, name: str, levels: Sequence[dict[str, PhysicalValue]]) -> str:
+    """JUnit XML: one test case per torque level, one failure element per failing window."""
+    suites = ElementTree.Element("testsuites", name="gearchaos envelope")
+    suite = ElementTree.SubElement(suites, "testsuite", name=name)
+    failed = 0
+    for level in levels:
+        case = ElementTree.SubElement(
+            suite, "testcase", classname="gearchaos.envelope", name=level_text(level), time="0"
+        )
+        mine = [w for w in report.failures if w.level == level]
+        failed += bool(mine)
+        for w in mine:
+            node = ElementTree.SubElement(case, "failure", message=window_text(w), type=w.rule)
+            node.text = window_text(w)
+    for node in (suites, suite):
+        node.set("tests", str(len(levels)))
+        node.set("failures", str(failed))
+        node.set("errors", "0")
+    return ElementTree.tostring(suites, encoding="unicode", xml_declaration=True) + "\n"

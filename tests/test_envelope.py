@@ -1,0 +1,181 @@
+"""The operating envelope: physical sweep axes, one Melnikov boundary, speed windows, the CI
+gate over speed x torque (exit codes, JUnit, --server) and the CI examples as written."""
+
+from __future__ import annotations
+
+import copy
+import json
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import xmlschema
+from pydantic import ValidationError
+
+from gearengine.analysis import AnalysisRequest, analyze
+from gearengine.homoclinic import melnikov
+from gearengine.homoclinic.boundary import flips
+from gearengine.model.design import EXAMPLE_DESIGN
+from gearengine.sweeps import run_local, validated
+from gearengine.sweeps.gate import Rules, envelope_report
+from tests.conftest import PAPER_PARAMS, ROOT, Server
+
+LIGHT = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
+
+
+def rattling() -> dict:
+    """The README design with 5 µm half backlash, 10 µm transmission error and 1 N m: it
+    rattles on both flanks and is chaotic at some speeds between 1000 and 2000 rpm."""
+    d = copy.deepcopy(EXAMPLE_DESIGN)
+    d["mesh"]["half_backlash"] = "5 um"
+    d["torque"] = "1 N*m"
+    d["transmission_error"]["harmonics"][0]["amplitude"] = "10 um"
+    return d
+
+
+def speed_sweep(design: dict, lo: str, hi: str, num: int, **more: object) -> dict:
+    axes = [{"parameter": "speed", "start": lo, "stop": hi, "num": num}]
+    return {"design": design, "settings": LIGHT, "axes": axes, **more}
+
+
+def test_speed_sweep_points_are_single_analyses_at_that_speed() -> None:
+    req = validated(speed_sweep(EXAMPLE_DESIGN, "500 rpm", "6000 rpm", 4))
+    result = run_local(req)
+    for p in result.points:
+        d = copy.deepcopy(EXAMPLE_DESIGN)
+        d["speed"] = f"{p.physical['speed'].value} rpm"
+        single = analyze(AnalysisRequest.model_validate({"design": d, "settings": LIGHT}))
+        assert (p.classification, p.period) == (single.numerics.classification,
+                                                single.numerics.period)  # fmt: skip
+        assert p.melnikov_chaos_possible == single.melnikov.chaos_possible
+        dte = single.engineering.response.dte_peak_to_peak_um
+        assert p.physical["dte"].value == pytest.approx(dte, rel=1e-9)
+    assert [p.physical["speed"].value for p in result.points] == [
+        500,
+        2333.33333333,
+        4166.66666667,
+        6000,
+    ]
+
+
+def test_sweep_boundary_is_the_melnikov_verdict_of_each_point() -> None:
+    """The thresholds drawn on a speed sweep are where /v1/melnikov flips for the same design."""
+    req = validated(speed_sweep(EXAMPLE_DESIGN, "500 rpm", "6000 rpm", 3))
+    crossings = flips(lambda v: req.point({"speed": v}), 52.36, 628.3, 60)
+    assert len(crossings) == 2
+    for edge in crossings:
+        below, above = (
+            melnikov(req.point({"speed": edge * f})).chaos_possible for f in (0.999, 1.001)
+        )
+        assert below != above
+
+
+def test_axes_that_change_nothing_or_need_a_design_are_refused() -> None:
+    only_k = {"damping": 0.1, "stiffness": {"frequency": 1.0, "harmonics": [{"amplitude": 0.1}]}}
+    with pytest.raises(ValidationError, match="changes nothing"):
+        validated(
+            {
+                "params": only_k,
+                "axes": [{"parameter": "Omega_e", "start": 0.1, "stop": 1, "num": 3}],
+            }
+        )
+    with pytest.raises(ValidationError, match="need a design"):
+        validated(
+            {
+                "params": PAPER_PARAMS,
+                "axes": [{"parameter": "speed", "start": 1, "stop": 2, "num": 2}],
+            }
+        )
+    with pytest.raises(ValidationError, match="1 / \\[time\\]"):
+        validated(speed_sweep(EXAMPLE_DESIGN, "500 mm", "6000 rpm", 3))
+    with pytest.raises(ValidationError, match="no field"):
+        validated({**speed_sweep(EXAMPLE_DESIGN, "1 rpm", "2 rpm", 2), "axes": [
+            {"parameter": "mesh.nothing", "start": 1, "stop": 2, "num": 2}]})  # fmt: skip
+
+
+def test_omega_axis_scales_every_frequency() -> None:
+    p = {**PAPER_PARAMS, "torque": {"frequency": 0.25, "harmonics": [{"amplitude": 0.01}]}}
+    req = validated(
+        {"params": p, "axes": [{"parameter": "Omega", "start": 0.5, "stop": 1.0, "num": 2}]}
+    )
+    at = req.point({"Omega": 1.0})
+    assert at.transmission_error.frequency == 1.0 and at.torque.frequency == 0.5
+
+
+def test_windows_and_failing_windows_of_a_rattling_design() -> None:
+    doc = speed_sweep(rattling(), "1000 rpm", "2000 rpm", 6)
+    doc["axes"].append({"parameter": "torque", "start": "1 N*m", "stop": "3 N*m", "num": 2})
+    result = run_local(validated(doc))
+    assert [w.level["torque"].value for w in result.windows] == [1.0, 3.0]
+    assert result.windows[0].impacts == {"double_sided": [[1000.0, 2000.0]]}
+    report = envelope_report(result, Rules())
+    assert not report.passed and report.failing_points == sum(
+        p.classification == "chaotic" for p in result.points
+    )
+    chaotic = {tuple(s) for w in result.windows for s in w.response.get("chaotic", [])}
+    assert {tuple(f.speeds_rpm) for f in report.failures} == chaotic
+    assert envelope_report(result, Rules(fail_on=["diverged"])).passed
+    impacts = envelope_report(result, Rules(fail_on=["diverged", "impacts"]))
+    assert {f.rule for f in impacts.failures} == {"back-flank impacts"}
+
+
+def gearengine(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "gearengine.cli", *args], cwd=cwd,
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
+
+
+def test_gate_exit_codes_and_junit(tmp_path: Path) -> None:
+    bad = tmp_path / "rattling.json"
+    bad.write_text(json.dumps({"design": rattling(), "settings": LIGHT}))
+    junit = tmp_path / "envelope.xml"
+    out = gearengine("check", str(bad), "--speed", "1000:2000", "--speed-points", "6",
+                     "--torque", "1:3", "--torque-points", "2", "--junit", str(junit))  # fmt: skip
+    assert out.returncode == 1, out.stderr
+    assert out.stdout.startswith("FAIL") and "chaotic at" in out.stdout and "rpm" in out.stdout
+    schema = xmlschema.XMLSchema(ROOT / "tests" / "data" / "junit.xsd")
+    schema.validate(junit)
+    assert junit.read_text().count("<testcase ") == 2 and "<failure " in junit.read_text()
+    good = tmp_path / "damped.json"
+    damped = copy.deepcopy(EXAMPLE_DESIGN)
+    good.write_text(json.dumps({"design": damped, "settings": LIGHT}))
+    out = gearengine("check", str(good), "--speed", "500:6000", "--speed-points", "5",
+                     "--torque", "20 N*m:200 N*m", "--torque-points", "2",
+                     "--max-lle", "0.01")  # fmt: skip
+    assert out.returncode == 0 and out.stdout.startswith("PASS"), out.stdout + out.stderr
+    out = gearengine("check", str(good), "--speed", "500:6000", "--speed-points", "3",
+                     "--max-dte", "1um")  # fmt: skip
+    assert out.returncode == 1 and "DTE > 1 µm" in out.stdout
+    out = gearengine("check", str(good), "--speed", "500mm:6000")
+    assert out.returncode == 2 and "axes[0].start" in out.stderr
+
+
+def test_server_gives_the_same_report(tmp_path: Path) -> None:
+    bad = tmp_path / "rattling.json"
+    bad.write_text(json.dumps({"design": rattling(), "settings": LIGHT}))
+    args = ["check", str(bad), "--speed", "1000:2000", "--speed-points", "4", "--torque", "1:3",
+            "--torque-points", "2"]  # fmt: skip
+    local, remote = tmp_path / "local.json", tmp_path / "remote.json"
+    assert gearengine(*args, "--json", str(local)).returncode == 1
+    server = Server(tmp_path / "data")
+    try:
+        out = gearengine(*args, "--json", str(remote), "--server", server.url)
+    finally:
+        server.stop()
+    assert out.returncode == 1, out.stderr
+    assert json.loads(remote.read_text()) == json.loads(local.read_text())
+
+
+@pytest.mark.parametrize("example", ["github-actions.yml", "gitlab-ci.yml"])
+def test_ci_examples_run_as_written(example: str, tmp_path: Path) -> None:
+    """The gate command of each CI example, run as written from the repository root."""
+    text = (ROOT / "examples" / "ci" / example).read_text()
+    (command,) = re.findall(r"(gearengine check .*)$", text, flags=re.M)
+    argv = shlex.split(command)[1:]
+    argv = [str(tmp_path / a) if a.startswith("envelope.") else a for a in argv]
+    out = gearengine(*argv)
+    assert out.returncode == 0, out.stdout + out.stderr
+    xmlschema.XMLSchema(ROOT / "tests" / "data" / "junit.xsd").validate(tmp_path / "envelope.xml")
+    assert "python -m pip install ." in text
