@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 import re
 import shlex
 import subprocess
@@ -179,3 +180,27 @@ def test_ci_examples_run_as_written(example: str, tmp_path: Path) -> None:
     assert out.returncode == 0, out.stdout + out.stderr
     xmlschema.XMLSchema(ROOT / "tests" / "data" / "junit.xsd").validate(tmp_path / "envelope.xml")
     assert "python -m pip install ." in text
+
+
+def test_period_doubling_of_a_design_is_reported_in_rpm() -> None:
+    """The paper's case (mu~ = 0.07, F~_m = 0.01, F~_e1 = 0.22, cubic law) as gear data:
+    b = 50 µm, k_m = 1e8 N/m, T = 1.5 N m (F^_m = 50 N = 0.01 b k_m), e_1 = 11 µm. A
+    continuation sweep over the speed locates its period doubling in rpm, at the Omega the
+    same sweep of its dimensionless params finds (Omega_e = 18 w_a / w_n)."""
+    d = copy.deepcopy(EXAMPLE_DESIGN)
+    d["mesh"] = {"stiffness": "1e8 N/m", "damping_ratio": 0.07, "half_backlash": "50 um"}
+    d["transmission_error"]["harmonics"][0]["amplitude"] = "11 um"
+    d["torque"] = "1.5 N*m"
+    d["backlash_law"] = "cubic_fit"
+    del d["torque_fluctuation"]
+    req = validated({**speed_sweep(d, "1800 rpm", "2600 rpm", 17), "continuation": True})
+    (pd,) = [b for b in run_local(req).bifurcations if b.type == "period_doubling"]
+    conv = req.conversion
+    omega = pd.value / (2 * math.pi * conv.natural_frequency_hz) * 18
+    axis = {"parameter": "Omega", "start": omega - 0.01, "stop": omega + 0.01, "num": 5}
+    params = {"params": conv.params.model_dump(), "continuation": True, "axes": [axis],
+              "settings": req.settings.model_dump()}  # fmt: skip
+    (same,) = [b for b in run_local(validated(params)).bifurcations if b.type == "period_doubling"]
+    assert same.value == pytest.approx(omega, rel=1e-8)
+    assert pd.physical.unit == "rpm" and 2000 < pd.physical.value < 2400
+    assert pd.physical.value == pytest.approx(pd.value * 60 / (2 * math.pi), rel=1e-9)

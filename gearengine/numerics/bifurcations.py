@@ -19,8 +19,9 @@ docs/floquet.md.
 
 from __future__ import annotations
 
+import functools
 import itertools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -32,6 +33,9 @@ from gearengine.numerics.floquet import Flow, refine, stroboscopic_flow
 from gearengine.numerics.results import FloquetResult
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate
+
+Path = Callable[[float], GearParams]
+"""The parameters of Eq. (9) at a value of the swept parameter."""
 
 KICK = 1e-3
 """Offset in x (units of b) added to a just destabilised orbit before simulating beyond it."""
@@ -171,9 +175,8 @@ def _settle(
 
 
 def _locate(
-    params: GearParams, alias: str, bracket: tuple[float, float], orbit: FloquetResult, steps: int,
-    xtol: float,
-) -> tuple[float, FloquetResult]:  # fmt: skip
+    path: Path, bracket: tuple[float, float], orbit: FloquetResult, steps: int, xtol: float
+) -> tuple[float, FloquetResult]:
     """Root of the stability margin of ``orbit``'s branch in ``bracket``, and the orbit there.
 
     brentq on p -> 1 - max |lambda(p)|, each trial orbit followed from the already refined
@@ -185,7 +188,7 @@ def _locate(
     def margin(p: float) -> float:
         if p not in known:
             near = min(known, key=lambda q: abs(q - p)) if known else None
-            flow = stroboscopic_flow(with_alias(params, alias, p), steps)
+            flow = stroboscopic_flow(path(p), steps)
             known[p] = _follow(flow, orbit if near is None else known[near])
         return known[p].stability_margin
 
@@ -197,7 +200,7 @@ def _locate(
 
 
 def _walk(
-    params: GearParams, alias: str, bracket: tuple[float, float], orbit: FloquetResult, steps: int
+    path: Path, bracket: tuple[float, float], orbit: FloquetResult, steps: int
 ) -> tuple[tuple[float, float], FloquetResult]:
     """The part of ``bracket`` (one of WALK equal pieces) where ``orbit``'s margin turns
     negative, and the orbit at its start: the orbit is followed piece by piece, so a branch
@@ -205,7 +208,7 @@ def _walk(
     Raises ``_OrbitLostError`` (from ``_follow``) when the orbit is lost before."""
     grid = np.linspace(bracket[0], bracket[1], WALK + 1)
     for lo, hi in itertools.pairwise(grid.tolist()):
-        nxt = _follow(stroboscopic_flow(with_alias(params, alias, hi), steps), orbit)
+        nxt = _follow(stroboscopic_flow(path(hi), steps), orbit)
         if nxt.stability_margin <= 0.0:
             return (lo, hi), orbit
         orbit = nxt
@@ -221,7 +224,7 @@ def _beyond(flow: Flow, orbit: FloquetResult) -> FloquetResult | None:
 
 
 def _crossing(
-    params: GearParams, alias: str, bracket: tuple[float, float], orbit: FloquetResult,
+    path: Path, bracket: tuple[float, float], orbit: FloquetResult,
     settings: SimulationSettings, xtol: float,
 ) -> tuple[dict[str, Any], _Attractor]:  # fmt: skip
     """The event where ``orbit`` stops being a stable orbit inside ``bracket``, and the attractor
@@ -232,19 +235,19 @@ def _crossing(
     parent's multiplier crosses the circle), or it is lost (value None, type orbit_lost).
     """
     steps = settings.steps_per_period
-    point = with_alias(params, alias, bracket[1])
+    point = path(bracket[1])
     event: dict[str, Any] = {"period_before": orbit.period, "bracket": list(bracket)}
     doubled = None
     try:
         try:
-            sub, near = _walk(params, alias, bracket, orbit, steps)
-            root, crit = _locate(params, alias, sub, near, steps, xtol)
+            sub, near = _walk(path, bracket, orbit, steps)
+            root, crit = _locate(path, sub, near, steps, xtol)
             if crit.nearest_bifurcation == "period_doubling":
                 doubled = _beyond(stroboscopic_flow(point, steps), crit)
         except _OrbitLostError as lost:
             if lost.parent is None:
                 raise
-            root, crit = _locate(params, alias, bracket, lost.parent, steps, xtol)
+            root, crit = _locate(path, bracket, lost.parent, steps, xtol)
         event |= {"value": root, "type": crit.nearest_bifurcation}
         event["critical_multiplier"] = crit.multipliers[0]
     except _OrbitLostError:
@@ -261,6 +264,7 @@ def locate_bifurcations(
     settings: SimulationSettings | None = None,
     xtol: float = 1e-10,
     responses: Sequence[Response] | None = None,
+    path: Path | None = None,
 ) -> list[dict[str, Any]]:
     """Bifurcation points of the periodic responses along a sweep of one parameter.
 
@@ -280,6 +284,9 @@ def locate_bifurcations(
         responses: the responses already simulated at ``values`` by continuation (e.g. a
             continuation sweep's points), used instead of simulating there again; only the
             branch switch after an event is then simulated.
+        path: the parameters at a value of the swept parameter, when it is not the alias set
+            on ``params`` (a physical field of a design, converted at each value; ``alias``
+            then only names it in the events).
 
     Returns:
         One dict per event, in sweep order: {"parameter", "value", "type", "period_before",
@@ -300,9 +307,11 @@ def locate_bifurcations(
     if responses is not None and len(responses) != len(grid):
         raise ValueError(f"{len(responses)} responses for {len(grid)} values")
     base = {"parameter": alias, "branch": "up" if diffs[0] > 0.0 else "down"}
+    if path is None:
+        path = functools.partial(with_alias, params, alias)
 
     def attractor(i: int, start: Sequence[float] | None) -> _Attractor:
-        point = with_alias(params, alias, grid[i])
+        point = path(grid[i])
         if responses is not None:
             return _settle(point, settings, responses[i])
         return _settle(point, settings, _simulated(point, settings, start or (0.0, 0.0)))
@@ -316,15 +325,13 @@ def locate_bifurcations(
             orbit, start = att.orbit, att.final
             continue
         try:
-            nxt = _follow(
-                stroboscopic_flow(with_alias(params, alias, hi), settings.steps_per_period), orbit
-            )
+            nxt = _follow(stroboscopic_flow(path(hi), settings.steps_per_period), orbit)
             if nxt.stability_margin > 0.0:
                 orbit = nxt
                 continue
         except _OrbitLostError:
             pass
-        event, att = _crossing(params, alias, (lo, hi), orbit, settings, xtol)
+        event, att = _crossing(path, (lo, hi), orbit, settings, xtol)
         events.append({**base, **event})
         orbit, start = att.orbit, att.final
     return events
