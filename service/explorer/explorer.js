@@ -1,0 +1,640 @@
+// gearchaos design explorer: a form for a design, the verdict of one design, and the
+// speed x torque envelope of the job queue. Plain JavaScript, no build step; the one library,
+// plotly.js (the interactive map), is loaded from this server when the first map is drawn.
+"use strict";
+
+const $ = (id) => document.getElementById(id);
+const KEY_STORE = "gearchaos.apiKey"; // sessionStorage: forgotten with the tab
+const JOBS_STORE = "gearchaos.jobs"; // localStorage: recent envelopes of this browser
+const CLASS_COLORS = {
+  periodic: "#2b7bb9", quasi_periodic: "#e69f00", chaotic: "#d62728", diverged: "#555555",
+};
+
+// ---------------------------------------------------------------- the form, as data
+// [path under design, label, kind, mode]; kind: unit (text with a unit), int, num, or a list of
+// choices; mode: direct or geometry for fields of one form only.
+const GEAR_FIELDS = [
+  ["teeth", "teeth", "int"],
+  ["base_radius", "base radius", "unit", "direct"],
+  ["inertia", "inertia", "unit", "direct"],
+  ["module", "module", "unit", "geometry"],
+  ["face_width", "face width", "unit", "geometry"],
+  ["pressure_angle", "pressure angle", "unit", "geometry"],
+  ["profile_shift", "profile shift x", "num", "geometry"],
+  ["bore", "bore diameter", "unit", "geometry"],
+  ["material", "material", ["steel", "cast_iron", "bronze", "aluminium"], "geometry"],
+];
+const GROUPS = [
+  ["driver", "Driver (gear a)", GEAR_FIELDS.map(([p, ...r]) => ["driver." + p, ...r])],
+  ["driven", "Driven (gear b)", GEAR_FIELDS.map(([p, ...r]) => ["driven." + p, ...r])],
+  ["", "Operating point", [
+    ["speed", "driver speed", "unit"],
+    ["torque", "driver torque", "unit"],
+    ["braking_torque", "braking torque (optional)", "unit"],
+  ]],
+  ["mesh", "Mesh", [
+    ["mesh.stiffness", "mean stiffness (or iso6336)", "unit"],
+    ["mesh.stiffness_harmonics[0].amplitude", "stiffness variation", "unit"],
+    ["mesh.damping_ratio", "damping ratio ζ", "num"],
+    ["mesh.damping", "or damping c", "unit"],
+    ["mesh.half_backlash", "half backlash", "unit"],
+    ["backlash_law", "backlash law", ["piecewise", "cubic_fit"]],
+  ]],
+  ["transmission_error", "Transmission error", [
+    ["transmission_error.harmonics[0].amplitude", "amplitude", "unit"],
+    ["transmission_error.order", "order (default: teeth)", "num"],
+  ]],
+  ["torque_fluctuation", "Torque fluctuation", [
+    ["torque_fluctuation.harmonics[0].amplitude", "amplitude", "unit"],
+    ["torque_fluctuation.order", "order (× shaft speed)", "num"],
+  ]],
+  ["speed_range", "Melnikov speed scan (optional)", [
+    ["speed_range[0]", "from", "unit"],
+    ["speed_range[1]", "to", "unit"],
+  ]],
+];
+const SETTINGS_FIELDS = [
+  ["settings.transient_periods", "transient periods", "int", 500],
+  ["settings.record_periods", "recorded periods", "int", 500],
+  ["settings.steps_per_period", "steps per period", "int", 200],
+];
+const ENVELOPE_FIELDS = [
+  ["axes[0].start", "speed from", "unit", "500 rpm"],
+  ["axes[0].stop", "speed to", "unit", "6000 rpm"],
+  ["axes[0].num", "speed points", "int", 21],
+  ["axes[1].start", "torque from", "unit", "20 N*m"],
+  ["axes[1].stop", "torque to", "unit", "200 N*m"],
+  ["axes[1].num", "torque points", "int", 5],
+  ["settings.transient_periods", "transient periods", "int", 100],
+  ["settings.record_periods", "recorded periods", "int", 100],
+];
+
+let defaults = null; // {direct, geometry, params} from /explorer/defaults.json
+let lastParams = null; // the dimensionless parameters of the last analysis
+
+function el(tag, attrs = {}, ...children) {
+  const node = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) {
+    if (k === "class") node.className = v;
+    else if (k === "text") node.textContent = v;
+    else node.setAttribute(k, v);
+  }
+  node.append(...children);
+  return node;
+}
+
+function fieldInput(path, label, kind, mode) {
+  const input = Array.isArray(kind)
+    ? el("select", {}, ...kind.map((c) => el("option", { value: c, text: c })))
+    : el("input", { type: "text", inputmode: kind === "unit" ? "text" : "decimal" });
+  Object.assign(input.dataset, { path, kind: Array.isArray(kind) ? "choice" : kind });
+  input.name = path;
+  const wrap = el("label", { class: "field" }, el("span", { text: label }), input);
+  if (mode) wrap.dataset.mode = mode;
+  return wrap;
+}
+
+function buildForms() {
+  const box = $("design-fields");
+  for (const [group, title, fields] of GROUPS) {
+    const set = el("fieldset", {}, el("legend", { text: title }));
+    if (group) set.dataset.path = "design." + group;
+    const grid = el("div", { class: "grid" });
+    for (const [p, label, kind, mode] of fields) grid.append(fieldInput("design." + p, label, kind, mode));
+    set.append(grid);
+    box.append(set);
+  }
+  for (const [p, label, kind, value] of SETTINGS_FIELDS) {
+    const f = fieldInput(p, label, kind);
+    f.querySelector("input").value = value;
+    $("settings-fields").append(f);
+  }
+  for (const [p, label, kind, value] of ENVELOPE_FIELDS) {
+    const f = fieldInput("envelope." + p, label, kind);
+    f.querySelector("input").value = value;
+    $("envelope-fields").append(f);
+  }
+}
+
+// ---------------------------------------------------------------- paths <-> documents
+const inputs = (box) => box.querySelectorAll("input[data-path], select[data-path], textarea[data-path]");
+const splitPath = (path) => path.replace(/\[(\d+)\]/g, ".$1").split(".");
+
+function getAt(doc, path) {
+  return splitPath(path).reduce((node, k) => (node == null ? undefined : node[k]), doc);
+}
+
+function setAt(doc, path, value) {
+  const keys = splitPath(path);
+  let node = doc;
+  keys.slice(0, -1).forEach((k, i) => {
+    if (node[k] == null) node[k] = /^\d+$/.test(keys[i + 1]) ? [] : {};
+    node = node[k];
+  });
+  node[keys[keys.length - 1]] = value;
+}
+
+function inputValue(input) {
+  const text = input.value.trim();
+  if (text === "") return undefined;
+  if (input.dataset.kind === "int" || input.dataset.kind === "num") {
+    const n = Number(text);
+    return Number.isFinite(n) ? n : text; // not a number: the server names the field
+  }
+  return text;
+}
+
+const mode = () => document.querySelector("input[name=form-mode]:checked").value;
+const visible = (input) => !input.closest("[data-mode]") || input.closest("[data-mode]").dataset.mode === mode();
+
+function readDesign() {
+  const doc = {};
+  for (const input of inputs($("design-fields"))) {
+    const v = inputValue(input);
+    if (v !== undefined && visible(input)) setAt(doc, input.dataset.path, v);
+  }
+  const design = doc.design || {};
+  for (const exc of ["transmission_error", "torque_fluctuation"]) {
+    if (design[exc] && !design[exc].harmonics) delete design[exc]; // no amplitude: no excitation
+  }
+  return design;
+}
+
+function fillDesign(design) {
+  for (const input of inputs($("design-fields"))) {
+    const v = getAt({ design }, input.dataset.path);
+    input.value = v === undefined || v === null ? (input.tagName === "SELECT" ? input.options[0].value : "") : String(v);
+  }
+}
+
+function readGroup(container, prefix) {
+  const doc = {};
+  for (const input of inputs(container)) {
+    const v = inputValue(input);
+    if (v !== undefined) setAt(doc, input.dataset.path.slice(prefix.length), v);
+  }
+  return doc;
+}
+
+function designOrParams() {
+  if (!$("advanced").checked) return { design: readDesign() };
+  try {
+    return { params: JSON.parse($("params").value) };
+  } catch (err) {
+    throw { errors: [{ path: "params", message: "not valid JSON: " + err.message }] };
+  }
+}
+
+// ---------------------------------------------------------------- the API
+function api(method, path, body) {
+  const headers = { Accept: "application/json, application/problem+json, image/png" };
+  const key = sessionStorage.getItem(KEY_STORE);
+  if (key) headers.Authorization = "Bearer " + key;
+  if (body !== undefined) headers["Content-Type"] = "application/json";
+  return fetch(path, { method, headers, body: body === undefined ? undefined : JSON.stringify(body) });
+}
+
+async function problemOf(res) {
+  let doc = {};
+  try {
+    doc = await res.json();
+  } catch (_) { /* not JSON */ }
+  if (res.status === 401) doc.detail = (doc.detail || "unauthorized") + ": enter the API key at the top of the page";
+  return { detail: doc.detail || `${res.status} ${res.statusText}`, errors: doc.errors || [] };
+}
+
+// ---------------------------------------------------------------- field errors
+function clearErrors(form) {
+  form.querySelectorAll(".field-error").forEach((n) => n.remove());
+  form.querySelectorAll(".invalid").forEach((n) => n.classList.remove("invalid"));
+  form.querySelector(".problem").hidden = true;
+}
+
+// The element a server path such as design.mesh.half_backlash (or design.axes[0].start,
+// prefixed by the caller) belongs to: the field itself, else its nearest fieldset.
+function target(form, path) {
+  for (let p = path; p; p = p.replace(/(\.[^.]*|\[\d+\])$/, "")) {
+    const hit = [...form.querySelectorAll("[data-path]")].find((n) => n.dataset.path === p && !n.closest("[hidden]"));
+    if (hit) return hit;
+    if (!/[.[]/.test(p)) break;
+  }
+  return null;
+}
+
+function showProblem(form, problem, prefix = "") {
+  clearErrors(form);
+  const loose = [];
+  for (const e of problem.errors || []) {
+    const message = e.message.replace(/^Value error, /, "");
+    const node = target(form, prefix + e.path);
+    if (!node) { loose.push(`${e.path}: ${message}`); continue; }
+    node.classList.add("invalid");
+    const whole = node.tagName === "FIELDSET" || node.tagName === "TEXTAREA"; // name the field
+    const note = el("span", { class: "field-error", role: "alert", text: whole ? `${e.path}: ${message}` : message });
+    if (node.tagName === "FIELDSET") node.append(note);
+    else node.closest("label").append(note);
+  }
+  const box = form.querySelector(".problem");
+  if (loose.length || !(problem.errors || []).length) {
+    box.textContent = loose.length ? loose.join("\n") : problem.detail;
+    box.hidden = false;
+  }
+  const first = form.querySelector(".invalid");
+  if (first) first.scrollIntoView({ block: "center" });
+}
+
+// ---------------------------------------------------------------- one design
+// a number to `digits` significant digits, trailing zeros dropped, exponent when tiny or huge
+function fmt(x, digits = 4) {
+  if (x === null || x === undefined) return "—";
+  const a = Math.abs(x);
+  const text = a && (a < 1e-3 || a >= 1e6) ? Number(x).toExponential(digits - 1) : Number(x).toPrecision(digits);
+  return text.replace(/(\.\d*?)0+(e|$)/, "$1$2").replace(/\.(e|$)/, "$1").replace("e+", "e");
+}
+const rpm = (x) => Math.round(x).toLocaleString("en-US");
+const CONTACT = {
+  no_impact: "teeth always in contact",
+  single_sided: "single-sided impacts: the teeth separate",
+  double_sided: "double-sided impacts: back-flank contact",
+};
+
+function facts(result) {
+  const n = result.numerics;
+  const eng = result.engineering;
+  const resp = eng && eng.response;
+  const rows = [["Numerical class", n.classification.replace("_", "-")],
+    ["Period", n.period ? `${n.period}T` + (resp && resp.period_ms ? ` (${fmt(resp.period_ms, 3)} ms)` : "") : "none found"],
+    ["Largest Lyapunov exponent", `${fmt(n.lle)} ± ${fmt(n.lle_stderr, 2)} per unit τ`],
+    ["Stability margin", n.floquet && n.floquet.stability_margin !== null && n.floquet.stability_margin !== undefined
+      ? n.floquet.stability_margin.toFixed(3)
+        + (n.floquet.nearest_bifurcation ? ` (nearest: ${n.floquet.nearest_bifurcation.replace("_", "-")})` : "")
+      : "—" + (n.floquet_note ? ` (${n.floquet_note})` : "")],
+    ["Melnikov", result.melnikov.chaos_possible ? "chaos possible" : "chaos ruled out"]];
+  if (eng) {
+    const w = eng.speed_windows_rpm || [];
+    const scan = eng.speed_range_rpm ? ` (scanned ${rpm(eng.speed_range_rpm[0])}–${rpm(eng.speed_range_rpm[1])} rpm)` : "";
+    rows.push(["Melnikov speed windows", (w.length ? w.map(([a, b]) => `${rpm(a)}–${rpm(b)} rpm`).join(", ") : "none") + scan]);
+  }
+  if (resp) {
+    rows.push(["Dynamic transmission error", `${fmt(resp.dte_peak_to_peak_um, 3)} µm peak to peak`],
+      ["Dynamic factor", fmt(resp.dynamic_factor, 3)],
+      ["Contact", (CONTACT[resp.contact.regime] || resp.contact.regime)
+        + (resp.contact.separation_fraction
+          ? `, separated ${fmt(100 * resp.contact.separation_fraction, 2)} % of the time` : "")]);
+  }
+  rows.push(["Agreement", result.verdict.agreement.replaceAll("_", " ")]);
+  return rows;
+}
+
+// Beside the form, in the results' place: what the server refused, field by field.
+function showRefusal(problem) {
+  const n = problem.errors.length;
+  $("welcome").hidden = true;
+  $("verdict").hidden = true;
+  const title = n ? `The server refused ${n === 1 ? "a field" : n + " fields"} (marked in red)` : "The server refused the request";
+  const lines = n ? problem.errors.map((e) => `${e.path}: ${e.message.replace(/^Value error, /, "")}`) : [problem.detail];
+  $("refused").replaceChildren(el("h2", { text: title }), ...lines.map((text) => el("p", { text })));
+  $("refused").hidden = false;
+}
+
+function showVerdict(result) {
+  $("welcome").hidden = true;
+  $("verdict").hidden = false;
+  const cls = result.numerics.classification;
+  $("verdict-class").textContent = cls.replace("_", "-");
+  $("verdict-class").style.background = CLASS_COLORS[cls] || "#555";
+  $("verdict-summary").textContent = result.engineering ? result.engineering.summary : result.verdict.summary;
+  $("verdict-facts").replaceChildren(...facts(result).flatMap(([k, v]) => [el("dt", { text: k }), el("dd", { text: v })]));
+}
+
+// A figure fetched with the key (an <img src> could not send it); data-state tells tests
+// and styles whether it is loading, shown or failed.
+async function loadFigure(img, path, body, note) {
+  if (note) note.textContent = "";
+  img.dataset.state = "loading";
+  const res = await api("POST", path, body);
+  if (img.src.startsWith("blob:")) URL.revokeObjectURL(img.src);
+  if (!res.ok) {
+    img.removeAttribute("src");
+    img.dataset.state = "failed";
+    if (note) note.textContent = "(not available: " + (await problemOf(res)).detail + ")";
+    return;
+  }
+  img.onload = () => { img.dataset.state = "shown"; };
+  img.src = URL.createObjectURL(await res.blob());
+}
+
+let thresholdSubject = null;
+function loadThresholds() {
+  if (!thresholdSubject) return;
+  loadFigure($("threshold-figure"), "/v1/thresholds/plot",
+    { ...thresholdSubject, parameter: $("threshold-parameter").value }, $("threshold-note"));
+}
+
+async function analyse() {
+  const form = $("design-form");
+  let subject;
+  try {
+    subject = designOrParams();
+  } catch (problem) {
+    return showProblem(form, problem);
+  }
+  const body = { ...subject, settings: readGroup($("settings-fields"), "settings.") };
+  clearErrors(form);
+  $("analyse").disabled = true;
+  $("analyse-status").textContent = "Analysing…";
+  try {
+    const res = await api("POST", "/v1/analyses", body);
+    if (!res.ok) {
+      const problem = await problemOf(res);
+      showProblem(form, problem);
+      showRefusal(problem);
+      $("analyse-status").textContent = "";
+      return;
+    }
+    $("refused").hidden = true;
+    const result = await res.json();
+    lastParams = result.params || subject.params || null;
+    showVerdict(result);
+    $("analyse-status").textContent = "Done.";
+    $("verdict").scrollIntoView({ block: "start" });
+    loadFigure($("analysis-figure"), "/v1/analyses/plot", body);
+    thresholdSubject = subject;
+    loadThresholds();
+  } catch (err) {
+    showProblem(form, { detail: "the server did not answer: " + err.message });
+    $("analyse-status").textContent = "";
+  } finally {
+    $("analyse").disabled = false;
+  }
+}
+
+// ---------------------------------------------------------------- the envelope
+let polling = null; // {id, timer}
+
+const recentJobs = () => JSON.parse(localStorage.getItem(JOBS_STORE) || "[]");
+function rememberJob(job) {
+  const jobs = [job, ...recentJobs().filter((j) => j.id !== job.id)].slice(0, 10);
+  localStorage.setItem(JOBS_STORE, JSON.stringify(jobs));
+  listJobs();
+}
+function updateJob(id, changes) {
+  localStorage.setItem(JOBS_STORE, JSON.stringify(recentJobs().map((j) => (j.id === id ? { ...j, ...changes } : j))));
+  listJobs();
+}
+
+function listJobs() {
+  const items = recentJobs().map((j) => {
+    const open = el("button", { type: "button", class: "link", text: j.label });
+    open.addEventListener("click", () => watchJob(j.id));
+    return el("li", {}, open, el("small", { text: ` ${j.status || ""} · ${new Date(j.created).toLocaleString()}` }));
+  });
+  $("recent-jobs").replaceChildren(...(items.length ? items : [el("li", { class: "hint", text: "none yet" })]));
+}
+
+async function mapRange() {
+  const form = $("envelope-form");
+  clearErrors(form);
+  if ($("advanced").checked) {
+    const detail = "the envelope sweeps speed and torque of a design in physical units: switch off the advanced mode";
+    return showProblem(form, { detail });
+  }
+  const env = readGroup($("envelope-fields"), "envelope.");
+  const design = readDesign();
+  const axes = [{ parameter: "speed", ...env.axes[0] }, { parameter: "torque", ...env.axes[1] }];
+  const label = `${axes[0].start}–${axes[0].stop} × ${axes[1].start}–${axes[1].stop}`;
+  const body = { design, axes, settings: env.settings, label };
+  let res;
+  $("map-range").disabled = true;
+  try {
+    res = await api("POST", "/v1/sweeps", body);
+  } catch (err) {
+    return showProblem(form, { detail: "the server did not answer: " + err.message });
+  } finally {
+    $("map-range").disabled = false;
+  }
+  if (!res.ok) {
+    // errors name design.* (the design form) or axes.* and settings.* (this form)
+    const problem = await problemOf(res);
+    const own = problem.errors.filter((e) => !e.path.startsWith("design"));
+    const theirs = problem.errors.filter((e) => e.path.startsWith("design"));
+    if (theirs.length) showProblem($("design-form"), { ...problem, errors: theirs });
+    if (own.length || !theirs.length) showProblem(form, { ...problem, errors: own }, "envelope.");
+    return;
+  }
+  const job = await res.json();
+  rememberJob({ id: job.id, label, design, settings: env.settings, created: Date.now(), status: job.status });
+  watchJob(job.id);
+}
+
+function watchJob(id) {
+  if (polling) clearTimeout(polling.timer);
+  polling = { id, timer: null };
+  $("welcome").hidden = true;
+  $("envelope").hidden = false;
+  $("envelope-progress-row").hidden = false;
+  $("envelope-hint").hidden = true;
+  $("envelope-map").replaceChildren();
+  $("windows").replaceChildren();
+  $("envelope").scrollIntoView({ block: "start" });
+  poll(id);
+}
+
+async function poll(id) {
+  if (!polling || polling.id !== id) return;
+  let res;
+  try {
+    res = await api("GET", `/v1/sweeps/${id}`);
+  } catch (err) { // the server is restarting, say: the job is durable, keep asking
+    $("envelope-progress-text").textContent = "server not answering, retrying…";
+    polling.timer = setTimeout(() => poll(id), 3000);
+    return;
+  }
+  if (!res.ok) {
+    $("envelope-status").textContent = "unavailable";
+    $("envelope-progress-text").textContent = (await problemOf(res)).detail;
+    updateJob(id, { status: res.status === 404 ? "gone" : "unavailable" });
+    return;
+  }
+  const job = await res.json();
+  const { done, total } = job.progress;
+  $("envelope-status").textContent = job.status;
+  $("envelope-progress").max = total || 1;
+  $("envelope-progress").value = done;
+  $("envelope-progress-text").textContent = `${done} / ${total} points`;
+  $("cancel-sweep").hidden = !["queued", "running"].includes(job.status);
+  updateJob(id, { status: job.status });
+  if (job.status === "queued" || job.status === "running") {
+    polling.timer = setTimeout(() => poll(id), 1000);
+  } else if (job.status === "succeeded") {
+    const result = await api("GET", `/v1/sweeps/${id}/result`);
+    if (result.ok) drawEnvelope(id, await result.json());
+  } else {
+    $("envelope-progress-text").textContent += job.error ? ` · ${job.error}` : "";
+  }
+}
+
+async function cancelSweep() {
+  if (!polling) return;
+  await api("DELETE", `/v1/sweeps/${polling.id}`);
+  poll(polling.id);
+}
+
+let plotlyLoading = null;
+function loadPlotly() {
+  plotlyLoading = plotlyLoading || new Promise((resolve, reject) => {
+    const s = el("script", { src: "/static/plotly.min.js" });
+    s.onload = () => resolve(window.Plotly);
+    s.onerror = () => reject(new Error("could not load /static/plotly.min.js"));
+    document.head.append(s);
+  });
+  return plotlyLoading;
+}
+
+// speed in rpm and torque in N m of a point (the `physical` block, else SI values)
+const pointSpeed = (p) => (p.physical && p.physical.speed ? p.physical.speed.value : p.values.speed * 30 / Math.PI);
+const pointTorque = (p) => (p.physical && p.physical.torque ? p.physical.torque.value : p.values.torque);
+
+async function drawEnvelope(id, result) {
+  const Plotly = await loadPlotly();
+  $("envelope-progress-row").hidden = true;
+  $("envelope-hint").hidden = false;
+  const pts = result.points.map((p) => ({ ...p, rpm: pointSpeed(p), nm: pointTorque(p) }));
+  const traces = Object.keys(CLASS_COLORS).map((cls) => {
+    const sel = pts.filter((p) => p.classification === cls);
+    return {
+      type: "scatter", mode: "markers", name: cls.replace("_", "-"),
+      x: sel.map((p) => p.rpm), y: sel.map((p) => p.nm),
+      customdata: sel.map((p) => [
+        p.classification.replace("_", "-"), p.period ? p.period + "T" : "none", fmt(p.lle), fmt(p.lle_stderr, 2),
+        (p.impact_regime || "—").replace("_", "-"), p.melnikov_chaos_possible ? "possible" : "ruled out",
+      ]),
+      hovertemplate: "speed %{x:,.0f} rpm<br>torque %{y:,.1f} N·m"
+        + "<br>class %{customdata[0]}, period %{customdata[1]}<br>LLE %{customdata[2]} ± %{customdata[3]}"
+        + "<br>impacts %{customdata[4]}<br>Melnikov: chaos %{customdata[5]}<extra></extra>",
+      marker: { color: CLASS_COLORS[cls], size: 11, symbol: "square", line: { color: "white", width: 1 } },
+    };
+  }).filter((t) => t.x.length);
+  const xs = [...new Set(pts.map((p) => p.rpm))].sort((a, b) => a - b);
+  const ys = [...new Set(pts.map((p) => p.nm))].sort((a, b) => a - b);
+  if (xs.length > 1 && ys.length > 1) {
+    const z = ys.map((y) => xs.map((x) => {
+      const p = pts.find((q) => q.rpm === x && q.nm === y);
+      return p && p.melnikov_chaos_possible ? 1 : 0;
+    }));
+    traces.unshift({
+      type: "contour", x: xs, y: ys, z, name: "Melnikov: chaos possible", showlegend: true,
+      showscale: false, hoverinfo: "skip", autocontour: false,
+      contours: { start: 0.5, end: 0.5, size: 1, coloring: "fill" },
+      colorscale: [[0, "rgba(255,255,255,0)"], [1, "rgba(214,39,40,0.13)"]],
+      line: { color: "#d62728", dash: "dash", width: 2 },
+    });
+  }
+  const layout = {
+    margin: { l: 60, r: 10, t: 10, b: 50 }, height: 420,
+    xaxis: { title: { text: "driver speed [rpm]" }, zeroline: false },
+    yaxis: { title: { text: "driver torque [N·m]" }, zeroline: false },
+    legend: { orientation: "h", y: -0.18 }, hovermode: "closest",
+  };
+  const map = $("envelope-map");
+  await Plotly.newPlot(map, traces, layout, { displaylogo: false, responsive: true });
+  map.on("plotly_click", (ev) => {
+    const hit = ev.points.find((p) => p.data.type === "scatter");
+    if (hit) openPoint(id, hit.x, hit.y);
+  });
+  showWindows(result.windows);
+}
+
+// The windows table: per torque level, the speed intervals [rpm] of each response, of tooth
+// impacts and of Melnikov chaos (the result's `windows`).
+const span = ([a, b]) => (a === b ? `${rpm(a)}` : `${rpm(a)}–${rpm(b)}`) + " rpm";
+const runs = (byName) => Object.entries(byName)
+  .map(([name, list]) => `${name.replaceAll("_", "-")}: ${list.map(span).join(", ")}`);
+
+function showWindows(windows) {
+  const box = $("windows");
+  if (!windows || !windows.length) return box.replaceChildren();
+  const row = (w) => {
+    const level = Object.entries(w.level)
+      .map(([k, v]) => `${k} ${fmt(v.value)} ${v.unit.replace("*", "·")}`).join(", ") || "all";
+    const cells = [[level], runs(w.response), runs(w.impacts).concat(w.impacts && Object.keys(w.impacts).length ? [] : ["none"]),
+      w.melnikov.length ? w.melnikov.map(span) : ["none"]];
+    return el("tr", {}, ...cells.map((lines) => el("td", {}, ...lines.flatMap((t, i) => (i ? [el("br"), t] : [t])))));
+  };
+  box.replaceChildren(el("h3", { text: "Speed windows" }), el("table", {},
+    el("thead", {}, el("tr", {}, ...["level", "response", "tooth impacts", "Melnikov: chaos possible"]
+      .map((c) => el("th", { text: c })))),
+    el("tbody", {}, ...windows.map(row))));
+}
+
+// A point of the map: its design (the job's, at that speed and torque) analysed with the
+// sweep's settings, so the verdict is the one the map shows.
+function openPoint(id, speedRpm, torqueNm) {
+  const job = recentJobs().find((j) => j.id === id);
+  $("advanced").checked = false;
+  toggleAdvanced();
+  const design = {
+    ...(job ? job.design : readDesign()),
+    speed: `${+speedRpm.toPrecision(10)} rpm`,
+    torque: `${+torqueNm.toPrecision(10)} N*m`,
+  };
+  if (job && job.design.driver && job.design.driver.module) setMode("geometry");
+  else if (job) setMode("direct");
+  fillDesign(design);
+  if (job && job.settings) {
+    for (const [k, v] of Object.entries(job.settings)) {
+      const input = $("settings-fields").querySelector(`[data-path="settings.${k}"]`);
+      if (input) input.value = v;
+    }
+  }
+  analyse();
+}
+
+// ---------------------------------------------------------------- modes and start-up
+function setMode(m) {
+  document.querySelector(`input[name=form-mode][value=${m}]`).checked = true;
+  document.querySelectorAll("#design-fields [data-mode]").forEach((n) => { n.hidden = n.dataset.mode !== m; });
+}
+
+function switchMode(m) {
+  const design = readDesign();
+  const other = defaults[m === "direct" ? "geometry" : "direct"];
+  setMode(m);
+  // keep what the user typed; fields of the new form come from its example, and the mesh
+  // stiffness follows the form while it still holds the other form's example value
+  const example = defaults[m];
+  const merged = { ...example, ...design,
+    driver: { ...example.driver, teeth: design.driver?.teeth },
+    driven: { ...example.driven, teeth: design.driven?.teeth } };
+  if (design.mesh && design.mesh.stiffness === other.mesh.stiffness) {
+    merged.mesh = { ...design.mesh, stiffness: example.mesh.stiffness, stiffness_harmonics: example.mesh.stiffness_harmonics };
+  }
+  fillDesign(merged);
+}
+
+function toggleAdvanced() {
+  const on = $("advanced").checked;
+  $("design-fields").hidden = on;
+  $("params-box").hidden = !on;
+  document.querySelectorAll("input[name=form-mode]").forEach((r) => { r.disabled = on; });
+  if (on && !$("params").value) $("params").value = JSON.stringify(lastParams || defaults.params, null, 2);
+}
+
+async function start() {
+  buildForms();
+  $("api-key").value = sessionStorage.getItem(KEY_STORE) || "";
+  $("api-key").addEventListener("input", (e) => sessionStorage.setItem(KEY_STORE, e.target.value.trim()));
+  defaults = await (await fetch("/explorer/defaults.json")).json();
+  setMode("direct");
+  fillDesign(defaults.direct);
+  document.querySelectorAll("input[name=form-mode]").forEach((r) => r.addEventListener("change", () => switchMode(r.value)));
+  $("advanced").addEventListener("change", toggleAdvanced);
+  $("design-form").addEventListener("submit", (e) => { e.preventDefault(); analyse(); });
+  $("envelope-form").addEventListener("submit", (e) => { e.preventDefault(); mapRange(); });
+  $("cancel-sweep").addEventListener("click", cancelSweep);
+  $("threshold-parameter").addEventListener("change", loadThresholds);
+  listJobs();
+  document.body.dataset.ready = "true"; // for tests: the form is built and prefilled
+}
+
+document.addEventListener("DOMContentLoaded", start);

@@ -1,0 +1,382 @@
+"""The design explorer (GET /): served offline by the service, and driven in a real browser.
+
+The route tests run in-process. The browser tests drive Debian's ``chromium`` through
+``chromedriver`` (selenium) against a real ``gearengine serve`` with API keys on: fill the form
+and analyse, see a field error for a wrong unit, run a small envelope and open a map point.
+Every request the page makes is recorded (Chrome's performance log, CDP Network events) and
+must stay on the server's origin. Without chromium, chromedriver or selenium the browser tests
+skip, saying which is missing; with GEARCHAOS_BROWSER_TESTS=required (set by .ci/run after it
+installs the browser) they fail instead.
+
+GEARCHAOS_EXPLORER_SCREENSHOTS=DIR saves the README's screenshots (explorer-verdict.png,
+explorer-field-error.png, explorer-envelope.png) into DIR, GEARCHAOS_EXPLORER_WIDTH=800 at
+another window width (default 1280).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import tempfile
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+from fastapi.testclient import TestClient
+
+from gearengine.model.design import EXAMPLE_DESIGN
+from service.api.routes.explorer import GEOMETRY_EXAMPLE, PAGE_DIR, plotly_js
+from service.core.config import Settings
+from service.main import create_app
+from tests.conftest import ROOT, Server
+
+KEY = "explorer-test-key"
+CHROMIUM = ("/usr/bin/chromium", "chromium", "chromium-browser")
+CHROMEDRIVER = ("/usr/bin/chromedriver", "chromedriver")
+CHROME_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--disable-dev-shm-usage",
+    "--window-size=1280,900",
+]
+
+
+# ---------------------------------------------------------------------------- in-process
+
+
+def test_root_serves_the_explorer_with_links_to_the_docs(client: TestClient) -> None:
+    page = client.get("/")
+    assert page.status_code == 200 and page.headers["content-type"].startswith("text/html")
+    assert 'href="/docs"' in page.text and 'href="/redoc"' in page.text
+    assert client.get("/explorer/explorer.js").headers["content-type"].startswith("text/javascript")
+    assert client.get("/explorer/explorer.css").headers["content-type"].startswith("text/css")
+    assert client.get("/explorer/index.html").status_code == 404  # only the listed files
+    assert client.get("/explorer/..%2Fmain.py").status_code == 404
+
+
+def test_plotly_is_served_from_the_python_environment(client: TestClient) -> None:
+    path = plotly_js()
+    assert path is not None, "plotly is a dependency: pip install -e ."
+    r = client.get("/static/plotly.min.js")
+    assert r.status_code == 200 and r.content == path.read_bytes()
+
+
+def test_the_form_is_prefilled_with_the_readme_design(client: TestClient) -> None:
+    defaults = client.get("/explorer/defaults.json").json()
+    assert defaults["direct"] == EXAMPLE_DESIGN
+    geometry = json.loads((ROOT / "examples/design-geometry.json").read_text())["design"]
+    assert defaults["geometry"] == GEOMETRY_EXAMPLE == geometry
+
+
+def test_the_page_names_no_other_host() -> None:
+    """No CDN, no font service: every URL in the page's files is a path on this server."""
+    for path in PAGE_DIR.iterdir():
+        urls = re.findall(r"""(?:https?:)?//[\w.-]+""", path.read_text())
+        assert urls == [], (path.name, urls)
+
+
+def test_the_page_is_open_when_api_keys_are_on(tmp_path: Path) -> None:
+    settings = Settings(data_dir=tmp_path, workers=0, api_keys=KEY)
+    with TestClient(create_app(settings)) as c:
+        assert c.get("/").status_code == 200
+        assert c.get("/static/plotly.min.js").status_code == 200
+        assert c.post("/v1/analyses", json={"design": EXAMPLE_DESIGN}).status_code == 401
+
+
+# ---------------------------------------------------------------------------- the browser
+
+
+def _find(candidates: tuple[str, ...]) -> str | None:
+    return next((p for p in map(shutil.which, candidates) if p), None)
+
+
+def _browser_missing() -> str | None:
+    try:
+        import selenium  # noqa: F401
+    except ImportError:
+        return "selenium is not installed (pip install -e '.[test]')"
+    if _find(CHROMIUM) is None:
+        return "no chromium on PATH (apt-get install chromium chromium-driver)"
+    if _find(CHROMEDRIVER) is None:
+        return "no chromedriver on PATH (apt-get install chromium-driver)"
+    return None
+
+
+@pytest.fixture(scope="module")
+def keyed_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
+    missing = _browser_missing()
+    if missing:
+        if os.environ.get("GEARCHAOS_BROWSER_TESTS") == "required":
+            pytest.fail(f"browser tests required but {missing}")
+        pytest.skip(f"browser tests skipped: {missing}")
+    env = {"GEARCHAOS_API_KEYS": KEY, "GEARCHAOS_SWEEP_CHUNK_POINTS": "4"}
+    srv = Server(tmp_path_factory.mktemp("explorer") / "data", env)
+    yield srv
+    srv.stop()
+
+
+class Page:
+    """A Chromium tab on the explorer, recording every request the page makes."""
+
+    def __init__(self, server: Server) -> None:
+        from selenium import webdriver
+        from selenium.webdriver.chrome.service import Service
+
+        os.environ.setdefault("SE_OFFLINE", "true")  # never let selenium fetch a driver
+        options = webdriver.ChromeOptions()
+        options.binary_location = _find(CHROMIUM) or ""
+        self.profile = tempfile.mkdtemp(prefix="gearchaos-chromium-")
+        for flag in [*CHROME_FLAGS, f"--user-data-dir={self.profile}"]:
+            options.add_argument(flag)
+        options.set_capability("goog:loggingPrefs", {"performance": "ALL"})
+        self.driver = webdriver.Chrome(service=Service(_find(CHROMEDRIVER)), options=options)
+        self.driver.set_script_timeout(30)
+        self.server = server
+        self.urls: list[str] = []
+
+    def open(self, key: str | None = KEY) -> None:
+        width = int(os.environ.get("GEARCHAOS_EXPLORER_WIDTH", "1280"))
+        self.driver.set_window_size(width, 900)
+        self.driver.get("about:blank")
+        self.driver.get_log("performance")  # Chrome's own start-up pages are not the explorer's
+        self.driver.get(self.server.url + "/")
+        self.wait(lambda d: d.execute_script("return document.body.dataset.ready === 'true'"))
+        if key:
+            self.field("api-key", by="id").send_keys(key)
+
+    def wait(self, condition: Callable[[Any], Any], timeout: float = 90.0) -> Any:
+        from selenium.webdriver.support.ui import WebDriverWait
+
+        return WebDriverWait(self.driver, timeout, poll_frequency=0.1).until(condition)
+
+    def field(self, key: str, by: str = "path") -> Any:
+        from selenium.webdriver.common.by import By
+
+        if by == "id":
+            return self.driver.find_element(By.ID, key)
+        return self.driver.find_element(By.CSS_SELECTOR, f'[data-path="{key}"]')
+
+    def type(self, path: str, text: str) -> None:
+        box = self.field(path)
+        box.clear()
+        box.send_keys(text)
+
+    def text(self, css: str) -> str:
+        from selenium.webdriver.common.by import By
+
+        return self.driver.find_element(By.CSS_SELECTOR, css).text
+
+    def figures_done(self) -> None:
+        self.wait(
+            lambda d: d.execute_script(
+                "return [...document.querySelectorAll('figure img')]"
+                ".every(i => ['shown', 'failed'].includes(i.dataset.state))"
+            )
+        )
+
+    def requested(self) -> list[str]:
+        """URLs the page requested since the last call (CDP Network.requestWillBeSent)."""
+        for entry in self.driver.get_log("performance"):
+            message = json.loads(entry["message"])["message"]
+            if message["method"] == "Network.requestWillBeSent":
+                self.urls.append(message["params"]["request"]["url"])
+        return self.urls
+
+    def assert_same_origin(self) -> None:
+        urls = self.requested()
+        assert urls, "no request recorded: is the performance log on?"
+        origin = self.server.url
+        foreign = [
+            u
+            for u in urls
+            if not (u == origin or u.startswith(origin + "/") or u.startswith("data:"))
+            and not u.startswith("blob:" + origin + "/")
+        ]
+        assert foreign == [], foreign
+
+    def show(self, css: str) -> None:
+        """The page from its top, or from ``css`` when that is below the fold (one column)."""
+        self.driver.execute_script(
+            "window.scrollTo(0, 0); const e = document.querySelector(arguments[0]);"
+            "if (e.getBoundingClientRect().top > innerHeight / 2) e.scrollIntoView()",
+            css,
+        )
+
+    def screenshot(self, name: str, height: int | None = None) -> None:
+        target = os.environ.get("GEARCHAOS_EXPLORER_SCREENSHOTS")
+        if not target:
+            return
+        if height:
+            self.driver.set_window_size(self.driver.get_window_size()["width"], height)
+        self.driver.save_screenshot(str(Path(target) / name))
+
+    def close(self) -> None:
+        self.driver.quit()
+        shutil.rmtree(self.profile, ignore_errors=True)
+
+
+@pytest.fixture
+def page(keyed_server: Server) -> Iterator[Page]:
+    p = Page(keyed_server)
+    try:
+        yield p
+    finally:
+        p.close()
+
+
+def test_analyse_shows_the_verdict(page: Page) -> None:
+    page.open()
+    assert page.field("design.speed").get_attribute("value") == EXAMPLE_DESIGN["speed"]
+    assert page.field("design.mesh.half_backlash").get_attribute("value") == "50 um"
+    page.field("analyse", by="id").click()
+    summary = page.wait(lambda d: page.text("#verdict-summary"))
+    assert "1,500 rpm" in summary and "Melnikov" in summary
+    facts = page.text("#verdict-facts")
+    for label in ("Numerical class", "Largest Lyapunov exponent", "Stability margin",
+                  "Melnikov speed windows", "Dynamic factor", "Contact"):  # fmt: skip
+        assert label in facts
+    assert "2,879–4,500 rpm" in facts and "µm peak to peak" in facts
+    page.figures_done()
+    states = page.driver.execute_script(
+        "return [...document.querySelectorAll('figure img')].map(i => i.dataset.state)"
+    )
+    assert states == ["shown", "shown"]
+    page.show("#verdict")
+    page.screenshot("explorer-verdict.png", height=1150)
+    page.assert_same_origin()
+
+
+def test_a_wrong_unit_is_shown_next_to_its_field(page: Page) -> None:
+    page.open()
+    page.type("design.mesh.half_backlash", "100 m")
+    page.field("analyse", by="id").click()
+    note = page.wait(lambda d: page.text("label:has(> [data-path='design.mesh.half_backlash'])"
+                                         " .field-error"))  # fmt: skip
+    assert "did you mean 100 µm?" in note
+    assert "invalid" in page.field("design.mesh.half_backlash").get_attribute("class")
+    assert page.driver.find_element("id", "verdict").get_attribute("hidden") is not None
+    assert "design.mesh.half_backlash: 100 m is outside" in page.text("#refused")
+    page.screenshot("explorer-field-error.png")
+    page.assert_same_origin()
+
+
+def test_an_envelope_runs_on_the_queue_and_opens_a_point(page: Page) -> None:
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+
+    page.open()
+    small = {
+        "envelope.axes[0].start": "1000 rpm",
+        "envelope.axes[0].stop": "4000 rpm",
+        "envelope.axes[0].num": "7",
+        "envelope.axes[1].start": "20 N*m",
+        "envelope.axes[1].stop": "120 N*m",
+        "envelope.axes[1].num": "3",
+        "envelope.settings.transient_periods": "30",
+        "envelope.settings.record_periods": "30",
+    }
+    screenshots = bool(os.environ.get("GEARCHAOS_EXPLORER_SCREENSHOTS"))
+    if not screenshots:  # the screenshot shows the form's own envelope, 21 x 5 points
+        for path, value in small.items():
+            page.type(path, value)
+    n = 105 if screenshots else 21
+    page.field("map-range", by="id").click()
+    progress = page.wait(lambda d: re.search(rf"\d+ / {n} points", page.text("#envelope")))
+    assert progress
+    page.wait(lambda d: page.text("#envelope-status") == "succeeded")
+    points = page.wait(
+        lambda d: d.find_elements(By.CSS_SELECTOR, "#envelope-map .scatterlayer path.point")
+    )
+    assert len(points) == n
+    assert page.driver.find_elements(By.CSS_SELECTOR, "#envelope-map .contourlayer path")
+    assert ("500 rpm–6000 rpm" if screenshots else "1000 rpm–4000 rpm") in page.text("#recent-jobs")
+    stored = page.driver.execute_script("return localStorage.getItem('gearchaos.jobs')")
+    assert json.loads(stored)[0]["status"] == "succeeded"
+
+    # hover shows speed, torque, class, period and LLE
+    point = points[len(points) // 2 + 1]
+    ActionChains(page.driver).move_to_element(point).perform()
+    hover = page.wait(lambda d: page.text("#envelope-map .hoverlayer"))
+    for word in ("rpm", "N·m", "class", "period", "LLE"):
+        assert word in hover
+    page.show("#envelope")
+    page.screenshot("explorer-envelope.png", height=1000)
+
+    # clicking a point analyses the design at that speed and torque
+    ActionChains(page.driver).move_to_element(point).click().perform()
+    page.wait(lambda d: page.text("#verdict-summary"))
+    speed = page.field("design.speed").get_attribute("value")
+    torque = page.field("design.torque").get_attribute("value")
+    assert speed.endswith(" rpm") and torque.endswith(" N*m")
+    assert f"At {float(speed.split()[0]):,.0f} rpm" in page.text("#verdict-summary")
+    assert page.field("settings.record_periods").get_attribute("value") == (
+        "100" if screenshots else "30"
+    )
+    page.figures_done()
+    page.assert_same_origin()
+    assert any(u.endswith("/static/plotly.min.js") for u in page.urls)
+
+
+def test_an_envelope_can_be_cancelled(page: Page) -> None:
+    page.open()
+    page.type("envelope.axes[0].num", "40")
+    page.type("envelope.settings.transient_periods", "3000")
+    page.field("map-range", by="id").click()
+    page.wait(lambda d: page.text("#envelope-status") in ("queued", "running"))
+    page.field("cancel-sweep", by="id").click()
+    page.wait(lambda d: page.text("#envelope-status") == "cancelled")
+    assert not page.field("cancel-sweep", by="id").is_displayed()
+    page.assert_same_origin()
+
+
+def test_without_the_key_the_page_says_so(page: Page) -> None:
+    page.open(key=None)
+    page.field("analyse", by="id").click()
+    problem = page.wait(lambda d: page.text("#form-problem"))
+    assert "API key" in problem
+    assert page.driver.find_element("id", "verdict").get_attribute("hidden") is not None
+    page.field("api-key", by="id").send_keys(KEY)
+    page.field("analyse", by="id").click()
+    page.wait(lambda d: page.text("#verdict-summary"))
+    key = page.driver.execute_script("return sessionStorage.getItem('gearchaos.apiKey')")
+    assert key == KEY
+    page.assert_same_origin()
+
+
+def test_advanced_mode_sends_dimensionless_params(page: Page) -> None:
+    page.open()
+    page.field("advanced", by="id").click()
+    params = json.loads(page.field("params").get_attribute("value"))
+    assert params["damping"] == 0.07  # the paper's section 4.1 design
+    page.type("params", json.dumps({**params, "damping": -1}))
+    page.field("analyse", by="id").click()
+    note = page.wait(lambda d: page.text("label:has(> [data-path='params']) .field-error"))
+    assert note.startswith("params.damping:")
+    page.type("params", json.dumps(params))
+    page.field("analyse", by="id").click()
+    summary = page.wait(lambda d: page.text("#verdict-summary"))
+    assert summary.startswith("numerics:") and "Melnikov: chaos possible" in summary
+    page.figures_done()
+    page.assert_same_origin()
+
+
+def test_the_geometry_form_derives_the_gears(page: Page) -> None:
+    page.open()
+    assert not page.field("design.driver.module").is_displayed()
+    page.driver.find_element("css selector", "input[name=form-mode][value=geometry]").click()
+    assert page.field("design.driver.module").get_attribute("value") == "3 mm"
+    assert page.field("design.mesh.stiffness").get_attribute("value") == "iso6336"
+    assert not page.field("design.driver.base_radius").is_displayed()
+    page.field("analyse", by="id").click()
+    page.wait(lambda d: page.text("#verdict-summary"))
+    assert "Dynamic factor" in page.text("#verdict-facts")
+    page.assert_same_origin()
