@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Literal
 
@@ -216,11 +217,16 @@ def _one_sinusoid_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
     base = off0 + 0.0
     kinks = (-math.inf, -a / b, math.inf)
     sign = 1.0 if b > 0.0 else -1.0
+    return _union_of_pieces(  # piece j lies between kinks j-1 and j
+        (base + s * a, offg + s * b, kinks[j], kinks[j + 1]) for j, s in ((0, -sign), (1, sign))
+    )
+
+
+def _union_of_pieces(pieces: Iterable[tuple[float, float, float, float]]) -> Interval | None:
+    """The union of {p in [left, right] : alpha + beta p <= 0} over the linear pieces
+    (alpha, beta, left, right) of a convex piecewise-linear function: an interval, or None."""
     lo, hi = math.inf, -math.inf
-    for j in (0, 1):  # piece j lies between kinks j-1 and j
-        s = sign if j else -sign
-        alpha, beta = base + s * a, offg + s * b
-        left, right = kinks[j], kinks[j + 1]
+    for alpha, beta, left, right in pieces:
         if beta > 0.0:
             right = min(right, -alpha / beta)
         elif beta < 0.0:
@@ -231,7 +237,7 @@ def _one_sinusoid_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
             lo, hi = min(lo, left), max(hi, right)
     if lo > hi:
         return None
-    return Interval(None if lo == -math.inf else lo, None if hi == math.inf else hi)
+    return Interval(None if lo == -math.inf else float(lo), None if hi == math.inf else float(hi))
 
 
 def _flushed(m: TrigSum) -> TrigSum:
@@ -277,20 +283,9 @@ def _supremum_interval(m0: TrigSum, g: TrigSum, active: np.ndarray) -> Interval 
     order = np.argsort(-a / b)
     a, b = a[order], b[order]
     kinks = np.concatenate([[-np.inf], -a / b, [np.inf]])
-    lo, hi = np.inf, -np.inf
-    for j in range(b.size + 1):  # piece j lies between kinks j-1 and j (sorted)
+
+    def piece(j: int) -> tuple[float, float, float, float]:  # between kinks j-1 and j (sorted)
         signs = np.sign(b) * np.where(np.arange(b.size) < j, 1.0, -1.0)
-        alpha = base + float(signs @ a)
-        beta = g.offset + float(signs @ b)
-        left, right = kinks[j], kinks[j + 1]
-        if beta > 0.0:
-            right = min(right, -alpha / beta)
-        elif beta < 0.0:
-            left = max(left, -alpha / beta)
-        elif alpha > 0.0:
-            continue
-        if left <= right:
-            lo, hi = min(lo, left), max(hi, right)
-    if lo > hi:
-        return None
-    return Interval(None if lo == -np.inf else float(lo), None if hi == np.inf else float(hi))
+        return base + float(signs @ a), g.offset + float(signs @ b), kinks[j], kinks[j + 1]
+
+    return _union_of_pieces(piece(j) for j in range(b.size + 1))
