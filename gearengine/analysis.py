@@ -16,9 +16,10 @@ from pydantic import BaseModel, ConfigDict, Field
 from gearengine.engineering import Engineering, engineering
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
 from gearengine.homoclinic.verdict import melnikov
-from gearengine.model.design import EXAMPLE_DESIGN, DesignConversion, ParamsOrDesign
+from gearengine.model.design import EXAMPLE_DESIGN
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
+from gearengine.model.reduction import DesignConversion, ParamsOrDesign
 from gearengine.numerics.results import NumericsResult
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate

@@ -27,8 +27,8 @@ from gearengine.homoclinic.boundary import chaos_intervals
 from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
 from gearengine.model.aliases import with_speed_factor
 from gearengine.model.backlash import LAWS
-from gearengine.model.design import Derived, DesignConversion
 from gearengine.model.params import GearParams
+from gearengine.model.reduction import Derived, DesignConversion
 from gearengine.numerics.forcing import forcing_coefficients
 from gearengine.numerics.results import NumericsResult
 

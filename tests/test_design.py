@@ -19,7 +19,8 @@ from gearengine.homoclinic import melnikov
 from gearengine.homoclinic.schemas import MelnikovRequest
 from gearengine.model.aliases import with_speed_factor
 from gearengine.model.conversion import to_dimensionless
-from gearengine.model.design import EXAMPLE_DESIGN, Design, convert_design, physical_data
+from gearengine.model.design import EXAMPLE_DESIGN, Design
+from gearengine.model.reduction import convert_design, physical_data
 from gearengine.numerics.results import NumericsResult
 from tests.test_conversion import dimensionless_response, physical_response
 

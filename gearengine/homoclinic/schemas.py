@@ -8,9 +8,9 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
 
 from gearengine.homoclinic.coefficients import BranchCoefficients, HomoclinicBranch, Method
-from gearengine.model.design import ParamsOrDesign
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import MIN_FREQUENCY, request_config
+from gearengine.model.reduction import ParamsOrDesign
 
 WholeNumber = Annotated[
     int, BeforeValidator(lambda v: int(v) if isinstance(v, float) and v.is_integer() else v)

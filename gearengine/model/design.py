@@ -6,7 +6,8 @@ half backlash) and the excitations (transmission error, torque fluctuation). Qua
 strings with units or SI numbers (``model.units``). ``convert_design`` derives what the data
 leave implicit (``model.geometry``: base radii, inertias, contact ratio, ISO 6336-1 mesh
 stiffness and its variation) and reduces the pair to the dimensionless parameters of Eq. (9)
-through ``model.conversion`` (Eq. 7-8, with the r_a correction of the mean force).
+through ``model.conversion`` (Eq. 7-8, with the r_a correction of the mean force); that
+reduction lives in ``model.reduction``.
 
 Frequencies: the mesh frequency is teeth x speed; the transmission error runs at the mesh
 frequency unless an ``order`` (multiple of the driver speed) is given; the torque fluctuation at
@@ -20,37 +21,16 @@ from typing import Annotated, Any, Literal
 
 from pydantic import (
     BaseModel,
-    ConfigDict,
     Field,
-    GetJsonSchemaHandler,
-    PrivateAttr,
-    ValidationInfo,
-    field_validator,
     model_validator,
 )
-from pydantic.json_schema import JsonSchemaValue
-from pydantic_core import CoreSchema
 
-from gearengine.model import geometry
-from gearengine.model.backlash import collocation_fit
-from gearengine.model.conversion import (
-    PhysicalGearData,
-    StiffnessHarmonic,
-    TorqueHarmonic,
-    TransmissionErrorHarmonic,
-    to_dimensionless,
-)
-from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import (
     MAX_HARMONICS,
-    CubicBacklash,
-    GearParams,
     Phase,
-    PiecewiseBacklash,
     request_config,
 )
 from gearengine.model.units import (
-    RPM,
     Angle,
     Bore,
     Damping,
@@ -63,14 +43,6 @@ from gearengine.model.units import (
     StiffnessVariation,
     Torque,
 )
-
-RATIO_TOLERANCE = 0.01
-"""Largest relative mismatch of base-radius ratio and teeth ratio accepted."""
-BALANCE_TOLERANCE = 1e-3
-"""Relative mismatch of a given braking torque with the balancing one that raises a note
-(rounding such as 66.667 for 200/3 N m stays below it)."""
-ISO_HARMONICS = 5
-"""Harmonics of the mesh-stiffness wave kept when the variation comes from the contact ratio."""
 
 
 class _Strict(BaseModel):
@@ -239,247 +211,3 @@ class Design(_Strict):
         if self.speed_range is not None and not self.speed_range[0] < self.speed_range[1]:
             raise ValueError("speed_range: the first speed must be below the second")
         return self
-
-
-class Derived(BaseModel):
-    """A quantity derived from the design, with its unit and where it comes from."""
-
-    model_config = ConfigDict(frozen=True)
-
-    value: float | list[dict[str, float]] = Field(description="The value (SI units).")
-    unit: str = Field(description="Its unit.")
-    source: str = Field(description="The formula or standard it comes from.")
-
-
-class DesignConversion(BaseModel):
-    """The design reduced to Eq. (9), with the scales that map answers back to gear data."""
-
-    model_config = ConfigDict(frozen=True)
-
-    params: GearParams = Field(description="Dimensionless parameters of Eq. (9) used.")
-    derived: dict[str, Derived] = Field(description="Quantities derived from the design.")
-    natural_frequency_hz: float = Field(description="f_n = sqrt(k_m / m) / (2 pi) [Hz].")
-    time_scale_s: float = Field(description="Time unit 1 / omega_n [s]: t = tau / omega_n.")
-    mesh_frequency_hz: float = Field(description="Mesh frequency teeth x speed [Hz].")
-    speed_rpm: float = Field(description="Driver speed [rpm].")
-    equivalent_mass_kg: float = Field(description="m = I_a I_b / (I_b r_a^2 + I_a r_b^2).")
-    half_backlash_m: float = Field(description="b [m]: x = 1 is one half backlash.")
-    mesh_stiffness_n_per_m: float = Field(description="k_m [N/m]: forces scale with b k_m.")
-    static_force_n: float = Field(description="Mean mesh force F^_m [N] (Eq. 7).")
-    torque_gain: float = Field(description="F~_p per N m of driver torque fluctuation [1/(N m)].")
-    notes: list[str] = Field(description="Assumptions and remarks, in plain words.")
-
-
-def _gear_values(design: Design, derived: dict[str, Derived]) -> dict[str, float]:
-    """Base radii and inertias: given ones win over those derived from geometry."""
-    out = {}
-    for role, gear in (("driver", design.driver), ("driven", design.driven)):
-        for name in ("base_radius", "inertia"):
-            given = getattr(gear, name)
-            key = f"{name}_{role}"
-            if given is None:
-                given = float(derived[key].value)  # type: ignore[arg-type]
-            out[key] = given
-    return out
-
-
-def _geometry(design: Design) -> dict[str, Derived]:
-    """Quantities of ``model.geometry`` for the gears given in geometry form."""
-    g1, g2 = design.driver.geometry(), design.driven.geometry()
-    if g1 is not None and g2 is not None:
-        radius = g1["module"] * g1["teeth"] / 2.0
-        pair = geometry.pair_from_geometry(
-            g1, g2, tangential_load=abs(design.torque) / radius, n_harmonics=ISO_HARMONICS
-        )
-        return {k: Derived(**v) for k, v in pair.items()}
-    derived = {}
-    for role, g in (("driver", g1), ("driven", g2)):
-        if g is None:
-            continue
-        derived[f"base_radius_{role}"] = Derived(
-            value=geometry.base_radius(g["teeth"], g["module"], g["pressure_angle"]),
-            unit="m",
-            source="involute geometry: r_b = (m z/2) cos(alpha)",
-        )
-        density = geometry.MATERIALS[g["material"]]["density"]
-        r = geometry.reference_radius(g["teeth"], g["module"])
-        derived[f"inertia_{role}"] = Derived(
-            value=geometry.disc_inertia(density, g["face_width"], r, g["bore_diameter"] / 2.0),
-            unit="kg*m^2",
-            source="solid disc with bore at the reference diameter: J = rho b pi/2 (r^4 - r_i^4)",
-        )
-    return derived
-
-
-def _stiffness(design: Design, derived: dict[str, Derived]) -> tuple[float, list]:
-    """(k_m, harmonics as (amplitude N/m, phase)) from the mesh data or ISO 6336-1."""
-    mesh = design.mesh
-    if mesh.stiffness == "iso6336":
-        k_m = float(derived["mesh_stiffness"].value)  # type: ignore[arg-type]
-        wave = derived["stiffness_harmonics"].value
-        harmonics = [(h["amplitude"], h["phase"]) for h in wave]  # type: ignore[union-attr]
-    else:
-        k_m, harmonics = float(mesh.stiffness), []  # type: ignore[arg-type]
-    if mesh.stiffness_harmonics is not None:
-        harmonics = [(h.amplitude, h.phase) for h in mesh.stiffness_harmonics]
-    return k_m, harmonics
-
-
-def physical_data(design: Design) -> tuple[PhysicalGearData, dict[str, Derived], list[str]]:
-    """The design as the SI record of ``model.conversion``, the derived quantities and notes.
-
-    Raises ValueError (message starting with the field) for inconsistent radii and teeth.
-    """
-    derived = _geometry(design)
-    gears = _gear_values(design, derived)
-    ra, rb = gears["base_radius_driver"], gears["base_radius_driven"]
-    teeth = design.driver.teeth / design.driven.teeth
-    if abs(ra / rb - teeth) > RATIO_TOLERANCE * teeth:
-        raise ValueError(
-            f"design.driven.base_radius: base radii ratio r_a / r_b = {ra / rb:.4f} differs "
-            f"from the teeth ratio {design.driver.teeth}/{design.driven.teeth} = {teeth:.4f} "
-            "by more than 1 %"
-        )
-    k_m, harmonics = _stiffness(design, derived)
-    if sum(abs(a) for a, _ in harmonics) >= k_m:
-        raise ValueError(
-            "design.mesh.stiffness_harmonics: the amplitudes add up to the mean mesh stiffness "
-            f"{k_m:.6g} N/m or more, so the stiffness would become negative"
-        )
-    balancing = design.torque * rb / ra
-    braking = balancing if design.braking_torque is None else design.braking_torque
-    notes = []
-    if abs(braking - balancing) > BALANCE_TOLERANCE * max(abs(balancing), 1e-12):
-        notes.append(f"braking torque {braking:.6g} N m differs from the balancing "
-                     f"{balancing:.6g} N m: the pair would speed up or slow down")  # fmt: skip
-    mesh, te, tf = design.mesh, design.transmission_error, design.torque_fluctuation
-    ia, ib = gears["inertia_driver"], gears["inertia_driven"]
-    m = ia * ib / (ib * ra**2 + ia * rb**2)  # equivalent mass (Eq. 7)
-    zeta = mesh.damping_ratio
-    damping = mesh.damping if zeta is None else 2.0 * zeta * math.sqrt(k_m * m)  # mu~ = zeta
-    data = PhysicalGearData(
-        inertia_a=ia, inertia_b=ib,
-        base_radius_a=ra, base_radius_b=rb,
-        teeth_a=design.driver.teeth, teeth_b=design.driven.teeth,
-        shaft_speed_a=design.speed, mesh_stiffness=k_m,
-        stiffness_harmonics=[StiffnessHarmonic(amplitude=a, phase=p) for a, p in harmonics],
-        mesh_damping=damping, half_backlash=mesh.half_backlash,
-        torque_a_mean=design.torque, torque_b_mean=braking,
-        torque_harmonics=[] if tf is None else [
-            TorqueHarmonic(amplitude=h.amplitude, phase=h.phase) for h in tf.harmonics],
-        transmission_error_harmonics=[] if te is None else [
-            TransmissionErrorHarmonic(amplitude=h.amplitude, phase=h.phase) for h in te.harmonics],
-        backlash=PiecewiseBacklash() if design.backlash_law == "piecewise" else _paper_cubic(),
-        torque_order=1.0 if tf is None else tf.order,
-        transmission_error_order=None if te is None else te.order,
-    )  # fmt: skip
-    return data, derived, notes
-
-
-def _paper_cubic() -> CubicBacklash:
-    fit = collocation_fit(0.0)
-    return CubicBacklash(a=fit.a, c=fit.c)
-
-
-def convert_design(design: Design) -> DesignConversion:
-    """The dimensionless parameters of ``design`` (Eq. 7-9) with the scales and derivations."""
-    data, derived, notes = physical_data(design)
-    conv = to_dimensionless(data)
-    notes += [n for n in conv.notes if n.startswith(("base-radius", "sum of |k_r|"))]
-    m = conv.equivalent_mass
-    for role, r, inertia in (
-        ("driver", data.base_radius_a, data.inertia_a),
-        ("driven", data.base_radius_b, data.inertia_b),
-    ):
-        derived.setdefault(f"base_radius_{role}", Derived(value=r, unit="m", source="given"))
-        derived.setdefault(f"inertia_{role}", Derived(value=inertia, unit="kg*m^2", source="given"))
-    derived["equivalent_mass"] = Derived(
-        value=m, unit="kg", source="m = I_a I_b / (I_b r_a^2 + I_a r_b^2) (Eq. 7)"
-    )
-    if design.mesh.damping_ratio is None:
-        notes.append(f"damping {data.mesh_damping:.6g} N s/m is a damping ratio of "
-                     f"{conv.params.damping:.4g}")  # fmt: skip
-    if design.backlash_law == "piecewise":
-        notes.append(
-            "the numerical verdict uses the exact piecewise backlash law; the Melnikov "
-            "criterion needs a smooth law and uses its cubic fit -x/6 + x^3/6 (the paper's)"
-        )
-    force_scale = data.half_backlash * data.mesh_stiffness
-    return DesignConversion(
-        params=conv.params,
-        derived=derived,
-        natural_frequency_hz=conv.natural_frequency / (2.0 * math.pi),
-        time_scale_s=conv.time_scale,
-        mesh_frequency_hz=conv.mesh_frequency / (2.0 * math.pi),
-        speed_rpm=design.speed / RPM,
-        equivalent_mass_kg=m,
-        half_backlash_m=data.half_backlash,
-        mesh_stiffness_n_per_m=data.mesh_stiffness,
-        static_force_n=conv.params.mean_force * force_scale,
-        torque_gain=m * data.base_radius_a / data.inertia_a / force_scale,
-        notes=notes,
-    )
-
-
-class ParamsOrDesign(BaseModel):
-    """A request that carries exactly one of ``params`` (dimensionless) or ``design``.
-
-    With a design, ``params`` is filled with its conversion after validation, so every engine
-    function reads ``params`` (never None once validated); ``conversion`` keeps the scales for
-    answers in physical units.
-    """
-
-    design: Design | None = Field(
-        None,
-        description="The pair in physical units (see docs/units.md). Give this or params.",
-        examples=[EXAMPLE_DESIGN],
-    )
-    params: GearParams | None = Field(
-        None,
-        validate_default=True,
-        description="Dimensionless parameters of Eq. (9). Give this or design.",
-        examples=[PAPER_SECTION_41],
-    )
-    _conversion: DesignConversion | None = PrivateAttr(None)
-
-    @field_validator("params")
-    @classmethod
-    def _given(cls, params: GearParams | None, info: ValidationInfo) -> GearParams | None:
-        # design is validated first: absent from info.data when it failed (its errors suffice)
-        if params is None and "design" in info.data and info.data["design"] is None:
-            raise ValueError("Field required: give params (dimensionless) or design (physical)")
-        return params
-
-    @model_validator(mode="after")
-    def _convert(self) -> ParamsOrDesign:
-        if self.design is None:
-            return self
-        conversion = convert_design(self.design)
-        # a stored request (a sweep job) carries both: params must be the design's conversion
-        if self.params is not None and self.params != conversion.params:
-            raise ValueError("give params or design, not both")
-        object.__setattr__(self, "params", conversion.params)
-        self._conversion = conversion
-        return self
-
-    @classmethod
-    def __get_pydantic_json_schema__(
-        cls, core_schema: CoreSchema, handler: GetJsonSchemaHandler
-    ) -> JsonSchemaValue:
-        """The schema says what validation does: exactly one of params and design."""
-        schema = handler.resolve_ref_schema(handler(core_schema))
-        schema["oneOf"] = [{"required": ["params"]}, {"required": ["design"]}]
-        return schema
-
-    @property
-    def conversion(self) -> DesignConversion | None:
-        """The design's conversion, or None for a dimensionless request."""
-        return self._conversion
-
-    def speed_rpm_range(self) -> tuple[float, float]:
-        """Driver speeds [rpm] scanned for Melnikov windows (design's range or the default)."""
-        assert self.design is not None
-        if self.design.speed_range is not None:
-            lo, hi = self.design.speed_range
-            return lo / RPM, hi / RPM
-        return 10.0, 3.0 * self.design.speed / RPM

@@ -21,8 +21,9 @@ from typing import Any
 from pydantic import ValidationError
 
 from gearengine.model.aliases import ALIASES, with_aliases, with_speed_factor
-from gearengine.model.design import Design, convert_design
+from gearengine.model.design import Design
 from gearengine.model.params import GearParams
+from gearengine.model.reduction import convert_design
 from gearengine.model.units import RPM
 from gearengine.numerics.forcing import packed_forcing
 

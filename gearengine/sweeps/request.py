@@ -21,9 +21,10 @@ import numpy as np
 from pydantic import BaseModel, Field, PlainValidator, ValidationError, WithJsonSchema
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
-from gearengine.model.design import Design, ParamsOrDesign
+from gearengine.model.design import Design
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
+from gearengine.model.reduction import ParamsOrDesign
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.sweeps.axes import (
     axis_problem,
