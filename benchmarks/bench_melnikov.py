@@ -23,6 +23,9 @@ from report import write_section  # benchmarks/report.py (the script's own folde
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = "2216844"
+PREVIOUS = "8ba34c9"
+"""Before the per-point verdicts ran compiled: the baseline of rows the old engine cannot run."""
+DESIGN = ROOT / "examples" / "design-direct.json"
 
 WORKER = r"""
 import json, random, sys, time
@@ -72,6 +75,20 @@ else:
     out["batch"] = best_ms(lambda: melnikov_batch(designs), 1, 5)
     threes = [THREE.model_copy(update={"damping": 0.01 + 0.1 * k / 1000}) for k in range(1000)]
     out["batch_three"] = best_ms(lambda: melnikov_batch(threes), 1, 3) / 1000
+# per-point verdicts: one chaos_possible per sweep point, strength_at along paths
+out["chaos_one"] = best_ms(lambda: chaos_possible(ONE), 200)
+out["chaos_three"] = best_ms(lambda: chaos_possible(THREE), 200)
+try:
+    from gearengine.analysis import MelnikovRequest
+    from gearengine.engineering import engineering
+except ImportError:  # before the design conversion: no engineering block
+    out["engineering"] = None
+else:
+    with open(sys.argv[1]) as f:
+        req = MelnikovRequest.model_validate(json.load(f))
+    mel = melnikov(req.conversion.params)
+    out["engineering"] = best_ms(
+        lambda: engineering(req.conversion, req.speed_rpm_range(), mel), 3, 3)
 print(json.dumps(out))
 """
 
@@ -80,25 +97,42 @@ def measure(pythonpath: Path) -> dict:
     """Run the worker with ``pythonpath`` first on the path; its timings in ms."""
     env = {**os.environ, "PYTHONPATH": str(pythonpath)}
     run = subprocess.run(
-        [sys.executable, "-c", WORKER], env=env, cwd=pythonpath, capture_output=True, text=True
+        [sys.executable, "-c", WORKER, str(DESIGN)],
+        env=env,
+        cwd=pythonpath,
+        capture_output=True,
+        text=True,
     )
     if run.returncode:
         raise RuntimeError(run.stderr)
     return json.loads(run.stdout.strip().splitlines()[-1])
 
 
-def main() -> None:
+def measure_commit(commit: str) -> dict:
+    """The worker's timings on the engine of ``commit`` (``git archive`` into a temporary dir)."""
     with tempfile.TemporaryDirectory(prefix="gearchaos-baseline-") as tmp:
         archive = subprocess.run(
-            ["git", "archive", BASELINE, "gearengine"], cwd=ROOT, capture_output=True, check=True
+            ["git", "archive", commit, "gearengine"], cwd=ROOT, capture_output=True, check=True
         )
         subprocess.run(["tar", "-x", "-C", tmp], input=archive.stdout, check=True)
-        old = measure(Path(tmp))
+        return measure(Path(tmp))
+
+
+def main() -> None:
+    old = measure_commit(BASELINE)
+    previous = measure_commit(PREVIOUS)
     new = measure(ROOT)
     rows = [
         ("verdict + thresholds, one excitation (paper 4.1), ms per verdict", "one"),
         ("verdict + thresholds, three excitations, ms per verdict", "three"),
         ("10,000 one-excitation designs: verdict + 4 margins, ms per call", "batch"),
+        ("verdict alone (`chaos_possible`, once per sweep point), one excitation, ms", "chaos_one"),
+        ("verdict alone (`chaos_possible`), three excitations, ms per call", "chaos_three"),
+        (
+            "`engineering()` of examples/design-direct.json (speed windows: about 250 "
+            "`strength_at`, three excitations, piecewise law), ms per call",
+            "engineering",
+        ),
     ]
     lines = [
         "## Melnikov verdict",
@@ -111,11 +145,20 @@ def main() -> None:
         "The baseline has no batch: its row is its per-design verdict and four parameter "
         "thresholds, timed on 500 designs and scaled to 10,000.",
         "",
-        f"| what | {BASELINE}, ms | now, ms | speed-up |",
-        "| --- | ---: | ---: | ---: |",
+        f"The per-point rows (`chaos_possible`, `strength_at` behind the speed windows of "
+        f"`engineering()`) run `kernels.scan_strength` at the design's own speed; the "
+        f"`engineering()` row is compared with commit {PREVIOUS} (the baseline has no design "
+        "conversion), the last commit before that change, extracted the same way.",
+        "",
+        f"| what | baseline | baseline, ms | {PREVIOUS}, ms | now, ms | speed-up |",
+        "| --- | --- | ---: | ---: | ---: | ---: |",
     ]
     for label, key in rows:
-        lines.append(f"| {label} | {old[key]:.3f} | {new[key]:.3f} | {old[key] / new[key]:.1f}x |")
+        base, ref = (old, BASELINE) if old[key] is not None else (previous, PREVIOUS)
+        lines.append(
+            f"| {label} | {ref} | {base[key]:.3f} | {previous[key]:.3f} | {new[key]:.3f} "
+            f"| {base[key] / new[key]:.1f}x |"
+        )
     lines += [
         "",
         f"Designs with several excitations take the per-design path of `melnikov_batch`: "

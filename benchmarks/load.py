@@ -1,6 +1,10 @@
-"""Bounded load test: a real `gearengine serve` on loopback, N concurrent httpx clients.
+"""Bounded load test: a real `gearengine serve` on loopback, N concurrent keep-alive clients.
 
-    .venv/bin/python benchmarks/load.py [--clients 50] [--seconds 60]     (make load)
+    .venv/bin/python benchmarks/load.py [--clients 50] [--seconds 60] [--mixes mixed,melnikov]
+        [--baseline REV]     (make load)
+
+Each mix runs against a fresh server from the source of commit REV (``git archive``, the
+previous implementation) and then from the working tree, in one run.
 
 Clients mix Melnikov verdicts (half of them repeated designs that hit the cache), short
 analyses and small sweep submissions. The queue cap is set low so the run also shows that a full
@@ -12,8 +16,10 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import json
 import os
 import random
+import resource
 import subprocess
 import sys
 import tempfile
@@ -32,6 +38,9 @@ PARAMS = {
 }
 SHORT = {"transient_periods": 100, "record_periods": 100, "steps_per_period": 100}
 QUEUE_CAP = 8
+ROOT = Path(__file__).resolve().parents[1]
+BASELINE = "8ba34c9"
+"""The previous implementation (before item 3 of issue 13), served for comparison."""
 
 
 def design(rng: random.Random, fresh: bool) -> dict:
@@ -48,23 +57,82 @@ def request_for(op: str, rng: random.Random) -> tuple[str, dict]:
     return "/v1/sweeps", {"params": PARAMS, "settings": SHORT, "axes": [axis]}
 
 
+MIXES = {"mixed": [6, 3, 1], "melnikov": [1, 0, 0]}
+"""Weights of (melnikov, analysis, sweep) per mix: mixed, or Melnikov verdicts only."""
+
+
+class Connection:
+    """One keep-alive HTTP/1.1 connection on asyncio streams, what each client drives.
+
+    httpx costs the driver about as much CPU per request as the server spends answering it, and
+    driver and server share this machine's two cores; this bare client costs a fraction of that,
+    so the numbers say more about the server. Responses must carry Content-Length (the API's do).
+    """
+
+    def __init__(self, host: str, port: int) -> None:
+        self.host, self.port = host, port
+        self.reader: asyncio.StreamReader | None = None
+        self.writer: asyncio.StreamWriter | None = None
+
+    async def post(self, path: str, body: bytes) -> tuple[int, dict[bytes, bytes]]:
+        """(status, lower-cased headers) of a POST; raises OSError or asyncio errors."""
+        if self.writer is None:
+            self.reader, self.writer = await asyncio.open_connection(self.host, self.port)
+        assert self.reader is not None
+        head = (
+            f"POST {path} HTTP/1.1\r\nHost: {self.host}:{self.port}\r\n"
+            f"Content-Type: application/json\r\nContent-Length: {len(body)}\r\n\r\n"
+        )
+        self.writer.write(head.encode() + body)
+        lines = (await self.reader.readuntil(b"\r\n\r\n")).split(b"\r\n")
+        headers = {}
+        for line in lines[1:]:
+            if b":" in line:
+                key, value = line.split(b":", 1)
+                headers[key.strip().lower()] = value.strip()
+        if b"content-length" not in headers:
+            raise ConnectionError("response without Content-Length")
+        await self.reader.readexactly(int(headers[b"content-length"]))
+        if headers.get(b"connection", b"").lower() == b"close":
+            self.close()
+        return int(lines[0].split()[1]), headers
+
+    def close(self) -> None:
+        if self.writer is not None:
+            self.writer.close()
+        self.reader = self.writer = None
+
+
 async def client(
-    http: httpx.AsyncClient, seed: int, deadline: float, log: dict[str, list], codes: dict
+    url: str,
+    seed: int,
+    deadline: float,
+    log: dict[str, list],
+    codes: dict,
+    mix: str = "mixed",
 ) -> None:
     rng = random.Random(seed)
-    while time.monotonic() < deadline:
-        op = rng.choices(["melnikov", "analysis", "sweep"], weights=[6, 3, 1])[0]
-        path, body = request_for(op, rng)
-        start = time.perf_counter()
-        try:
-            r = await http.post(path, json=body)
-            codes[(op, r.status_code)] += 1
-            if r.status_code == 429:
-                assert "retry-after" in r.headers, "429 without Retry-After"
-        except httpx.HTTPError as exc:
-            codes[(op, type(exc).__name__)] += 1
-            continue
-        log[op].append(time.perf_counter() - start)
+    host, port = url.removeprefix("http://").rsplit(":", 1)
+    conn = Connection(host, int(port))
+    try:
+        while time.monotonic() < deadline:
+            op = rng.choices(["melnikov", "analysis", "sweep"], weights=MIXES[mix])[0]
+            path, body = request_for(op, rng)
+            start = time.perf_counter()
+            try:
+                status, headers = await asyncio.wait_for(
+                    conn.post(path, json.dumps(body).encode()), 120.0
+                )
+                codes[(op, status)] += 1
+                if status == 429:
+                    assert b"retry-after" in headers, "429 without Retry-After"
+            except (TimeoutError, OSError, asyncio.IncompleteReadError) as exc:
+                codes[(op, type(exc).__name__)] += 1
+                conn.close()
+                continue
+            log[op].append(time.perf_counter() - start)
+    finally:
+        conn.close()
 
 
 async def drain_and_retry(http: httpx.AsyncClient, timeout: float = 600.0) -> tuple[float, int]:
@@ -87,74 +155,230 @@ def percentile(values: list[float], q: float) -> float:
     return float(np.percentile(values, q)) * 1e3 if values else float("nan")
 
 
-async def run(clients: int, seconds: float, url: str) -> tuple[str, bool]:
+def cpu_seconds(pid: int) -> float:
+    """User + system CPU seconds of a process and its children (Linux /proc; 0 elsewhere)."""
+    found = subprocess.run(["pgrep", "-P", str(pid)], capture_output=True, text=True)
+    total = 0.0
+    for p in [pid, *(int(w) for w in found.stdout.split())]:
+        try:
+            fields = Path(f"/proc/{p}/stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        total += (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    return total
+
+
+def own_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_SELF)
+    return usage.ru_utime + usage.ru_stime
+
+
+async def run(clients: int, seconds: float, url: str, mix: str, pid: int) -> dict:
+    """One load run of ``mix`` against the server at ``url`` (process ``pid``): its numbers."""
     log: dict[str, list] = defaultdict(list)
     codes: dict = defaultdict(int)
     limits = httpx.Limits(max_connections=clients, keepalive_expiry=2.0)
     async with httpx.AsyncClient(base_url=url, timeout=120.0, limits=limits) as http:
         deadline = time.monotonic() + seconds
-        started = time.perf_counter()
-        await asyncio.gather(*(client(http, i, deadline, log, codes) for i in range(clients)))
+        cpu0, own0, started = cpu_seconds(pid), own_cpu(), time.perf_counter()
+        await asyncio.gather(*(client(url, i, deadline, log, codes, mix) for i in range(clients)))
         wall = time.perf_counter() - started
-        drained, retry = await drain_and_retry(http)
-    rows = ["| operation | requests | p50 ms | p99 ms | per second |", "|---|---:|---:|---:|---:|"]
-    for op, lat in sorted(log.items()):
-        rows.append(
-            f"| {op} | {len(lat)} | {percentile(lat, 50):.1f} | {percentile(lat, 99):.1f} "
-            f"| {len(lat) / wall:.1f} |"
-        )
-    total = sum(len(v) for v in log.values())
-    status = ", ".join(f"{op} {code}: {n}" for (op, code), n in sorted(codes.items(), key=str))
+        server_cpu, driver_cpu = (cpu_seconds(pid) - cpu0) / wall, (own_cpu() - own0) / wall
+        drained, retry = await drain_and_retry(http) if MIXES[mix][2] else (0.0, None)
     bad = sum(n for (_, code), n in codes.items() if not isinstance(code, int) or code >= 500)
     full = sum(n for (op, code), n in codes.items() if code == 429)
-    ok = bad == 0 and full > 0 and retry == 202
-    table = "\n".join(rows)
+    return {
+        "mix": mix,
+        "wall": wall,
+        "log": dict(log),
+        "codes": dict(codes),
+        "bad": bad,
+        "full": full,
+        "drained": drained,
+        "retry": retry,
+        "server_cpu": server_cpu,
+        "driver_cpu": driver_cpu,
+        "ok": bad == 0 and (retry is None or (full > 0 and retry == 202)),
+    }
+
+
+def details(label: str, r: dict, clients: int) -> str:
+    """The per-operation table and status codes of one run."""
+    rows = ["| operation | requests | p50 ms | p99 ms | per second |", "|---|---:|---:|---:|---:|"]
+    for op, lat in sorted(r["log"].items()):
+        rows.append(
+            f"| {op} | {len(lat)} | {percentile(lat, 50):.1f} | {percentile(lat, 99):.1f} "
+            f"| {len(lat) / r['wall']:.1f} |"
+        )
+    total = sum(len(v) for v in r["log"].values())
+    status = ", ".join(f"{op} {code}: {n}" for (op, code), n in sorted(r["codes"].items(), key=str))
     text = (
-        f"{table}\n\nAll operations: {total} requests in {wall:.1f} s = {total / wall:.1f} "
-        f"per second, {clients} concurrent clients.\n\n"
-        f"Status codes: {status}.\n\n"
-        f"Errors (5xx or transport): {bad}. Sweep submissions refused with 429 while the queue "
-        f"(cap {QUEUE_CAP}) was full: {full}; after it drained ({drained:.0f} s) a new "
-        f"submission got {retry}."
+        f"### {label}, {r['mix']}\n\n" + "\n".join(rows) + f"\n\nAll operations: {total} requests "
+        f"in {r['wall']:.1f} s = {total / r['wall']:.1f} per second, {clients} concurrent "
+        f"clients. Status codes: {status}. Errors (5xx or transport): {r['bad']}."
     )
-    return text, ok
+    if r["retry"] is not None:
+        text += (
+            f" Sweep submissions refused with 429 while the queue (cap {QUEUE_CAP}) was full: "
+            f"{r['full']}; after it drained ({r['drained']:.0f} s) a new submission got "
+            f"{r['retry']}."
+        )
+    return text
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--clients", type=int, default=50)
-    parser.add_argument("--seconds", type=float, default=60.0)
-    args = parser.parse_args()
-    port = 18000 + os.getpid() % 1000
-    with tempfile.TemporaryDirectory() as tmp:
-        env = {**os.environ, "GEARCHAOS_MAX_QUEUED_JOBS": str(QUEUE_CAP)}
-        cmd = [sys.executable, "-m", "gearengine.cli", "serve", "--port", str(port)]
-        log = open(Path(tmp) / "server.log", "w")  # noqa: SIM115
+def summary_row(label: str, r: dict) -> str:
+    total = sum(len(v) for v in r["log"].values())
+    mel = r["log"].get("melnikov", [])
+    return (
+        f"| {label} | {r['mix']} | {total / r['wall']:.0f} | {len(mel) / r['wall']:.0f} "
+        f"| {percentile(mel, 50):.1f} | {percentile(mel, 99):.1f} | {r['bad']} "
+        f"| {r['server_cpu']:.2f} | {r['driver_cpu']:.2f} |"
+    )
+
+
+OLD_MIXED = 230.5
+"""Requests per second of the mixed run before issue 13 (httpx driver, h11; the target's base)."""
+
+
+def targets(results: list[tuple[str, dict]]) -> str:
+    """The issue's load targets, checked on the working tree's default server."""
+    now = [r for label, r in results if label == "now"]
+    mel = [r for r in now if r["mix"] == "melnikov"]
+    if not mel:
+        return ""
+    r = mel[0]
+    rate, p99 = len(r["log"]["melnikov"]) / r["wall"], percentile(r["log"]["melnikov"], 99)
+    errors = sum(x["bad"] for x in now)
+    met = rate >= 4 * OLD_MIXED and p99 < 250.0 and errors == 0
+    base = [r for label, r in results if not label.startswith("now")]
+    old = [r for r in base if r["mix"] == "melnikov"]
+    same_run = ""
+    if old:
+        old_rate = len(old[0]["log"]["melnikov"]) / old[0]["wall"]
+        same_run = (
+            f" Against the previous implementation in this run, with this driver: "
+            f"{rate / old_rate:.1f}x the Melnikov-only rate. Most of the step from "
+            f"{OLD_MIXED} is the driver: the old httpx driver spent as much CPU per request as "
+            "the server, on the same two cores."
+        )
+    return (
+        f"Targets (issue 13): 0 errors and 0 5xx in every run of the working tree (measured "
+        f"{errors}); Melnikov-only at least 4 x {OLD_MIXED} = {4 * OLD_MIXED:.0f} requests/s, "
+        f"4 x the mixed rate before issue 13 (measured {rate:.0f}); p99 below 250 ms (measured "
+        f"{p99:.0f} ms): {'met' if met else 'NOT met'}.{same_run}"
+    )
+
+
+def serve_and_run(
+    tree: Path, tmp: Path, args: argparse.Namespace, mix: str, extra: list[str]
+) -> dict:
+    """Start ``gearengine serve`` from the source tree ``tree`` on a free loopback port, run
+    one load run of ``mix`` against it, stop it."""
+    port = 18000 + (os.getpid() + 7 * len(list(tmp.iterdir()))) % 1000
+    data = tmp / f"data-{port}-{mix}"
+    env = {
+        **os.environ,
+        "GEARCHAOS_MAX_QUEUED_JOBS": str(QUEUE_CAP),
+        "PYTHONPATH": str(tree),
+    }
+    cmd = [sys.executable, "-m", "gearengine.cli", "serve", "--port", str(port), *extra]
+    with open(tmp / f"server-{port}.log", "w") as log:
         server = subprocess.Popen(
-            [*cmd, "--data-dir", str(Path(tmp) / "data")], env=env, stdout=log, stderr=log
+            [*cmd, "--data-dir", str(data)], env=env, cwd=tree, stdout=log, stderr=log
         )
         url = f"http://127.0.0.1:{port}"
         try:
-            for _ in range(600):
+            for _ in range(1500):  # bounded: a fresh tree compiles its kernels first
+                if server.poll() is not None:
+                    tail = (tmp / f"server-{port}.log").read_text()[-2000:]
+                    raise RuntimeError(f"server from {tree} exited:\n{tail}")
                 try:
                     if httpx.get(url + "/v1/ready", timeout=1.0).status_code == 200:
                         break
                 except httpx.HTTPError:
                     pass
                 time.sleep(0.2)
-            text, ok = asyncio.run(run(args.clients, args.seconds, url))
+            return asyncio.run(run(args.clients, args.seconds, url, mix, server.pid))
         finally:
             server.terminate()
             server.wait(timeout=60)
-            log.close()
-    section = (
-        "## Load\n\nReproduce: `make load` (`.venv/bin/python benchmarks/load.py --clients "
-        f"{args.clients} --seconds {args.seconds:g}`) against a real `gearengine serve` on "
-        f"loopback with its default workers.\n\n{text}\n"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--clients", type=int, default=50)
+    parser.add_argument("--seconds", type=float, default=60.0)
+    parser.add_argument(
+        "--mixes", default="mixed,melnikov", help="comma-separated: " + ", ".join(MIXES)
+    )
+    parser.add_argument(
+        "--baseline",
+        default=BASELINE,
+        help="git revision to run first, for comparison ('' for none)",
+    )
+    parser.add_argument(
+        "--processes",
+        default="default,1",
+        help="HTTP processes of the working tree's server, one run each ('default': no flag)",
+    )
+    args = parser.parse_args()
+    mixes = args.mixes.split(",")
+    results: list[tuple[str, dict]] = []
+    with tempfile.TemporaryDirectory(prefix="gearchaos-load-") as name:
+        tmp = Path(name)
+        trees = [
+            ("now", ROOT, [])
+            if n == "default"
+            else (f"now, --http-processes {n}", ROOT, ["--http-processes", n])
+            for n in args.processes.split(",")
+        ]
+        if args.baseline:
+            old = tmp / "baseline"
+            old.mkdir()
+            archive = subprocess.run(
+                ["git", "archive", args.baseline, "gearengine", "service"],
+                cwd=ROOT,
+                capture_output=True,
+                check=True,
+            )
+            subprocess.run(["tar", "-x", "-C", str(old)], input=archive.stdout, check=True)
+            for name in ("httptools", "uvloop"):  # its dependencies: uvicorn falls back to h11
+                (old / f"{name}.py").write_text(f"raise ImportError('{name}: not a dependency')\n")
+            trees.insert(0, (args.baseline, old, []))
+        for label, tree, extra in trees:
+            for mix in mixes:
+                results.append((label, serve_and_run(tree, tmp, args, mix, extra)))
+                print(summary_row(*results[-1]), flush=True)
+    head = (
+        "| server | mix | requests/s | Melnikov/s | Melnikov p50 ms | Melnikov p99 ms | errors "
+        "| server CPU, cores | driver CPU, cores |\n"
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|"
+    )
+    section = "\n\n".join(
+        [
+            "## Load",
+            "Reproduce: `make load` (`.venv/bin/python benchmarks/load.py --clients "
+            f"{args.clients} --seconds {args.seconds:g}`): a real `gearengine serve` with its "
+            "defaults on loopback, started afresh for each run, first from the source of "
+            f"commit {args.baseline or '(none)'} (`git archive`, the previous implementation, "
+            "with its dependencies: uvicorn on the pure-Python h11 parser and the asyncio loop, "
+            "as httptools and uvloop are hidden from it), then from the working tree (httptools, "
+            "uvloop; by default one HTTP process per core, also run with `--http-processes 1`), "
+            "in one run. Mixes: `mixed` (Melnikov verdicts, half of "
+            "them repeated designs that hit the cache; short analyses; small sweep "
+            "submissions, 6 : 3 : 1) and `melnikov` (verdicts only, the same designs). CPU is "
+            "measured from /proc over the run: the server with its child processes, and the "
+            "load driver (one process, bare asyncio HTTP/1.1 keep-alive connections, one per "
+            "client: `Connection`; httpx cost as much CPU per request as the server) on the "
+            "same 2-core machine, which other work may share: the load average is printed.",
+            head + "\n" + "\n".join(summary_row(label, r) for label, r in results),
+            targets(results) + f" Load average after the runs: {os.getloadavg()[0]:.1f}.",
+            *(details(label, r, args.clients) for label, r in results),
+        ]
     )
     print(section)
     write_section("load", section)
-    sys.exit(0 if ok else 1)
+    sys.exit(0 if all(r["ok"] for _, r in results) else 1)
 
 
 if __name__ == "__main__":

@@ -32,13 +32,14 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
     from service.api.deps import load_key_hashes
     from service.main import create_app
-    from service.server import EXIT_STARTUP_FAILURE, AnnouncingServer
+    from service.server import EXIT_STARTUP_FAILURE, AnnouncingServer, serve_processes
 
     flags = {
         "host": args.host,
         "port": args.port,
         "data_dir": args.data_dir,
         "workers": args.workers,
+        "http_processes": args.http_processes,
         "dask_scheduler": args.dask,
         "insecure": args.insecure or None,
     }
@@ -73,6 +74,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
         access_log=False,  # the app logs each request once, as a JSON line (AccessLog)
         timeout_keep_alive=settings.keep_alive_seconds,
     )
+    if settings.http_processes > 1:  # several HTTP processes, one dispatcher
+        return EXIT_OK if serve_processes(config, settings) else EXIT_STARTUP_FAILURE
     server = AnnouncingServer(config, settings)  # prints the one "ready on ..." line
     server.run()
     return EXIT_OK if server.started else EXIT_STARTUP_FAILURE
@@ -93,6 +96,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--port", type=int, default=None, help="TCP port (default 8000)")
     p.add_argument("--data-dir", default=None, help="directory holding all state (default ./data)")
     p.add_argument("--workers", type=int, default=None, help="sweep worker processes")
+    p.add_argument(
+        "--http-processes",
+        type=int,
+        default=None,
+        help="HTTP server processes on the one port (default: cores)",
+    )
     p.add_argument("--dask", default=None, metavar="ADDRESS", help="Dask scheduler for sweeps")
     p.add_argument(
         "--insecure", action="store_true", help="allow a non-loopback bind without API keys"

@@ -2,7 +2,19 @@
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
+import ctypes
+import json
+import logging
+import os
+import signal
 import socket
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import uvicorn
@@ -22,17 +34,191 @@ def ready_line(settings: Settings, port: int) -> str:
     return f"ready on http://{host}:{port}, docs at /docs, data in {data}, Ctrl-C stops"
 
 
+PR_SET_PDEATHSIG = 1
+"""prctl option: the signal a process gets when its parent dies (Linux)."""
+PEER_START_SECONDS = 300.0
+"""How long the first process waits for the others to accept before it says ready anyway."""
+PEER_ENV = "GEARCHAOS_PEER"
+"""Environment variable handing a peer (``python -m service.peer``) its socket and settings."""
+
+
+@dataclass
+class Peers:
+    """The other HTTP processes of ``gearengine serve --http-processes N`` (N > 1), each a
+    ``python -m service.peer`` subprocess sharing the listening socket. Each writes one byte to
+    the ``up`` pipe once it accepts connections; when all have (``wait``), this process writes
+    one byte to each peer's ``go`` pipe and ``all_up`` is set: ``GET /v1/ready`` of every
+    process answers 200 only then, so a client that waited for ready finds all accepting."""
+
+    processes: list[subprocess.Popen]
+    up: int
+    go: list[int]
+    all_up: threading.Event = field(default_factory=threading.Event)
+
+    @classmethod
+    def start(cls, n: int, sock: socket.socket, settings: Settings) -> Peers:
+        up_r, up_w = os.pipe()
+        os.set_blocking(up_r, False)
+        processes, go = [], []
+        for _ in range(n):
+            go_r, go_w = os.pipe()
+            spec = {
+                "socket": sock.fileno(),
+                "up": up_w,
+                "go": go_r,
+                "parent": os.getpid(),
+                "settings": settings.model_dump(mode="json"),
+            }
+            processes.append(
+                subprocess.Popen(
+                    [sys.executable, "-m", "service.peer"],
+                    env={**os.environ, PEER_ENV: json.dumps(spec)},
+                    pass_fds=(sock.fileno(), up_w, go_r),
+                )
+            )
+            os.close(go_r)
+            go.append(go_w)
+        os.close(up_w)
+        return cls(processes, up_r, go)
+
+    async def wait(self, server: uvicorn.Server) -> None:
+        """Until every peer accepts (or one died, or the server stops, or PEER_START_SECONDS);
+        then tell them all (``go``) and set ``all_up``."""
+        deadline = time.monotonic() + PEER_START_SECONDS
+        count = 0
+        while count < len(self.processes) and time.monotonic() < deadline:
+            if server.should_exit or any(p.poll() is not None for p in self.processes):
+                break
+            with contextlib.suppress(OSError):  # BlockingIOError: nothing yet
+                count += len(os.read(self.up, 64))
+            await asyncio.sleep(0.05)
+        if count < len(self.processes) and not server.should_exit:
+            logging.getLogger("gearchaos").warning(
+                "only %d of %d extra HTTP processes started", count, len(self.processes)
+            )
+        for fd in self.go:
+            with contextlib.suppress(OSError):
+                os.write(fd, b"1")
+        self.all_up.set()
+
+    def terminate(self) -> None:
+        """SIGTERM every peer still running: uvicorn's graceful shutdown."""
+        for p in self.processes:
+            if p.poll() is None:
+                p.terminate()
+
+    def stop(self, grace: float = 10.0) -> None:
+        """``terminate``, then SIGKILL what is left after ``grace`` seconds."""
+        self.terminate()
+        deadline = time.monotonic() + grace
+        for p in self.processes:
+            try:
+                p.wait(timeout=max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait()
+        for fd in [self.up, *self.go]:  # once: a second stop must not close reused numbers
+            if fd >= 0:
+                with contextlib.suppress(OSError):
+                    os.close(fd)
+        self.up, self.go = -1, []
+
+
 class AnnouncingServer(uvicorn.Server):
     """Prints ``ready_line`` to standard output once the socket listens. That is after the
     lifespan's start-up (kernels warmed, job store open): uvicorn binds the socket only then,
-    so the lifespan itself would say it too early."""
+    so the lifespan itself would say it too early. With ``peers``, after they accept too."""
 
-    def __init__(self, config: uvicorn.Config, settings: Settings) -> None:
+    def __init__(
+        self, config: uvicorn.Config, settings: Settings, peers: Peers | None = None
+    ) -> None:
         super().__init__(config)
         self.settings = settings
+        self.peers = peers
 
     async def startup(self, sockets: list[socket.socket] | None = None) -> None:
         await super().startup(sockets)
         if self.started:
+            if self.peers is not None:
+                await self.peers.wait(self)
             port = self.servers[0].sockets[0].getsockname()[1]
             print(ready_line(self.settings, port), flush=True)
+
+    async def shutdown(self, sockets: list[socket.socket] | None = None) -> None:
+        """Peers shut down alongside this process, and are gone before it exits (uvicorn
+        re-raises the stopping signal after its shutdown)."""
+        if self.peers is not None:
+            self.peers.terminate()
+        await super().shutdown(sockets)
+        if self.peers is not None:
+            await asyncio.to_thread(self.peers.stop)
+
+
+class _PeerServer(uvicorn.Server):
+    """A peer's uvicorn server: writes to its ``up`` pipe once it accepts connections."""
+
+    def __init__(self, config: uvicorn.Config, up: int) -> None:
+        super().__init__(config)
+        self.up = up
+
+    async def startup(self, sockets: list[socket.socket] | None = None) -> None:
+        await super().startup(sockets)
+        if self.started:
+            os.write(self.up, b"1")
+
+
+def serve_peer() -> None:
+    """One more HTTP process (``python -m service.peer``, started by ``serve_processes``): the
+    same app on the listening socket of ``gearengine serve``, without a sweep dispatcher
+    (``workers=0``: store only; the first process's dispatcher picks submitted jobs up within
+    its idle poll). It stops with uvicorn's signals, and at once when its parent dies (no
+    orphan keeps the port)."""
+    from service.main import create_app
+
+    spec = json.loads(os.environ[PEER_ENV])
+    parent = spec["parent"]
+    with contextlib.suppress(OSError, AttributeError):  # Linux: killed when the parent dies
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+
+    def watch_parent() -> None:  # elsewhere, and if the parent died before prctl
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    all_up = threading.Event()
+
+    def wait_go() -> None:
+        with contextlib.suppress(OSError):
+            os.read(spec["go"], 1)
+        all_up.set()
+
+    threading.Thread(target=watch_parent, name="parent-watch", daemon=True).start()
+    threading.Thread(target=wait_go, name="all-up", daemon=True).start()
+    logging.basicConfig(level=logging.INFO, format="%(message)s")  # JSON access/job lines
+    settings = Settings.model_validate(spec["settings"])
+    app = create_app(settings.model_copy(update={"workers": 0, "dask_scheduler": None}))
+    app.state.ready_checks["http_processes"] = all_up.is_set
+    config = uvicorn.Config(
+        app, log_level="warning", access_log=False, timeout_keep_alive=settings.keep_alive_seconds
+    )
+    sock = socket.socket(fileno=spec["socket"])
+    _PeerServer(config, spec["up"]).run(sockets=[sock])
+
+
+def serve_processes(config: uvicorn.Config, settings: Settings) -> bool:
+    """``http_processes`` HTTP processes on one socket: this one (the sweep dispatcher, the
+    ready line) and ``http_processes - 1`` peers (``serve_peer``); the kernel hands each new
+    connection to whichever process accepts it first. True if this one started."""
+    try:
+        sock = config.bind_socket()
+    except SystemExit:  # uvicorn could not bind (the port is taken) and logged why
+        return False
+    peers = Peers.start(settings.http_processes - 1, sock, settings)
+    config.app.state.ready_checks["http_processes"] = peers.all_up.is_set
+    server = AnnouncingServer(config, settings, peers)
+    try:
+        server.run(sockets=[sock])
+    finally:
+        peers.stop()
+        sock.close()
+    return server.started

@@ -8,6 +8,7 @@ for every term and harmonic. Omega_e enters M non-linearly and is scanned.
 
 from __future__ import annotations
 
+import functools
 import math
 from fractions import Fraction
 
@@ -33,7 +34,7 @@ from gearengine.homoclinic.schemas import (
 from gearengine.model.aliases import get_alias, with_alias, with_aliases
 from gearengine.model.backlash import melnikov_cubic
 from gearengine.model.frequencies import MAX_DENOMINATOR, RATIO_TOLERANCE
-from gearengine.model.params import GearParams
+from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash
 
 CONTROL_PARAMETERS = ("F_e1", "mu", "k_p1", "F_p1")
 """Control parameters with thresholds; the amplitudes are first harmonics."""
@@ -57,7 +58,14 @@ def sign_change_strength(
 
     Continuous in the parameters (for a fixed set of commensurate frequencies), so its roots
     are the critical values of any parameter. ``method`` names the coefficients (``METHODS``).
+    The closed form runs compiled (``kernels.scan_strength`` at the design's own speed, on the
+    arrays of ``scan_terms``); quadrature, and the rare design on which a coefficient underflows
+    to 0, take the same algorithm on the pydantic documents.
     """
+    if method == "closed_form":
+        strength = _compiled_strength(params, a, c)
+        if not math.isnan(strength):
+            return strength
     strengths = []
     for br in BRANCH_SIGN:
         ext = extrema(melnikov_coefficients(params, a, c, br, method).trig_sum())
@@ -65,11 +73,34 @@ def sign_change_strength(
     return max(strengths)
 
 
+def _compiled_strength(params: GearParams, a: float, c: float) -> float:
+    """``sign_change_strength`` (closed form) by ``kernels.scan_strength`` with Omega_e at its
+    own value (factor 1, so the frequencies are exactly r Omega); NaN to fall back."""
+    base, r, kind, amp, phase = scan_terms(params)
+    gcd, lcm = _commensurability(tuple((r * base).tolist()))
+    mu = float(params.damping)
+    return float(kernels.scan_strength(1.0, 1.0, base, r, kind, amp, phase, mu, a, c, gcd, lcm))
+
+
+@functools.lru_cache(maxsize=4096)
+def _commensurability(frequencies: tuple[float, ...]) -> tuple[float, float]:
+    """``commensurability``, remembered (sweeps and scans ask for the same ratios again)."""
+    return commensurability(list(frequencies))
+
+
+@functools.lru_cache(maxsize=1024)
+def _cubic(backlash: CubicBacklash | PiecewiseBacklash) -> tuple[float, float]:
+    """(a, c) of ``melnikov_cubic``, remembered per backlash model (frozen, hashable): the
+    piecewise law's collocation fit costs more than a compiled verdict."""
+    a, c, _ = melnikov_cubic(backlash)
+    return a, c
+
+
 def strength_at(params: GearParams, values: dict[str, float] | None = None) -> float:
     """``sign_change_strength`` of ``params`` with aliases set to ``values``; NaN without a
     saddle loop (the criterion does not apply there)."""
     design = with_aliases(params, values) if values else params
-    a, c, _ = melnikov_cubic(design.backlash)
+    a, c = _cubic(design.backlash)
     return sign_change_strength(design, a, c) if saddle_loop(a, c) else math.nan
 
 

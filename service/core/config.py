@@ -25,6 +25,14 @@ class Settings(BaseSettings):
     workers: int = Field(
         max(1, os.cpu_count() or 1), ge=0, le=256, description="Sweep worker processes."
     )
+    http_processes: int = Field(
+        max(1, os.cpu_count() or 1),
+        ge=1,
+        le=64,
+        description="HTTP server processes sharing the listening socket (``gearengine serve "
+        "--http-processes``), one per core by default; only the first runs the sweep "
+        "dispatcher. Each has its own response cache and metrics.",
+    )
     api_keys: str = Field(
         "", description="Comma-separated API keys; empty = no auth (loopback only)."
     )
