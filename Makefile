@@ -46,6 +46,7 @@ bench: $(VENV)/.installed-test
 	$(BIN)/python benchmarks/bench_sweep.py
 	$(BIN)/python benchmarks/bench_melnikov.py
 	$(BIN)/python benchmarks/bench_floquet.py
+	$(BIN)/python benchmarks/bench_map.py
 
 load: $(VENV)/.installed-test
 	$(BIN)/python benchmarks/load.py --clients 50 --seconds 60

@@ -123,7 +123,8 @@ def _call(url: str, key: str | None, body: bytes | None = None) -> dict:
 def rules_of(args: argparse.Namespace) -> Rules:
     """--fail-on classes (default chaotic; limits add to them, never replace them)."""
     return Rules(fail_on=args.fail_on or ["chaotic"], max_lle=args.max_lle,
-                 max_dte_um=args.max_dte)  # fmt: skip
+                 max_dte_um=args.max_dte,
+                 max_dynamic_factor=getattr(args, "max_dynamic_factor", None))  # fmt: skip
 
 
 def rules_text(rules: Rules) -> str:
@@ -133,6 +134,8 @@ def rules_text(rules: Rules) -> str:
         parts.append(f"--max-lle {rules.max_lle:g}")
     if rules.max_dte_um is not None:
         parts.append(f"--max-dte {rules.max_dte_um:g} µm")
+    if rules.max_dynamic_factor is not None:
+        parts.append(f"--max-dynamic-factor {rules.max_dynamic_factor:g}")
     return ", ".join(parts)
 
 

@@ -78,7 +78,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="--fail-on X fails on X or anything worse "
         "(periodic < quasi_periodic < chaotic < diverged); melnikov fails when a transverse "
         "homoclinic tangle is possible; impacts on back-flank contact. Default: --fail-on "
-        "chaotic; the limits (--max-lle, --max-dte, --min-stability-margin) add to it. With "
+        "chaotic; the limits (--max-lle, --max-dte, --max-dynamic-factor, --min-stability-margin) "
+        "add to it. With "
         "--speed and/or --torque the whole operating envelope of a design is checked.",
     )
     p.add_argument("file", help='JSON file holding {"params": {...}, "settings": {...}}, or -')
@@ -95,6 +96,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-dte", type=micrometres, default=None, metavar="E",
                    help="fail where the dynamic transmission error (peak to peak) exceeds E "
                    "(µm, or with a unit: 20um, 0.02mm)")  # fmt: skip
+    p.add_argument("--max-dynamic-factor", type=float, default=None, metavar="F",
+                   help="fail where the largest dynamic mesh force exceeds F times the static "
+                   "force (envelope checks)")  # fmt: skip
     p.add_argument("--json", metavar="FILE", help="write the envelope report (JSON)")
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
     p.add_argument("--server", metavar="URL", help="run the envelope on a running service "

@@ -48,7 +48,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     stem = "sweep" if args.file == "-" else Path(args.file).stem
     result = run_local(request, progress_bar(time.monotonic()))
     (out / f"{stem}.json").write_text(dumps(result))
-    (out / f"{stem}.csv").write_text("".join(to_csv(result)))
+    (out / f"{stem}.csv").write_text("".join(to_csv(result, request.outputs)))
     (out / f"{stem}.png").write_bytes(
         sweep_figure(request, result.points, "png", result.bifurcations)
     )

@@ -7,6 +7,7 @@ by one in the single kernels (``numerics.runs``). Numbers equal those of ``simul
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from gearengine.model.params import GearParams
@@ -35,6 +36,9 @@ def batch_point(runs: list[tuple[Run, StartVerdict]]) -> BatchPoint:
         poincare=np.column_stack([run.xs[:n_ok], run.vs[:n_ok]])[-BATCH_POINCARE:].tolist(),
         start_index=idx,
         x_peak_to_peak=None if run.diverged else finite_or_none(run.xmax - run.xmin),
+        periods_run=run.done,
+        force_max=None if run.diverged else finite_or_none(run.fmax),
+        force_min=None if run.diverged else finite_or_none(run.fmin),
     )
 
 
@@ -78,16 +82,20 @@ def simulate_batch(
         mu = np.array([points[i].damping for i, _ in lanes])
         x0 = np.array([s[0] for _, s in lanes])
         v0 = np.array([s[1] for _, s in lanes])
-        xs, vs, logs, xmin, xmax, done, xf, vf = kernels.run_batch(
-            a, c, mu, x0, v0, Kt, Ft, per, N, n_trans, n_rec, DIVERGENCE_BOUND
-        )
+        streams = max(1, min(numba.get_num_threads(), -(-len(lanes) // kernels.LANES)))
+        out = kernels.run_batch(
+            a, c, mu, x0, v0, Kt, Ft, per, N, n_trans, n_rec, DIVERGENCE_BOUND,
+            settings.adaptive, streams,
+        )  # fmt: skip
+        xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf = out
         per_point: dict[int, list[tuple[Run, StartVerdict]]] = {i: [] for i in members}
         empty = np.zeros(0)
         for lane, (i, s) in enumerate(lanes):
+            k = int(rec[lane]) if not diverged[lane] else n_rec
             run = Run(
-                xs[lane], vs[lane], logs[lane], empty, empty, float(xmin[lane]),
+                xs[lane, :k], vs[lane, :k], logs[lane, :k], empty, empty, float(xmin[lane]),
                 float(xmax[lane]), int(done[lane]), (float(xf[lane]), float(vf[lane])),
-                bool(done[lane] < n_trans + n_rec), max(0, int(done[lane]) - n_trans),
+                bool(diverged[lane]), int(rec[lane]), float(fmin[lane]), float(fmax[lane]),
             )  # fmt: skip
             per_point[i].append((run, start_verdict(run, s, plans[i].period, True)))
         for i, runs in per_point.items():

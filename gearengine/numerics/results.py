@@ -126,3 +126,16 @@ class BatchPoint(_Result):
     x_peak_to_peak: float | None = Field(
         None, description="max x - min x over the record (units of b), null if diverged."
     )
+    periods_run: int | None = Field(
+        None,
+        description="Intervals T0 the reported start actually ran: transient_periods + "
+        "record_periods, fewer when it stopped early (adaptive) or diverged.",
+    )
+    force_max: float | None = Field(
+        None,
+        description="Largest dimensionless mesh force K(t) f_h(x) + 2 mu x' over the record's "
+        "step ends; null if diverged.",
+    )
+    force_min: float | None = Field(
+        None, description="Smallest dimensionless mesh force over the record; null if diverged."
+    )

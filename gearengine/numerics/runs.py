@@ -29,7 +29,9 @@ MAX_HISTORY_SAMPLES = 2**15
 
 @dataclass(frozen=True)
 class Run:
-    """Raw kernel output for one start (shapes as in ``kernels.run_rk4``)."""
+    """Raw kernel output for one start (shapes as in ``kernels.run_rk4``); ``done`` intervals
+    were run, the record is ``xs[:recorded]`` (shorter than n_rec when the run stopped early,
+    ``kernels.adaptive``); fmin, fmax: extremes of the mesh force over the record's steps."""
 
     xs: np.ndarray
     vs: np.ndarray
@@ -42,6 +44,8 @@ class Run:
     final: tuple[float, float]
     diverged: bool
     recorded: int
+    fmin: float = math.nan
+    fmax: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -106,10 +110,10 @@ def integrate(params: GearParams, settings: SimulationSettings, start: tuple[flo
     kernel = INTEGRATORS[lw.name][0]
     out = kernel(lw, params.damping, start, packed_forcing(params), plan, n_trans, n_rec,
                  history_stride(settings, plan.steps))  # fmt: skip
-    xs, vs, logs, hx, hv, xmin, xmax, done, xf, vf = out
+    xs, vs, logs, hx, hv, xmin, xmax, done, xf, vf, fmin, fmax = out
     return Run(
         xs, vs, logs, hx, hv, xmin, xmax, done, (xf, vf), done < n_trans + n_rec,
-        max(0, done - n_trans),
+        max(0, done - n_trans), fmin, fmax,
     )  # fmt: skip
 
 

@@ -95,6 +95,15 @@ class SimulationSettings(BaseModel):
     random_initial_states: RandomStarts | None = Field(
         None, description="Initial states drawn at random from a box."
     )
+    adaptive: bool = Field(
+        True,
+        description="Sweeps and batches: let a point stop early once its strobes repeat with a "
+        "period <= 12 over the last 120 intervals and its LLE has converged below zero "
+        "(numerics.kernels.adaptive); false runs every point transient_periods + "
+        "record_periods. Applies to cubic-law points with commensurate forcing (the lock-step "
+        "kernel); piecewise-law and incommensurate points, and simulate(), run the full length.",
+        examples=[True],
+    )
     lyapunov_nolds: bool = Field(
         False,
         description="Also estimate the LLE from x(t) with nolds.lyap_r (slow).",

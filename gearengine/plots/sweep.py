@@ -109,8 +109,8 @@ def bifurcation(
     branches = sorted({p.branch for p in points}, key=lambda b: b or "")
     for branch in branches:
         mine = [p for p in points if p.branch == branch]
-        xs = [p.values[name] * factor for p in mine for _ in p.poincare_x]
-        ys = [x for p in mine for x in p.poincare_x]
+        xs = [p.values[name] * factor for p in mine for _ in p.poincare_x or []]
+        ys = [x for p in mine for x in p.poincare_x or []]
         suffix = f", branch {branch}" if branch else ""
         top.scatter(xs, ys, s=0.6, c=colours[branch], marker=".", linewidths=0,
                     label="Poincaré points" + suffix)  # fmt: skip

@@ -26,6 +26,9 @@ from gearengine.sweeps.request import SweepBranch, SweepRequest
 from gearengine.sweeps.results import PhysicalValue, SweepBifurcation, SweepPoint, SweepResult
 from gearengine.sweeps.windows import speed_windows
 
+LOCAL_CHUNK_POINTS = 1024
+"""Default chunk of ``run_local`` without continuation (see there)."""
+
 
 def _physical(
     request: SweepRequest, values: dict[str, float], params: GearParams, bp: BatchPoint
@@ -41,6 +44,10 @@ def _physical(
     b = values.get("mesh.half_backlash", request.design.mesh.half_backlash)
     if bp.x_peak_to_peak is not None:
         shown["dte"] = PhysicalValue(value=rounded(bp.x_peak_to_peak * b * 1e6), unit="um")
+    if bp.force_max is not None and params.mean_force > 0:  # F / F_m: scales b k_m cancel
+        shown["dynamic_factor"] = PhysicalValue(
+            value=rounded(bp.force_max / params.mean_force), unit="1"
+        )
     aliases = {a: get_alias(params, a) for a in ALIASES}
     return {"physical": shown, "dimensionless": {k: v for k, v in aliases.items() if v is not None}}
 
@@ -63,6 +70,9 @@ def _point(
         melnikov_chaos_possible=chaos_possible(params),
         poincare_x=[s[0] for s in bp.poincare],
         x_peak_to_peak=bp.x_peak_to_peak,
+        periods_run=bp.periods_run,
+        force_max=bp.force_max,
+        force_min=bp.force_min,
         **_physical(request, values, params, bp),
     )
 
@@ -99,8 +109,6 @@ def _compute(
     ]
     if not request.continuation or len(axes) != 1 or len(values) < 2:
         return points, None
-    if axes[0].parameter not in ALIASES:  # located by shooting in an alias of Eq. (9) only
-        return points, []
     line = [v[axes[0].parameter] for v in values]
     return points, _line_bifurcations(request, line, designs, verdicts)
 
@@ -127,8 +135,24 @@ def _line_bifurcations(
     steps = request.settings.steps_per_period
     if any(step_plan(d, steps).omega0 is None for d in designs):
         return []
-    events = locate_bifurcations(request.params, alias, line, request.settings, responses=responses)
-    return [SweepBifurcation.model_validate(e) for e in events]
+
+    def path(v: float) -> GearParams:
+        return request.point({alias: v})
+
+    assert request.params is not None
+    events = locate_bifurcations(
+        request.params, alias, line, request.settings, responses=responses, path=path
+    )
+    if is_dimensionless(alias):
+        return [SweepBifurcation.model_validate(e) for e in events]
+    unit, factor = display_unit(alias)
+    return [
+        SweepBifurcation.model_validate(
+            {**e, "physical": None if e["value"] is None else
+             PhysicalValue(value=rounded(e["value"] * factor), unit=unit)}
+        )
+        for e in events
+    ]  # fmt: skip
 
 
 def _carried(settings: SimulationSettings, bp: BatchPoint) -> SimulationSettings:
@@ -148,20 +172,26 @@ def compute_chunk_json(request_json: str, chunk_index: int, chunk_points: int) -
     """``compute_chunk`` on JSON text, returning the chunk's output (what workers exchange):
     a JSON array of points, or for a continuation line also its bifurcations (``chunk_json``)."""
     request = SweepRequest.model_validate_json(request_json)
-    return chunk_json(*_compute(request, chunk_index, chunk_points))
+    return chunk_json(*_compute(request, chunk_index, chunk_points), request.outputs)
 
 
 def run_local(
     request: SweepRequest,
     progress_callback: Callable[[int, int], None] | None = None,
-    chunk_points: int = DEFAULT_CHUNK_POINTS,
+    chunk_points: int | None = None,
     workers: int = 1,
 ) -> SweepResult:
     """Compute every chunk in this process; ``progress_callback(done, total)`` in points.
 
     ``workers`` > 1 computes chunks on that many threads: the kernels release the GIL
     (``nogil``), so the integration runs on every core. The result does not depend on it.
+
+    ``chunk_points`` defaults to ``LOCAL_CHUNK_POINTS`` without continuation: the batch
+    kernel refills a lane as soon as its point stops early (adaptive stopping), which pays
+    only when a lane has several points to run; points do not depend on their chunk.
     """
+    if chunk_points is None:
+        chunk_points = DEFAULT_CHUNK_POINTS if request.continuation else LOCAL_CHUNK_POINTS
     plan = SweepPlan(request, chunk_points)
     total, done = request.n_points(), 0
     text = request.model_dump_json()

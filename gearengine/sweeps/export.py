@@ -7,7 +7,7 @@ from __future__ import annotations
 import csv
 import io
 import json
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Sequence
 
 from pydantic import BaseModel, Field
 
@@ -18,10 +18,16 @@ _LINE_HEAD = '{"bifurcations":'
 _LINE_POINTS = ',"points":['
 
 
-def chunk_json(points: Iterable[SweepPoint], bifurcations: list[SweepBifurcation] | None) -> str:
+def chunk_json(
+    points: Iterable[SweepPoint],
+    bifurcations: list[SweepBifurcation] | None,
+    outputs: Sequence[str] | None = None,
+) -> str:
     """A chunk's output (what workers exchange): the JSON array of its points, or, for a line
-    of a one-axis continuation sweep, ``{"bifurcations": [...], "points": [...]}``."""
-    array = ",".join(p.model_dump_json() for p in points)
+    of a one-axis continuation sweep, ``{"bifurcations": [...], "points": [...]}``. With
+    ``outputs`` (``SweepRequest.outputs``) a point holds values, branch and those fields only."""
+    keep = None if outputs is None else {"values", "branch", *outputs}
+    array = ",".join(p.model_dump_json(include=keep) for p in points)
     if bifurcations is None:
         return "[" + array + "]"
     located = ",".join(b.model_dump_json() for b in bifurcations)
@@ -91,20 +97,28 @@ CSV_FIELDS = (
 )
 
 
-def to_csv(result: SweepResult) -> Iterator[str]:
+def to_csv(result: SweepResult, outputs: Sequence[str] | None = None) -> Iterator[str]:
     """CSV rows of a result (see ``csv_rows``)."""
-    return csv_rows(result.axes, result.points)
+    return csv_rows(result.axes, result.points, outputs)
 
 
-def csv_rows(axes: list[SweepAxis], points: Iterable[SweepPoint]) -> Iterator[str]:
+def csv_rows(
+    axes: list[SweepAxis], points: Iterable[SweepPoint], outputs: Sequence[str] | None = None
+) -> Iterator[str]:
     """CSV rows (header first): one column per axis, the verdicts, and poincare_x as
-    space-separated numbers. Empty cells are nulls; booleans are true/false."""
+    space-separated numbers. Empty cells are nulls; booleans are true/false. With ``outputs``
+    (``SweepRequest.outputs``) only the columns it names (and branch) are written. Rows are
+    yielded one by one, so a streamed response never holds the whole table."""
     names = [a.parameter for a in axes]
-    yield _csv_row([*names, *CSV_FIELDS])
+    fields = [f for f in CSV_FIELDS if outputs is None or f == "branch" or f in outputs]
+    yield _csv_row([*names, *fields])
     for p in points:
-        cells = [_grid_value(p.values[n]) for n in names]
-        cells += [getattr(p, f) for f in CSV_FIELDS[:-1]]
-        cells.append(" ".join(repr(x) for x in p.poincare_x))
+        cells: list[object] = [_grid_value(p.values[n]) for n in names]
+        for f in fields:
+            value = getattr(p, f)
+            if f == "poincare_x":
+                value = " ".join(repr(x) for x in value or [])
+            cells.append(value)
         yield _csv_row(cells)
 
 

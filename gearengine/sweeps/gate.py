@@ -6,7 +6,8 @@ Rules (``Rules``): ``fail_on`` classes (``chaotic`` fails chaotic and diverged p
 periodic < quasi_periodic < chaotic < diverged as in ``numerics.classify.SEVERITY``),
 ``melnikov`` (the criterion allows chaos), ``impacts`` (back-flank contact); and numeric limits,
 which add to the classes instead of replacing them: ``max_lle`` (per unit tau), ``max_dte_um``
-(dynamic transmission error peak to peak, µm).
+(dynamic transmission error peak to peak, µm), ``max_dynamic_factor`` (largest mesh force over
+the static force F~_m).
 """
 
 from __future__ import annotations
@@ -35,6 +36,9 @@ class Rules(BaseModel):
     )
     max_lle: float | None = Field(None, description="Largest LLE allowed, per unit tau.")
     max_dte_um: float | None = Field(None, description="Largest DTE peak to peak [µm].")
+    max_dynamic_factor: float | None = Field(
+        None, description="Largest dynamic factor allowed: max mesh force / static force."
+    )
 
 
 def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
@@ -53,7 +57,16 @@ def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
     dte = (p.physical or {}).get("dte")
     if rules.max_dte_um is not None and (dte is None or dte.value > rules.max_dte_um):
         out.append(f"DTE > {rules.max_dte_um:g} µm")
+    factor = (p.physical or {}).get("dynamic_factor")
+    if rules.max_dynamic_factor is not None and (
+        factor is None or factor.value > rules.max_dynamic_factor
+    ):
+        out.append(f"dynamic factor > {rules.max_dynamic_factor:g}")
     return out
+
+
+RESPONSE_KEYS = ("dte", "dynamic_factor")
+"""Keys of a point's ``physical`` that are responses, not axis levels."""
 
 
 class FailingWindow(BaseModel):
@@ -82,7 +95,7 @@ class EnvelopeReport(BaseModel):
 
 def _level_key(p: SweepPoint) -> tuple:
     return tuple(sorted((k, v.value) for k, v in (p.physical or {}).items() if k not in
-                        (SPEED, "dte")))  # fmt: skip
+                        (SPEED, *RESPONSE_KEYS)))  # fmt: skip
 
 
 def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
@@ -95,7 +108,9 @@ def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
     failing = 0
     for row in rows.values():
         row.sort(key=lambda p: p.values[SPEED])
-        level = {k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, "dte")}
+        level = {
+            k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, *RESPONSE_KEYS)
+        }
         speeds = [p.physical[SPEED].value for p in row]  # type: ignore[index]
         broken = [point_failures(p, rules) for p in row]
         failing += sum(1 for b in broken if b)
@@ -114,7 +129,7 @@ def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
 
 
 def level_text(level: dict[str, PhysicalValue]) -> str:
-    """"torque 40 N*m", or "all" for a one-axis sweep."""
+    """ "torque 40 N*m", or "all" for a one-axis sweep."""
     return ", ".join(f"{k} {v.value:g} {v.unit}" for k, v in level.items()) or "all"
 
 

@@ -11,8 +11,6 @@ import itertools
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
 from gearengine.numerics.settings import work
 from gearengine.sweeps.request import SweepBranch, SweepRequest
 
@@ -79,9 +77,13 @@ class SweepPlan:
     request: SweepRequest
     chunk_points: int = DEFAULT_CHUNK_POINTS
 
-    def _grid(self) -> list[tuple[int, ...]]:
-        shape = [a.num for a in self.request.axes]
-        return [tuple(reversed(ix)) for ix in np.ndindex(*reversed(shape))]
+    def _grid_index(self, k: int) -> tuple[int, ...]:
+        """Grid indices (i0, i1?) of the k-th point, first axis fastest."""
+        out = []
+        for a in self.request.axes:
+            k, i = divmod(k, a.num)
+            out.append(i)
+        return tuple(out)
 
     def n_chunks(self) -> int:
         """Number of chunks."""
@@ -103,7 +105,8 @@ class SweepPlan:
             line = [(i0, *rest) for i0 in range(req.axes[0].num)]
             return Chunk(index, line if branch == "up" else line[::-1], branch)
         lo = index * self.chunk_points
-        return Chunk(index, self._grid()[lo : lo + self.chunk_points], None)
+        hi = min(lo + self.chunk_points, req.n_points())
+        return Chunk(index, [self._grid_index(k) for k in range(lo, hi)], None)
 
     def point_counts(self) -> list[int]:
         """Number of points of each chunk."""

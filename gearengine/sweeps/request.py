@@ -54,6 +54,13 @@ AxisValue = Annotated[
 ]
 """An axis end: a number (dimensionless, or SI for a physical field) or a string with a unit."""
 
+SweepOutput = Literal[
+    "classification", "period", "lle", "lle_stderr", "impact_regime", "melnikov_chaos_possible",
+    "poincare_x", "x_peak_to_peak", "periods_run", "force_max", "force_min", "physical",
+    "dimensionless",
+]  # fmt: skip
+"""A field of ``SweepPoint`` a sweep may keep (``SweepRequest.outputs``)."""
+
 SweepBranch = Literal["up", "down"]
 """A line of a continuation sweep: up (run start -> stop) or down (stop -> start)."""
 Direction = Literal["forward", "backward", "both"]
@@ -134,6 +141,12 @@ class SweepRequest(ParamsOrDesign):
         max_length=200,
         description="The client's name for the sweep, shown in job listings; not computed on.",
         examples=["stage 1: F_e1 at 1500 rpm"],
+    )
+    outputs: Annotated[list[SweepOutput], Field(min_length=1)] | None = Field(
+        None,
+        description="The point fields to keep (values and branch are always kept); null keeps "
+        "every field. Leaving out poincare_x makes a map's result about 30 times smaller.",
+        examples=[["classification", "period", "lle"]],
     )
 
     def branches(self) -> list[SweepBranch]:

@@ -30,24 +30,46 @@ class SweepPoint(BaseModel):
     branch: SweepBranch | None = Field(
         description="With continuation: up (forward) or down (backward) branch; else null."
     )
-    classification: str = Field(description="periodic | chaotic | quasi_periodic | diverged.")
-    period: int | None = Field(description="Period in units of T0, null if none found.")
-    lle: float | None = Field(description="Largest Lyapunov exponent per unit tau.")
-    lle_stderr: float | None = Field(description="Standard error of lle.")
+    classification: str | None = Field(
+        None,
+        description="periodic | chaotic | quasi_periodic | diverged. This and every field "
+        "below are left out of the stored and returned points that a sweep's outputs do not "
+        "name (null when read back into this model).",
+    )
+    period: int | None = Field(None, description="Period in units of T0, null if none found.")
+    lle: float | None = Field(None, description="Largest Lyapunov exponent per unit tau.")
+    lle_stderr: float | None = Field(None, description="Standard error of lle.")
     impact_regime: str | None = Field(
-        description="no_impact | single_sided | double_sided, null when not reported."
+        None, description="no_impact | single_sided | double_sided, null when not reported."
     )
     melnikov_chaos_possible: bool | None = Field(
-        description="Melnikov verdict at this point; null when not applicable (a or c <= 0)."
+        None,
+        description="Melnikov verdict at this point; null when not applicable (a or c <= 0).",
     )
-    poincare_x: list[float] = Field(description="x of the last stroboscopic points (units of b).")
+    poincare_x: list[float] | None = Field(
+        None, description="x of the last stroboscopic points (units of b)."
+    )
     x_peak_to_peak: float | None = Field(
         None, description="max x - min x over the record (units of b); null if diverged."
+    )
+    periods_run: int | None = Field(
+        None,
+        description="Intervals T0 the point actually ran (fewer than transient + record when "
+        "it stopped early, settings.adaptive).",
+    )
+    force_max: float | None = Field(
+        None,
+        description="Largest dimensionless mesh force K(t) f_h(x) + 2 mu x' over the record; "
+        "null if diverged.",
+    )
+    force_min: float | None = Field(
+        None, description="Smallest dimensionless mesh force over the record; null if diverged."
     )
     physical: dict[str, PhysicalValue] | None = Field(
         None,
         description="With a design: the physical axes' values in display units (rpm, N*m, "
-        "µm, ...) and the dynamic transmission error dte (µm peak to peak).",
+        "µm, ...), the dynamic transmission error dte (µm peak to peak) and the "
+        "dynamic_factor (largest mesh force / static force F~_m).",
         examples=[{"speed": {"value": 1500.0, "unit": "rpm"}, "torque": {"value": 40.0,
                    "unit": "N*m"}, "dte": {"value": 3.4, "unit": "um"}}],
     )  # fmt: skip
@@ -83,6 +105,11 @@ class SweepBifurcation(BaseModel):
     critical_multiplier: list[float] | None = Field(
         description="The dominant multiplier [re, im] at the point (about [-1, 0] for a "
         "period doubling); null for orbit_lost."
+    )
+    physical: PhysicalValue | None = Field(
+        None,
+        description="With a physical axis: the located value in its display unit (the speed "
+        "in rpm of a period doubling, say).",
     )
 
 

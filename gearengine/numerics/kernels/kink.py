@@ -14,6 +14,7 @@ from gearengine.numerics.kernels.smooth import (
     forcing_at,
     region,
     region_force,
+    stiffness_at,
 )
 
 
@@ -182,7 +183,10 @@ def run_kink(
     stride: int,
     bound: float,
 ):  # pragma: no cover - compiled
-    """Kink-splitting RK4 of Eq. (9) with the piecewise law of Eq. (8); outputs as ``run_rk4``."""
+    """Kink-splitting RK4 of Eq. (9) with the piecewise law of Eq. (8); outputs as ``run_rk4``.
+
+    The mesh force needs K at the step end: one ``stiffness_at`` per recorded step (the
+    stiffness harmonics only), beside the ~12 forcing evaluations of a kink-splitting step."""
     h = T / N
     twomu = 2.0 * mu
     xs = np.zeros(n_rec)
@@ -193,6 +197,7 @@ def run_kink(
     x, v, dx, dv = x0, v0, SQRT1_2, SQRT1_2
     reg = region(x)
     xmin, xmax = np.inf, -np.inf
+    fmin, fmax = np.inf, -np.inf
     done = 0
     count = 0
     ih = 0
@@ -206,6 +211,11 @@ def run_kink(
             )
             xmin = min(xmin, x)
             xmax = max(xmax, x)
+            if rec:  # mesh force K(t) f_h(x) + 2 mu x' at the step end
+                force = stiffness_at(n * T + (j + 1) * h, kc) * region_force(reg, alpha, x)[0]
+                force += twomu * v
+                fmin = min(fmin, force)
+                fmax = max(fmax, force)
             count += 1
             if count == stride:
                 count = 0
@@ -225,4 +235,4 @@ def run_kink(
         elif n + 1 == n_trans:
             xmin, xmax, count, ih = np.inf, -np.inf, 0, 0
         done = n + 1
-    return xs, vs, logs, hx, hv, xmin, xmax, done, x, v
+    return xs, vs, logs, hx, hv, xmin, xmax, done, x, v, fmin, fmax

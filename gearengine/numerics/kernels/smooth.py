@@ -28,6 +28,15 @@ def forcing_at(
 
 
 @njit(**JIT_OPTIONS)
+def stiffness_at(t: float, kc: np.ndarray) -> float:  # pragma: no cover - compiled
+    """K(t) of Eq. (9) alone at absolute time t (the mesh force's stiffness factor)."""
+    K = 1.0
+    for i in range(kc.shape[1]):
+        K += kc[0, i] * math.cos(kc[1, i] * t + kc[2, i])
+    return K
+
+
+@njit(**JIT_OPTIONS)
 def forcing_table(
     T: float, N: int, kc: np.ndarray, fm: float, fc: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:  # pragma: no cover - compiled
@@ -130,7 +139,9 @@ def run_rk4(
         hx, hv: (x, v) after recorded steps stride, 2 stride, ..., shape (n_rec N // stride,);
         xmin, xmax: extremes of x over every recorded step;
         done: intervals completed (< n_trans + n_rec when diverged);
-        x, v: final state.
+        x, v: final state;
+        fmin, fmax: extremes of the dimensionless mesh force K(t) f_h(x) + 2 mu x' at the
+            recorded step ends (a few flops per step).
     """
     h = T / N
     h2 = 0.5 * h
@@ -148,6 +159,7 @@ def run_rk4(
     hv = np.zeros(n_rec * N // stride)
     x, v, dx, dv = x0, v0, SQRT1_2, SQRT1_2
     xmin, xmax = np.inf, -np.inf
+    fmin, fmax = np.inf, -np.inf
     done = 0
     count = 0
     ih = 0
@@ -200,6 +212,9 @@ def run_rk4(
             dv += h6 * (d1 + 2.0 * (d2 + d3) + d4)
             xmin = min(xmin, x)
             xmax = max(xmax, x)
+            force = K2 * law_force(law, a, c, alpha, x)[0] + twomu * v  # mesh force
+            fmin = min(fmin, force)
+            fmax = max(fmax, force)
             count += 1
             if count == stride:
                 count = 0
@@ -218,5 +233,6 @@ def run_rk4(
             vs[k] = v
         elif n + 1 == n_trans:
             xmin, xmax, count, ih = np.inf, -np.inf, 0, 0
+            fmin, fmax = np.inf, -np.inf
         done = n + 1
-    return xs, vs, logs, hx, hv, xmin, xmax, done, x, v
+    return xs, vs, logs, hx, hv, xmin, xmax, done, x, v, fmin, fmax

@@ -25,7 +25,8 @@ from gearengine.sweeps import (
     csv_rows,
     result_json,
 )
-from gearengine.sweeps.windows import speed_windows
+from gearengine.sweeps.results import SpeedWindows
+from gearengine.sweeps.windows import SPEED, speed_windows
 from service.api.deps import AppSettings, Jobs, Owner
 from service.api.responses import JSON, PNG, PROBLEMS, RETRY_AFTER_HEADER, SVG, header
 from service.errors import ProblemError
@@ -176,6 +177,23 @@ def cancel_sweep(job_id: str, owner: Owner, jobs: Jobs) -> Job:
     return job
 
 
+def _windows(jobs: SweepJobs, job_id: str, sweep: SweepRequest) -> list[SpeedWindows] | None:
+    """The speed windows of a sweep over the driver speed; None, without reading a point,
+    for other sweeps (a map's result streams chunk by chunk)."""
+    if SPEED not in [a.parameter for a in sweep.axes]:
+        return None
+    return speed_windows(sweep, list(_points(jobs, job_id)))
+
+
+def _stored_points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
+    """The stored points unvalidated (``model_construct``: the workers wrote them from valid
+    points), one chunk in memory at a time: the CSV of a million-point map streams at the
+    speed of the csv module, not of validation."""
+    for array in jobs.store.chunk_results(job_id):
+        for item in chunk_points(array):
+            yield SweepPoint.model_construct(**item)
+
+
 def _points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
     for array in jobs.store.chunk_results(job_id):
         for item in chunk_points(array):
@@ -227,7 +245,7 @@ def get_result(
     if format == "csv":
         name = f"sweep-{job_id}{'-partial' if missing else ''}.csv"
         return StreamingResponse(
-            csv_rows(axes, _points(jobs, job_id)),
+            csv_rows(axes, _stored_points(jobs, job_id), sweep.outputs),
             media_type=CSV,
             headers={"Content-Disposition": f'attachment; filename="{name}"', **headers},
         )
@@ -236,7 +254,7 @@ def get_result(
             axes,
             jobs.store.chunk_results(job_id),
             partial=missing,
-            windows=speed_windows(sweep, list(_points(jobs, job_id))),
+            windows=_windows(jobs, job_id, sweep),
         ),
         media_type=JSON,
         headers=headers,
