@@ -27,6 +27,7 @@ from pathlib import Path
 import httpx
 import psutil
 from report import write_section  # benchmarks/report.py (the script's own folder)
+from serving import wait_ready  # benchmarks/serving.py
 
 ROOT = Path(__file__).resolve().parents[1]
 MB = 1024 * 1024
@@ -86,14 +87,7 @@ def main() -> None:
         peak.start()
         try:
             with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=600) as c:
-                deadline = time.monotonic() + 120
-                while time.monotonic() < deadline:
-                    try:
-                        if c.get("/v1/ready").status_code == 200:
-                            break
-                    except httpx.HTTPError:
-                        pass
-                    time.sleep(0.1)
+                wait_ready(c)
                 t0 = time.perf_counter()
                 r = c.post("/v1/sweeps", json=doc)
                 assert r.status_code in (200, 201, 202), r.text

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import httpx
 from report import write_section  # benchmarks/report.py (the script's own folder)
+from serving import wait_ready  # benchmarks/serving.py
 
 ROOT = Path(__file__).resolve().parents[1]
 GEAR_REF = Path("/work/shared/reference/gear_ref.c")
@@ -67,14 +68,7 @@ def http_sweep_seconds(tmp: Path) -> tuple[float, int]:
     )
     try:
         with httpx.Client(base_url=url, timeout=60) as c:
-            deadline = time.monotonic() + 120
-            while time.monotonic() < deadline:
-                try:
-                    if c.get("/v1/ready").status_code == 200:
-                        break
-                except httpx.HTTPError:
-                    pass
-                time.sleep(0.1)
+            wait_ready(c)
             times = []
             for _ in range(REPEATS):
                 t = time.perf_counter()
