@@ -62,13 +62,15 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("melnikov", help="Melnikov verdict, thresholds and margins of a design")
-    p.add_argument("file", help='JSON file holding {"params": {...}}, or - for stdin')
+    p.add_argument("file", help='JSON file holding {"params": {...}} or {"design": {...}}, or -')
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
     p.add_argument("--method", choices=["closed_form", "quadrature"], default=None)
     p.set_defaults(func=cmd_melnikov)
 
     p = sub.add_parser("analyze", help="Melnikov and numerical verdicts of a design")
-    p.add_argument("file", help='JSON file holding {"params": {...}, "settings": {...}}, or -')
+    p.add_argument(
+        "file", help='JSON file holding {"params" or "design": {...}, "settings": {...}}, or -'
+    )
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
     p.set_defaults(func=cmd_analyze)
 
@@ -82,7 +84,9 @@ def build_parser() -> argparse.ArgumentParser:
         "add to it. With "
         "--speed and/or --torque the whole operating envelope of a design is checked.",
     )
-    p.add_argument("file", help='JSON file holding {"params": {...}, "settings": {...}}, or -')
+    p.add_argument(
+        "file", help='JSON file holding {"params" or "design": {...}, "settings": {...}}, or -'
+    )
     p.add_argument(
         "--fail-on",
         action="append",
