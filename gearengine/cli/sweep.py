@@ -7,9 +7,11 @@ being FILE's name without extension; a progress bar goes to standard error.
 from __future__ import annotations
 
 import argparse
+import gc
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from gearengine.cli.documents import EXIT_OK, read_document, validated_input
@@ -21,6 +23,29 @@ from gearengine.sweeps.request import SweepRequest, validated
 
 BAR = 30
 """Width of the progress bar, characters."""
+
+GC_GEN0_THRESHOLD = 50_000
+"""Allocations between young-generation collections while a sweep runs (Python's default 700)."""
+
+
+@contextmanager
+def quiet_gc() -> Iterator[None]:
+    """Stop the cyclic collector from rescanning what the sweep keeps alive.
+
+    A map builds a few objects per point (points, Poincaré lists) and no reference cycles; with
+    the default thresholds the full collections rescan every imported module and every point
+    built so far, about a quarter of a 100 x 100 map's wall time. ``gc.freeze`` moves what
+    exists now (imports, request) out of the collector's sight and a larger young generation
+    makes collections rare. Both are undone on exit (the command may run inside a test process).
+    """
+    old = gc.get_threshold()
+    gc.freeze()
+    gc.set_threshold(GC_GEN0_THRESHOLD, 50, 100)
+    try:
+        yield
+    finally:
+        gc.set_threshold(*old)
+        gc.unfreeze()
 
 
 def read_sweep(path: str) -> SweepRequest:
@@ -42,6 +67,11 @@ def progress_bar(start: float) -> Callable[[int, int], None]:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
+    with quiet_gc():
+        return _sweep(args)
+
+
+def _sweep(args: argparse.Namespace) -> int:
     request = read_sweep(args.file)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -20,13 +20,17 @@ from gearengine.numerics.settings import SimulationSettings, check_work
 
 
 def batch_point(runs: list[tuple[Run, StartVerdict]]) -> BatchPoint:
-    """The verdict of a point: its worst start's, with that start's last strobes."""
+    """The verdict of a point: its worst start's, with that start's last strobes.
+
+    Built with ``model_construct``: the fields come typed and finite from ``start_verdict`` and
+    ``finite_or_none``, so validating them again would only cost time (~0.1 ms a point).
+    """
     idx = max(
         range(len(runs)), key=lambda i: severity(runs[i][1].classification, runs[i][1].period)
     )
     run, v = runs[idx]
     n_ok = run.recorded
-    return BatchPoint(
+    return BatchPoint.model_construct(
         classification=v.classification,
         period=v.period,
         lle=v.summary.lle,
@@ -34,9 +38,9 @@ def batch_point(runs: list[tuple[Run, StartVerdict]]) -> BatchPoint:
         final_state=v.summary.final_state,
         impact_regime=v.summary.impact_regime,
         poincare=np.column_stack([run.xs[:n_ok], run.vs[:n_ok]])[-BATCH_POINCARE:].tolist(),
-        start_index=idx,
+        start_index=int(idx),
         x_peak_to_peak=None if run.diverged else finite_or_none(run.xmax - run.xmin),
-        periods_run=run.done,
+        periods_run=int(run.done),
         force_max=None if run.diverged else finite_or_none(run.fmax),
         force_min=None if run.diverged else finite_or_none(run.fmin),
     )

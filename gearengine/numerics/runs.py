@@ -121,9 +121,10 @@ def start_verdict(
     run: Run, start: tuple[float, float], period_T: float, commensurate: bool
 ) -> StartVerdict:
     """Period (stroboscopic), LLE (Benettin) and classification of one run."""
+    # model_construct: every field below is built here with its exact type (no re-validation)
     if run.diverged:
-        summary = StartSummary(
-            initial_state=list(start),
+        summary = StartSummary.model_construct(
+            initial_state=[float(start[0]), float(start[1])],
             classification="diverged",
             period=None,
             lle=None,
@@ -138,10 +139,10 @@ def start_verdict(
         period = detect_period(run.xs, run.vs, attractor_size(run.xmin, run.xmax))
     verdict = classify(False, period, est.lle, est.stderr)
     final = [finite_or_none(run.final[0]), finite_or_none(run.final[1])]
-    summary = StartSummary(
-        initial_state=list(start),
+    summary = StartSummary.model_construct(
+        initial_state=[float(start[0]), float(start[1])],
         classification=verdict,
-        period=period,
+        period=None if period is None else int(period),
         lle=finite_or_none(est.lle),
         lle_stderr=finite_or_none(est.stderr),
         impact_regime=impact_regime(run.xmin, run.xmax),

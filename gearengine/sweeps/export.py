@@ -111,15 +111,16 @@ def csv_rows(
     yielded one by one, so a streamed response never holds the whole table."""
     names = [a.parameter for a in axes]
     fields = [f for f in CSV_FIELDS if outputs is None or f == "branch" or f in outputs]
-    yield _csv_row([*names, *fields])
+    buf = io.StringIO()
+    yield _csv_row([*names, *fields], buf)
     for p in points:
         cells: list[object] = [_grid_value(p.values[n]) for n in names]
         for f in fields:
             value = getattr(p, f)
             if f == "poincare_x":
-                value = " ".join(repr(x) for x in value or [])
+                value = " ".join(map(repr, value or []))
             cells.append(value)
-        yield _csv_row(cells)
+        yield _csv_row(cells, buf)
 
 
 def _grid_value(x: float) -> float:
@@ -129,8 +130,12 @@ def _grid_value(x: float) -> float:
     return float(f"{x:.15g}")
 
 
-def _csv_row(cells: list[object]) -> str:
-    buf = io.StringIO()
+def _csv_row(cells: list[object], buf: io.StringIO | None = None) -> str:
+    """One CSV line of ``cells``; ``buf`` (emptied first) is reused across rows if given."""
+    if buf is None:
+        buf = io.StringIO()
+    buf.seek(0)
+    buf.truncate()
     csv.writer(buf, lineterminator="\n").writerow(
         ["" if c is None else str(c).lower() if isinstance(c, bool) else c for c in cells]
     )
