@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Iterable
 from fractions import Fraction
 
 import numpy as np
@@ -289,10 +290,23 @@ def frequency_threshold(
 def scan_terms(params: GearParams) -> tuple[np.ndarray, ...]:
     """The active harmonics as arrays (fundamental, r, kind, amplitude, phase), in the order of
     ``melnikov_coefficients``: the per-unit coefficients are functions of r Omega alone."""
-    rows = [
-        (exc.frequency, r, kernels.KIND[name], h.amplitude, h.phase)
+    return terms_table(
+        (name, exc.frequency, [(h.amplitude, h.phase) for h in exc.harmonics])
         for name, exc in params.excitations()
-        for r, h in exc.active()
+    )
+
+
+def terms_table(
+    excitations: Iterable[tuple[str, float, list[tuple[float, float]]]],
+) -> tuple[np.ndarray, ...]:
+    """``scan_terms`` of excitations given as (name, fundamental, [(amplitude, phase), ...]) in
+    the order of ``model.params.EXCITATIONS``; harmonics are numbered r = 1, 2, ... as listed
+    and those with a zero amplitude are left out."""
+    rows = [
+        (float(frequency), r, kernels.KIND[name], float(amplitude), float(phase))
+        for name, frequency, harmonics in excitations
+        for r, (amplitude, phase) in enumerate(harmonics, start=1)
+        if amplitude != 0.0
     ]
     table = np.array(rows, dtype=float).reshape(len(rows), 5).T
     return table[0], table[1], table[2].astype(np.int64), table[3], table[4]

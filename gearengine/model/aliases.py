@@ -51,14 +51,22 @@ def with_alias(params: GearParams, name: str, value: float) -> GearParams:
 
 def with_aliases(params: GearParams, values: dict[str, float]) -> GearParams:
     """A copy of ``params`` with several aliases set at once, validated (see ``with_alias``)."""
-    data = params.model_dump()
+    return GearParams.model_validate(aliased_data(params.model_dump(), values))
+
+
+def aliased_data(data: dict, values: dict[str, float]) -> dict:
+    """The dumped parameters ``data`` with aliases set, not validated (a copy: ``data`` and its
+    excitations are left as they were). Raises ``ValueError`` like ``with_alias``."""
+    data = dict(data)
     for name, value in values.items():
         field, what = _alias(name)
         if not what:
             data[field] = value
             continue
         exc = data.get(field)
-        if exc is None:
+        if exc is not None:
+            exc = data[field] = {**exc, "harmonics": [dict(h) for h in exc["harmonics"]]}
+        else:
             if what == "amplitude" and value == 0.0:
                 continue
             freq_alias = next(k for k, v in ALIASES.items() if v == (field, "frequency"))
@@ -74,7 +82,7 @@ def with_aliases(params: GearParams, values: dict[str, float]) -> GearParams:
             if not exc["harmonics"]:
                 exc["harmonics"].append({"amplitude": 0.0, "phase": 0.0})
             exc["harmonics"][0]["amplitude"] = value
-    return GearParams.model_validate(data)
+    return data
 
 
 def _alias(name: str) -> tuple[str, str]:

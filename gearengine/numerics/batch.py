@@ -1,8 +1,9 @@
 """Verdicts of many parameter points at once: the sweeps' path to the kernels.
 
 Cubic-law points with commensurate forcing are grouped by steps per T0 and advanced in lock-step
-by the SIMD kernel ``kernels.run_batch`` (parallel over chunks of lanes); other points run one
-by one in the single kernels (``numerics.runs``). Numbers equal those of ``simulate``.
+by the SIMD kernel ``kernels.run_batch`` (parallel over chunks of lanes), and their verdicts are
+taken array-wise (``numerics.lanes``); other points run one by one in the single kernels
+(``numerics.runs``). Numbers equal those of ``simulate``.
 """
 
 from __future__ import annotations
@@ -13,7 +14,8 @@ import numpy as np
 from gearengine.model.params import GearParams
 from gearengine.numerics import kernels
 from gearengine.numerics.classify import DIVERGENCE_BOUND, severity
-from gearengine.numerics.forcing import law, packed_forcing, step_plan
+from gearengine.numerics.forcing import StepPlan, law, packed_forcing, step_plan
+from gearengine.numerics.lanes import lockstep_points
 from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
 from gearengine.numerics.runs import Run, StartVerdict, finite_or_none, integrate, start_verdict
 from gearengine.numerics.settings import SimulationSettings, check_work
@@ -46,6 +48,22 @@ def batch_point(runs: list[tuple[Run, StartVerdict]]) -> BatchPoint:
     )
 
 
+def step_plans(points: list[GearParams], steps_per_period: int) -> list[StepPlan]:
+    """``step_plan`` of each point, computed once per set of active harmonics: the plan depends
+    only on the excitations' frequencies and which of their harmonics are active."""
+    known: dict[tuple, StepPlan] = {}
+    plans = []
+    for p in points:
+        key = tuple(
+            (name, exc.frequency, tuple(r for r, _ in exc.active()))
+            for name, exc in p.excitations()
+        )
+        if key not in known:
+            known[key] = step_plan(p, steps_per_period)
+        plans.append(known[key])
+    return plans
+
+
 def simulate_batch(
     points: list[GearParams], settings: SimulationSettings | None = None
 ) -> list[BatchPoint]:
@@ -61,7 +79,7 @@ def simulate_batch(
     n_trans, n_rec = settings.transient_periods, settings.record_periods
     results: dict[int, BatchPoint] = {}
     groups: dict[int, list[int]] = {}
-    plans = [step_plan(p, settings.steps_per_period) for p in points]
+    plans = step_plans(points, settings.steps_per_period)
     for i, (p, plan) in enumerate(zip(points, plans, strict=True)):
         check_work(settings, plan.steps)
         if p.backlash.model == "cubic" and plan.omega0 is not None:
@@ -81,8 +99,9 @@ def simulate_batch(
         Kt = np.array([tables[rows[i]][0] for i, _ in lanes])
         Ft = np.array([tables[rows[i]][1] for i, _ in lanes])
         per = np.array([plans[i].period for i, _ in lanes])
-        a = np.array([law(points[i]).a for i, _ in lanes])
-        c = np.array([law(points[i]).c for i, _ in lanes])
+        laws = {i: law(points[i]) for i in members}
+        a = np.array([laws[i].a for i, _ in lanes])
+        c = np.array([laws[i].c for i, _ in lanes])
         mu = np.array([points[i].damping for i, _ in lanes])
         x0 = np.array([s[0] for _, s in lanes])
         v0 = np.array([s[1] for _, s in lanes])
@@ -91,17 +110,5 @@ def simulate_batch(
             a, c, mu, x0, v0, Kt, Ft, per, N, n_trans, n_rec, DIVERGENCE_BOUND,
             settings.adaptive, streams,
         )  # fmt: skip
-        xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf = out
-        per_point: dict[int, list[tuple[Run, StartVerdict]]] = {i: [] for i in members}
-        empty = np.zeros(0)
-        for lane, (i, s) in enumerate(lanes):
-            k = int(rec[lane]) if not diverged[lane] else n_rec
-            run = Run(
-                xs[lane, :k], vs[lane, :k], logs[lane, :k], empty, empty, float(xmin[lane]),
-                float(xmax[lane]), int(done[lane]), (float(xf[lane]), float(vf[lane])),
-                bool(diverged[lane]), int(rec[lane]), float(fmin[lane]), float(fmax[lane]),
-            )  # fmt: skip
-            per_point[i].append((run, start_verdict(run, s, plans[i].period, True)))
-        for i, runs in per_point.items():
-            results[i] = batch_point(runs)
+        results.update(lockstep_points(out, members, lanes, per))
     return [results[i] for i in range(len(points))]

@@ -74,31 +74,11 @@ class StepPlan:
 
 def forcing_coefficients(params: GearParams) -> ForcingCoefficients:
     """Cosine terms of K(t) and F(t) of Eq. (9) for every harmonic with nonzero amplitude."""
-    k_terms: list[tuple[float, float, float]] = []
-    f_terms: list[tuple[float, float, float]] = []
-    if params.stiffness is not None:
-        w = params.stiffness.frequency
-        k_terms += [(2.0 * h.amplitude, r * w, h.phase) for r, h in params.stiffness.active()]
-    if params.torque is not None:
-        w = params.torque.frequency
-        f_terms += [(h.amplitude, r * w, h.phase) for r, h in params.torque.active()]
-    if params.transmission_error is not None:
-        w = params.transmission_error.frequency
-        f_terms += [
-            ((r * w) * (r * w) * h.amplitude, r * w, h.phase)
-            for r, h in params.transmission_error.active()
-        ]
-    k = np.array(k_terms, dtype=np.float64).reshape(-1, 3)
-    f = np.array(f_terms, dtype=np.float64).reshape(-1, 3)
+    kc, fm, fc = packed_forcing(params)
     return ForcingCoefficients(
-        k_amp=np.ascontiguousarray(k[:, 0]),
-        k_omega=np.ascontiguousarray(k[:, 1]),
-        k_phase=np.ascontiguousarray(k[:, 2]),
-        mean_force=float(params.mean_force),
-        f_amp=np.ascontiguousarray(f[:, 0]),
-        f_omega=np.ascontiguousarray(f[:, 1]),
-        f_phase=np.ascontiguousarray(f[:, 2]),
-    )
+        k_amp=kc[0], k_omega=kc[1], k_phase=kc[2], mean_force=fm,
+        f_amp=fc[0], f_omega=fc[1], f_phase=fc[2],
+    )  # fmt: skip
 
 
 def law(params: GearParams) -> Law:
@@ -112,11 +92,26 @@ def law(params: GearParams) -> Law:
 
 def packed_forcing(params: GearParams) -> tuple[np.ndarray, float, np.ndarray]:
     """(kc, fm, fc): the forcing as the kernels take it, kc and fc of shape (3, n_terms) with
-    rows amplitude, omega, phase, and fm the mean force F~_m."""
-    co = forcing_coefficients(params)
-    kc = np.ascontiguousarray(np.vstack([co.k_amp, co.k_omega, co.k_phase]))
-    fc = np.ascontiguousarray(np.vstack([co.f_amp, co.f_omega, co.f_phase]))
-    return kc, co.mean_force, fc
+    rows amplitude, omega, phase, and fm the mean force F~_m. Stiffness terms 2 k~_pr at
+    r Omega_k; torque terms F~_pr at r Omega_p, then transmission-error terms
+    (r Omega_e)^2 F~_er at r Omega_e (Eq. 9); only harmonics with a nonzero amplitude."""
+    k: list[tuple[float, float, float]] = []
+    f: list[tuple[float, float, float]] = []
+    if params.stiffness is not None:
+        w = params.stiffness.frequency
+        k += [(2.0 * h.amplitude, r * w, h.phase) for r, h in params.stiffness.active()]
+    if params.torque is not None:
+        w = params.torque.frequency
+        f += [(h.amplitude, r * w, h.phase) for r, h in params.torque.active()]
+    if params.transmission_error is not None:
+        w = params.transmission_error.frequency
+        f += [
+            ((r * w) * (r * w) * h.amplitude, r * w, h.phase)
+            for r, h in params.transmission_error.active()
+        ]
+    kc = np.ascontiguousarray(np.array(k, dtype=np.float64).reshape(-1, 3).T)
+    fc = np.ascontiguousarray(np.array(f, dtype=np.float64).reshape(-1, 3).T)
+    return kc, float(params.mean_force), fc
 
 
 def fastest_excitation(params: GearParams) -> float | None:

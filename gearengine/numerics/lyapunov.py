@@ -70,3 +70,26 @@ def benettin(logs: np.ndarray, period: float, blocks: int = BLOCKS) -> LyapunovE
         and abs(first_half - lle) <= max(3.0 * stderr, 0.05 * abs(lle), ABS_TOL)
     )
     return LyapunovEstimate(lle, stderr, first_half, converged)
+
+
+def benettin_rows(logs: np.ndarray, period: np.ndarray, blocks: int = BLOCKS) -> tuple:
+    """``benettin``'s LLE and stderr for many records of one length at once.
+
+    ``logs`` has shape (m, n), n >= 1, one record per row taken every ``period[row]``. The sums
+    run as ``benettin``'s (a sequential cumsum for the total, numpy's row sums for the blocks),
+    so the numbers are the same bit for bit. Returns (lle, stderr) arrays; stderr is NaN where
+    ``benettin`` gives None (fewer than two blocks).
+    """
+    n = logs.shape[1]
+    lle = np.cumsum(logs, axis=1)[:, -1] / (n * period)
+    b = min(blocks, n)
+    if b < 2:
+        return lle, np.full(lle.shape, np.nan)
+    each, extra = divmod(n, b)
+    estimates = np.empty((logs.shape[0], b))
+    start = 0
+    for k in range(b):
+        stop = start + each + (1 if k < extra else 0)
+        estimates[:, k] = logs[:, start:stop].sum(axis=1) / ((stop - start) * period)
+        start = stop
+    return lle, np.std(estimates, axis=1, ddof=1) / math.sqrt(b)

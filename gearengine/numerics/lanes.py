@@ -1,0 +1,174 @@
+"""Verdicts of the lanes of one lock-step group (``kernels.run_batch``), array-wise.
+
+The LLE and its standard error of every lane come from ``lyapunov.benettin_rows`` (the same
+sums as ``benettin``, so the same bits), the period from the compiled ``detect_period`` per lane,
+and each point's ``BatchPoint`` is built once, from its worst start only: the numbers equal those
+of ``runs.start_verdict`` + ``batch.batch_point`` without a ``Run`` or ``StartSummary`` per lane.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from typing import Any, TypeVar
+
+import numpy as np
+from pydantic import BaseModel
+
+from gearengine.numerics.classify import classify, severity
+from gearengine.numerics.diagnostics import impact_regime
+from gearengine.numerics.lyapunov import benettin_rows
+from gearengine.numerics.periodicity import attractor_size, detect_period
+from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
+
+M = TypeVar("M", bound=BaseModel)
+
+
+def _finite(value: float) -> float | None:
+    """``runs.finite_or_none`` of a float."""
+    return float(value) if math.isfinite(value) else None
+
+
+def lane_lle(
+    logs: np.ndarray, rec: np.ndarray, diverged: np.ndarray, per: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """LLE and stderr (NaN where none) of every lane that did not diverge, grouped by the
+    length of its record (``kernels.adaptive`` stops lanes early)."""
+    lle = np.full(rec.size, np.nan)
+    stderr = np.full(rec.size, np.nan)
+    alive = np.flatnonzero(np.logical_not(diverged))
+    lengths = rec[alive]
+    for k in np.unique(lengths):
+        idx = alive[lengths == k]
+        lle[idx], stderr[idx] = benettin_rows(logs[idx, : int(k)], per[idx])
+    return lle, stderr
+
+
+def lane_verdicts(out: tuple, per: np.ndarray) -> list[tuple]:
+    """(classification, period, LLE, stderr) of every lane, as ``runs.start_verdict`` gives
+    them (LLE and stderr NaN where there is none)."""
+    xs, vs, logs, xmin, xmax, _, _, _, rec, diverged, _, _ = out
+    lle, stderr = lane_lle(logs, rec, diverged, per)
+    verdicts: list[tuple] = []
+    for lane in range(rec.size):
+        if diverged[lane]:
+            verdicts.append(("diverged", None, math.nan, math.nan))
+            continue
+        k = int(rec[lane])
+        size = attractor_size(float(xmin[lane]), float(xmax[lane]))
+        period = detect_period(xs[lane, :k], vs[lane, :k], size)
+        e, s = float(lle[lane]), float(stderr[lane])
+        verdict = classify(False, period, e, None if math.isnan(s) else s)
+        verdicts.append((verdict, period, e, s))
+    return verdicts
+
+
+def last_strobes(out: tuple, lanes: list[int]) -> list[list]:
+    """The last ``BATCH_POINCARE`` recorded strobes [x, v] of each of ``lanes`` (fewer when the
+    record is shorter), one gather and one ``tolist`` for the lanes with a full window."""
+    xs, vs, rec = out[0], out[1], out[8]
+    n_ok = rec[lanes].astype(np.int64)
+    strobes: list[list] = [[] for _ in lanes]
+    full = np.flatnonzero(n_ok >= BATCH_POINCARE)
+    if full.size:
+        rows = np.asarray(lanes)[full][:, None]
+        cols = n_ok[full][:, None] - BATCH_POINCARE + np.arange(BATCH_POINCARE)
+        window = np.stack([xs[rows, cols], vs[rows, cols]], axis=2).tolist()
+        for k, w in zip(full.tolist(), window, strict=True):
+            strobes[k] = w
+    for k in np.flatnonzero(n_ok < BATCH_POINCARE).tolist():
+        lane, n = lanes[k], int(n_ok[k])
+        strobes[k] = np.column_stack([xs[lane, :n], vs[lane, :n]]).tolist()
+    return strobes
+
+
+def lane_point(
+    out: tuple, lane: int, start_index: int, verdict: tuple, strobes: list
+) -> BatchPoint:
+    """The ``BatchPoint`` of a point whose worst start is ``lane`` (``batch.batch_point``),
+    with that lane's last ``strobes``."""
+    _, _, _, xmin, xmax, fmin, fmax, done, _, diverged, xf, vf = out
+    classification, period, lle, stderr = verdict
+    dead = bool(diverged[lane])
+    lo, hi = float(xmin[lane]), float(xmax[lane])
+    final = [_finite(float(xf[lane])), _finite(float(vf[lane]))]
+    return construct(
+        BatchPoint,
+        classification=classification,
+        period=period,
+        lle=None if dead else _finite(lle),
+        lle_stderr=None if dead else _finite(stderr),
+        final_state=None if dead or None in final else final,
+        impact_regime=None if dead else impact_regime(lo, hi),
+        poincare=strobes,
+        start_index=start_index,
+        x_peak_to_peak=None if dead else _finite(hi - lo),
+        periods_run=int(done[lane]),
+        force_max=None if dead else _finite(float(fmax[lane])),
+        force_min=None if dead else _finite(float(fmin[lane])),
+    )
+
+
+def lockstep_points(
+    out: tuple, members: list[int], lanes: list[tuple[int, tuple]], per: np.ndarray
+) -> dict[int, BatchPoint]:
+    """``BatchPoint`` of each member point from the group's kernel output ``out`` (lanes in
+    point-major order, one per point and start; ``per``: each lane's T0)."""
+    verdicts = lane_verdicts(out, per)
+    first: dict[int, int] = {}
+    for lane, (i, _) in enumerate(lanes):
+        first.setdefault(i, lane)
+    worst: list[int] = []
+    for i in members:
+        lane0 = first[i]
+        lane1 = lane0
+        while lane1 < len(lanes) and lanes[lane1][0] == i:
+            lane1 += 1
+        worst.append(max(range(lane0, lane1), key=lambda j: severity(*verdicts[j][:2])))
+    strobes = last_strobes(out, worst)
+    return {
+        i: lane_point(out, best, best - first[i], verdicts[best], window)
+        for i, best, window in zip(members, worst, strobes, strict=True)
+    }
+
+
+@functools.cache
+def _layout(cls: type[BaseModel]) -> tuple[tuple[str, ...], dict[str, Any]] | None:
+    """Field names of ``cls`` in order and the plain defaults of the optional ones; None when
+    ``construct`` must leave the model to ``model_construct`` (aliases, factories, hooks)."""
+    if cls.__pydantic_post_init__ or cls.model_config.get("extra") == "allow":
+        return None
+    defaults: dict[str, Any] = {}
+    for name, field in cls.model_fields.items():
+        if field.alias not in (None, name) or field.validation_alias not in (None, name):
+            return None
+        if field.default_factory is not None:
+            return None
+        if not field.is_required():
+            if not isinstance(field.default, str | int | float | None):
+                return None
+            defaults[name] = field.default
+    return tuple(cls.model_fields), defaults
+
+
+@functools.cache
+def names_of(names: tuple[str, ...]) -> frozenset[str]:
+    """The field names as a set (remembered per model)."""
+    return frozenset(names)
+
+
+def construct(cls: type[M], **values: Any) -> M:
+    """``cls.model_construct(**values)`` (no validation) without its per-field alias lookups:
+    the same ``__dict__`` (fields in order, defaults filled) and the same set of fields set."""
+    layout = _layout(cls)
+    if layout is None:
+        return cls.model_construct(**values)
+    names, defaults = layout
+    if not names_of(names) >= values.keys() >= names_of(names) - defaults.keys():
+        return cls.model_construct(**values)
+    m = cls.__new__(cls)
+    object.__setattr__(m, "__dict__", {n: values[n] if n in values else defaults[n] for n in names})
+    object.__setattr__(m, "__pydantic_fields_set__", set(values))
+    object.__setattr__(m, "__pydantic_extra__", None)
+    object.__setattr__(m, "__pydantic_private__", None)
+    return m
