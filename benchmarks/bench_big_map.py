@@ -26,8 +26,8 @@ from pathlib import Path
 
 import httpx
 import psutil
+from common import wait_ready  # benchmarks/common.py
 from report import write_section  # benchmarks/report.py (the script's own folder)
-from serving import wait_ready  # benchmarks/serving.py
 
 ROOT = Path(__file__).resolve().parents[1]
 MB = 1024 * 1024

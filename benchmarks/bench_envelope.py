@@ -22,9 +22,9 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
+from common import best_of  # benchmarks/common.py
 from report import write_section  # benchmarks/report.py (the script's own folder)
 
 from gearengine.cli.envelope import ENVELOPE_SETTINGS
@@ -55,22 +55,13 @@ def sweep_doc(design: dict) -> dict:
     return {"design": design, "settings": ENVELOPE_SETTINGS, "axes": axes}
 
 
-def best(run: object) -> float:
-    times = []
-    for _ in range(REPEATS):
-        t = time.perf_counter()
-        run()  # type: ignore[operator]
-        times.append(time.perf_counter() - t)
-    return min(times)
-
-
 def command_seconds(design: dict, tmp: Path) -> float:
     path = tmp / "design.json"
     path.write_text(json.dumps({"design": design}))
     speed, torque = f"{SPEEDS[0]:g}:{SPEEDS[1]:g}", f"{TORQUES[0]:g}:{TORQUES[1]:g}"
     args = [sys.executable, "-m", "gearengine.cli", "check", str(path), "--speed", speed,
             "--torque", torque]  # fmt: skip
-    return best(lambda: subprocess.run(args, capture_output=True, check=False))
+    return best_of(lambda: subprocess.run(args, capture_output=True, check=False), REPEATS)
 
 
 def gear_ref_seconds(tmp: Path) -> float:
@@ -95,7 +86,7 @@ def gear_ref_seconds(tmp: Path) -> float:
         for call in calls:
             subprocess.run(call, check=True, capture_output=True)
 
-    return best(run)
+    return best_of(run, REPEATS)
 
 
 def main() -> None:
@@ -106,7 +97,7 @@ def main() -> None:
         cores = os.cpu_count() or 1
         chunk = max(1, req.n_points() // (4 * cores))
         run_local(req, chunk_points=chunk, workers=cores)  # warm
-        sweep = best(lambda: run_local(req, chunk_points=chunk, workers=cores))
+        sweep = best_of(lambda: run_local(req, chunk_points=chunk, workers=cores), REPEATS)
         command = command_seconds(cubic_te_design(), tmp)
         readme = command_seconds(copy.deepcopy(EXAMPLE_DESIGN), tmp)
     n = SPEEDS[2] * TORQUES[2]

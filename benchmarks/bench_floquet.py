@@ -18,8 +18,9 @@ responses (what a continuation chunk adds).
 
 from __future__ import annotations
 
-import time
+from collections.abc import Callable
 
+import common  # benchmarks/common.py
 import numba
 import numpy as np
 from report import write_section  # benchmarks/report.py (the script's own folder)
@@ -43,14 +44,9 @@ DESIGN = GearParams.model_validate(PARAMS)
 LINE = {"parameter": "F_e1", "start": 0.2, "stop": 0.235, "num": 36}
 
 
-def best_of(fn, repeats: int = REPEATS) -> float:
-    """Smallest wall time of ``repeats`` calls, seconds."""
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
+def best_of(fn: Callable[[], object], repeats: int = REPEATS) -> float:
+    """Smallest wall time of ``repeats`` calls, seconds (``common.best_of``)."""
+    return common.best_of(fn, repeats)
 
 
 def line_responses(grid: np.ndarray) -> list[Response]:

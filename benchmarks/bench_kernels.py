@@ -15,8 +15,10 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
+import common  # benchmarks/common.py
 import numba
 import numpy as np
 from report import write_section  # benchmarks/report.py (the script's own folder)
@@ -50,14 +52,9 @@ def paper(fe: float) -> GearParams:
     )
 
 
-def best_of(fn, repeats: int = REPEATS) -> float:
-    """Smallest wall time of ``repeats`` calls, seconds."""
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
+def best_of(fn: Callable[[], object], repeats: int = REPEATS) -> float:
+    """Smallest wall time of ``repeats`` calls, seconds (``common.best_of``)."""
+    return common.best_of(fn, repeats)
 
 
 def scipy_ns_per_step(periods: int = 20) -> float:

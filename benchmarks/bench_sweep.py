@@ -21,8 +21,8 @@ import time
 from pathlib import Path
 
 import httpx
+from common import wait_ready  # benchmarks/common.py
 from report import write_section  # benchmarks/report.py (the script's own folder)
-from serving import wait_ready  # benchmarks/serving.py
 
 ROOT = Path(__file__).resolve().parents[1]
 GEAR_REF = Path("/work/shared/reference/gear_ref.c")

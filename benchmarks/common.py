@@ -1,10 +1,21 @@
-"""What the benchmarks that start a real ``gearengine serve`` share."""
+"""What several benchmark scripts share: timing a call, and waiting for a real server."""
 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 
 import httpx
+
+
+def best_of(fn: Callable[[], object], repeats: int) -> float:
+    """Smallest wall time of ``repeats`` calls of ``fn``, seconds."""
+    times = []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return min(times)
 
 
 def wait_ready(client: httpx.Client, seconds: float = 120.0) -> None:
