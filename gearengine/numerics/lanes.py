@@ -8,25 +8,16 @@ of ``runs.start_verdict`` + ``batch.batch_point`` without a ``Run`` or ``StartSu
 
 from __future__ import annotations
 
-import functools
 import math
-from typing import Any, TypeVar
 
 import numpy as np
-from pydantic import BaseModel
 
 from gearengine.numerics.classify import classify, severity
 from gearengine.numerics.diagnostics import impact_regime
 from gearengine.numerics.lyapunov import benettin_rows
 from gearengine.numerics.periodicity import attractor_size, detect_period
 from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
-
-M = TypeVar("M", bound=BaseModel)
-
-
-def _finite(value: float) -> float | None:
-    """``runs.finite_or_none`` of a float."""
-    return float(value) if math.isfinite(value) else None
+from gearengine.numerics.runs import finite_or_none
 
 
 def lane_lle(
@@ -91,21 +82,20 @@ def lane_point(
     classification, period, lle, stderr = verdict
     dead = bool(diverged[lane])
     lo, hi = float(xmin[lane]), float(xmax[lane])
-    final = [_finite(float(xf[lane])), _finite(float(vf[lane]))]
-    return construct(
-        BatchPoint,
+    final = [finite_or_none(float(xf[lane])), finite_or_none(float(vf[lane]))]
+    return BatchPoint.model_construct(
         classification=classification,
         period=period,
-        lle=None if dead else _finite(lle),
-        lle_stderr=None if dead else _finite(stderr),
+        lle=None if dead else finite_or_none(lle),
+        lle_stderr=None if dead else finite_or_none(stderr),
         final_state=None if dead or None in final else final,
         impact_regime=None if dead else impact_regime(lo, hi),
         poincare=strobes,
         start_index=start_index,
-        x_peak_to_peak=None if dead else _finite(hi - lo),
+        x_peak_to_peak=None if dead else finite_or_none(hi - lo),
         periods_run=int(done[lane]),
-        force_max=None if dead else _finite(float(fmax[lane])),
-        force_min=None if dead else _finite(float(fmin[lane])),
+        force_max=None if dead else finite_or_none(float(fmax[lane])),
+        force_min=None if dead else finite_or_none(float(fmin[lane])),
     )
 
 
@@ -130,45 +120,3 @@ def lockstep_points(
         i: lane_point(out, best, best - first[i], verdicts[best], window)
         for i, best, window in zip(members, worst, strobes, strict=True)
     }
-
-
-@functools.cache
-def _layout(cls: type[BaseModel]) -> tuple[tuple[str, ...], dict[str, Any]] | None:
-    """Field names of ``cls`` in order and the plain defaults of the optional ones; None when
-    ``construct`` must leave the model to ``model_construct`` (aliases, factories, hooks)."""
-    if cls.__pydantic_post_init__ or cls.model_config.get("extra") == "allow":
-        return None
-    defaults: dict[str, Any] = {}
-    for name, field in cls.model_fields.items():
-        if field.alias not in (None, name) or field.validation_alias not in (None, name):
-            return None
-        if field.default_factory is not None:
-            return None
-        if not field.is_required():
-            if not isinstance(field.default, str | int | float | None):
-                return None
-            defaults[name] = field.default
-    return tuple(cls.model_fields), defaults
-
-
-@functools.cache
-def names_of(names: tuple[str, ...]) -> frozenset[str]:
-    """The field names as a set (remembered per model)."""
-    return frozenset(names)
-
-
-def construct(cls: type[M], **values: Any) -> M:
-    """``cls.model_construct(**values)`` (no validation) without its per-field alias lookups:
-    the same ``__dict__`` (fields in order, defaults filled) and the same set of fields set."""
-    layout = _layout(cls)
-    if layout is None:
-        return cls.model_construct(**values)
-    names, defaults = layout
-    if not names_of(names) >= values.keys() >= names_of(names) - defaults.keys():
-        return cls.model_construct(**values)
-    m = cls.__new__(cls)
-    object.__setattr__(m, "__dict__", {n: values[n] if n in values else defaults[n] for n in names})
-    object.__setattr__(m, "__pydantic_fields_set__", set(values))
-    object.__setattr__(m, "__pydantic_extra__", None)
-    object.__setattr__(m, "__pydantic_private__", None)
-    return m

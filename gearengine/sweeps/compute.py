@@ -15,7 +15,6 @@ from gearengine.model.params import GearParams
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.bifurcations import Response, locate_bifurcations
 from gearengine.numerics.forcing import step_plan
-from gearengine.numerics.lanes import construct
 from gearengine.numerics.results import BatchPoint
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.sweeps.axes import display_unit, is_dimensionless
@@ -63,8 +62,7 @@ def _point(
     """The sweep's point from the engine's verdict ``bp`` (typed and finite, built by
     ``numerics.batch``), so ``model_construct`` skips a second validation (~0.05 ms a point)."""
     possible = chaos_possible(params)
-    return construct(
-        SweepPoint,
+    return SweepPoint.model_construct(
         values={name: float(v) for name, v in values.items()},
         branch=branch,
         classification=bp.classification,
