@@ -25,6 +25,7 @@ from gearengine.sweeps import (
     agreement_table,
     compute_chunk,
     compute_chunk_json,
+    export,
     run_local,
     sweep_work,
     to_csv,
@@ -151,6 +152,36 @@ def test_csv_has_a_row_per_point_and_axis_columns() -> None:
     assert [float(x) for x in rows[1]["poincare_x"].split()] == result.points[1].poincare_x
     counts = agreement_table(result.points)
     assert sum(counts.model_dump().values()) == 6
+
+
+def test_csv_numbers_read_as_the_json_writes_them() -> None:
+    """Every number of a CSV row is, verbatim, a number of the JSON result (so a cell reads as
+    the JSON value, e.g. 0.00001 rather than 1e-05) and parses back to the same float."""
+    req = validated(sweep(("F_e1", 0.0, 0.3, 3), ("Omega_e", 0.4, 0.6, 2)))
+    result = run_local(req)
+    small = result.points[0].model_copy(update={"lle": 1e-05, "poincare_x": [1e-07, 0.25]})
+    result.points.append(small)  # numbers that repr writes in another form (1e-05, 1e-07)
+    rows = list(csv.reader(io.StringIO("".join(to_csv(result)))))
+    header = rows[0]
+    assert rows[-1][header.index("lle")] == "0.00001"
+    assert rows[-1][header.index("poincare_x")] == "1e-7 0.25"
+    for row, point in zip(rows[1:], result.points, strict=True):
+        doc = point.model_dump_json()
+        cells = dict(zip(header, row, strict=True))
+        for name in ("lle", "lle_stderr"):
+            if getattr(point, name) is not None:
+                assert f'"{name}":{cells[name]},' in doc
+                assert float(cells[name]) == getattr(point, name)
+        tokens = cells["poincare_x"].split()
+        assert "[" + ",".join(tokens) + "]" in doc
+        assert [float(t) for t in tokens] == point.poincare_x
+
+
+@pytest.mark.parametrize("text", ["upper", 'say "x"', "a,b", "two\nlines"])
+def test_csv_text_cells_are_quoted_only_when_they_must_be(text: str) -> None:
+    cell = export._text_cell(text)
+    assert next(csv.reader(io.StringIO(cell + ",1\n"))) == [text, "1"]
+    assert (cell == text) == (text == "upper")
 
 
 def test_progress_reaches_the_total() -> None:
