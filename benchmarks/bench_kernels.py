@@ -36,7 +36,9 @@ from gearengine.numerics.simulation import (
 ROOT = Path(__file__).resolve().parent
 GEAR_REF = Path("/work/shared/reference/gear_ref.c")
 REPEATS = 5
-SETTINGS = SimulationSettings()
+SETTINGS = SimulationSettings(adaptive=False)
+"""Default settings at fixed length: every point runs every step, so time per step is honest
+(adaptive stopping is measured by bench_map.py and adaptive_agreement.py)."""
 STEPS = (SETTINGS.transient_periods + SETTINGS.record_periods) * SETTINGS.steps_per_period
 SWEEP = np.linspace(0.0, 0.3, 301)
 

@@ -7,12 +7,15 @@ points with default settings (500 + 500 periods x 200 RK4 steps, one start), mea
 * ``gearengine sweep FILE`` end to end (a subprocess: imports, every point's verdict, JSON, CSV
   and the PNG map), once with ``"adaptive": true`` (the default) and once with ``false``;
 * ``gear_ref --simd --batch We`` (gcc -O3 -march=native, single-threaded), one call per line of
-  the second axis (one F_e1 value, all Omega_e values), wall time of all calls.
+  the second axis (one F_e1 value, all Omega_e values), wall time of all calls;
+* the same command of the previous implementation (commit 2216844, before issue 13: no adaptive
+  stopping; its ``gearengine`` package extracted with ``git archive``, same dependencies, its
+  numba cache warmed first), default settings, on the same points.
 
-The previous implementation (before adaptive stopping) took 16.7 s wall for the 100 x 100 map
-through ``gearengine sweep`` on both cores (issue 13); the target is at most a fifth of that.
-Writes its section of benchmarks/README.md. Wall times on a shared machine vary; the CPU time
-of the sweep process is printed beside them.
+Issue 13 measured 16.7 s for the 100 x 100 map with the previous implementation; the target is
+at most a fifth of the previous implementation's time, measured here in the same run. Writes
+its section of benchmarks/README.md. Wall times on a shared machine vary; the CPU time of each
+sweep process is printed beside them.
 """
 
 from __future__ import annotations
@@ -28,18 +31,23 @@ import time
 from pathlib import Path
 
 import numpy as np
-from report import write_section  # benchmarks/report.py (the script's own folder)
+from common import extracted  # benchmarks/common.py (the script's own folder)
+from report import write_section
 
 ROOT = Path(__file__).resolve().parents[1]
 GEAR_REF = Path("/work/shared/reference/gear_ref.c")
-PREVIOUS_100 = 16.7
-"""Wall time [s] of the 100 x 100 map through ``gearengine sweep`` before (issue 13)."""
+BASELINE = "2216844"
+"""The last commit before issue 13 (the layout commit, numerics unchanged since the round began)."""
 SIZES = (100, 200)
+TAGS = {True: "a", False: "f", None: "p"}
+"""File tags of the runs: adaptive, fixed length, previous implementation."""
 
 
-def map_doc(num: int, adaptive: bool) -> dict:
+def map_doc(num: int, adaptive: bool | None) -> dict:
+    """The map at ``num`` x ``num`` points, default settings (``adaptive`` None: the previous
+    implementation's settings document, which has no such field)."""
     doc = json.loads((ROOT / "examples" / "chaos-map.json").read_text())
-    doc["settings"] = {"adaptive": adaptive}
+    doc["settings"] = {} if adaptive is None else {"adaptive": adaptive}
     for axis in doc["axes"]:
         axis["num"] = num
     return doc
@@ -50,16 +58,20 @@ def children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def sweep_seconds(tmp: Path, num: int, adaptive: bool) -> tuple[float, float, dict]:
-    """Wall and CPU seconds of ``gearengine sweep`` on the map, and its result document."""
-    name = f"map{num}{'a' if adaptive else 'f'}"
+def sweep_seconds(
+    tmp: Path, num: int, adaptive: bool | None, code: Path = ROOT
+) -> tuple[float, float, dict]:
+    """Wall and CPU seconds of ``gearengine sweep`` on the map, and its result document;
+    ``code``: the directory whose ``gearengine`` package runs (``PYTHONPATH``)."""
+    name = f"map{num}{TAGS[adaptive]}"
     path = tmp / f"{name}.json"
     path.write_text(json.dumps(map_doc(num, adaptive)))
     out = tmp / "out"
+    env = {**os.environ, "PYTHONPATH": str(code)}
     cpu = children_cpu()
     t = time.perf_counter()
     subprocess.run([sys.executable, "-m", "gearengine.cli", "sweep", str(path), "--out",
-                    str(out)], cwd=ROOT, check=True, capture_output=True)  # fmt: skip
+                    str(out)], cwd=code, env=env, check=True, capture_output=True)  # fmt: skip
     wall = time.perf_counter() - t
     return wall, children_cpu() - cpu, json.loads((out / f"{name}.json").read_text())
 
@@ -80,48 +92,57 @@ def gear_ref_seconds(exe: Path, num: int) -> float:
 
 def main() -> None:
     rows = []
-    with tempfile.TemporaryDirectory() as d:
+    with tempfile.TemporaryDirectory() as d, extracted(BASELINE) as old:
         tmp = Path(d)
         exe = tmp / "gear_ref"
         gcc = shutil.which("gcc") or sys.exit("gcc is needed to build gear_ref")
         subprocess.run([gcc, "-O3", "-march=native", "-o", exe, GEAR_REF, "-lm"], check=True)
         sweep_seconds(tmp, 4, True)  # numba caches warm
+        sweep_seconds(tmp, 4, None, old)
         for num in SIZES:
+            pr, pr_cpu, res_p = sweep_seconds(tmp, num, None, old)
             ad, ad_cpu, res_a = sweep_seconds(tmp, num, True)
             fx, fx_cpu, res_f = sweep_seconds(tmp, num, False)
             ref = gear_ref_seconds(exe, num)
-            pa, pf = res_a["points"], res_f["points"]
+            pa, pf, pp = res_a["points"], res_f["points"], res_p["points"]
             same = sum((a["classification"], a["period"]) == (f["classification"], f["period"])
                        for a, f in zip(pa, pf, strict=True))  # fmt: skip
+            as_before = sum((a["classification"], a["period"]) == (q["classification"], q["period"])
+                            for a, q in zip(pa, pp, strict=True))  # fmt: skip
             mean_run = sum(a["periods_run"] for a in pa) / len(pa)
-            rows.append((num, ad, ad_cpu, fx, fx_cpu, ref, 100.0 * same / len(pa), mean_run))
+            agree = (100.0 * same / len(pa), 100.0 * as_before / len(pa))
+            rows.append((num, pr, pr_cpu, ad, ad_cpu, fx, fx_cpu, ref, *agree, mean_run))
             print(rows[-1], flush=True)
     cores = os.cpu_count() or 1
     table = (
-        "| map | adaptive, s (CPU s) | fixed length, s (CPU s) | gear_ref --simd --batch, 1 "
-        "thread, s | adaptive / fixed | adaptive / gear_ref | verdicts equal | mean periods "
-        "run |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n"
+        f"| map | previous ({BASELINE}), s (CPU s) | adaptive, s (CPU s) | fixed length, s (CPU s) "
+        "| gear_ref --simd --batch, 1 thread, s | previous / adaptive | adaptive / fixed | "
+        "adaptive / gear_ref | verdicts equal to fixed length | to previous | mean periods run |"
+        "\n| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n"
     )
-    for num, ad, ad_cpu, fx, fx_cpu, ref, same, mean_run in rows:
+    for num, pr, pr_cpu, ad, ad_cpu, fx, fx_cpu, ref, same, as_before, mean_run in rows:
         table += (
-            f"| {num} x {num} | {ad:.1f} ({ad_cpu:.1f}) | {fx:.1f} ({fx_cpu:.1f}) | {ref:.1f} | "
-            f"{ad / fx:.2f}x | {ad / ref:.2f}x | {same:.2f} % | {mean_run:.0f} of 1000 |\n"
+            f"| {num} x {num} | {pr:.1f} ({pr_cpu:.1f}) | {ad:.1f} ({ad_cpu:.1f}) | {fx:.1f} "
+            f"({fx_cpu:.1f}) | {ref:.1f} | **{pr / ad:.1f}x** | {ad / fx:.2f}x | {ad / ref:.2f}x | "
+            f"{same:.2f} % | {as_before:.2f} % | {mean_run:.0f} of 1000 |\n"
         )
-    first = rows[0][1]
-    summary = (
-        f"The 100 x 100 map now takes {first:.1f} s wall against {PREVIOUS_100} s before "
-        f"(issue 13): {PREVIOUS_100 / first:.1f}x faster, target >= 5x."
+    summary = "Target (issue 13): each map in at most a fifth of the previous implementation's " + (
+        "time: met." if all(r[1] / r[3] >= 5.0 for r in rows) else "time: NOT met."
     )
     print(table + "\n" + summary)
     write_section(
         "maps",
-        "## Chaos maps: adaptive stopping vs fixed length vs gear_ref\n\n"
+        "## Chaos maps: adaptive stopping vs fixed length vs the previous implementation vs "
+        "gear_ref\n\n"
         "Reproduce: `.venv/bin/python benchmarks/bench_map.py` (rewrites this section).\n\n"
         "examples/chaos-map.json (Omega_e 0.3..1.2 x F_e1 0..0.6, cubic law) at default "
-        "settings (500 + 500 periods x 200 RK4 steps): `gearengine sweep` end to end (imports, "
-        f"verdicts, JSON, CSV, PNG; {cores} cores) with adaptive stopping (default) and with "
-        '`"adaptive": false`, and `gear_ref --simd --batch We` single-threaded, one call per '
-        "F_e1 line, on the same points. Adaptive stopping: numerics/kernels/adaptive.py.\n\n"
+        "settings (500 + 500 periods x 200 RK4 steps), all in one run: `gearengine sweep` end "
+        f"to end (a new process: imports, verdicts, JSON, CSV, PNG; {cores} cores) of the "
+        f"previous implementation (commit {BASELINE}, extracted with `git archive`, its numba "
+        "cache warmed first) and of this one with adaptive stopping (default) and with "
+        '`"adaptive": false`; and `gear_ref --simd --batch We` single-threaded, one call per '
+        "F_e1 line, on the same points. Adaptive stopping: numerics/kernels/adaptive.py. "
+        "Wall times on a shared machine vary; the CPU time of each command is beside it.\n\n"
         f"{table}\n{summary}\n",
     )
 

@@ -16,10 +16,10 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
-from report import write_section  # benchmarks/report.py (the script's own folder)
+from common import extracted  # benchmarks/common.py (the script's own folder)
+from report import write_section
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = "2216844"
@@ -110,12 +110,8 @@ def measure(pythonpath: Path) -> dict:
 
 def measure_commit(commit: str) -> dict:
     """The worker's timings on the engine of ``commit`` (``git archive`` into a temporary dir)."""
-    with tempfile.TemporaryDirectory(prefix="gearchaos-baseline-") as tmp:
-        archive = subprocess.run(
-            ["git", "archive", commit, "gearengine"], cwd=ROOT, capture_output=True, check=True
-        )
-        subprocess.run(["tar", "-x", "-C", tmp], input=archive.stdout, check=True)
-        return measure(Path(tmp))
+    with extracted(commit) as tmp:
+        return measure(tmp)
 
 
 def main() -> None:

@@ -1,11 +1,18 @@
-"""What several benchmark scripts share: timing a call, and waiting for a real server."""
+"""What several benchmark scripts share: timing a call, an earlier commit's engine, and waiting
+for a real server."""
 
 from __future__ import annotations
 
+import subprocess
+import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
 
 import httpx
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def best_of(fn: Callable[[], object], repeats: int) -> float:
@@ -29,3 +36,15 @@ def wait_ready(client: httpx.Client, seconds: float = 120.0) -> None:
             pass
         time.sleep(0.1)
     raise TimeoutError(f"the server was not ready within {seconds:g} s")
+
+
+@contextmanager
+def extracted(commit: str) -> Iterator[Path]:
+    """A temporary directory holding the ``gearengine`` package of ``commit`` (``git archive``):
+    the previous implementation, run with ``PYTHONPATH`` set to it and the same dependencies."""
+    with tempfile.TemporaryDirectory(prefix="gearchaos-baseline-") as tmp:
+        archive = subprocess.run(
+            ["git", "archive", commit, "gearengine"], cwd=ROOT, capture_output=True, check=True
+        )
+        subprocess.run(["tar", "-x", "-C", tmp], input=archive.stdout, check=True)
+        yield Path(tmp)
