@@ -22,6 +22,7 @@ so the engine's commands work without the web stack installed.
 from __future__ import annotations
 
 import argparse
+import importlib
 import logging
 import os
 import sys
@@ -29,14 +30,26 @@ import traceback
 from collections.abc import Callable, Sequence
 from importlib.metadata import entry_points
 
-from gearengine.cli.analyze import cmd_analyze, cmd_check
-from gearengine.cli.convert import cmd_convert
 from gearengine.cli.documents import EXIT_INTERNAL, EXIT_INVALID, EXIT_PIPE, InvalidInputError
-from gearengine.cli.melnikov import cmd_melnikov
-from gearengine.cli.sweep import cmd_sweep
 from gearengine.model.units import QUANTITIES, parse_quantity
 
 PLUGIN_GROUP = "gearengine.commands"
+"""Entry-point group of command plugins: each is a ``register(subparsers)`` function."""
+
+Command = Callable[[argparse.Namespace], int]
+
+
+def lazy(module: str, name: str) -> Command:
+    """The command ``name`` of ``module``, imported when it runs: each command pays only for
+    the rooms it uses (``convert`` and ``melnikov`` never load matplotlib), and ``--help`` or
+    a usage error for none."""
+
+    def run(args: argparse.Namespace) -> int:
+        command: Command = getattr(importlib.import_module(module), name)
+        return command(args)
+
+    run.__qualname__ = run.__name__ = name
+    return run
 
 
 def micrometres(text: str) -> float:
@@ -51,9 +64,6 @@ def micrometres(text: str) -> float:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
-"""Entry-point group of command plugins: each is a ``register(subparsers)`` function."""
-
-
 def build_parser() -> argparse.ArgumentParser:
     """The engine's commands and those of every installed plugin."""
     parser = argparse.ArgumentParser(
@@ -65,14 +75,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help='JSON file holding {"params": {...}} or {"design": {...}}, or -')
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
     p.add_argument("--method", choices=["closed_form", "quadrature"], default=None)
-    p.set_defaults(func=cmd_melnikov)
+    p.set_defaults(func=lazy("gearengine.cli.melnikov", "cmd_melnikov"))
 
     p = sub.add_parser("analyze", help="Melnikov and numerical verdicts of a design")
     p.add_argument(
         "file", help='JSON file holding {"params" or "design": {...}, "settings": {...}}, or -'
     )
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
-    p.set_defaults(func=cmd_analyze)
+    p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_analyze"))
 
     p = sub.add_parser(
         "check",
@@ -116,17 +126,17 @@ def build_parser() -> argparse.ArgumentParser:
         help="fail when the response is periodic and its Floquet stability margin "
         "1 - max |lambda| is below X (or unavailable)",
     )
-    p.set_defaults(func=cmd_check)
+    p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
 
     p = sub.add_parser("sweep", help="run a sweep here, no server: JSON, CSV and PNG")
     p.add_argument("file", help="JSON file holding a sweep request (as POST /v1/sweeps), or -")
     p.add_argument("--out", default=".", help="directory for the outputs (default .)")
-    p.set_defaults(func=cmd_sweep)
+    p.set_defaults(func=lazy("gearengine.cli.sweep", "cmd_sweep"))
 
     p = sub.add_parser("convert", help="a design in physical units: parameters, derivations, rpm")
     p.add_argument("file", help='JSON file holding {"design": {...}}, or - for stdin')
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
-    p.set_defaults(func=cmd_convert)
+    p.set_defaults(func=lazy("gearengine.cli.convert", "cmd_convert"))
 
     for plugin in entry_points(group=PLUGIN_GROUP):
         try:
@@ -139,7 +149,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit code."""
     args = build_parser().parse_args(argv)
-    func: Callable[[argparse.Namespace], int] = args.func
+    func: Command = args.func
     try:
         code = func(args)
         sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's exit

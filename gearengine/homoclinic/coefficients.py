@@ -35,7 +35,6 @@ from typing import Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
-from scipy import integrate
 
 from gearengine.homoclinic.extrema import TrigSum
 from gearengine.model.params import GearParams
@@ -187,6 +186,8 @@ def _quad(f: Callable[[float], float], t_max: float, **weight: object) -> float:
 
     Raises ArithmeticError when QUADPACK's error estimate exceeds 1e-9 relative (1e-12 absolute).
     """
+    from scipy import integrate  # scipy loads in ~0.2 s; only the quadrature check needs it
+
     value, abserr, *_ = integrate.quad(
         f, 0.0, t_max, epsabs=1e-14, epsrel=1e-11, limit=1000, full_output=1, **weight
     )

@@ -14,7 +14,6 @@ from collections.abc import Iterable
 from fractions import Fraction
 
 import numpy as np
-from scipy import optimize
 
 from gearengine.homoclinic import kernels
 from gearengine.homoclinic.coefficients import (
@@ -121,6 +120,8 @@ def verdict_flips(
     """Values of ``alias`` in [lo, hi] where the Melnikov verdict flips: brentq on the
     sign-change strength from a scan of ``num`` values (flips closer than a step may be missed).
     """
+    from scipy import optimize  # scipy loads in ~0.2 s; only root finding here needs it
+
     grid = np.linspace(min(lo, hi), max(lo, hi), num)
     s = [strength_at(params, {alias: float(v)}) for v in grid]
     return [
@@ -359,6 +360,8 @@ def _scan_python(
             for name, exc in params.excitations()
         }
         return sign_change_strength(params.model_copy(update=moved), a, c, method)
+
+    from scipy import optimize
 
     omegas = np.linspace(start, stop, num)
     values = [strength(om) for om in omegas]

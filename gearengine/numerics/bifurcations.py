@@ -25,7 +25,6 @@ from collections.abc import Callable, Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
-from scipy.optimize import brentq
 
 from gearengine.model.aliases import with_alias
 from gearengine.model.params import GearParams
@@ -183,6 +182,8 @@ def _locate(
     orbit nearest in p (so the two ends, evaluated first, are never recomputed from elsewhere
     on the branch). Raises ``_OrbitLostError`` when the margin has the same sign at both ends.
     """
+    from scipy.optimize import brentq  # scipy loads in ~0.2 s; only this root finding needs it
+
     known: dict[float, FloquetResult] = {}
 
     def margin(p: float) -> float:

@@ -26,7 +26,6 @@ from __future__ import annotations
 import math
 import warnings
 
-import nolds
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -73,6 +72,8 @@ def lyap_r_check(x: np.ndarray, dt: float, omega_dominant: float) -> NoldsResult
         dt: sample spacing, time units.
         omega_dominant: dominant angular frequency of x (rad per unit time), > 0.
     """
+    import nolds  # ~0.08 s to import (it loads pkg_resources); only this opt-in check needs it
+
     decim = max(1, round(2.0 * math.pi / omega_dominant / dt / SAMPLES_PER_PERIOD))
     series = x[::decim][-MAX_POINTS:]
     step = decim * dt

@@ -7,7 +7,8 @@ Rendering only: every number drawn comes from a result object of the engine.
 from __future__ import annotations
 
 import numpy as np
-from matplotlib import pyplot as plt
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 
 from gearengine.analysis import AnalysisResult
 from gearengine.homoclinic.schemas import ThresholdCurve
@@ -18,7 +19,8 @@ from gearengine.plots.style import ImageFormat, figure_bytes, symbol
 def analysis_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
     """(a) time history, (b) phase plane, (c) Poincare section, (d) amplitude spectrum."""
     num = result.numerics
-    fig, axes = plt.subplots(2, 2, figsize=(10, 7.5), layout="constrained")
+    fig = Figure(figsize=(10, 7.5), layout="constrained")
+    axes = fig.subplots(2, 2)
     (ax_t, ax_p), (ax_s, ax_f) = axes
     hist = num.time_history
     period = f"{num.period}T-periodic" if num.period else num.classification.replace("_", "-")
@@ -60,7 +62,7 @@ def analysis_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
 CLEARANCE = "|x| = 1: clearance edges"
 
 
-def _spectrum(ax: plt.Axes, peaks: list[SpectrumPeak], record_periods: int) -> None:
+def _spectrum(ax: Axes, peaks: list[SpectrumPeak], record_periods: int) -> None:
     """The spectrum the JSON reports (``numerics.spectrum_peaks``): its largest peaks as stems,
     so the figure and the numbers agree; computed over the whole record (``record_periods``
     sampling intervals), Hann window, amplitude-corrected (a sinusoid A cos wt peaks at A)."""
@@ -96,7 +98,8 @@ def threshold_figure(
 ) -> bytes:
     """Critical values of the parameter against the frequency, the no-chaos band shaded, and
     the design as a point at (``design_frequency``, ``curve.value``) when both are known."""
-    fig, ax = plt.subplots(figsize=(8, 5.5), layout="constrained")
+    fig = Figure(figsize=(8, 5.5), layout="constrained")
+    ax = fig.subplots()
     w = np.asarray(curve.frequencies)
     lo, hi = _band(curve.no_chaos)
     sym, fsym = symbol(curve.parameter), symbol(curve.frequency_parameter)

@@ -12,7 +12,6 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import matplotlib.pyplot as plt
 from matplotlib.figure import Figure
 
 ImageFormat = Literal["png", "svg"]
@@ -40,10 +39,10 @@ def symbol(alias: str) -> str:
 
 def figure_bytes(fig: Figure, fmt: ImageFormat) -> bytes:
     """Figure to PNG (150 dpi) or SVG bytes; deterministic (no timestamps, fixed hash salt),
-    cropped to what is drawn so no title is clipped."""
+    cropped to what is drawn so no title is clipped. Figures are made with ``Figure()``, not
+    pyplot (~0.2 s to import, and a registry of open figures to close): nothing to release."""
     buf = io.BytesIO()
-    with plt.rc_context({"svg.hashsalt": "gearchaos"}):
+    with matplotlib.rc_context({"svg.hashsalt": "gearchaos"}):
         metadata = {"Date": None} if fmt == "svg" else {"Software": "gearchaos"}
         fig.savefig(buf, format=fmt, dpi=150, metadata=metadata, bbox_inches="tight")
-    plt.close(fig)
     return buf.getvalue()
