@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import gc
+import os
 import sys
 import time
 from collections.abc import Callable, Iterator
@@ -76,7 +77,7 @@ def _sweep(args: argparse.Namespace) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     stem = "sweep" if args.file == "-" else Path(args.file).stem
-    result = run_local(request, progress_bar(time.monotonic()))
+    result = run_local(request, progress_bar(time.monotonic()), workers=os.cpu_count() or 1)
     (out / f"{stem}.json").write_text(dumps(result))
     (out / f"{stem}.csv").write_text("".join(to_csv(result, request.outputs)))
     (out / f"{stem}.png").write_bytes(
