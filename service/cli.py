@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import ipaddress
-import logging
 from pathlib import Path
 
 from gearengine.cli.documents import EXIT_OK, InvalidInputError
@@ -32,7 +31,12 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
     from service.api.deps import load_key_hashes
     from service.main import create_app
-    from service.server import EXIT_STARTUP_FAILURE, AnnouncingServer, serve_processes
+    from service.server import (
+        EXIT_STARTUP_FAILURE,
+        AnnouncingServer,
+        log_to_stderr,
+        serve_processes,
+    )
 
     flags = {
         "host": args.host,
@@ -65,7 +69,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         raise InvalidInputError(
             [f"data directory {settings.data_dir} is not writable: {exc.strerror}"]
         ) from None
-    logging.basicConfig(level=logging.INFO, format="%(message)s")  # JSON access/job lines
+    log_to_stderr()
     config = uvicorn.Config(
         create_app(settings),
         host=settings.host,

@@ -331,6 +331,15 @@ def commensurability(frequencies: list[float]) -> tuple[float, float]:
     return float(math.gcd(*(q.numerator * (lcm // q.denominator) for q in ratios))), float(lcm)
 
 
+@functools.lru_cache(maxsize=256)
+def scan_grid(start: float, stop: float, num: int) -> np.ndarray:
+    """``numpy.linspace(start, stop, num)``, read-only and kept: a service answers many designs
+    on the same Omega_e scan, and linspace costs as much as a verdict's root finding."""
+    grid = np.linspace(start, stop, num)
+    grid.flags.writeable = False
+    return grid
+
+
 def _scan_compiled(
     params: GearParams, a: float, c: float, scan: tuple, value: float
 ) -> tuple[list[float], list[tuple[float, float]]] | None:
@@ -338,7 +347,7 @@ def _scan_compiled(
     start, stop, num = scan
     base, r, kind, amp, phase = scan_terms(params)
     gcd, lcm = commensurability((r * base).tolist())
-    omegas = np.linspace(start, stop, num)
+    omegas = scan_grid(start, stop, num)
     args = (value, base, r, kind, amp, phase, float(params.damping), a, c, gcd, lcm)
     critical, flags, ok = kernels.scan_roots(omegas, 1e-12, *args)
     if not ok:
