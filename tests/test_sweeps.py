@@ -245,3 +245,26 @@ def test_sweep_work_costs_every_frequency_combination() -> None:
     assert sweep_work(req) == sum(per_point) == 279_800_000
     amplitude = validated(sweep(("F_e1", 0.0, 0.3, 31)))
     assert sweep_work(amplitude) == 31 * work(amplitude.params, amplitude.settings)
+
+
+def test_csv_of_a_design_sweep_has_its_values_in_gear_units() -> None:
+    """A design's sweep: the axes also in rpm and N*m, the DTE in µm and the dynamic factor,
+    equal to each point's ``physical``; a sweep of params has no such columns."""
+    doc = json.loads((Path(__file__).parents[1] / "examples" / "envelope-map.json").read_text())
+    doc["settings"] = SHORT
+    doc["axes"][0]["num"], doc["axes"][1]["num"] = 3, 2
+    req = validated(doc)
+    result = run_local(req)
+    rows = list(csv.DictReader(io.StringIO("".join(to_csv(result, design=True)))))
+    assert list(rows[0])[:6] == [
+        "speed", "torque", "speed [rpm]", "torque [N*m]", "dte [um]", "dynamic_factor"
+    ]  # fmt: skip
+    assert [float(r["speed [rpm]"]) for r in rows[:3]] == [500.0, 3250.0, 6000.0]
+    for row, point in zip(rows, result.points, strict=True):
+        assert point.physical is not None
+        for key, title in (("torque", "torque [N*m]"), ("dte", "dte [um]")):
+            assert float(row[title]) == point.physical[key].value
+        assert int(row["periods_run"]) == point.periods_run
+    plain = validated(sweep(("F_e1", 0.0, 0.3, 2)))
+    header = next(csv.reader(io.StringIO("".join(to_csv(run_local(plain))))))
+    assert header[:2] == ["F_e1", "branch"]

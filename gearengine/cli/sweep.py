@@ -79,7 +79,8 @@ def _sweep(args: argparse.Namespace) -> int:
     stem = "sweep" if args.file == "-" else Path(args.file).stem
     result = run_local(request, progress_bar(time.monotonic()), workers=os.cpu_count() or 1)
     (out / f"{stem}.json").write_text(dumps(result))
-    (out / f"{stem}.csv").write_text("".join(to_csv(result, request.outputs)))
+    csv = to_csv(result, request.outputs, design=request.design is not None)
+    (out / f"{stem}.csv").write_text("".join(csv))
     (out / f"{stem}.png").write_bytes(
         sweep_figure(request, result.points, "png", result.bifurcations)
     )

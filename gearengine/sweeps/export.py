@@ -9,6 +9,7 @@ from collections.abc import Iterable, Iterator, Sequence
 
 from pydantic import BaseModel, Field, TypeAdapter
 
+from gearengine.sweeps.axes import display_unit, is_dimensionless
 from gearengine.sweeps.request import SweepAxis
 from gearengine.sweeps.results import SweepBifurcation, SweepPoint, SweepResult
 
@@ -91,35 +92,63 @@ CSV_FIELDS = (
     "lle_stderr",
     "impact_regime",
     "melnikov_chaos_possible",
+    "periods_run",
+    "x_peak_to_peak",
+    "force_max",
+    "force_min",
     "poincare_x",
 )
+"""The CSV's columns after the axes, the long Poincaré column last."""
 
 
-def to_csv(result: SweepResult, outputs: Sequence[str] | None = None) -> Iterator[str]:
+def to_csv(
+    result: SweepResult, outputs: Sequence[str] | None = None, design: bool = False
+) -> Iterator[str]:
     """CSV rows of a result (see ``csv_rows``)."""
-    return csv_rows(result.axes, result.points, outputs)
+    return csv_rows(result.axes, result.points, outputs, design)
 
 
 def csv_rows(
-    axes: list[SweepAxis], points: Iterable[SweepPoint], outputs: Sequence[str] | None = None
+    axes: list[SweepAxis],
+    points: Iterable[SweepPoint],
+    outputs: Sequence[str] | None = None,
+    design: bool = False,
 ) -> Iterator[str]:
-    """CSV rows (header first): one column per axis, the verdicts, and poincare_x as
-    space-separated numbers. Empty cells are nulls; booleans are true/false; every number is
-    written as the JSON result writes it (``_json_numbers``). With ``outputs``
-    (``SweepRequest.outputs``) only the columns it names (and branch) are written. Rows are
-    yielded one by one, so a streamed response never holds the whole table."""
+    """CSV rows (header first): one column per axis (SI for a design's fields), with a
+    ``design`` (a sweep of a design in physical units) the same axes in display units and the
+    DTE and dynamic factor (``speed [rpm]``, ``dte [um]``, ``dynamic_factor``: the point's
+    ``physical``), then the verdicts, and poincare_x as space-separated numbers. Empty cells
+    are nulls; booleans are true/false; every number is written as the JSON result writes it
+    (``_json_numbers``). With ``outputs`` (``SweepRequest.outputs``) only the columns it names
+    (and branch) are written. Rows are yielded one by one, so a streamed response never holds
+    the whole table."""
     names = [a.parameter for a in axes]
+    shown = _physical_columns(names, outputs) if design else []
     fields = [f for f in CSV_FIELDS if outputs is None or f == "branch" or f in outputs]
-    yield ",".join(_text_cell(c) for c in (*names, *fields)) + "\n"
+    header = [*names, *(title for _, title in shown), *fields]
+    yield ",".join(_text_cell(c) for c in header) + "\n"
+    keys = [key for key, _ in shown]
     for p in points:
-        yield ",".join(_row(p, names, fields)) + "\n"
+        yield ",".join(_row(p, names, keys, fields)) + "\n"
 
 
-def _row(p: SweepPoint, names: list[str], fields: list[str]) -> list[str]:
-    """The text cells of a point's row: the axis values, then each field. The floats (with the
-    Poincaré numbers) are formatted in one ``_json_numbers`` call, then taken in order."""
+def _physical_columns(names: list[str], outputs: Sequence[str] | None) -> list[tuple[str, str]]:
+    """(key of ``SweepPoint.physical``, column title) of a design's sweep: each physical axis in
+    its display unit, the DTE and the dynamic factor (none when ``outputs`` leaves them out)."""
+    if outputs is not None and "physical" not in outputs:
+        return []
+    axes = [(n, f"{n} [{display_unit(n)[0]}]") for n in names if not is_dimensionless(n)]
+    return [*axes, ("dte", "dte [um]"), ("dynamic_factor", "dynamic_factor")]
+
+
+def _row(p: SweepPoint, names: list[str], keys: list[str], fields: list[str]) -> list[str]:
+    """The text cells of a point's row: the axis values, the ``physical`` values named by
+    ``keys``, then each field. The floats (with the Poincaré numbers) are formatted in one
+    ``_json_numbers`` call, then taken in order."""
     values = [getattr(p, f) for f in fields]
     floats = [_grid_value(p.values[n]) for n in names]
+    shown = [(p.physical or {}).get(key) for key in keys]
+    floats.extend(v.value for v in shown if v is not None)
     for f, value in zip(fields, values, strict=True):
         if f == "poincare_x":
             floats.extend(value or [])
@@ -128,6 +157,9 @@ def _row(p: SweepPoint, names: list[str], fields: list[str]) -> list[str]:
     numbers = _json_numbers(floats)
     cells = numbers[: len(names)]
     k = len(names)
+    for v in shown:
+        cells.append("" if v is None else numbers[k])
+        k += v is not None
     for f, value in zip(fields, values, strict=True):
         if f == "poincare_x":
             n = len(value or [])

@@ -245,7 +245,7 @@ def get_result(
     if format == "csv":
         name = f"sweep-{job_id}{'-partial' if missing else ''}.csv"
         return StreamingResponse(
-            csv_rows(axes, _stored_points(jobs, job_id), sweep.outputs),
+            csv_rows(axes, _stored_points(jobs, job_id), sweep.outputs, sweep.design is not None),
             media_type=CSV,
             headers={"Content-Disposition": f'attachment; filename="{name}"', **headers},
         )
