@@ -83,6 +83,9 @@ class Engineering(_Doc):
     natural_frequency_hz: float
     time_scale_s: float
     mesh_frequency_hz: float
+    half_backlash_um: float = Field(
+        description="The half backlash b [µm], the unit of x in the dimensionless results."
+    )
     speed_rpm: float
     speed_range_rpm: list[float] = Field(description="Driver speeds scanned [rpm].")
     speed_windows_rpm: list[list[float]] = Field(
@@ -244,6 +247,7 @@ def engineering(
         natural_frequency_hz=conv.natural_frequency_hz,
         time_scale_s=conv.time_scale_s,
         mesh_frequency_hz=conv.mesh_frequency_hz,
+        half_backlash_um=conv.half_backlash_m * 1e6,
         speed_rpm=conv.speed_rpm,
         speed_range_rpm=list(rpm_range),
         speed_windows_rpm=windows,

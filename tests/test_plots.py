@@ -3,6 +3,8 @@ what they are, the design is a point, one legend entry per drawn threshold line.
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -90,3 +92,33 @@ def test_threshold_figure_marks_the_design_and_labels_each_line(drawn: list[Figu
         if line.get_label() in thresholds
     }
     assert len(thresholds) == len(lines) == 2, (thresholds, lines)
+
+
+def test_a_design_is_drawn_in_gear_units(drawn: list[Figure]) -> None:
+    """A design's four panels: time in ms, x b in µm, velocity in mm/s, spectrum in Hz and µm,
+    each scale agreeing with the JSON's engineering block (computed by another path)."""
+    doc = json.loads((Path(__file__).parents[1] / "examples" / "design-direct.json").read_text())
+    doc["settings"] = {"transient_periods": 100, "record_periods": 100, "steps_per_period": 128}
+    result = analyze(AnalysisRequest.model_validate(doc))
+    eng, num = result.engineering, result.numerics
+    assert eng is not None and eng.response is not None and num.time_history is not None
+    plots.analysis_figure(result)
+    (fig,) = drawn
+    ax_t, ax_p, _, ax_f = fig.axes
+    assert (ax_t.get_xlabel(), ax_p.get_ylabel(), ax_f.get_xlabel()) == (
+        "time (ms)", "relative velocity (mm/s)", "frequency (Hz)"
+    )  # fmt: skip
+    assert "µm" in ax_t.get_ylabel() and "µm" in ax_f.get_ylabel()
+    t = ax_t.lines[0].get_xdata()
+    tau = num.time_history.t
+    assert t[-1] - t[0] == pytest.approx((tau[-1] - tau[0]) * eng.time_scale_s * 1e3)
+    b_um = eng.half_backlash_um
+    assert b_um == pytest.approx(50.0)  # the design's "half_backlash": "50 um"
+    x = ax_t.lines[0].get_ydata()
+    assert x.max() - x.min() <= eng.response.dte_peak_to_peak_um * (1 + 1e-12)
+    (stems,) = ax_f.collections
+    tops = max(stems.get_segments(), key=lambda s: s[1][1])
+    assert tops[1][0] == pytest.approx(eng.response.dominant_frequency_hz)
+    assert tops[1][1] == pytest.approx(num.spectrum_peaks[0].amplitude * b_um)
+    edges = sorted(line.get_ydata()[0] for line in ax_t.lines[1:])
+    assert edges == pytest.approx([-b_um, b_um])  # the clearance edges at the half backlash

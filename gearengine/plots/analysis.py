@@ -6,6 +6,9 @@ Rendering only: every number drawn comes from a result object of the engine.
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
+
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
@@ -16,44 +19,91 @@ from gearengine.numerics.results import SpectrumPeak
 from gearengine.plots.style import ImageFormat, figure_bytes, symbol
 
 
+@dataclass(frozen=True)
+class Units:
+    """How the four-panel figure shows x, x', tau and frequencies: factors from the
+    dimensionless quantities of Eq. (9) and axis labels. A design's analysis is drawn in gear
+    units (x b in µm, time in ms, velocity in mm/s, frequency in Hz); params in Eq. (9)'s own."""
+
+    x: float
+    v: float
+    t: float
+    f: float
+    x_label: str
+    v_label: str
+    t_label: str
+    f_label: str
+    amplitude: str
+    lle: float
+    lle_unit: str
+    mesh_hz: float | None
+
+    @classmethod
+    def of(cls, result: AnalysisResult) -> Units:
+        eng = result.engineering
+        if eng is None:
+            return cls(
+                1.0, 1.0, 1.0, 1.0,
+                r"$x$ (units of the half backlash $b$)",
+                r"$\dot x = dx/d\tau$ ($b$ per unit $\tau$)",
+                r"$\tau$ (dimensionless time)",
+                r"order: frequency / $\Omega_0$ (fundamental of the forcing)",
+                "units of b",
+                1.0, "per unit τ", None,
+            )  # fmt: skip
+        b_um, tau_s = eng.half_backlash_um, eng.time_scale_s
+        return cls(
+            b_um, 1e-3 * b_um / tau_s, 1e3 * tau_s, 1.0 / (2.0 * math.pi * tau_s),
+            f"relative displacement $x\\,b$ (µm; b = {b_um:.3g} µm)",
+            "relative velocity (mm/s)",
+            "time (ms)",
+            "frequency (Hz)",
+            "µm",
+            1.0 / tau_s, "per s", eng.mesh_frequency_hz,
+        )  # fmt: skip
+
+
 def analysis_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
-    """(a) time history, (b) phase plane, (c) Poincare section, (d) amplitude spectrum."""
+    """(a) time history, (b) phase plane, (c) Poincare section, (d) amplitude spectrum; in gear
+    units for a design (``Units``)."""
     num = result.numerics
+    u = Units.of(result)
     fig = Figure(figsize=(10, 7.5), layout="constrained")
     axes = fig.subplots(2, 2)
     (ax_t, ax_p), (ax_s, ax_f) = axes
     hist = num.time_history
     period = f"{num.period}T-periodic" if num.period else num.classification.replace("_", "-")
-    lle = "n/a" if num.lle is None else f"{num.lle:+.4f} ± {num.lle_stderr or 0.0:.4f}"
+    lle = "n/a"
+    if num.lle is not None:
+        spread = (num.lle_stderr or 0.0) * u.lle
+        lle = f"{num.lle * u.lle:+.4g} ± {spread:.2g} {u.lle_unit}"
     mel = result.melnikov.chaos_possible
+    at = "" if result.engineering is None else f" at {result.engineering.speed_rpm:,.0f} rpm"
     fig.suptitle(
-        f"{period} response   LLE λ₁ = {lle} per unit τ   "
+        f"{period} response{at}   LLE λ₁ = {lle}   "
         f"Melnikov: chaos {'possible' if mel else 'not possible' if mel is False else 'n/a'}",
         fontsize=11,
     )
     if hist is not None and hist.t:
         t, x, v = (np.asarray(a) for a in (hist.t, hist.x, hist.v))
-        ax_t.plot(t, x, lw=0.8, color="C0")
-        ax_p.plot(x, v, lw=0.6, color="C0")
+        ax_t.plot(t * u.t, x * u.x, lw=0.8, color="C0")
+        ax_p.plot(x * u.x, v * u.v, lw=0.6, color="C0")
     if num.poincare:
         pts = np.asarray(num.poincare)
-        ax_p.plot(pts[:, 0], pts[:, 1], "o", ms=3, color="C3", label="Poincaré points")
-        ax_s.plot(pts[:, 0], pts[:, 1], "o", ms=2.5, color="C3")
+        ax_p.plot(pts[:, 0] * u.x, pts[:, 1] * u.v, "o", ms=3, color="C3", label="Poincaré points")
+        ax_s.plot(pts[:, 0] * u.x, pts[:, 1] * u.v, "o", ms=2.5, color="C3")
+        _no_zoom_into_noise(ax_s, pts[:, 1] * u.v)
     for ax in (ax_t, ax_p, ax_s):
-        for edge in (-1.0, 1.0):  # clearance edges |x| = 1 (Eq. 8)
+        for edge in (-u.x, u.x):  # clearance edges |x| = 1 (Eq. 8), |x b| = b
             (ax.axhline if ax is ax_t else ax.axvline)(
                 edge, color="0.45", lw=0.7, ls=":", label=CLEARANCE if edge > 0 else None
             )
     # one legend for panels (a)-(c), under them, where it hides no data
     fig.legend(*ax_p.get_legend_handles_labels(), loc="outside lower center", ncols=2, fontsize=8.5)
-    x_label, v_label = (
-        r"$x$ (units of the half backlash $b$)",
-        r"$\dot x = dx/d\tau$ ($b$ per unit $\tau$)",
-    )
-    ax_t.set(title="(a) time history", xlabel=r"$\tau$ (dimensionless time)", ylabel=x_label)
-    ax_p.set(title="(b) phase plane", xlabel=x_label, ylabel=v_label)
-    ax_s.set(title="(c) Poincaré section (one point per $T_0$)", xlabel=x_label, ylabel=v_label)
-    _spectrum(ax_f, num.spectrum_peaks, result.settings.record_periods)
+    ax_t.set(title="(a) time history", xlabel=u.t_label, ylabel=u.x_label)
+    ax_p.set(title="(b) phase plane", xlabel=u.x_label, ylabel=u.v_label)
+    ax_s.set(title="(c) Poincaré section (one point per $T_0$)", xlabel=u.x_label, ylabel=u.v_label)
+    _spectrum(ax_f, num.spectrum_peaks, result.settings.record_periods, u)
     for ax in axes.flat:
         ax.grid(alpha=0.3)
     return figure_bytes(fig, fmt)
@@ -61,15 +111,31 @@ def analysis_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
 
 CLEARANCE = "|x| = 1: clearance edges"
 
+NOISE = 1e-6
+"""Relative spread below which the strobes of a section count as one point (a 1T orbit)."""
 
-def _spectrum(ax: Axes, peaks: list[SpectrumPeak], record_periods: int) -> None:
+
+def _no_zoom_into_noise(ax: Axes, values: np.ndarray) -> None:
+    """The vertical axis of a Poincaré section around the strobes' level: a periodic orbit's
+    strobes agree to ~1e-11, and matplotlib would otherwise zoom into that rounding noise
+    (ticks under an offset like 1e-11-3.426e-1)."""
+    ax.ticklabel_format(axis="y", useOffset=False)
+    level = float(np.mean(values))
+    scale = max(abs(level), float(np.max(np.abs(values))), 1e-12)
+    if float(np.ptp(values)) < NOISE * scale:
+        half = 0.1 * scale
+        ax.set_ylim(level - half, level + half)
+
+
+def _spectrum(ax: Axes, peaks: list[SpectrumPeak], record_periods: int, u: Units) -> None:
     """The spectrum the JSON reports (``numerics.spectrum_peaks``): its largest peaks as stems,
     so the figure and the numbers agree; computed over the whole record (``record_periods``
-    sampling intervals), Hann window, amplitude-corrected (a sinusoid A cos wt peaks at A)."""
+    sampling intervals), Hann window, amplitude-corrected (a sinusoid A cos wt peaks at A).
+    Dimensionless: against the order of the forcing fundamental; in gear units: in Hz."""
     ax.set(
         title="(d) amplitude spectrum of x: largest peaks",
-        xlabel=r"order: frequency / $\Omega_0$ (fundamental of the forcing)",
-        ylabel="amplitude of x (units of b)",
+        xlabel=u.f_label,
+        ylabel=f"amplitude of x ({u.amplitude})",
     )
     ax.text(
         0.98, 0.97,
@@ -81,15 +147,22 @@ def _spectrum(ax: Axes, peaks: list[SpectrumPeak], record_periods: int) -> None:
     if not peaks:
         return
     order = np.array([p.order for p in peaks])
-    amp = np.array([p.amplitude for p in peaks])
-    ax.vlines(order, 0.0, amp, color="C0", lw=1.6)
-    ax.plot(order, amp, "o", color="C0", ms=4)
+    where = order if u.f == 1.0 else np.array([p.frequency for p in peaks]) * u.f
+    amp = np.array([p.amplitude for p in peaks]) * u.x
+    ax.vlines(where, 0.0, amp, color="C0", lw=1.6)
+    ax.plot(where, amp, "o", color="C0", ms=4)
     top = int(np.argmax(amp))
+    text = f"{amp[top]:.3g} at order {order[top]:.3g}"
+    if u.f != 1.0:
+        text = f"{amp[top]:.3g} µm at {where[top]:,.0f} Hz (order {order[top]:.3g})"
     ax.annotate(
-        f"{amp[top]:.3g} at order {order[top]:.3g}",
-        (order[top], amp[top]), xytext=(6, -2), textcoords="offset points", fontsize=8,
+        text, (where[top], amp[top]), xytext=(6, -2), textcoords="offset points", fontsize=8,
     )  # fmt: skip
-    ax.set_xlim(0.0, max(1.05 * order.max(), 1.0))
+    if u.mesh_hz is not None:
+        ax.axvline(u.mesh_hz, color="0.45", lw=0.8, ls=":",
+                   label=f"mesh frequency {u.mesh_hz:,.0f} Hz")  # fmt: skip
+        ax.legend(loc="upper left", fontsize=8)
+    ax.set_xlim(0.0, max(1.05 * where.max(), 1.0))
     ax.set_ylim(0.0, 1.35 * amp.max())
 
 
