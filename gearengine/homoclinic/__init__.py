@@ -9,10 +9,13 @@ margins of many designs at once; ``kernels`` holds the compiled inner loops. Imp
 model room.
 """
 
+from pathlib import Path
+
 from gearengine.homoclinic.batch import MelnikovBatchRequest, MelnikovBatchResult, melnikov_batch
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult, ThresholdCurve
 from gearengine.homoclinic.thresholds import chaos_possible, threshold_curve
 from gearengine.homoclinic.verdict import melnikov
+from gearengine.jitcache import drop_stale
 
 __all__ = [
     "MelnikovBatchRequest",
@@ -25,3 +28,8 @@ __all__ = [
     "melnikov_batch",
     "threshold_curve",
 ]
+
+_HERE = Path(__file__).parent
+# batch's compiled verdict calls kernels.py's (gearengine.jitcache says why this matters);
+# numba loads a cached kernel on its first call, so this runs before any kernel does
+drop_stale("kernels,batch", [_HERE / "kernels.py", _HERE / "batch.py"], _HERE / "__pycache__")

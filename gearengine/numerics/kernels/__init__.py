@@ -28,8 +28,15 @@ interval end (this also catches NaN).
 Forcing coefficients are packed as kc, fc of shape (3, n_terms): rows amplitude, omega, phase
 (see ``gearengine.numerics.forcing``); K(t) = 1 + sum kc0 cos(kc1 t + kc2),
 F(t) = fm + sum fc0 cos(fc1 t + fc2).
+
+The kernels call each other across these files and freeze constants of ``numerics.periodicity``
+and ``numerics.lyapunov``; ``gearengine.jitcache`` drops their numba cache when any of those
+sources changes (numba itself watches only the defining file).
 """
 
+from pathlib import Path
+
+from gearengine.jitcache import drop_stale
 from gearengine.numerics.kernels.kink import run_kink
 from gearengine.numerics.kernels.lockstep import LANES, run_batch
 from gearengine.numerics.kernels.monodromy import monodromy
@@ -54,3 +61,10 @@ __all__ = [
     "run_kink",
     "run_rk4",
 ]
+
+_HERE = Path(__file__).parent
+drop_stale(  # before any kernel runs: numba loads a cached kernel on its first call
+    "adaptive,kink,lockstep,monodromy,smooth",
+    [*_HERE.glob("*.py"), _HERE.parent / "periodicity.py", _HERE.parent / "lyapunov.py"],
+    _HERE / "__pycache__",
+)

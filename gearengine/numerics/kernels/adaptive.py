@@ -40,9 +40,9 @@ extremes of x and of the mesh force over their steps); chaotic, quasi-periodic, 
 fixed-length record, bit for bit. Runs with ``n_rec < ADAPT_WINDOW`` never stop early.
 
 Only the lock-step kernel ``run_batch`` applies the rule (the cubic map path); ``run_rk4`` and
-``run_kink`` always run the full length. numba's on-disk cache keys ``run_batch`` on
-lockstep.py alone: after editing the helpers or constants here, delete
-``kernels/__pycache__/lockstep.*.nb*`` (or touch lockstep.py) so that it is compiled again.
+``run_kink`` always run the full length. ``run_batch`` compiles the helpers and constants
+here into its own code; an edit here drops its numba cache (``gearengine.jitcache``), so it is
+compiled again on its next call.
 """
 
 from __future__ import annotations
