@@ -85,6 +85,7 @@ _SUBMODULES = frozenset(
         "cli",
         "engineering",
         "homoclinic",
+        "jitcache",
         "jsonio",
         "model",
         "numerics",

@@ -254,8 +254,9 @@ def _line_envelope(mv: np.ndarray, gv: np.ndarray) -> tuple[float | None, float 
     if np.any((gv == 0.0) & (mv > 0.0)):
         return 1.0, 0.0
     neg, pos = gv < 0.0, gv > 0.0
-    lo = float(np.max(-mv[neg] / gv[neg])) if neg.any() else None
-    hi = float(np.min(-mv[pos] / gv[pos])) if pos.any() else None
+    with np.errstate(over="ignore"):  # a ratio past the float range is a bound at +-inf
+        lo = float(np.max(-mv[neg] / gv[neg])) if neg.any() else None
+        hi = float(np.min(-mv[pos] / gv[pos])) if pos.any() else None
     return lo, hi
 
 
