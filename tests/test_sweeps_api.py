@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -13,7 +14,7 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
-from gearengine.sweeps import compute_chunk_json, run_local, validated
+from gearengine.sweeps import compute_chunk_json, run_local, to_csv, validated
 from service.core.config import Settings
 from service.main import create_app
 from tests.conftest import PAPER_PARAMS
@@ -250,3 +251,23 @@ def test_openapi_declares_the_headers_it_sends(client: TestClient) -> None:
     for path in ("/v1/melnikov", "/v1/analyses", "/v1/thresholds", "/v1/analyses/plot"):
         responses = paths[path]["post"]["responses"]
         assert "ETag" in responses["200"]["headers"] and "304" in responses, path
+
+
+def test_a_design_sweep_csv_from_the_service_is_in_gear_units(working: TestClient) -> None:
+    """The stored points are read back unvalidated: the CSV's gear-unit cells still come out,
+    equal to the JSON's ``physical`` and to what the CLI writes for the same sweep."""
+    doc = json.loads((Path(__file__).parents[1] / "examples" / "envelope-map.json").read_text())
+    doc["settings"] = SHORT
+    doc["axes"][0]["num"], doc["axes"][1]["num"] = 3, 2
+    job = wait(working, working.post("/v1/sweeps", json=doc).json()["id"])
+    assert job["status"] == "succeeded"
+    text = working.get(f"/v1/sweeps/{job['id']}/result", params={"format": "csv"}).text
+    rows = list(csv.DictReader(io.StringIO(text)))
+    points = working.get(f"/v1/sweeps/{job['id']}/result").json()["points"]
+    assert len(rows) == 6
+    for row, point in zip(rows, points, strict=True):
+        for key, title in (("speed", "speed [rpm]"), ("dte", "dte [um]")):
+            assert float(row[title]) == point["physical"][key]["value"]
+    request = validated(doc)
+    local = "".join(to_csv(run_local(request), request.outputs, design=True))
+    assert text == local

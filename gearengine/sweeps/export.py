@@ -10,6 +10,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from pydantic import BaseModel, Field, TypeAdapter
 
 from gearengine.sweeps.axes import display_unit, is_dimensionless
+from gearengine.sweeps.axes import shown as shown_value
 from gearengine.sweeps.request import SweepAxis
 from gearengine.sweeps.results import SweepBifurcation, SweepPoint, SweepResult
 
@@ -114,41 +115,65 @@ def csv_rows(
     outputs: Sequence[str] | None = None,
     design: bool = False,
 ) -> Iterator[str]:
-    """CSV rows (header first): one column per axis (SI for a design's fields), with a
-    ``design`` (a sweep of a design in physical units) the same axes in display units and the
-    DTE and dynamic factor (``speed [rpm]``, ``dte [um]``, ``dynamic_factor``: the point's
-    ``physical``), then the verdicts, and poincare_x as space-separated numbers. Empty cells
-    are nulls; booleans are true/false; every number is written as the JSON result writes it
-    (``_json_numbers``). With ``outputs`` (``SweepRequest.outputs``) only the columns it names
-    (and branch) are written. Rows are yielded one by one, so a streamed response never holds
-    the whole table."""
+    """CSV rows (header first): one column per axis (SI for a design's fields); with a
+    ``design`` (a sweep of a design in physical units) the same axes in display units
+    (``speed [rpm]``, ``torque [N*m]``) and, unless ``outputs`` leaves ``physical`` out, the
+    DTE and the dynamic factor (``dte [um]``, ``dynamic_factor``, from the point's
+    ``physical``); then the verdicts, and poincare_x as space-separated numbers. Empty cells are
+    nulls; booleans are true/false; every number is written as the JSON result writes it
+    (``_json_numbers``), the axis values rounded to the 15 significant digits they were given
+    with (``_grid_value``). With ``outputs`` (``SweepRequest.outputs``) only the columns it
+    names (and branch) are written. Rows are yielded one by one, so a streamed response never
+    holds the whole table."""
     names = [a.parameter for a in axes]
-    shown = _physical_columns(names, outputs) if design else []
+    extra = _physical_columns(names, outputs) if design else []
     fields = [f for f in CSV_FIELDS if outputs is None or f == "branch" or f in outputs]
-    header = [*names, *(title for _, title in shown), *fields]
+    header = [*names, *(title for _, title, _ in extra), *fields]
     yield ",".join(_text_cell(c) for c in header) + "\n"
-    keys = [key for key, _ in shown]
+    shown = [(key, factor) for key, _, factor in extra]
     for p in points:
-        yield ",".join(_row(p, names, keys, fields)) + "\n"
+        yield ",".join(_row(p, names, shown, fields)) + "\n"
 
 
-def _physical_columns(names: list[str], outputs: Sequence[str] | None) -> list[tuple[str, str]]:
-    """(key of ``SweepPoint.physical``, column title) of a design's sweep: each physical axis in
-    its display unit, the DTE and the dynamic factor (none when ``outputs`` leaves them out)."""
+def _physical_columns(
+    names: list[str], outputs: Sequence[str] | None
+) -> list[tuple[str, str, float | None]]:
+    """(key, column title, factor from SI) of a design's sweep: each physical axis in its
+    display unit (factor: from the point's ``values``), then the DTE and the dynamic factor
+    (factor None: from its ``physical``, unless ``outputs`` leaves that out)."""
+    axes = [
+        (n, f"{n} [{unit}]", factor)
+        for n in names
+        if not is_dimensionless(n)
+        for unit, factor in [display_unit(n)]
+    ]
     if outputs is not None and "physical" not in outputs:
-        return []
-    axes = [(n, f"{n} [{display_unit(n)[0]}]") for n in names if not is_dimensionless(n)]
-    return [*axes, ("dte", "dte [um]"), ("dynamic_factor", "dynamic_factor")]
+        return axes
+    return [*axes, ("dte", "dte [um]", None), ("dynamic_factor", "dynamic_factor", None)]
 
 
-def _row(p: SweepPoint, names: list[str], keys: list[str], fields: list[str]) -> list[str]:
-    """The text cells of a point's row: the axis values, the ``physical`` values named by
-    ``keys``, then each field. The floats (with the Poincaré numbers) are formatted in one
+def _physical(p: SweepPoint, key: str, factor: float | None) -> float | None:
+    """A gear-unit cell: an axis value in its display unit (rounded as ``physical`` rounds it),
+    or an entry of ``physical``, which points read back from the job store unvalidated
+    (``model_construct``) hold as plain dicts."""
+    if factor is not None:
+        return shown_value(p.values[key] * factor)
+    entry = (p.physical or {}).get(key)
+    if entry is None:
+        return None
+    return float(entry["value"] if isinstance(entry, dict) else entry.value)
+
+
+def _row(
+    p: SweepPoint, names: list[str], shown: list[tuple[str, float | None]], fields: list[str]
+) -> list[str]:
+    """The text cells of a point's row: the axis values, the gear-unit values of ``shown``,
+    then each field. The floats (with the Poincaré numbers) are formatted in one
     ``_json_numbers`` call, then taken in order."""
     values = [getattr(p, f) for f in fields]
     floats = [_grid_value(p.values[n]) for n in names]
-    shown = [(p.physical or {}).get(key) for key in keys]
-    floats.extend(v.value for v in shown if v is not None)
+    gear = [_physical(p, key, factor) for key, factor in shown]
+    floats.extend(v for v in gear if v is not None)
     for f, value in zip(fields, values, strict=True):
         if f == "poincare_x":
             floats.extend(value or [])
@@ -157,7 +182,7 @@ def _row(p: SweepPoint, names: list[str], keys: list[str], fields: list[str]) ->
     numbers = _json_numbers(floats)
     cells = numbers[: len(names)]
     k = len(names)
-    for v in shown:
+    for v in gear:
         cells.append("" if v is None else numbers[k])
         k += v is not None
     for f, value in zip(fields, values, strict=True):

@@ -187,8 +187,9 @@ def _windows(jobs: SweepJobs, job_id: str, sweep: SweepRequest) -> list[SpeedWin
 
 def _stored_points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
     """The stored points unvalidated (``model_construct``: the workers wrote them from valid
-    points), one chunk in memory at a time: the CSV of a million-point map streams at the
-    speed of the csv module, not of validation."""
+    points; nested documents such as ``physical`` stay plain dicts), one chunk in memory at a
+    time: the CSV of a million-point map streams at the speed of its writer, not of
+    validation."""
     for array in jobs.store.chunk_results(job_id):
         for item in chunk_points(array):
             yield SweepPoint.model_construct(**item)
