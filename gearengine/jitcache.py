@@ -9,7 +9,10 @@ all the sources of a group of kernels beside their cache and deletes the group's
 when the digest changes, so the next call compiles from the current sources.
 
 Only the in-tree cache (``__pycache__`` next to the sources, where a developer's edits happen) is
-kept in step; a read-only install, whose sources do not change, is left as it is.
+kept in step; a read-only install, whose sources do not change, is left as it is, and so is a
+cache moved elsewhere with ``NUMBA_CACHE_DIR`` (the Docker image, built once from fixed sources).
+A process still running code compiled before an edit may write a stale entry after the new
+stamp: restart what runs while kernels are being edited.
 """
 
 from __future__ import annotations

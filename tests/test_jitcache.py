@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import gearengine.homoclinic
 import gearengine.numerics.kernels as kernels
 from gearengine.jitcache import STAMP_SUFFIX, drop_stale, sources_digest
 
@@ -45,10 +46,21 @@ def test_a_cache_that_cannot_be_written_is_left_alone(tmp_path: Path) -> None:
     assert blocker.read_text() == ""
 
 
-def test_the_kernels_cache_is_stamped_with_their_current_sources() -> None:
-    """Importing the kernels keeps their cache in step: the stamp holds today's digest, so an
-    edit of adaptive.py or periodicity.py would drop run_batch's cached code on next import."""
-    here = Path(kernels.__file__).parent
-    sources = [*here.glob("*.py"), here.parent / "periodicity.py", here.parent / "lyapunov.py"]
-    stamp = here / "__pycache__" / f"adaptive+kink+lockstep+monodromy+smooth{STAMP_SUFFIX}"
-    assert stamp.read_text() == sources_digest(sources)
+def test_the_kernels_caches_are_stamped_with_their_current_sources() -> None:
+    """Importing the kernels keeps their caches in step: each stamp holds today's digest of
+    every file its group compiles in, so an edit of adaptive.py, periodicity.py or extrema.py
+    drops the cached code that froze it on the next import."""
+    numerics = Path(kernels.__file__).parent
+    homoclinic = Path(gearengine.homoclinic.__file__).parent
+    groups = {
+        numerics / "__pycache__" / "adaptive+kink+lockstep+monodromy+smooth": [
+            *numerics.glob("*.py"), numerics.parent / "periodicity.py",
+            numerics.parent / "lyapunov.py",
+        ],
+        homoclinic / "__pycache__" / "kernels+batch": [
+            homoclinic / name for name in ("kernels.py", "batch.py", "extrema.py")
+        ],
+    }  # fmt: skip
+    for stem, sources in groups.items():
+        stamp = stem.with_name(stem.name + STAMP_SUFFIX)
+        assert stamp.read_text() == sources_digest(sources), stamp

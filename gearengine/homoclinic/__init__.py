@@ -30,6 +30,10 @@ __all__ = [
 ]
 
 _HERE = Path(__file__).parent
-# batch's compiled verdict calls kernels.py's (gearengine.jitcache says why this matters);
-# numba loads a cached kernel on its first call, so this runs before any kernel does
-drop_stale("kernels,batch", [_HERE / "kernels.py", _HERE / "batch.py"], _HERE / "__pycache__")
+# batch's compiled verdict calls kernels.py's and freezes extrema.NEGLIGIBLE (gearengine.jitcache
+# says why this matters); numba loads a cached kernel on its first call, so this runs first
+drop_stale(
+    "kernels,batch",
+    [_HERE / "kernels.py", _HERE / "batch.py", _HERE / "extrema.py"],
+    _HERE / "__pycache__",
+)
