@@ -28,12 +28,16 @@ EXIT_STARTUP_FAILURE = 3
 """uvicorn could not start (the port is taken, the lifespan failed): uvicorn's own code."""
 
 
+_LISTENER: list[logging.handlers.QueueListener] = []
+"""The log thread of this process, once ``log_to_stderr`` started it."""
+
+
 def log_to_stderr() -> None:
     """The server's log (a JSON line per request and per job transition) on stderr, written by
     a background thread: a request only puts its record on a queue (``QueueHandler``), and the
     ``QueueListener`` thread formats and writes it. A write and flush per line on the event loop
-    cost about 15 % of a Melnikov verdict's throughput (benchmarks/load.py). Lines still queued
-    at exit are written then (``atexit``)."""
+    cost about 15 % of a Melnikov verdict's throughput (benchmarks/load.py). ``flush_log`` ends
+    it; a normal exit (a start-up failure) does too, through ``atexit``."""
     lines: queue.SimpleQueue[logging.LogRecord] = queue.SimpleQueue()
     out = logging.StreamHandler(sys.stderr)
     out.setFormatter(logging.Formatter("%(message)s"))
@@ -42,7 +46,18 @@ def log_to_stderr() -> None:
     root.handlers[:] = [logging.handlers.QueueHandler(lines)]
     root.setLevel(logging.INFO)
     listener.start()
-    atexit.register(listener.stop)
+    _LISTENER.append(listener)
+    atexit.register(flush_log)
+
+
+def flush_log() -> None:
+    """Write every queued log line and go back to writing lines directly. The servers call it
+    at the end of their shutdown: uvicorn re-raises a stopping signal (SIGTERM from ``docker
+    stop``, or from the parent to a peer) after it, so an ``atexit`` hook would not run."""
+    while _LISTENER:
+        listener = _LISTENER.pop()
+        listener.stop()
+        logging.getLogger().handlers[:] = list(listener.handlers)
 
 
 def ready_line(settings: Settings, port: int) -> str:
@@ -172,6 +187,7 @@ class AnnouncingServer(uvicorn.Server):
         await super().shutdown(sockets)
         if self.peers is not None:
             await asyncio.to_thread(self.peers.stop)
+        flush_log()
 
 
 class _PeerServer(uvicorn.Server):
@@ -185,6 +201,11 @@ class _PeerServer(uvicorn.Server):
         await super().startup(sockets)
         if self.started:
             os.write(self.up, b"1")
+
+    async def shutdown(self, sockets: list[socket.socket] | None = None) -> None:
+        """The queued log lines are written before uvicorn re-raises the parent's SIGTERM."""
+        await super().shutdown(sockets)
+        flush_log()
 
 
 def serve_peer() -> None:
