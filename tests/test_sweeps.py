@@ -5,6 +5,9 @@ from __future__ import annotations
 import csv
 import io
 import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -268,3 +271,26 @@ def test_csv_of_a_design_sweep_has_its_values_in_gear_units() -> None:
     plain = validated(sweep(("F_e1", 0.0, 0.3, 2)))
     header = next(csv.reader(io.StringIO("".join(to_csv(run_local(plain))))))
     assert header[:2] == ["F_e1", "branch"]
+
+
+WORKQUEUE_RUN = """
+import json, sys
+from gearengine.sweeps import run_local, validated
+doc = json.loads(sys.argv[1])
+result = run_local(validated(doc), chunk_points=4, workers=2)
+print(len(result.points))
+"""
+
+
+def test_threads_under_numbas_workqueue_layer_take_turns() -> None:
+    """Where numba has neither OpenMP nor TBB it falls back to the workqueue threading layer,
+    which aborts the process when two threads run a parallel kernel at once; run_local then
+    runs the chunks one after the other (same result)."""
+    doc = sweep(("F_e1", 0.0, 0.3, 4), ("Omega_e", 0.4, 0.6, 3))
+    env = {**os.environ, "NUMBA_THREADING_LAYER": "workqueue"}
+    run = subprocess.run(
+        [sys.executable, "-c", WORKQUEUE_RUN, json.dumps(doc)],
+        env=env, capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.split() == ["12"]

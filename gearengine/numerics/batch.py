@@ -11,6 +11,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams
 from gearengine.numerics import kernels
 from gearengine.numerics.classify import DIVERGENCE_BOUND, severity
@@ -112,3 +113,19 @@ def simulate_batch(
         )  # fmt: skip
         results.update(lockstep_points(out, members, lanes, per))
     return [results[i] for i in range(len(points))]
+
+
+def threads_may_share_kernels() -> bool:
+    """True when several threads may run the parallel kernel ``run_batch`` at once.
+
+    numba's OpenMP and TBB threading layers allow it; its fallback, the workqueue layer (where
+    neither library is installed), aborts the process instead ("Concurrent access has been
+    detected"). The layer is chosen on the first parallel run, so a tiny one runs if needed.
+    """
+    try:
+        return numba.threading_layer() != "workqueue"
+    except ValueError:  # no parallel kernel has run in this process yet
+        tiny = SimulationSettings(transient_periods=1, record_periods=4, steps_per_period=8)
+        point = GearParams.model_validate(PAPER_SECTION_41)
+        simulate_batch([point, point], tiny)
+        return numba.threading_layer() != "workqueue"

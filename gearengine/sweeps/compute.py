@@ -12,7 +12,7 @@ from typing import Any
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
-from gearengine.numerics.batch import simulate_batch
+from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
 from gearengine.numerics.bifurcations import Response, locate_bifurcations
 from gearengine.numerics.forcing import step_plan
 from gearengine.numerics.results import BatchPoint
@@ -187,7 +187,9 @@ def run_local(
     """Compute every chunk in this process; ``progress_callback(done, total)`` in points.
 
     ``workers`` > 1 computes chunks on that many threads: the kernels release the GIL
-    (``nogil``), so the integration runs on every core. The result does not depend on it.
+    (``nogil``), so one chunk's verdicts (Python) overlap another's integration. The result
+    does not depend on it; under numba's workqueue threading layer, which cannot run two
+    parallel kernels at once, the chunks run one after the other.
 
     ``chunk_points`` defaults to ``LOCAL_CHUNK_POINTS`` without continuation: the batch
     kernel refills a lane as soon as its point stops early (adaptive stopping), which pays
@@ -198,6 +200,8 @@ def run_local(
     plan = SweepPlan(request, chunk_points)
     total, done = request.n_points(), 0
     text = request.model_dump_json()
+    if workers > 1 and not threads_may_share_kernels():
+        workers = 1  # numba's workqueue layer: one kernel call at a time, or it aborts
     with ThreadPoolExecutor(max(1, workers)) as pool:
         futures = [pool.submit(compute_chunk_json, text, i, chunk_points)
                    for i in range(plan.n_chunks())]  # fmt: skip
