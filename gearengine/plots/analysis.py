@@ -37,6 +37,7 @@ class Units:
     lle: float
     lle_unit: str
     mesh_hz: float | None
+    edges: str
 
     @classmethod
     def of(cls, result: AnalysisResult) -> Units:
@@ -49,7 +50,7 @@ class Units:
                 r"$\tau$ (dimensionless time)",
                 r"order: frequency / $\Omega_0$ (fundamental of the forcing)",
                 "units of b",
-                1.0, "per unit τ", None,
+                1.0, "per unit τ", None, CLEARANCE,
             )  # fmt: skip
         b_um, tau_s = eng.half_backlash_um, eng.time_scale_s
         return cls(
@@ -60,6 +61,7 @@ class Units:
             "frequency (Hz)",
             "µm",
             1.0 / tau_s, "per s", eng.mesh_frequency_hz,
+            f"x b = ±b = ±{b_um:.3g} µm: clearance edges",
         )  # fmt: skip
 
 
@@ -88,15 +90,16 @@ def analysis_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
         t, x, v = (np.asarray(a) for a in (hist.t, hist.x, hist.v))
         ax_t.plot(t * u.t, x * u.x, lw=0.8, color="C0")
         ax_p.plot(x * u.x, v * u.v, lw=0.6, color="C0")
+        _no_zoom_into_noise(ax_p, v * u.v, VELOCITY_FLOOR * u.v)
     if num.poincare:
         pts = np.asarray(num.poincare)
         ax_p.plot(pts[:, 0] * u.x, pts[:, 1] * u.v, "o", ms=3, color="C3", label="Poincaré points")
         ax_s.plot(pts[:, 0] * u.x, pts[:, 1] * u.v, "o", ms=2.5, color="C3")
-        _no_zoom_into_noise(ax_s, pts[:, 1] * u.v)
+        _no_zoom_into_noise(ax_s, pts[:, 1] * u.v, VELOCITY_FLOOR * u.v)
     for ax in (ax_t, ax_p, ax_s):
         for edge in (-u.x, u.x):  # clearance edges |x| = 1 (Eq. 8), |x b| = b
             (ax.axhline if ax is ax_t else ax.axvline)(
-                edge, color="0.45", lw=0.7, ls=":", label=CLEARANCE if edge > 0 else None
+                edge, color="0.45", lw=0.7, ls=":", label=u.edges if edge > 0 else None
             )
     # one legend for panels (a)-(c), under them, where it hides no data
     fig.legend(*ax_p.get_legend_handles_labels(), loc="outside lower center", ncols=2, fontsize=8.5)
@@ -110,18 +113,22 @@ def analysis_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
 
 
 CLEARANCE = "|x| = 1: clearance edges"
+"""Legend of the clearance edges in Eq. (9)'s units."""
 
 NOISE = 1e-6
 """Relative spread below which the strobes of a section count as one point (a 1T orbit)."""
+VELOCITY_FLOOR = 1e-3
+"""Smallest velocity scale drawn, b per unit tau: below it a velocity axis shows rest."""
 
 
-def _no_zoom_into_noise(ax: Axes, values: np.ndarray) -> None:
-    """The vertical axis of a Poincaré section around the strobes' level: a periodic orbit's
-    strobes agree to ~1e-11, and matplotlib would otherwise zoom into that rounding noise
-    (ticks under an offset like 1e-11-3.426e-1)."""
+def _no_zoom_into_noise(ax: Axes, values: np.ndarray, floor: float) -> None:
+    """The vertical axis around the values' level when they are one value up to rounding: a
+    periodic orbit's strobes agree to ~1e-11 (and a resting pair's velocity is ~1e-16), and
+    matplotlib would otherwise zoom into that noise (ticks under an offset like
+    1e-11-3.426e-1). ``floor``: the smallest half-height shown, in the axis' unit."""
     ax.ticklabel_format(axis="y", useOffset=False)
     level = float(np.mean(values))
-    scale = max(abs(level), float(np.max(np.abs(values))), 1e-12)
+    scale = max(abs(level), float(np.max(np.abs(values))), floor)
     if float(np.ptp(values)) < NOISE * scale:
         half = 0.1 * scale
         ax.set_ylim(level - half, level + half)
@@ -147,13 +154,13 @@ def _spectrum(ax: Axes, peaks: list[SpectrumPeak], record_periods: int, u: Units
     if not peaks:
         return
     order = np.array([p.order for p in peaks])
-    where = order if u.f == 1.0 else np.array([p.frequency for p in peaks]) * u.f
+    where = order if u.mesh_hz is None else np.array([p.frequency for p in peaks]) * u.f
     amp = np.array([p.amplitude for p in peaks]) * u.x
     ax.vlines(where, 0.0, amp, color="C0", lw=1.6)
     ax.plot(where, amp, "o", color="C0", ms=4)
     top = int(np.argmax(amp))
     text = f"{amp[top]:.3g} at order {order[top]:.3g}"
-    if u.f != 1.0:
+    if u.mesh_hz is not None:
         text = f"{amp[top]:.3g} µm at {where[top]:,.0f} Hz (order {order[top]:.3g})"
     ax.annotate(
         text, (where[top], amp[top]), xytext=(6, -2), textcoords="offset points", fontsize=8,
@@ -162,7 +169,7 @@ def _spectrum(ax: Axes, peaks: list[SpectrumPeak], record_periods: int, u: Units
         ax.axvline(u.mesh_hz, color="0.45", lw=0.8, ls=":",
                    label=f"mesh frequency {u.mesh_hz:,.0f} Hz")  # fmt: skip
         ax.legend(loc="upper left", fontsize=8)
-    ax.set_xlim(0.0, max(1.05 * where.max(), 1.0))
+    ax.set_xlim(0.0, 1.05 * max(where.max(), u.mesh_hz or 0.0, 1.0 / 1.05))
     ax.set_ylim(0.0, 1.35 * amp.max())
 
 
