@@ -73,6 +73,12 @@ def display_unit(path: str) -> tuple[str, float]:
     return ("SI", 1.0)
 
 
+def in_display_unit(path: str, si: float) -> float:
+    """A physical field's SI value in its display unit (``display_unit``), rounded (``shown``):
+    the number of a sweep point's ``physical`` entry and of its CSV column."""
+    return shown(si * display_unit(path)[1])
+
+
 def _set(tree: dict[str, Any], path: str, value: object) -> None:
     *head, last = path.split(".")
     node: Any = tree

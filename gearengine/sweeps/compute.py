@@ -17,13 +17,19 @@ from gearengine.numerics.bifurcations import Response, locate_bifurcations
 from gearengine.numerics.forcing import step_plan
 from gearengine.numerics.results import BatchPoint
 from gearengine.numerics.settings import SimulationSettings
-from gearengine.sweeps.axes import display_unit, is_dimensionless
+from gearengine.sweeps.axes import display_unit, in_display_unit, is_dimensionless
 from gearengine.sweeps.axes import shown as rounded
 from gearengine.sweeps.export import chunk_json, result_json
 from gearengine.sweeps.export import chunk_points as points_of_chunk
 from gearengine.sweeps.plan import DEFAULT_CHUNK_POINTS, SweepPlan
 from gearengine.sweeps.request import SweepBranch, SweepRequest
-from gearengine.sweeps.results import PhysicalValue, SweepBifurcation, SweepPoint, SweepResult
+from gearengine.sweeps.results import (
+    RESPONSE_UNITS,
+    PhysicalValue,
+    SweepBifurcation,
+    SweepPoint,
+    SweepResult,
+)
 from gearengine.sweeps.windows import SPEED, speed_windows
 
 LOCAL_CHUNK_POINTS = 1024
@@ -36,18 +42,22 @@ def _physical(
     """With a design: the axes in display units, the DTE in µm and the point's aliases."""
     if request.design is None:
         return {}
-    shown = {}
-    for name, si in values.items():
-        if not is_dimensionless(name):
-            unit, factor = display_unit(name)
-            shown[name] = PhysicalValue(value=rounded(si * factor), unit=unit)
+    shown = {
+        name: PhysicalValue(value=in_display_unit(name, si), unit=display_unit(name)[0])
+        for name, si in values.items()
+        if not is_dimensionless(name)
+    }
     b = values.get("mesh.half_backlash", request.design.mesh.half_backlash)
-    if bp.x_peak_to_peak is not None:
-        shown["dte"] = PhysicalValue(value=rounded(bp.x_peak_to_peak * b * 1e6), unit="um")
-    if bp.force_max is not None and params.mean_force > 0:  # F / F_m: scales b k_m cancel
-        shown["dynamic_factor"] = PhysicalValue(
-            value=rounded(bp.force_max / params.mean_force), unit="1"
-        )
+    response = {
+        "dte": None if bp.x_peak_to_peak is None else bp.x_peak_to_peak * b * 1e6,
+        "dynamic_factor": None  # F / F_m: the scales b k_m cancel
+        if bp.force_max is None or params.mean_force <= 0
+        else bp.force_max / params.mean_force,
+    }
+    for key, unit in RESPONSE_UNITS.items():
+        value = response[key]
+        if value is not None:
+            shown[key] = PhysicalValue(value=rounded(value), unit=unit)
     aliases = {a: get_alias(params, a) for a in ALIASES}
     return {"physical": shown, "dimensionless": {k: v for k, v in aliases.items() if v is not None}}
 
@@ -148,11 +158,11 @@ def _line_bifurcations(
     )
     if is_dimensionless(alias):
         return [SweepBifurcation.model_validate(e) for e in events]
-    unit, factor = display_unit(alias)
+    unit = display_unit(alias)[0]
     return [
         SweepBifurcation.model_validate(
             {**e, "physical": None if e["value"] is None else
-             PhysicalValue(value=rounded(e["value"] * factor), unit=unit)}
+             PhysicalValue(value=in_display_unit(alias, e["value"]), unit=unit)}
         )
         for e in events
     ]  # fmt: skip

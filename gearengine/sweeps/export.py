@@ -9,10 +9,9 @@ from collections.abc import Iterable, Iterator, Sequence
 
 from pydantic import BaseModel, Field, TypeAdapter
 
-from gearengine.sweeps.axes import display_unit, is_dimensionless
-from gearengine.sweeps.axes import shown as shown_value
+from gearengine.sweeps.axes import display_unit, in_display_unit, is_dimensionless
 from gearengine.sweeps.request import SweepAxis
-from gearengine.sweeps.results import SweepBifurcation, SweepPoint, SweepResult
+from gearengine.sweeps.results import RESPONSE_UNITS, SweepBifurcation, SweepPoint, SweepResult
 
 _LINE_HEAD = '{"bifurcations":'
 _LINE_POINTS = ',"points":['
@@ -130,34 +129,33 @@ def csv_rows(
     fields = [f for f in CSV_FIELDS if outputs is None or f == "branch" or f in outputs]
     header = [*names, *(title for _, title, _ in extra), *fields]
     yield ",".join(_text_cell(c) for c in header) + "\n"
-    shown = [(key, factor) for key, _, factor in extra]
+    shown = [(key, axis) for key, _, axis in extra]
     for p in points:
         yield ",".join(_row(p, names, shown, fields)) + "\n"
 
 
 def _physical_columns(
     names: list[str], outputs: Sequence[str] | None
-) -> list[tuple[str, str, float | None]]:
-    """(key, column title, factor from SI) of a design's sweep: each physical axis in its
-    display unit (factor: from the point's ``values``), then the DTE and the dynamic factor
-    (factor None: from its ``physical``, unless ``outputs`` leaves that out)."""
-    axes = [
-        (n, f"{n} [{unit}]", factor)
-        for n in names
-        if not is_dimensionless(n)
-        for unit, factor in [display_unit(n)]
-    ]
+) -> list[tuple[str, str, bool]]:
+    """(key, column title, is an axis) of a design's sweep: each physical axis in its display
+    unit (from the point's ``values``), then the response entries of ``RESPONSE_UNITS`` (from
+    its ``physical``, unless ``outputs`` leaves that out)."""
+    axes = [(n, f"{n} [{display_unit(n)[0]}]", True) for n in names if not is_dimensionless(n)]
     if outputs is not None and "physical" not in outputs:
         return axes
-    return [*axes, ("dte", "dte [um]", None), ("dynamic_factor", "dynamic_factor", None)]
+    response = [
+        (key, key if unit == "1" else f"{key} [{unit}]", False)
+        for key, unit in RESPONSE_UNITS.items()
+    ]
+    return [*axes, *response]
 
 
-def _physical(p: SweepPoint, key: str, factor: float | None) -> float | None:
-    """A gear-unit cell: an axis value in its display unit (rounded as ``physical`` rounds it),
-    or an entry of ``physical``, which points read back from the job store unvalidated
-    (``model_construct``) hold as plain dicts."""
-    if factor is not None:
-        return shown_value(p.values[key] * factor)
+def _physical(p: SweepPoint, key: str, axis: bool) -> float | None:
+    """A gear-unit cell: an axis value in its display unit (``in_display_unit``, as
+    ``physical`` holds it), or an entry of ``physical``, which points read back from the job
+    store unvalidated (``model_construct``) hold as plain dicts."""
+    if axis:
+        return in_display_unit(key, p.values[key])
     entry = (p.physical or {}).get(key)
     if entry is None:
         return None
@@ -165,14 +163,14 @@ def _physical(p: SweepPoint, key: str, factor: float | None) -> float | None:
 
 
 def _row(
-    p: SweepPoint, names: list[str], shown: list[tuple[str, float | None]], fields: list[str]
+    p: SweepPoint, names: list[str], shown: list[tuple[str, bool]], fields: list[str]
 ) -> list[str]:
     """The text cells of a point's row: the axis values, the gear-unit values of ``shown``,
     then each field. The floats (with the Poincaré numbers) are formatted in one
     ``_json_numbers`` call, then taken in order."""
     values = [getattr(p, f) for f in fields]
     floats = [_grid_value(p.values[n]) for n in names]
-    gear = [_physical(p, key, factor) for key, factor in shown]
+    gear = [_physical(p, key, axis) for key, axis in shown]
     floats.extend(v for v in gear if v is not None)
     for f, value in zip(fields, values, strict=True):
         if f == "poincare_x":
