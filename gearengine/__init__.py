@@ -15,8 +15,9 @@ engine imports no web code.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from gearengine.lazyload import lazy_names
 
 if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDEs
     from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
@@ -87,6 +88,7 @@ _SUBMODULES = frozenset(
         "homoclinic",
         "jitcache",
         "jsonio",
+        "lazyload",
         "model",
         "numerics",
         "plots",
@@ -98,18 +100,4 @@ works (the eager facade used to import them). No public name may be one of these
 would hide the submodule (``gearengine.melnikov`` is the verb, there is no such module)."""
 
 
-def __getattr__(name: str) -> Any:
-    """A public name, imported from its module on first access and kept (PEP 562)."""
-    home = _HOMES.get(name)
-    if home is not None:
-        value = getattr(importlib.import_module(home[0]), home[1])
-        globals()[name] = value  # next access skips this function
-        return value
-    if name in _SUBMODULES:
-        return importlib.import_module(f"{__name__}.{name}")
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    """The public names with what is loaded, as ``dir`` showed them before they were lazy."""
-    return sorted({*__all__, *globals()})
+__getattr__, __dir__ = lazy_names(__name__, _HOMES, _SUBMODULES)

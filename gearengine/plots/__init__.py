@@ -11,8 +11,9 @@ alone, not ``plots.analysis`` and the whole analysis stack behind it.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from gearengine.lazyload import lazy_names
 
 if TYPE_CHECKING:
     from gearengine.plots.analysis import analysis_figure, threshold_figure
@@ -22,24 +23,12 @@ if TYPE_CHECKING:
 __all__ = ["MEDIA_TYPES", "ImageFormat", "analysis_figure", "sweep_figure", "threshold_figure"]
 
 _HOMES = {
-    "MEDIA_TYPES": "gearengine.plots.style",
-    "ImageFormat": "gearengine.plots.style",
-    "analysis_figure": "gearengine.plots.analysis",
-    "sweep_figure": "gearengine.plots.sweep",
-    "threshold_figure": "gearengine.plots.analysis",
+    "MEDIA_TYPES": ("gearengine.plots.style", "MEDIA_TYPES"),
+    "ImageFormat": ("gearengine.plots.style", "ImageFormat"),
+    "analysis_figure": ("gearengine.plots.analysis", "analysis_figure"),
+    "sweep_figure": ("gearengine.plots.sweep", "sweep_figure"),
+    "threshold_figure": ("gearengine.plots.analysis", "threshold_figure"),
 }
-"""The module of each public name (none is also a module's name: caching it would hide one)."""
+"""(module, attribute) of each public name (none is also a module's name)."""
 
-
-def __getattr__(name: str) -> Any:
-    """A public name, imported from its module on first access and kept."""
-    if name not in _HOMES:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(_HOMES[name]), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    """The public names with what is loaded."""
-    return sorted({*__all__, *globals()})
+__getattr__, __dir__ = lazy_names(__name__, _HOMES)
