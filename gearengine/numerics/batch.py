@@ -8,6 +8,8 @@ taken array-wise (``numerics.lanes``); other points run one by one in the single
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numba
 import numpy as np
 
@@ -16,22 +18,23 @@ from gearengine.model.params import GearParams
 from gearengine.numerics import kernels
 from gearengine.numerics.classify import DIVERGENCE_BOUND, severity
 from gearengine.numerics.forcing import StepPlan, law, packed_forcing, step_plan
-from gearengine.numerics.lanes import lockstep_points
+from gearengine.numerics.lanes import lane_point, lane_verdicts, last_strobes
 from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
-from gearengine.numerics.runs import Run, StartVerdict, finite_or_none, integrate, start_verdict
+from gearengine.numerics.runs import Run, finite_or_none, integrate, start_verdict
 from gearengine.numerics.settings import SimulationSettings, check_work
 
+Lane = tuple[int, tuple[float, float]]
+"""One run of a request: (index of its parameter point, initial state (x0, v0))."""
 
-def batch_point(runs: list[tuple[Run, StartVerdict]]) -> BatchPoint:
-    """The verdict of a point: its worst start's, with that start's last strobes.
+
+def run_verdict(run: Run, start: tuple[float, float], plan: StepPlan, lane: int) -> BatchPoint:
+    """The ``BatchPoint`` of one run of the single kernels (``runs.integrate``), numbered
+    ``lane``.
 
     Built with ``model_construct``: the fields come typed and finite from ``start_verdict`` and
     ``finite_or_none``, so validating them again would only cost time (~0.1 ms a point).
     """
-    idx = max(
-        range(len(runs)), key=lambda i: severity(runs[i][1].classification, runs[i][1].period)
-    )
-    run, v = runs[idx]
+    v = start_verdict(run, start, plan.period, plan.omega0 is not None)
     n_ok = run.recorded
     return BatchPoint.model_construct(
         classification=v.classification,
@@ -41,7 +44,7 @@ def batch_point(runs: list[tuple[Run, StartVerdict]]) -> BatchPoint:
         final_state=v.summary.final_state,
         impact_regime=v.summary.impact_regime,
         poincare=np.column_stack([run.xs[:n_ok], run.vs[:n_ok]])[-BATCH_POINCARE:].tolist(),
-        start_index=int(idx),
+        start_index=lane,
         x_peak_to_peak=None if run.diverged else finite_or_none(run.xmax - run.xmin),
         periods_run=int(run.done),
         force_max=None if run.diverged else finite_or_none(run.fmax),
@@ -49,7 +52,7 @@ def batch_point(runs: list[tuple[Run, StartVerdict]]) -> BatchPoint:
     )
 
 
-def step_plans(points: list[GearParams], steps_per_period: int) -> list[StepPlan]:
+def step_plans(points: Sequence[GearParams], steps_per_period: int) -> list[StepPlan]:
     """``step_plan`` of each point, computed once per set of active harmonics: the plan depends
     only on the excitations' frequencies and which of their harmonics are active."""
     known: dict[tuple, StepPlan] = {}
@@ -65,54 +68,100 @@ def step_plans(points: list[GearParams], steps_per_period: int) -> list[StepPlan
     return plans
 
 
+def run_lanes(
+    points: Sequence[GearParams],
+    lanes: Sequence[Lane],
+    settings: SimulationSettings | None = None,
+) -> list[BatchPoint]:
+    """The verdict of every lane: the one door of ensembles into the kernels.
+
+    Every run of a request (point x start x sample) is a lane ``(i, (x0, v0))``: parameter
+    point ``points[i]`` from the initial state (x0, v0). Lanes of cubic-law points with
+    commensurate forcing are grouped by steps per T0 and advanced together in the lock-step SIMD
+    kernel (``kernels.run_batch``); the others run one by one in the single kernels
+    (``runs.integrate``). Numbers equal those of ``simulate`` for the same point and start.
+
+    Args:
+        points: the parameter points, shape (P,).
+        lanes: the runs, shape (L,); a point may appear in any number of lanes.
+        settings: periods, steps and adaptive stopping shared by all lanes (their starts are
+            ignored: each lane carries its own).
+
+    Returns:
+        One ``BatchPoint`` per lane, in order, shape (L,); its ``start_index`` is the lane's
+        index in ``lanes``.
+    """
+    settings = settings or SimulationSettings()
+    return _run_lanes(points, step_plans(points, settings.steps_per_period), lanes, settings)
+
+
+def _run_lanes(
+    points: Sequence[GearParams],
+    plans: list[StepPlan],
+    lanes: Sequence[Lane],
+    settings: SimulationSettings,
+) -> list[BatchPoint]:
+    n_trans, n_rec = settings.transient_periods, settings.record_periods
+    results: list[BatchPoint | None] = [None] * len(lanes)
+    groups: dict[int, list[int]] = {}
+    for k, (i, s) in enumerate(lanes):
+        plan = plans[i]
+        if points[i].backlash.model == "cubic" and plan.omega0 is not None:
+            groups.setdefault(plan.steps, []).append(k)
+        else:
+            results[k] = run_verdict(integrate(points[i], settings, s), s, plan, k)
+    for N, ks in groups.items():
+        members = list(dict.fromkeys(lanes[k][0] for k in ks))
+        tables = {
+            i: kernels.forcing_table(plans[i].period, N, *packed_forcing(points[i]))
+            for i in members
+        }
+        laws = {i: law(points[i]) for i in members}
+        owner = [lanes[k][0] for k in ks]
+        Kt = np.array([tables[i][0] for i in owner])
+        Ft = np.array([tables[i][1] for i in owner])
+        per = np.array([plans[i].period for i in owner])
+        a = np.array([laws[i].a for i in owner])
+        c = np.array([laws[i].c for i in owner])
+        mu = np.array([points[i].damping for i in owner])
+        x0 = np.array([lanes[k][1][0] for k in ks])
+        v0 = np.array([lanes[k][1][1] for k in ks])
+        streams = max(1, min(numba.get_num_threads(), -(-len(ks) // kernels.LANES)))
+        out = kernels.run_batch(
+            a, c, mu, x0, v0, Kt, Ft, per, N, n_trans, n_rec, DIVERGENCE_BOUND,
+            settings.adaptive, streams,
+        )  # fmt: skip
+        verdicts = lane_verdicts(out, per)
+        strobes = last_strobes(out, list(range(len(ks))))
+        for j, k in enumerate(ks):
+            results[k] = lane_point(out, j, k, verdicts[j], strobes[j])
+    return results  # type: ignore[return-value]
+
+
 def simulate_batch(
     points: list[GearParams], settings: SimulationSettings | None = None
 ) -> list[BatchPoint]:
     """Verdict (period, LLE, final state, last strobes) for each parameter point of a sweep.
 
-    Cubic-law points with commensurate forcing are grouped by steps per T0 and run in the
-    lock-step SIMD kernel (``kernels.run_batch``, parallel over chunks of lanes; one lane per
-    point and start). Other points (piecewise law, incommensurate forcing) run one by one in the
-    single kernels. Numbers equal those of ``simulate`` for the same point and start.
+    Each point runs from every start of ``settings.starts()``, one lane per point and start
+    (``run_lanes``); the point's verdict is its worst start's (``classify.severity``, the first
+    such start on a tie), whose index in ``settings.starts()`` is ``start_index``. Numbers equal
+    those of ``simulate`` for the same point and start.
     """
     settings = settings or SimulationSettings()
     starts = settings.starts()
-    n_trans, n_rec = settings.transient_periods, settings.record_periods
-    results: dict[int, BatchPoint] = {}
-    groups: dict[int, list[int]] = {}
     plans = step_plans(points, settings.steps_per_period)
-    for i, (p, plan) in enumerate(zip(points, plans, strict=True)):
+    for plan in plans:
         check_work(settings, plan.steps)
-        if p.backlash.model == "cubic" and plan.omega0 is not None:
-            groups.setdefault(plan.steps, []).append(i)
-        else:
-            runs = []
-            for s in starts:
-                run = integrate(p, settings, s)
-                runs.append((run, start_verdict(run, s, plan.period, plan.omega0 is not None)))
-            results[i] = batch_point(runs)
-    for N, members in groups.items():
-        lanes = [(i, s) for i in members for s in starts]
-        tables = [
-            kernels.forcing_table(plans[i].period, N, *packed_forcing(points[i])) for i in members
-        ]
-        rows = {i: k for k, i in enumerate(members)}
-        Kt = np.array([tables[rows[i]][0] for i, _ in lanes])
-        Ft = np.array([tables[rows[i]][1] for i, _ in lanes])
-        per = np.array([plans[i].period for i, _ in lanes])
-        laws = {i: law(points[i]) for i in members}
-        a = np.array([laws[i].a for i, _ in lanes])
-        c = np.array([laws[i].c for i, _ in lanes])
-        mu = np.array([points[i].damping for i, _ in lanes])
-        x0 = np.array([s[0] for _, s in lanes])
-        v0 = np.array([s[1] for _, s in lanes])
-        streams = max(1, min(numba.get_num_threads(), -(-len(lanes) // kernels.LANES)))
-        out = kernels.run_batch(
-            a, c, mu, x0, v0, Kt, Ft, per, N, n_trans, n_rec, DIVERGENCE_BOUND,
-            settings.adaptive, streams,
-        )  # fmt: skip
-        results.update(lockstep_points(out, members, lanes, per))
-    return [results[i] for i in range(len(points))]
+    lanes = [(i, s) for i in range(len(points)) for s in starts]
+    per_lane = _run_lanes(points, plans, lanes, settings)
+    S = len(starts)
+    worst = []
+    for i in range(len(points)):
+        block = per_lane[i * S : (i + 1) * S]
+        j = max(range(S), key=lambda j: severity(block[j].classification, block[j].period))
+        worst.append(block[j].model_copy(update={"start_index": j}))
+    return worst
 
 
 def threads_may_share_kernels() -> bool:

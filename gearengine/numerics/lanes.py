@@ -2,8 +2,8 @@
 
 The LLE and its standard error of every lane come from ``lyapunov.benettin_rows`` (the same
 sums as ``benettin``, so the same bits), the period from the compiled ``detect_period`` per lane,
-and each point's ``BatchPoint`` is built once, from its worst start only: the numbers equal those
-of ``runs.start_verdict`` + ``batch.batch_point`` without a ``Run`` or ``StartSummary`` per lane.
+and each lane's ``BatchPoint`` is built without a ``Run`` or ``StartSummary``: the numbers equal
+those of ``runs.start_verdict`` + ``batch.run_verdict``.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from gearengine.numerics.classify import classify, severity
+from gearengine.numerics.classify import classify
 from gearengine.numerics.diagnostics import impact_regime
 from gearengine.numerics.lyapunov import benettin_rows
 from gearengine.numerics.periodicity import attractor_size, detect_period
@@ -76,8 +76,8 @@ def last_strobes(out: tuple, lanes: list[int]) -> list[list]:
 def lane_point(
     out: tuple, lane: int, start_index: int, verdict: tuple, strobes: list
 ) -> BatchPoint:
-    """The ``BatchPoint`` of a point whose worst start is ``lane`` (``batch.batch_point``),
-    with that lane's last ``strobes``."""
+    """The ``BatchPoint`` of ``lane`` (as ``batch.run_verdict`` gives it), numbered
+    ``start_index``, with that lane's last ``strobes``."""
     _, _, _, xmin, xmax, fmin, fmax, done, _, diverged, xf, vf = out
     classification, period, lle, stderr = verdict
     dead = bool(diverged[lane])
@@ -97,26 +97,3 @@ def lane_point(
         force_max=None if dead else finite_or_none(float(fmax[lane])),
         force_min=None if dead else finite_or_none(float(fmin[lane])),
     )
-
-
-def lockstep_points(
-    out: tuple, members: list[int], lanes: list[tuple[int, tuple]], per: np.ndarray
-) -> dict[int, BatchPoint]:
-    """``BatchPoint`` of each member point from the group's kernel output ``out`` (lanes in
-    point-major order, one per point and start; ``per``: each lane's T0)."""
-    verdicts = lane_verdicts(out, per)
-    first: dict[int, int] = {}
-    for lane, (i, _) in enumerate(lanes):
-        first.setdefault(i, lane)
-    worst: list[int] = []
-    for i in members:
-        lane0 = first[i]
-        lane1 = lane0
-        while lane1 < len(lanes) and lanes[lane1][0] == i:
-            lane1 += 1
-        worst.append(max(range(lane0, lane1), key=lambda j: severity(*verdicts[j][:2])))
-    strobes = last_strobes(out, worst)
-    return {
-        i: lane_point(out, best, best - first[i], verdicts[best], window)
-        for i, best, window in zip(members, worst, strobes, strict=True)
-    }
