@@ -96,6 +96,25 @@ def test_rounded_braking_torque_raises_no_note() -> None:
     assert any("balancing" in n for n in noted.notes)
 
 
+@pytest.mark.parametrize(
+    ("typed", "understood"),
+    [("40 Nm", "40 N*m"), ("0.04 kNm", "0.04 kN*m"), ("40000 Nmm", "40000 N*mm"),
+     ("40 N.m", None), ("40 N m", None)],
+)  # fmt: skip
+def test_torque_spellings_engineers_type(
+    client: TestClient, typed: str, understood: str | None
+) -> None:
+    """pint alone reads "Nm" as a number-metre (N: Avogadro's number) and refuses it as a
+    torque; the design reads it as newton metres and says so in its notes."""
+    d = Design.model_validate(design(torque=typed))
+    assert d.torque == pytest.approx(40.0)
+    said = [n for n in convert_design(d).notes if "read as" in n]
+    assert said == ([] if understood is None else [f"torque {typed!r} read as {understood!r}"])
+    r = client.post("/v1/melnikov", json={"design": design(torque=typed)})
+    assert r.status_code == 200, r.text
+    assert r.json()["engineering"]["notes"][: len(said)] == said
+
+
 def test_params_xor_design(client: TestClient) -> None:
     both = {"design": EXAMPLE_DESIGN, "params": {"damping": 0.1}}
     assert client.post("/v1/melnikov", json=both).status_code == 422

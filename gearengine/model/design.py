@@ -22,6 +22,8 @@ from typing import Annotated, Any, Literal
 from pydantic import (
     BaseModel,
     Field,
+    ModelWrapValidatorHandler,
+    PrivateAttr,
     model_validator,
 )
 
@@ -42,6 +44,7 @@ from gearengine.model.units import (
     Speed,
     StiffnessVariation,
     Torque,
+    readings,
 )
 
 
@@ -201,6 +204,23 @@ class Design(_Strict):
         None, description="Driver speeds scanned for Melnikov windows (default 10 rpm to 3x "
         "speed).",
     )  # fmt: skip
+
+    _readings: list[str] = PrivateAttr(default_factory=list)
+
+    @model_validator(mode="wrap")
+    @classmethod
+    def _with_readings(cls, data: Any, handler: ModelWrapValidatorHandler[Design]) -> Design:
+        """Validate, keeping what was understood from engineers' unit spellings ("40 Nm")."""
+        with readings() as found:
+            design = handler(data)
+        design._readings = found
+        return design
+
+    @property
+    def readings(self) -> list[str]:
+        """How unit spellings pint reads otherwise were understood ("torque '40 Nm' read as
+        '40 N*m'"), for the notes."""
+        return list(self._readings)
 
     @model_validator(mode="after")
     def _consistent(self) -> Design:

@@ -151,7 +151,7 @@ def physical_data(design: Design) -> tuple[PhysicalGearData, dict[str, Derived],
         )
     balancing = design.torque * rb / ra
     braking = balancing if design.braking_torque is None else design.braking_torque
-    notes = []
+    notes = design.readings
     if abs(braking - balancing) > BALANCE_TOLERANCE * max(abs(balancing), 1e-12):
         notes.append(f"braking torque {braking:.6g} N m differs from the balancing "
                      f"{balancing:.6g} N m: the pair would speed up or slow down")  # fmt: skip

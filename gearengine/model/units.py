@@ -13,7 +13,11 @@ Reference: H. E. Grecco et al., pint (https://pint.readthedocs.io), the registry
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import re
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass, field
 from functools import cache
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -44,6 +48,9 @@ class QuantityKind:
     high: float
     slips: tuple[str, ...]
     example: str
+    spellings: dict[str, str] = field(default_factory=dict)
+    """Units as engineers type them that pint reads otherwise (``Nm``: pint's N is Avogadro's
+    number), and the unit meant; the whole unit text must match."""
 
     @property
     def dimensionality(self) -> Any:
@@ -54,6 +61,42 @@ class QuantityKind:
         return f"{si:.6g} {self.unit}"
 
 
+TORQUE_SPELLINGS = {"Nm": "N*m", "kNm": "kN*m", "MNm": "MN*m", "Nmm": "N*mm"}
+"""Torque units as typed on drawings and in spreadsheets, read as newton metres (pint reads
+``Nm`` as a number-metre, ``N`` being Avogadro's number there; ``N.m`` and ``N m`` it reads
+right)."""
+
+_READINGS: ContextVar[list[str] | None] = ContextVar("readings", default=None)
+
+
+@contextmanager
+def readings() -> Iterator[list[str]]:
+    """Collect, while validating inside this block, what ``parse_quantity`` understood from a
+    spelling of ``QuantityKind.spellings`` (one sentence each, for the notes of a design)."""
+    found: list[str] = []
+    token = _READINGS.set(found)
+    try:
+        yield found
+    finally:
+        _READINGS.reset(token)
+
+
+_NUMBER_AND_UNIT = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)\s*")
+
+
+def _respelled(text: str, kind: QuantityKind) -> str:
+    """``text`` with an engineer's spelling of the unit (``40 Nm``) written as pint reads it
+    (``40 N*m``), noted in the current ``readings``; other text unchanged."""
+    match = _NUMBER_AND_UNIT.fullmatch(text)
+    if match is None or match.group(2) not in kind.spellings:
+        return text
+    meant = f"{match.group(1)} {kind.spellings[match.group(2)]}"
+    found = _READINGS.get()
+    if found is not None:
+        found.append(f"{kind.name} {text.strip()!r} read as {meant!r}")
+    return meant
+
+
 QUANTITIES: dict[str, QuantityKind] = {
     "length": QuantityKind("length", "m", 1e-9, 10.0, ("um", "mm"), "30 mm"),
     "half_backlash": QuantityKind("half backlash", "m", 1e-7, 5e-3, ("um", "mm"), "50 um"),
@@ -61,7 +104,7 @@ QUANTITIES: dict[str, QuantityKind] = {
     "speed": QuantityKind(
         "shaft speed", "rad/s", 2 * math.pi / 60, 2e5 * 2 * math.pi / 60, ("rpm",), "1500 rpm"
     ),
-    "torque": QuantityKind("torque", "N*m", 0.0, 1e6, (), "40 N*m"),
+    "torque": QuantityKind("torque", "N*m", 0.0, 1e6, (), "40 N*m", TORQUE_SPELLINGS),
     "stiffness": QuantityKind("mesh stiffness", "N/m", 1e6, 1e11, ("N/um", "N/mm"), "1e8 N/m"),
     "stiffness_variation": QuantityKind(
         "stiffness variation", "N/m", 0.0, 1e11, ("N/um", "N/mm"), "1e7 N/m"
@@ -87,6 +130,7 @@ def parse_quantity(value: object, kind: QuantityKind, allow_zero: bool = False) 
         raise ValueError(f"give a number in {kind.unit} or a string with a unit, e.g. "
                          f"{kind.example!r}")  # fmt: skip
     if isinstance(value, str):
+        value = _respelled(value, kind)
         try:
             quantity = ureg.Quantity(value.strip())
         except Exception as exc:
