@@ -33,7 +33,7 @@ from gearengine.homoclinic.schemas import (
 )
 from gearengine.model.aliases import get_alias, with_alias, with_aliases
 from gearengine.model.backlash import melnikov_cubic
-from gearengine.model.frequencies import MAX_DENOMINATOR, RATIO_TOLERANCE
+from gearengine.model.frequencies import COMMENSURABILITY_TOLERANCE, MAX_DENOMINATOR
 from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash
 
 CONTROL_PARAMETERS = ("F_e1", "mu", "k_p1", "F_p1")
@@ -324,7 +324,7 @@ def commensurability(frequencies: list[float]) -> tuple[float, float]:
     ratios = []
     for f in freqs:
         q = Fraction(f / top).limit_denominator(MAX_DENOMINATOR)
-        if abs(float(q) - f / top) > RATIO_TOLERANCE * (f / top):
+        if abs(float(q) - f / top) > COMMENSURABILITY_TOLERANCE * (f / top):
             return 0.0, 1.0
         ratios.append(q)
     lcm = math.lcm(*(q.denominator for q in ratios))

@@ -254,8 +254,10 @@ def to_dimensionless(data: PhysicalGearData) -> Conversion:
             [(h.amplitude * torque_gain, h.phase) for h in data.torque_harmonics],
         ),
     )
+    orders = {"stiffness": data.teeth_a, "transmission_error": te_order,
+              "torque": data.torque_order}  # fmt: skip
     return Conversion(
-        params=params,
+        params=params.with_shaft_orders(orders),
         equivalent_mass=m,
         natural_frequency=omega_n,
         time_scale=1.0 / omega_n,

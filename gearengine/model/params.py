@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr
 
 MAX_HARMONICS = 32
 """Largest number of harmonics r = 1..R accepted per excitation."""
@@ -170,6 +170,26 @@ class GearParams(_Strict):
             },
         }
     )
+
+    _shaft_orders: dict[str, float] | None = PrivateAttr(None)
+
+    @property
+    def shaft_orders(self) -> dict[str, float] | None:
+        """For the parameters of a design: each excitation's fundamental as a multiple of the
+        driver speed (stiffness: the teeth z; transmission error and torque: their orders),
+        from which ``model.frequencies`` takes the Poincare period exactly; None for
+        parameters given dimensionless. Not part of the JSON: it travels with the object."""
+        return None if self._shaft_orders is None else dict(self._shaft_orders)
+
+    def with_shaft_orders(self, orders: dict[str, float] | None) -> GearParams:
+        """A copy recording ``orders`` (see ``shaft_orders``)."""
+        copy = self.model_copy()
+        copy._shaft_orders = None if orders is None else dict(orders)
+        return copy
+
+    def same_parameters(self, other: GearParams) -> bool:
+        """Equal parameters of Eq. (9) (``==`` also compares ``shaft_orders``)."""
+        return self.model_dump() == other.model_dump()
 
     def excitations(self) -> Iterator[tuple[str, Excitation]]:
         """Yield (name, excitation) for each excitation that is given."""

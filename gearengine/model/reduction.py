@@ -259,7 +259,7 @@ class ParamsOrDesign(BaseModel):
             return self
         conversion = convert_design(self.design)
         # a stored request (a sweep job) carries both: params must be the design's conversion
-        if self.params is not None and self.params != conversion.params:
+        if self.params is not None and not self.params.same_parameters(conversion.params):
             raise ValueError("give params or design, not both")
         object.__setattr__(self, "params", conversion.params)
         self._conversion = conversion

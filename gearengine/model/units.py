@@ -14,10 +14,10 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cache
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -215,3 +215,113 @@ Angle = quantity_type("angle")
 
 RPM = 2.0 * math.pi / 60.0
 """One revolution per minute in rad/s."""
+
+
+def shown(value: float) -> float:
+    """A value in display units rounded to 12 significant digits (6000 rpm, not
+    6000.000000000001): how every physical number of a sweep point, of its CSV row and of an
+    analysis's response is given."""
+    return float(f"{value:.12g}")
+
+
+@dataclass(frozen=True)
+class Scales:
+    """What maps a dimensionless answer of Eq. (9) back to gear data (Eq. 8: x = x~ / b,
+    tau = omega_n t, forces in units of b k_m)."""
+
+    half_backlash: float
+    """b [m]: x = 1 is one half backlash."""
+    mesh_stiffness: float
+    """k_m [N/m]: a dimensionless force times b k_m is in N."""
+    natural_frequency: float
+    """omega_n = sqrt(k_m / m) [rad/s]: t = tau / omega_n."""
+    static_force: float
+    """Mean mesh force F^_m = F~_m b k_m [N] (Eq. 7)."""
+    mesh_frequency: float
+    """omega_k = n_a omega_a [rad/s]."""
+    speed: float
+    """Driver speed omega_a [rad/s]."""
+    torque_gain: float
+    """F~_p per N m of driver-torque fluctuation, m r_a / (I_a b k_m) [1/(N m)]."""
+
+    def at(self, mean_force: float) -> Scales:
+        """These scales for a point whose dimensionless mean force F~_m was set (an ``F_m``
+        axis): the static force is F~_m b k_m."""
+        return replace(self, static_force=mean_force * (self.half_backlash * self.mesh_stiffness))
+
+
+@dataclass(frozen=True)
+class OutputKind:
+    """A dimensionless result as a physical quantity: ``to_si(value, scales)`` inverts Eq. (8)
+    for it, ``display`` is the factor from its SI unit to the unit it is shown in."""
+
+    label: str
+    si_unit: str
+    unit: str
+    to_si: Callable[[float, Scales], float]
+    display: float = 1.0
+
+
+OUTPUTS: dict[str, OutputKind] = {
+    "dte": OutputKind(
+        "dynamic transmission error (peak to peak)", "m", "um", lambda x, s: x * s.half_backlash,
+        1e6,
+    ),
+    "dynamic_factor": OutputKind(
+        "dynamic factor (largest mesh force / static force)", "1", "1",
+        lambda f, s: f * s.half_backlash * s.mesh_stiffness / s.static_force,
+    ),
+    "mesh_force": OutputKind(
+        "dynamic mesh force", "N", "N", lambda f, s: f * s.half_backlash * s.mesh_stiffness
+    ),
+    "transmission_error_amplitude": OutputKind(
+        "transmission-error amplitude e_1 = F~_e1 b", "m", "um",
+        lambda v, s: v * s.half_backlash, 1e6,
+    ),
+    "torque_fluctuation_amplitude": OutputKind(
+        "torque-fluctuation amplitude T_p1 = F~_p1 / (m r_a / (I_a b k_m))", "N*m", "N*m",
+        lambda v, s: v / s.torque_gain,
+    ),
+    "stiffness_variation_amplitude": OutputKind(
+        "stiffness-variation amplitude k_1 = 2 k_m k~_p1", "N/m", "N/m",
+        lambda v, s: 2.0 * v * s.mesh_stiffness,
+    ),
+    "damping_ratio": OutputKind("damping ratio zeta = mu~", "1", "1", lambda v, s: v),
+}  # fmt: skip
+"""Output quantities by name: the physical meaning of a dimensionless result (beside the inputs'
+``QUANTITIES``); the engineering block, sweep points, CSV columns, gate rules and plots read it."""
+
+RESPONSES = ("dte", "dynamic_factor")
+"""The response quantities of a design's simulated point (a sweep point's ``physical`` entries
+beside its axes, the CSV's response columns, the gate's limits)."""
+
+
+def to_physical(name: str, value: float, scales: Scales) -> float:
+    """The dimensionless ``value`` of output ``name`` in its display unit (``OUTPUTS``): the one
+    crossing from a dimensionless result to a physical value."""
+    kind = OUTPUTS[name]
+    si = kind.to_si(value, scales)
+    return si if kind.display == 1.0 else si * kind.display
+
+
+def response_values(
+    x_peak_to_peak: float | None, force_max: float | None, scales: Scales
+) -> dict[str, float | None]:
+    """DTE [µm peak to peak] and dynamic factor of a simulated response, ``shown``: the one
+    definition used by an analysis's engineering block and by every sweep point.
+
+    ``x_peak_to_peak`` (units of b) and ``force_max`` (units of b k_m) come from the kernel's
+    per-step extremes over the record; the dynamic factor is None without a positive static
+    force."""
+    dte = None if x_peak_to_peak is None else shown(to_physical("dte", x_peak_to_peak, scales))
+    factor = None
+    if force_max is not None and scales.static_force > 0.0:
+        factor = shown(to_physical("dynamic_factor", force_max, scales))
+    return {"dte": dte, "dynamic_factor": factor}
+
+
+def display_label(name: str) -> str:
+    """An output's name with its display unit, as a CSV column title or a plot's axis label
+    ("dte [um]"; a dimensionless one bare)."""
+    unit = OUTPUTS[name].unit
+    return name if unit == "1" else f"{name} [{unit}]"
