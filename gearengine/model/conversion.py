@@ -198,10 +198,21 @@ class Conversion(_Strict):
     )
 
 
-def equivalent_mass(data: PhysicalGearData) -> float:
-    """m = I_a I_b / (I_b r_a^2 + I_a r_b^2) [kg] (Eq. 7)."""
-    ia, ib, ra, rb = data.inertia_a, data.inertia_b, data.base_radius_a, data.base_radius_b
+def pair_mass(ia: float, ib: float, ra: float, rb: float) -> float:
+    """Equivalent mass m = I_a I_b / (I_b r_a^2 + I_a r_b^2) [kg] of inertias I [kg m^2] on
+    base radii r [m] (Eq. 7)."""
     return ia * ib / (ib * ra**2 + ia * rb**2)
+
+
+def equivalent_mass(data: PhysicalGearData) -> float:
+    """m = I_a I_b / (I_b r_a^2 + I_a r_b^2) [kg] of the record (Eq. 7, ``pair_mass``)."""
+    return pair_mass(data.inertia_a, data.inertia_b, data.base_radius_a, data.base_radius_b)
+
+
+def torque_gain(data: PhysicalGearData) -> float:
+    """F~_p per N m of driver-torque fluctuation, m r_a / (I_a b k_m) [1/(N m)] (Eq. 7-8)."""
+    force_scale = data.half_backlash * data.mesh_stiffness
+    return equivalent_mass(data) * data.base_radius_a / data.inertia_a / force_scale
 
 
 def mean_force(data: PhysicalGearData) -> float:
@@ -237,7 +248,7 @@ def to_dimensionless(data: PhysicalGearData) -> Conversion:
             harmonics=[Harmonic(amplitude=amp, phase=phase) for amp, phase in harmonics],
         )
 
-    torque_gain = m * data.base_radius_a / data.inertia_a / force_scale
+    gain = torque_gain(data)
     params = GearParams(
         damping=data.mesh_damping / (2.0 * m * omega_n),
         mean_force=f_m / force_scale,
@@ -251,7 +262,7 @@ def to_dimensionless(data: PhysicalGearData) -> Conversion:
         ),
         torque=excitation(
             data.torque_order * data.shaft_speed_a,
-            [(h.amplitude * torque_gain, h.phase) for h in data.torque_harmonics],
+            [(h.amplitude * gain, h.phase) for h in data.torque_harmonics],
         ),
     )
     orders = {"stiffness": data.teeth_a, "transmission_error": te_order,

@@ -28,12 +28,14 @@ from gearengine.model.conversion import (
     StiffnessHarmonic,
     TorqueHarmonic,
     TransmissionErrorHarmonic,
+    pair_mass,
     to_dimensionless,
+    torque_gain,
 )
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash
-from gearengine.model.units import RPM
+from gearengine.model.units import RPM, Scales
 
 RATIO_TOLERANCE = 0.01
 """Largest relative mismatch of base-radius ratio and teeth ratio accepted."""
@@ -71,6 +73,20 @@ class DesignConversion(BaseModel):
     static_force_n: float = Field(description="Mean mesh force F^_m [N] (Eq. 7).")
     torque_gain: float = Field(description="F~_p per N m of driver torque fluctuation [1/(N m)].")
     notes: list[str] = Field(description="Assumptions and remarks, in plain words.")
+
+    @property
+    def scales(self) -> Scales:
+        """What maps this design's dimensionless answers back to gear data (``model.units``:
+        ``to_physical``, ``OUTPUTS``)."""
+        return Scales(
+            half_backlash=self.half_backlash_m,
+            mesh_stiffness=self.mesh_stiffness_n_per_m,
+            natural_frequency=1.0 / self.time_scale_s,
+            static_force=self.static_force_n,
+            mesh_frequency=2.0 * math.pi * self.mesh_frequency_hz,
+            speed=self.speed_rpm * RPM,
+            torque_gain=self.torque_gain,
+        )
 
 
 def _gear_values(design: Design, derived: dict[str, Derived]) -> dict[str, float]:
@@ -157,7 +173,7 @@ def physical_data(design: Design) -> tuple[PhysicalGearData, dict[str, Derived],
                      f"{balancing:.6g} N m: the pair would speed up or slow down")  # fmt: skip
     mesh, te, tf = design.mesh, design.transmission_error, design.torque_fluctuation
     ia, ib = gears["inertia_driver"], gears["inertia_driven"]
-    m = ia * ib / (ib * ra**2 + ia * rb**2)  # equivalent mass (Eq. 7)
+    m = pair_mass(ia, ib, ra, rb)
     zeta = mesh.damping_ratio
     damping = mesh.damping if zeta is None else 2.0 * zeta * math.sqrt(k_m * m)  # mu~ = zeta
     data = PhysicalGearData(
@@ -219,7 +235,7 @@ def convert_design(design: Design) -> DesignConversion:
         half_backlash_m=data.half_backlash,
         mesh_stiffness_n_per_m=data.mesh_stiffness,
         static_force_n=conv.params.mean_force * force_scale,
-        torque_gain=m * data.base_radius_a / data.inertia_a / force_scale,
+        torque_gain=torque_gain(data),
         notes=notes,
     )
 

@@ -325,3 +325,96 @@ def display_label(name: str) -> str:
     ("dte [um]"; a dimensionless one bare)."""
     unit = OUTPUTS[name].unit
     return name if unit == "1" else f"{name} [{unit}]"
+
+
+@dataclass(frozen=True)
+class FieldUnit:
+    """How a design field (a sweep axis) is shown: its SI unit, its display unit and the factor
+    from the one to the other."""
+
+    si: str
+    display: str
+    factor: float = 1.0
+
+
+DISPLAY_UNITS: dict[str, FieldUnit] = {
+    "speed": FieldUnit("rad/s", "rpm", 1.0 / RPM),
+    "torque": FieldUnit("N*m", "N*m"),
+    "braking_torque": FieldUnit("N*m", "N*m"),
+    "half_backlash": FieldUnit("m", "um", 1e6),
+    "transmission_error": FieldUnit("m", "um", 1e6),
+    "torque_fluctuation": FieldUnit("N*m", "N*m"),
+    "stiffness_harmonics": FieldUnit("N/m", "N/m"),
+    "stiffness": FieldUnit("N/m", "N/m"),
+    "damping_ratio": FieldUnit("1", "1"),
+    "damping": FieldUnit("N*s/m", "N*s/m"),
+    "inertia": FieldUnit("kg*m^2", "kg*m^2"),
+    "base_radius": FieldUnit("m", "mm", 1e3),
+    "module": FieldUnit("m", "mm", 1e3),
+    "face_width": FieldUnit("m", "mm", 1e3),
+    "bore": FieldUnit("m", "mm", 1e3),
+    "pressure_angle": FieldUnit("rad", "deg", 180.0 / math.pi),
+    "order": FieldUnit("1", "1"),
+    "profile_shift": FieldUnit("1", "1"),
+    "phase": FieldUnit("rad", "rad"),
+}
+"""Units of a design's fields by the most specific name in their path
+(``transmission_error.harmonics.0.amplitude`` is shown in µm)."""
+
+FIELD_NAMES = {
+    "speed": "driver speed",
+    "torque": "mean driver torque",
+    "braking_torque": "braking torque",
+    "half_backlash": "half backlash",
+    "damping_ratio": "damping ratio",
+    "damping": "mesh damping",
+    "stiffness": "mean mesh stiffness",
+    "stiffness_harmonics": "mesh-stiffness variation",
+    "transmission_error": "transmission error",
+    "torque_fluctuation": "torque fluctuation",
+    "base_radius": "base radius",
+    "face_width": "face width",
+    "pressure_angle": "pressure angle",
+    "profile_shift": "profile shift",
+}
+"""Readable names of the parts of a field path (others are shown as they are)."""
+
+
+def field_unit(path: str) -> FieldUnit:
+    """The units of a design field path (``DISPLAY_UNITS``; SI shown as it is when unknown)."""
+    for part in (path, *reversed(path.split("."))):
+        if part in DISPLAY_UNITS:
+            return DISPLAY_UNITS[part]
+    return FieldUnit("SI", "SI")
+
+
+def display_unit(path: str) -> tuple[str, float]:
+    """(display unit, factor from SI) of a design field path."""
+    unit = field_unit(path)
+    return unit.display, unit.factor
+
+
+def in_display_unit(path: str, si: float) -> float:
+    """A design field's SI value in its display unit, ``shown``: the number of a sweep point's
+    ``physical`` entry and of its CSV column."""
+    return shown(si * field_unit(path).factor)
+
+
+def pretty_unit(unit: str) -> str:
+    """A unit as printed on a figure: µm for um, a middle dot for a product."""
+    return unit.replace("um", "µm").replace("*", "·").replace("^2", "²")
+
+
+def field_label(path: str) -> str:
+    """A readable axis label of a design field path: "driver speed [rpm]",
+    "transmission error, harmonic 1 amplitude [µm]", "driver module [mm]"."""
+    parts = [p for p in path.split(".") if p != "mesh"]
+    words = []
+    for k, part in enumerate(parts):
+        if part.isdigit():
+            words[-1] += f", harmonic {int(part) + 1}"
+        elif part != "harmonics" or k == 0:
+            words.append(FIELD_NAMES.get(part, part.replace("_", " ")))
+    unit = field_unit(path).display
+    text = " ".join(words)
+    return text if unit == "1" else f"{text} [{pretty_unit(unit)}]"

@@ -9,9 +9,10 @@ from collections.abc import Iterable, Iterator, Sequence
 
 from pydantic import BaseModel, Field, TypeAdapter
 
-from gearengine.sweeps.axes import display_unit, in_display_unit, is_dimensionless
+from gearengine.model.units import RESPONSES, display_label, display_unit, in_display_unit
+from gearengine.sweeps.axes import is_dimensionless
 from gearengine.sweeps.request import SweepAxis
-from gearengine.sweeps.results import RESPONSE_UNITS, SweepBifurcation, SweepPoint, SweepResult
+from gearengine.sweeps.results import SweepBifurcation, SweepPoint, SweepResult
 
 _LINE_HEAD = '{"bifurcations":'
 _LINE_POINTS = ',"points":['
@@ -138,15 +139,12 @@ def _physical_columns(
     names: list[str], outputs: Sequence[str] | None
 ) -> list[tuple[str, str, bool]]:
     """(key, column title, is an axis) of a design's sweep: each physical axis in its display
-    unit (from the point's ``values``), then the response entries of ``RESPONSE_UNITS`` (from
+    unit (from the point's ``values``), then the responses of ``model.units.RESPONSES`` (from
     its ``physical``, unless ``outputs`` leaves that out)."""
     axes = [(n, f"{n} [{display_unit(n)[0]}]", True) for n in names if not is_dimensionless(n)]
     if outputs is not None and "physical" not in outputs:
         return axes
-    response = [
-        (key, key if unit == "1" else f"{key} [{unit}]", False)
-        for key, unit in RESPONSE_UNITS.items()
-    ]
+    response = [(key, display_label(key), False) for key in RESPONSES]
     return [*axes, *response]
 
 

@@ -18,6 +18,7 @@ from xml.etree import ElementTree
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from gearengine.model.units import RESPONSES
 from gearengine.numerics.classify import SEVERITY
 from gearengine.sweeps.results import PhysicalValue, SpeedWindows, SweepPoint, SweepResult
 from gearengine.sweeps.windows import SPEED, runs
@@ -65,10 +66,6 @@ def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
     return out
 
 
-RESPONSE_KEYS = ("dte", "dynamic_factor")
-"""Keys of a point's ``physical`` that are responses, not axis levels."""
-
-
 class FailingWindow(BaseModel):
     """A run of grid speeds at one torque level that breaks one rule."""
 
@@ -95,7 +92,7 @@ class EnvelopeReport(BaseModel):
 
 def _level_key(p: SweepPoint) -> tuple:
     return tuple(sorted((k, v.value) for k, v in (p.physical or {}).items() if k not in
-                        (SPEED, *RESPONSE_KEYS)))  # fmt: skip
+                        (SPEED, *RESPONSES)))  # fmt: skip
 
 
 def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
@@ -108,9 +105,7 @@ def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
     failing = 0
     for row in rows.values():
         row.sort(key=lambda p: p.values[SPEED])
-        level = {
-            k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, *RESPONSE_KEYS)
-        }
+        level = {k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, *RESPONSES)}
         speeds = [p.physical[SPEED].value for p in row]  # type: ignore[index]
         broken = [point_failures(p, rules) for p in row]
         failing += sum(1 for b in broken if b)
