@@ -17,6 +17,7 @@ from gearengine.engineering import Engineering, engineering
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
 from gearengine.homoclinic.verdict import melnikov
 from gearengine.model.design import EXAMPLE_DESIGN
+from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
@@ -156,7 +157,7 @@ def convert(request: DesignRequest) -> DesignReport:
     """The conversion of a design with its engineering block (Melnikov windows, thresholds)."""
     conv = request.conversion
     if conv is None:
-        raise ValueError("design: give a design (physical units) to convert")
+        raise InputError("design", "give a design (physical units) to convert")
     mel = melnikov(conv.params)
     return DesignReport(
         conversion=conv, engineering=engineering(conv, request.speed_rpm_range(), mel)

@@ -42,17 +42,12 @@ from gearengine.model.params import (
     PiecewiseBacklash,
     request_config,
 )
+from gearengine.model.units import RADIUS_RATIO_TOLERANCE, TORQUE_BALANCE_TOLERANCE
 
 Positive = Annotated[float, Field(ge=1.0e-12, le=1.0e12, allow_inf_nan=False)]
 """A physical quantity that must be positive, in [1e-12, 1e12] SI units (no subnormals)."""
 SIValue = Annotated[float, Field(ge=-1.0e12, le=1.0e12, allow_inf_nan=False)]
 """A signed physical quantity in SI units, |value| <= 1e12."""
-
-BALANCE_TOLERANCE = 1e-9
-"""Relative mismatch of T_ma / r_a and T_mb / r_b above which the notes flag unbalanced torques."""
-
-RATIO_TOLERANCE = 0.01
-"""Relative mismatch of r_a / r_b and n_a / n_b above which the notes flag inconsistent data."""
 
 
 class _Strict(BaseModel):
@@ -284,14 +279,14 @@ def _notes(data: PhysicalGearData, f_m: float) -> list[str]:
         "printed Eq. 7 omits r_a in the first term; corrected here)"
     ]
     imbalance = data.torque_a_mean / ra - data.torque_b_mean / rb
-    if abs(imbalance) > BALANCE_TOLERANCE * max(abs(data.torque_a_mean / ra), abs(f_m)):
+    if abs(imbalance) > TORQUE_BALANCE_TOLERANCE * max(abs(data.torque_a_mean / ra), abs(f_m)):
         notes.append(
             f"mean torques are unbalanced: T_ma / r_a - T_mb / r_b = {imbalance:.6g} N, so the "
             "pair speeds up or slows down (Eq. 1 assumes constant speeds); Eq. 7 for x~ still "
             "holds"
         )
     ratio, teeth_ratio = ra / rb, data.teeth_a / data.teeth_b
-    if abs(ratio - teeth_ratio) > RATIO_TOLERANCE * teeth_ratio:
+    if abs(ratio - teeth_ratio) > RADIUS_RATIO_TOLERANCE * teeth_ratio:
         notes.append(
             f"base-radius ratio r_a / r_b = {ratio:.6g} differs from the teeth ratio "
             f"n_a / n_b = {teeth_ratio:.6g}"

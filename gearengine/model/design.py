@@ -27,6 +27,7 @@ from pydantic import (
     model_validator,
 )
 
+from gearengine.model.errors import InputError
 from gearengine.model.params import (
     MAX_HARMONICS,
     Phase,
@@ -229,5 +230,5 @@ class Design(_Strict):
         ):
             raise ValueError("mesh.stiffness 'iso6336' needs module and face_width on both gears")
         if self.speed_range is not None and not self.speed_range[0] < self.speed_range[1]:
-            raise ValueError("speed_range: the first speed must be below the second")
+            raise InputError("speed_range", "the first speed must be below the second")
         return self

@@ -31,7 +31,9 @@ from gearengine.model.params import GearParams
 MAX_DENOMINATOR = 64
 """Largest denominator q of a ratio of two fundamentals of ``params`` (p / q) accepted."""
 COMMENSURABILITY_TOLERANCE = 1e-9
-"""Largest relative distance of a frequency ratio from its rational p / q accepted."""
+"""Largest relative distance of a frequency ratio from its rational p / q accepted (the tolerance
+of the units boundary's third kind, beside ``model.units``' radius-ratio and torque-balance
+tolerances)."""
 MAX_ORDER_DENOMINATOR = 1000
 """Largest denominator of a design's order (multiple of the shaft speed) read as a rational."""
 

@@ -33,15 +33,16 @@ from gearengine.model.conversion import (
     torque_gain,
 )
 from gearengine.model.design import EXAMPLE_DESIGN, Design
+from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash
-from gearengine.model.units import RPM, Scales
+from gearengine.model.units import (
+    RADIUS_RATIO_TOLERANCE,
+    RPM,
+    TORQUE_BALANCE_TOLERANCE,
+    Scales,
+)
 
-RATIO_TOLERANCE = 0.01
-"""Largest relative mismatch of base-radius ratio and teeth ratio accepted."""
-BALANCE_TOLERANCE = 1e-3
-"""Relative mismatch of a given braking torque with the balancing one that raises a note
-(rounding such as 66.667 for 200/3 N m stays below it)."""
 ISO_HARMONICS = 5
 """Harmonics of the mesh-stiffness wave kept when the variation comes from the contact ratio."""
 
@@ -153,22 +154,24 @@ def physical_data(design: Design) -> tuple[PhysicalGearData, dict[str, Derived],
     gears = _gear_values(design, derived)
     ra, rb = gears["base_radius_driver"], gears["base_radius_driven"]
     teeth = design.driver.teeth / design.driven.teeth
-    if abs(ra / rb - teeth) > RATIO_TOLERANCE * teeth:
-        raise ValueError(
-            f"design.driven.base_radius: base radii ratio r_a / r_b = {ra / rb:.4f} differs "
-            f"from the teeth ratio {design.driver.teeth}/{design.driven.teeth} = {teeth:.4f} "
-            "by more than 1 %"
+    if abs(ra / rb - teeth) > RADIUS_RATIO_TOLERANCE * teeth:
+        raise InputError(
+            "design.driven.base_radius",
+            f"base radii ratio r_a / r_b = {ra / rb:.4f} differs from the teeth ratio "
+            f"{design.driver.teeth}/{design.driven.teeth} = {teeth:.4f} by more than "
+            f"{RADIUS_RATIO_TOLERANCE:.0%}",
         )
     k_m, harmonics = _stiffness(design, derived)
     if sum(abs(a) for a, _ in harmonics) >= k_m:
-        raise ValueError(
-            "design.mesh.stiffness_harmonics: the amplitudes add up to the mean mesh stiffness "
-            f"{k_m:.6g} N/m or more, so the stiffness would become negative"
+        raise InputError(
+            "design.mesh.stiffness_harmonics",
+            f"the amplitudes add up to the mean mesh stiffness {k_m:.6g} N/m or more, so the "
+            "stiffness would become negative",
         )
     balancing = design.torque * rb / ra
     braking = balancing if design.braking_torque is None else design.braking_torque
     notes = design.readings
-    if abs(braking - balancing) > BALANCE_TOLERANCE * max(abs(balancing), 1e-12):
+    if abs(braking - balancing) > TORQUE_BALANCE_TOLERANCE * max(abs(balancing), 1e-12):
         notes.append(f"braking torque {braking:.6g} N m differs from the balancing "
                      f"{balancing:.6g} N m: the pair would speed up or slow down")  # fmt: skip
     mesh, te, tf = design.mesh, design.transmission_error, design.torque_fluctuation

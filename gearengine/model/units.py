@@ -216,6 +216,16 @@ Angle = quantity_type("angle")
 RPM = 2.0 * math.pi / 60.0
 """One revolution per minute in rad/s."""
 
+# Tolerances of the units boundary: one meaning per name.
+RADIUS_RATIO_TOLERANCE = 0.01
+"""Relative mismatch of the base-radius ratio r_a / r_b and the teeth ratio n_a / n_b beyond
+which the data are inconsistent: a design is refused, the SI record of
+/v1/conversions/physical (no teeth check of its own) gets a note."""
+TORQUE_BALANCE_TOLERANCE = 1e-3
+"""Relative mismatch of the braking torque with the balancing one, T_mb = T_ma r_b / r_a, beyond
+which a note says the pair would speed up or slow down (rounding such as 66.667 for 200/3 N m
+stays below it)."""
+
 
 def shown(value: float) -> float:
     """A value in display units rounded to 12 significant digits (6000 rpm, not

@@ -19,8 +19,7 @@ from gearengine.numerics.forcing import step_plan
 from gearengine.numerics.results import BatchPoint
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.sweeps.axes import is_dimensionless
-from gearengine.sweeps.export import chunk_json, result_json
-from gearengine.sweeps.export import chunk_points as points_of_chunk
+from gearengine.sweeps.export import chunk_json, points_of_chunk, result_json
 from gearengine.sweeps.plan import DEFAULT_CHUNK_POINTS, SweepPlan
 from gearengine.sweeps.request import SweepBranch, SweepRequest
 from gearengine.sweeps.results import (

@@ -14,36 +14,33 @@ from gearengine.sweeps.axes import is_dimensionless
 from gearengine.sweeps.request import SweepAxis
 from gearengine.sweeps.results import SweepBifurcation, SweepPoint, SweepResult
 
-_LINE_HEAD = '{"bifurcations":'
-_LINE_POINTS = ',"points":['
-
 
 def chunk_json(
     points: Iterable[SweepPoint],
     bifurcations: list[SweepBifurcation] | None,
     outputs: Sequence[str] | None = None,
 ) -> str:
-    """A chunk's output (what workers exchange): the JSON array of its points, or, for a line
-    of a one-axis continuation sweep, ``{"bifurcations": [...], "points": [...]}``. With
-    ``outputs`` (``SweepRequest.outputs``) a point holds values, branch and those fields only."""
+    """A chunk's output (what workers exchange), JSON lines: the JSON array of its points and,
+    for a line of a one-axis continuation sweep, a second line with the JSON array of its
+    bifurcations. Compact JSON holds no raw newline (strings escape it), so each line is one
+    whole document. With ``outputs`` (``SweepRequest.outputs``) a point holds values, branch
+    and those fields only."""
     keep = None if outputs is None else {"values", "branch", *outputs}
-    array = ",".join(p.model_dump_json(include=keep) for p in points)
+    array = "[" + ",".join(p.model_dump_json(include=keep) for p in points) + "]"
     if bifurcations is None:
-        return "[" + array + "]"
-    located = ",".join(b.model_dump_json() for b in bifurcations)
-    return _LINE_HEAD + "[" + located + "]" + _LINE_POINTS + array + "]}"
+        return array
+    return array + "\n[" + ",".join(b.model_dump_json() for b in bifurcations) + "]"
 
 
 def _chunk_parts(text: str) -> tuple[str, list[dict[str, object]] | None]:
-    """The inner text of a chunk's points array and its bifurcations (None if it has none)."""
-    text = text.strip()
-    if not text.startswith(_LINE_HEAD):
-        return text[1:-1], None
-    cut = text.index(_LINE_POINTS)
-    return text[cut + len(_LINE_POINTS) : -2], json.loads(text[len(_LINE_HEAD) : cut])
+    """The inner text of a chunk's points array (its elements, streamed as they are) and its
+    bifurcations (None if it has none), one JSON document per line (``chunk_json``)."""
+    points, *located = text.strip().split("\n")
+    inner = points.strip().removeprefix("[").removesuffix("]")
+    return inner, json.loads(located[0]) if located else None
 
 
-def chunk_points(text: str) -> list[dict[str, object]]:
+def points_of_chunk(text: str) -> list[dict[str, object]]:
     """The points of a chunk's output, as JSON objects."""
     return json.loads("[" + _chunk_parts(text)[0] + "]")
 

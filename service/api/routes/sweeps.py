@@ -21,13 +21,13 @@ from gearengine.sweeps import (
     SweepResult,
     checked,
     chunk_bifurcations,
-    chunk_points,
     csv_rows,
+    points_of_chunk,
     result_json,
 )
 from gearengine.sweeps.results import SpeedWindows
 from gearengine.sweeps.windows import SPEED, speed_windows
-from service.api.deps import AppSettings, Jobs, Owner
+from service.api.deps import AppLimits, AppSettings, Jobs, Owner
 from service.api.responses import JSON, PNG, PROBLEMS, RETRY_AFTER_HEADER, SVG, header
 from service.errors import ProblemError
 from service.jobs.models import UNFINISHED, Job, JobPage, JobStatus
@@ -98,16 +98,16 @@ def _succeeded(jobs: SweepJobs, job_id: str, owner: str | None) -> Job:
 )
 def post_sweep(
     body: SweepRequest,
-    request: Request,
     response: Response,
     owner: Owner,
     settings: AppSettings,
     jobs: Jobs,
+    limits: AppLimits,
 ) -> Job:
     """Validate and store the sweep; it runs on the workers. Answers 202 with the job and its
     ``Location``; poll it (``Retry-After``) and fetch ``/result`` or ``/plot`` once succeeded."""
     checked(body, settings.max_sweep_points)
-    request.app.state.limits.check_sweep(body)
+    limits.check_sweep(body)
     plan = SweepPlan(body, settings.sweep_chunk_points)
     try:
         job = jobs.store.submit(
@@ -191,13 +191,13 @@ def _stored_points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
     time: the CSV of a million-point map streams at the speed of its writer, not of
     validation."""
     for array in jobs.store.chunk_results(job_id):
-        for item in chunk_points(array):
+        for item in points_of_chunk(array):
             yield SweepPoint.model_construct(**item)
 
 
 def _points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
     for array in jobs.store.chunk_results(job_id):
-        for item in chunk_points(array):
+        for item in points_of_chunk(array):
             yield SweepPoint.model_validate(item)
 
 
