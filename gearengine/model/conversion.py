@@ -176,6 +176,17 @@ class PhysicalGearData(_Strict):
     )
 
 
+CONVERSION_UNITS = {
+    "equivalent_mass": "kg",
+    "natural_frequency": "rad/s",
+    "time_scale": "s",
+    "mesh_frequency": "rad/s",
+    "natural_frequency_hz": "Hz",
+    "mesh_frequency_hz": "Hz",
+}
+"""Units of the numbers of a ``Conversion`` (/v1/conversions/physical)."""
+
+
 class Conversion(_Strict):
     """Result of ``to_dimensionless``: the parameters of Eq. (8) and the scales used."""
 
@@ -190,6 +201,13 @@ class Conversion(_Strict):
     mesh_frequency: float = Field(description="Mesh frequency w_k = n_a w_a [rad/s].")
     notes: list[str] = Field(
         default_factory=list, description="Derived values and warnings about the input."
+    )
+    natural_frequency_hz: float = Field(description="f_n = w_n / (2 pi) [Hz].")
+    mesh_frequency_hz: float = Field(description="Mesh frequency w_k / (2 pi) [Hz].")
+    units: dict[str, str] = Field(
+        default_factory=lambda: dict(CONVERSION_UNITS),
+        description="The unit of each number above.",
+        examples=[{"natural_frequency": "rad/s", "mesh_frequency": "rad/s"}],
     )
 
 
@@ -269,6 +287,8 @@ def to_dimensionless(data: PhysicalGearData) -> Conversion:
         time_scale=1.0 / omega_n,
         mesh_frequency=omega_k,
         notes=_notes(data, f_m),
+        natural_frequency_hz=omega_n / (2.0 * math.pi),
+        mesh_frequency_hz=omega_k / (2.0 * math.pi),
     )
 
 

@@ -230,9 +230,9 @@ def convert_design(design: Design) -> DesignConversion:
     return DesignConversion(
         params=conv.params,
         derived=derived,
-        natural_frequency_hz=conv.natural_frequency / (2.0 * math.pi),
+        natural_frequency_hz=conv.natural_frequency_hz,
         time_scale_s=conv.time_scale,
-        mesh_frequency_hz=conv.mesh_frequency / (2.0 * math.pi),
+        mesh_frequency_hz=conv.mesh_frequency_hz,
         speed_rpm=design.speed / RPM,
         equivalent_mass_kg=m,
         half_backlash_m=data.half_backlash,
