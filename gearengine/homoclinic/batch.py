@@ -29,9 +29,19 @@ from typing_extensions import TypedDict  # pydantic needs it on Python < 3.12
 
 from gearengine.homoclinic.coefficients import BRANCH_SIGN, active_only, saddle_loop
 from gearengine.homoclinic.extrema import NEGLIGIBLE, extrema
-from gearengine.homoclinic.kernels import KIND, damping_unit, unit_coefficient
+from gearengine.homoclinic.kernels import (
+    AMPLITUDE,
+    FUNDAMENTAL,
+    HARMONIC,
+    KIND_ROW,
+    MU,
+    damping_unit,
+    unit_coefficient,
+)
+from gearengine.homoclinic.terms import packed_terms
 from gearengine.homoclinic.thresholds import CONTROL_PARAMETERS, parameter_threshold
 from gearengine.homoclinic.verdict import applicability
+from gearengine.model.aliases import get_alias
 from gearengine.model.backlash import melnikov_cubic
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
@@ -91,23 +101,27 @@ def _margin(value: float, critical: Sequence[float]) -> Margin:
 
 
 @numba.njit(cache=True, nogil=True)
-def _simple(kind, freq, amp, mu, a, c):  # pragma: no cover - compiled
-    """Per design: (status, chaos, amplitude critical H, mu critical R).
+def _simple(terms, systems):  # pragma: no cover - compiled
+    """Per design j: (status, chaos, amplitude critical H, mu critical R) of the one-term
+    packed form (``homoclinic.terms``) column ``terms[:, j]`` on ``systems[j]``.
 
     status 0: closed forms valid (critical F_1 = -/+H unless H is NaN, mu critical R unless NaN);
     1: not applicable (M overflows, as ``verdict.applicability``); 2: take the per-design path.
     """
-    n = kind.size
+    n = terms.shape[1]
     status = np.zeros(n, dtype=np.int8)
     chaos = np.zeros(n, dtype=np.bool_)
     h, r = np.full(n, np.nan), np.full(n, np.nan)
     for j in range(n):
-        au = damping_unit(a[j], c[j])
-        bu = unit_coefficient(kind[j], freq[j], a[j], c[j], 1.0)
+        system = systems[j]
+        kind = int(terms[KIND_ROW, j])
+        freq = terms[HARMONIC, j] * terms[FUNDAMENTAL, j]
+        au = damping_unit(system)
+        bu = unit_coefficient(kind, freq, system, 1.0)
         if not (math.isfinite(au) and abs(au) < 1e150 and math.isfinite(bu) and abs(bu) < 1e150):
             status[j] = 1
             continue
-        big_a, big_b = au * mu[j], bu * amp[j]
+        big_a, big_b = au * system[MU], bu * terms[AMPLITUDE, j]
         chaos[j] = big_a - abs(big_b) < 0.0 < big_a + abs(big_b)
         if abs(big_a) < NEGLIGIBLE or abs(au) < NEGLIGIBLE or abs(bu) < NEGLIGIBLE:
             status[j] = 2
@@ -127,13 +141,12 @@ def _simple(kind, freq, amp, mu, a, c):  # pragma: no cover - compiled
     return status, chaos, h, r
 
 
-def _simple_row(p: GearParams) -> tuple[str, float, float] | None:
-    """(excitation, Omega, F_1) when ``p`` has one excitation with at most one harmonic."""
+def _simple_row(p: GearParams) -> str | None:
+    """The excitation's name when ``p`` has one excitation with at most one harmonic."""
     given = [(name, exc) for name, exc in p.excitations()]
     if len(given) != 1 or len(given[0][1].harmonics) > 1 or p.damping == 0.0:
         return None
-    name, exc = given[0]
-    return name, exc.frequency, exc.harmonics[0].amplitude if exc.harmonics else 0.0
+    return given[0][0]
 
 
 def design_verdict(p: GearParams) -> BatchVerdict:
@@ -163,25 +176,25 @@ def melnikov_batch(designs: Sequence[GearParams]) -> list[BatchVerdict]:
     designs run together in one compiled pass; the others one by one (see the module docstring).
     """
     out: list[BatchVerdict | None] = [None] * len(designs)
-    rows, where = [], []
+    packs, where = [], []
     for i, p in enumerate(designs):
         simple = _simple_row(p)
         a, c, _ = melnikov_cubic(p.backlash)
         if simple is None or not saddle_loop(a, c):
             out[i] = design_verdict(p)
             continue
-        name, omega, amplitude = simple
-        rows.append((KIND[name], omega, amplitude, p.damping, a, c))
-        where.append((i, _PARAMETER_OF[name]))
-    if rows:
-        table = np.array(rows, dtype=float)
-        status, chaos, h, r = _simple(table[:, 0].astype(np.int64), *table[:, 1:].T)
+        packs.append(packed_terms(p, a, c, inactive=True))
+        where.append((i, _PARAMETER_OF[simple]))
+    if packs:
+        terms = np.concatenate([q.terms for q in packs], axis=1)
+        systems = np.stack([q.system for q in packs])
+        status, chaos, h, r = _simple(terms, systems)
         for k, (i, own) in enumerate(where):
-            out[i] = _simple_verdict(designs[i], own, status[k], chaos[k], h[k], r[k], table[k])
+            out[i] = _simple_verdict(designs[i], own, status[k], chaos[k], h[k], r[k])
     return out  # type: ignore[return-value]
 
 
-def _simple_verdict(p, own, status, chaos, h, r, row) -> BatchVerdict:
+def _simple_verdict(p, own, status, chaos, h, r) -> BatchVerdict:
     """The verdict of a one-excitation design from the compiled closed forms."""
     if status == 2:
         return design_verdict(p)
@@ -190,7 +203,8 @@ def _simple_verdict(p, own, status, chaos, h, r, row) -> BatchVerdict:
             "chaos_possible": None,
             "margins": {q: _margin(0.0, []) for q in CONTROL_PARAMETERS},
         }
-    amplitude, mu = float(row[2]), float(row[3])
+    amplitude = float(get_alias(p, own))
+    mu = float(p.damping)
     margins: dict[str, Margin] = {
         q: {"margin": None, "relative_margin": None} for q in CONTROL_PARAMETERS
     }

@@ -36,7 +36,9 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
+from gearengine.homoclinic import kernels
 from gearengine.homoclinic.extrema import TrigSum
+from gearengine.homoclinic.terms import system_array
 from gearengine.model.params import GearParams
 
 HomoclinicBranch = Literal["plus", "minus"]
@@ -112,22 +114,17 @@ def homoclinic_orbit(t: np.ndarray | float, a: float, c: float, branch: Homoclin
     return x, y
 
 
-# --- Closed form, corrected Eq. (19) ----------------------------------------------------------
+# --- Closed form, corrected Eq. (19), compiled in ``kernels`` ------------------------------------
 
 
-def _sech(z: float) -> float:
-    e = math.exp(-abs(z))
-    return 2.0 * e / (1.0 + e * e)
-
-
-def _csch(z: float) -> float:
-    e = math.exp(-abs(z))
-    return 2.0 * e / (1.0 - e * e)
+def _system(a: float, c: float) -> np.ndarray:
+    """The unperturbed system (a, c) in the kernels' packed ``system`` form."""
+    return system_array(0.0, a, c, 0.0, 0.0, 1.0)
 
 
 def damping_coefficient(a: float, c: float) -> float:
     """dA/dmu = -(8/3) a^(3/2) / c, from -2 mu * integral of y_h^2 (Eq. 19, first term)."""
-    return -8.0 / 3.0 * a**1.5 / c
+    return float(kernels.damping_unit(_system(a, c)))
 
 
 def stiffness_coefficient(omega: float, a: float, c: float) -> float:
@@ -135,19 +132,13 @@ def stiffness_coefficient(omega: float, a: float, c: float) -> float:
 
     Corrected stiffness term of Eq. (19); the same for both branches.
     """
-    return (
-        math.pi
-        * omega**2
-        * (2.0 * a - omega**2)
-        / (3.0 * c)
-        * _csch(math.pi * omega / (2.0 * math.sqrt(a)))
-    )
+    return float(kernels.unit_coefficient(kernels.STIFFNESS, omega, _system(a, c), 1.0))
 
 
 def torque_coefficient(omega: float, a: float, c: float, branch: HomoclinicBranch) -> float:
     """B per unit F_pr: s sqrt(2/c) pi Omega sech(pi Omega / (2 sqrt a)) (Eq. 19)."""
-    sigma = math.pi * omega / (2.0 * math.sqrt(a))
-    return BRANCH_SIGN[branch] * math.sqrt(2.0 / c) * math.pi * omega * _sech(sigma)
+    s = BRANCH_SIGN[branch]
+    return float(kernels.unit_coefficient(kernels.TORQUE, omega, _system(a, c), s))
 
 
 def transmission_error_coefficient(
@@ -157,7 +148,8 @@ def transmission_error_coefficient(
 
     The forcing amplitude is Omega^2 F_er (Eq. 9), hence Omega^3.
     """
-    return omega**2 * torque_coefficient(omega, a, c, branch)
+    s = BRANCH_SIGN[branch]
+    return float(kernels.unit_coefficient(kernels.TRANSMISSION_ERROR, omega, _system(a, c), s))
 
 
 # --- Quadrature of Eq. (18), term by term -------------------------------------------------------

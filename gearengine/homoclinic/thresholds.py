@@ -10,12 +10,9 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterable
-from fractions import Fraction
 
 import numpy as np
 
-from gearengine.homoclinic import kernels
 from gearengine.homoclinic.coefficients import (
     BRANCH_SIGN,
     BranchCoefficients,
@@ -31,9 +28,9 @@ from gearengine.homoclinic.schemas import (
     ThresholdCurve,
     ThresholdsRequest,
 )
+from gearengine.homoclinic.terms import packed_terms
 from gearengine.model.aliases import get_alias, with_alias, with_aliases
 from gearengine.model.backlash import melnikov_cubic
-from gearengine.model.frequencies import MAX_DENOMINATOR, RATIO_TOLERANCE
 from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash
 
 CONTROL_PARAMETERS = ("F_e1", "mu", "k_p1", "F_p1")
@@ -59,7 +56,7 @@ def sign_change_strength(
     Continuous in the parameters (for a fixed set of commensurate frequencies), so its roots
     are the critical values of any parameter. ``method`` names the coefficients (``METHODS``).
     The closed form runs compiled (``kernels.scan_strength`` at the design's own speed, on the
-    arrays of ``scan_terms``); quadrature, and the rare design on which a coefficient underflows
+    packed form of ``terms``); quadrature, and the rare design on which a coefficient underflows
     to 0, take the same algorithm on the pydantic documents.
     """
     if method == "closed_form":
@@ -74,18 +71,9 @@ def sign_change_strength(
 
 
 def _compiled_strength(params: GearParams, a: float, c: float) -> float:
-    """``sign_change_strength`` (closed form) by ``kernels.scan_strength`` with Omega_e at its
-    own value (factor 1, so the frequencies are exactly r Omega); NaN to fall back."""
-    base, r, kind, amp, phase = scan_terms(params)
-    gcd, lcm = _commensurability(tuple((r * base).tolist()))
-    mu = float(params.damping)
-    return float(kernels.scan_strength(1.0, 1.0, base, r, kind, amp, phase, mu, a, c, gcd, lcm))
-
-
-@functools.lru_cache(maxsize=4096)
-def _commensurability(frequencies: tuple[float, ...]) -> tuple[float, float]:
-    """``commensurability``, remembered (sweeps and scans ask for the same ratios again)."""
-    return commensurability(list(frequencies))
+    """``sign_change_strength`` (closed form) by the compiled kernel on the packed terms at the
+    design's own speed (factor 1, so the frequencies are exactly r Omega); NaN to fall back."""
+    return packed_terms(params, a, c).strength()
 
 
 @functools.lru_cache(maxsize=1024)
@@ -288,49 +276,6 @@ def frequency_threshold(
     )
 
 
-def scan_terms(params: GearParams) -> tuple[np.ndarray, ...]:
-    """The active harmonics as arrays (fundamental, r, kind, amplitude, phase), in the order of
-    ``melnikov_coefficients``: the per-unit coefficients are functions of r Omega alone."""
-    return terms_table(
-        (name, exc.frequency, [(h.amplitude, h.phase) for h in exc.harmonics])
-        for name, exc in params.excitations()
-    )
-
-
-def terms_table(
-    excitations: Iterable[tuple[str, float, list[tuple[float, float]]]],
-) -> tuple[np.ndarray, ...]:
-    """``scan_terms`` of excitations given as (name, fundamental, [(amplitude, phase), ...]) in
-    the order of ``model.params.EXCITATIONS``; harmonics are numbered r = 1, 2, ... as listed
-    and those with a zero amplitude are left out."""
-    rows = [
-        (float(frequency), r, kernels.KIND[name], float(amplitude), float(phase))
-        for name, frequency, harmonics in excitations
-        for r, (amplitude, phase) in enumerate(harmonics, start=1)
-        if amplitude != 0.0
-    ]
-    table = np.array(rows, dtype=float).reshape(len(rows), 5).T
-    return table[0], table[1], table[2].astype(np.int64), table[3], table[4]
-
-
-def commensurability(frequencies: list[float]) -> tuple[float, float]:
-    """(gcd, lcm) with Omega_0 = top * gcd / lcm (``model.frequencies.common_frequency``, whose
-    steps these are); (0, 1) when incommensurate or empty. Scaling every frequency by one factor
-    keeps the ratios, so one answer serves a whole running-speed scan."""
-    freqs = sorted({f for f in frequencies if f > 0.0})
-    if not freqs:
-        return 0.0, 1.0
-    top = freqs[-1]
-    ratios = []
-    for f in freqs:
-        q = Fraction(f / top).limit_denominator(MAX_DENOMINATOR)
-        if abs(float(q) - f / top) > RATIO_TOLERANCE * (f / top):
-            return 0.0, 1.0
-        ratios.append(q)
-    lcm = math.lcm(*(q.denominator for q in ratios))
-    return float(math.gcd(*(q.numerator * (lcm // q.denominator) for q in ratios))), float(lcm)
-
-
 @functools.lru_cache(maxsize=256)
 def scan_grid(start: float, stop: float, num: int) -> np.ndarray:
     """``numpy.linspace(start, stop, num)``, read-only and kept: a service answers many designs
@@ -345,11 +290,8 @@ def _scan_compiled(
 ) -> tuple[list[float], list[tuple[float, float]]] | None:
     """Critical Omega_e and no-chaos pieces by ``kernels.scan_roots``; None to fall back."""
     start, stop, num = scan
-    base, r, kind, amp, phase = scan_terms(params)
-    gcd, lcm = commensurability((r * base).tolist())
     omegas = scan_grid(start, stop, num)
-    args = (value, base, r, kind, amp, phase, float(params.damping), a, c, gcd, lcm)
-    critical, flags, ok = kernels.scan_roots(omegas, 1e-12, *args)
+    critical, flags, ok = packed_terms(params, a, c).scan_roots(omegas, value)
     if not ok:
         return None
     edges = [float(start), *critical.tolist(), float(stop)]
