@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from gearengine.homoclinic.coefficients import saddle_loop
+from gearengine.homoclinic.coefficients import MeanLoad, loop_load, saddle_loop
 from gearengine.homoclinic.terms import packed_data
 from gearengine.homoclinic.thresholds import strength_at
 from gearengine.model.aliases import ALIASES, aliased_data
@@ -37,6 +37,7 @@ def strength_grid(
     g0: np.ndarray,
     g1: np.ndarray,
     point: Callable[[dict[str, float]], GearParams],
+    mean_load: MeanLoad = "unperturbed",
 ) -> np.ndarray:
     """``strength_at(point({axes[0]: a, axes[1]: b}))`` for b in ``g1`` (rows) and a in ``g0``
     (columns), shape (g1.size, g0.size); NaN where the criterion does not apply.
@@ -46,11 +47,12 @@ def strength_grid(
         axes: the two parameters (aliases of ``model.aliases``, or any name ``point`` knows).
         g0, g1: the values of each axis.
         point: the dimensionless parameters at one grid point (a sweep's ``point``).
+        mean_load: where F_m goes (``coefficients.MeanLoad``).
     """
     p0, p1 = axes
 
     def slow(a: float, b: float) -> float:
-        return strength_at(point({p0: a, p1: b}))
+        return strength_at(point({p0: a, p1: b}), mean_load=mean_load)
 
     if p0 not in ALIASES or p1 not in ALIASES:
         return np.array([[slow(a, b) for a in g0] for b in g1])
@@ -64,6 +66,10 @@ def strength_grid(
             data = _set_aliases(base, {p0: a, p1: b})
             value = math.nan
             if data is not None:
-                value = packed_data(data, a_law, c_law).strength()
+                fm = loop_load(data, mean_load)
+                if not saddle_loop(a_law, c_law, fm):
+                    out[j, i] = math.nan  # |F_m| >= F_crit: the criterion does not apply
+                    continue
+                value = packed_data(data, a_law, c_law, fm).strength()
             out[j, i] = slow(a, b) if math.isnan(value) else value
     return out

@@ -26,6 +26,8 @@ import math
 import numba
 import numpy as np
 
+from gearengine.homoclinic.loops import loop_integrals
+
 STIFFNESS, TRANSMISSION_ERROR, TORQUE = 0, 1, 2
 KIND = {"stiffness": STIFFNESS, "transmission_error": TRANSMISSION_ERROR, "torque": TORQUE}
 
@@ -62,9 +64,13 @@ def _csch(z: float) -> float:
 
 
 @jit
-def damping_unit(system) -> float:
-    """dA/dmu = -(8/3) a^(3/2) / c (Eq. 19, first term) of the system's cubic (a, c)."""
-    a, c = system[A], system[C]
+def damping_unit(system, s: float) -> float:
+    """dA/dmu = -2 integral y_h^2 dt on branch s: -(8/3) a^(3/2) / c (Eq. 19, first term) of
+    the system's cubic (a, c), both branches; -2 T_2(0) of ``loops.loop_integrals`` on the
+    loaded loop s (F_m != 0: the loops differ)."""
+    a, c, fm = system[A], system[C], system[FM]
+    if fm != 0.0:
+        return -2.0 * loop_integrals(0.0, a, c, fm, s)[1]
     return -8.0 / 3.0 * a**1.5 / c
 
 
@@ -75,8 +81,16 @@ def unit_coefficient(kind: int, omega: float, system, s: float) -> float:
 
     stiffness: pi Omega^2 (2a - Omega^2) / (3c) csch(sigma); torque: s sqrt(2/c) pi Omega
     sech(sigma); transmission error: Omega^2 times torque; sigma = pi Omega / (2 sqrt a).
+    With the mean load F_m in the unperturbed system (F_m != 0), from the loaded loop's
+    integrals (``loops.loop_integrals``): torque Omega I_1, transmission error Omega^3 I_1,
+    stiffness Omega T_2 - 2 F_m Omega I_1 (Eq. 18 with a x - c x^3 = x'' - F_m on the loop).
     """
-    a, c = system[A], system[C]
+    a, c, fm = system[A], system[C], system[FM]
+    if fm != 0.0:
+        i1, t2 = loop_integrals(omega, a, c, fm, s)
+        if kind == STIFFNESS:
+            return omega * t2 - 2.0 * fm * omega * i1
+        return omega * i1 if kind == TORQUE else omega**3 * i1
     if kind == STIFFNESS:
         w2 = omega**2
         return (
@@ -224,10 +238,10 @@ def scan_strength(om: float, value: float, terms, system) -> float:
     else:
         taus, table = np.zeros(2), np.zeros((2, n))
     values = np.empty(taus.size)
-    damping = damping_unit(system) * system[MU]
     best = -np.inf
     amps = np.empty(n)
     for s in (1.0, -1.0):
+        damping = damping_unit(system, s) * system[MU]
         nact = 0
         for i in range(n):
             kind = int(terms[KIND_ROW, i])
