@@ -87,6 +87,7 @@ _SUBMODULES = frozenset(
         "engineering",
         "homoclinic",
         "jitcache",
+        "jobs",
         "jsonio",
         "lazyload",
         "model",
