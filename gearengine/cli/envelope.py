@@ -28,7 +28,7 @@ from gearengine.cli.documents import (
     read_document,
     validated_input,
 )
-from gearengine.cli.sweep import progress_bar
+from gearengine.cli.sweep import progress
 from gearengine.jsonio import dumps
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.sweeps.compute import run_local
@@ -85,22 +85,6 @@ def _here(design: dict, name: str) -> str:
     if value is None:
         raise InvalidInputError([f"--{name}: give a range, the design has no {name}"])
     return f"{value}:{value}"
-
-
-def progress(start: float) -> Callable[[int, int], None]:
-    """A bar on a terminal, plain lines (every 10 %) in a CI log."""
-    if sys.stderr.isatty():
-        return progress_bar(start)
-    shown = [-1]
-
-    def line(done: int, total: int) -> None:
-        tenth = 10 * done // max(total, 1)
-        if tenth > shown[0]:
-            shown[0] = tenth
-            elapsed = time.monotonic() - start
-            print(f"envelope: {done}/{total} points, {elapsed:.1f} s", file=sys.stderr)
-
-    return line
 
 
 def run_on_server(url: str, request: SweepRequest, key: str | None,
@@ -212,7 +196,7 @@ def cmd_envelope(args: argparse.Namespace) -> int:
     request = envelope_request(args)
     rules = rules_of(args)
     print(settings_text(request.settings), file=sys.stderr)
-    tick = progress(time.monotonic())
+    tick = progress(time.monotonic(), "envelope")
     if args.server:
         key = os.environ.get("GEARCHAOS_API_KEY")
         result = run_on_server(args.server, request, key, tick)

@@ -5,7 +5,7 @@
     gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov|impacts|separation]
         [--max-lle V] [--max-dte E] [--max-dynamic-factor F]
         [--min-stability-margin X]
-    gearengine sweep FILE [--out DIR]
+    gearengine sweep FILE [--out DIR|-] [--format json|csv]
     gearengine convert FILE [--json]
 
 FILE holds ``{"params": {...}}`` or ``{"design": {...}}`` (physical units), and ``"settings"``
@@ -132,7 +132,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("sweep", help="run a sweep here, no server: JSON, CSV and PNG")
     p.add_argument("file", help="JSON file holding a sweep request (as POST /v1/sweeps), or -")
-    p.add_argument("--out", default=".", help="directory for the outputs (default .)")
+    p.add_argument("--out", default=".", help="directory for the outputs (default .); - writes "
+                   "the result to standard output instead")  # fmt: skip
+    p.add_argument("--format", choices=["json", "csv"], default="json",
+                   help="with --out -: the JSON result (default) or the CSV table")  # fmt: skip
     p.set_defaults(func=lazy("gearengine.cli.sweep", "cmd_sweep"))
 
     p = sub.add_parser("convert", help="a design in physical units: parameters, derivations, rpm")
