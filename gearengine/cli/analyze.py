@@ -14,32 +14,9 @@ from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.cli.documents import EXIT_FAIL, EXIT_OK, InvalidInputError, read_request
 from gearengine.cli.envelope import cmd_envelope, physical_limits, rules_of
 from gearengine.cli.melnikov import fmt_value, render_engineering, render_melnikov
-from gearengine.engineering import IMPACT_WORDS
 from gearengine.jsonio import dumps
 from gearengine.sweeps.gate import Rules, point_failures
 from gearengine.sweeps.results import RESPONSE_UNITS, PhysicalValue, SweepPoint
-
-
-def numerics_line(r: AnalysisResult) -> str:
-    """The verdicts in one line: response, LLE, contact, Melnikov (and with a design its speed
-    windows): what the gate's PASS or FAIL line says."""
-    num = r.numerics
-    kind = f"periodic {num.period}T" if num.period else num.classification
-    lle = "LLE n/a" if num.lle is None else f"LLE {num.lle:+.4g} ± {num.lle_stderr or 0.0:.2g}"
-    contact = IMPACT_WORDS.get(num.impact_regime or "", "no verdict on impacts")
-    mel = {True: "possible", False: "not possible", None: "n/a"}[r.melnikov.chaos_possible]
-    line = f"{kind} ({lle} per unit tau, {contact}), Melnikov: chaos {mel}"
-    eng = r.engineering
-    if eng is not None:
-        resp = eng.response
-        if resp is not None and resp.dte_peak_to_peak_um is not None:
-            line += f"; DTE {resp.dte_peak_to_peak_um:.3g} µm"
-        if resp is not None and resp.dynamic_factor is not None:
-            line += f", dynamic factor {resp.dynamic_factor:.3g}"
-        lo, hi = eng.speed_range_rpm
-        spans = ", ".join(f"{a:,.0f}-{b:,.0f}" for a, b in eng.speed_windows_rpm) or "nowhere"
-        line += f"; Melnikov chaos possible at {spans} rpm (scanned {lo:,.0f}-{hi:,.0f} rpm)"
-    return line
 
 
 def cmd_analyze(args: argparse.Namespace) -> int:
@@ -48,7 +25,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         print(dumps(result))
     else:
         print(render_melnikov(result.melnikov))
-        print(f"Numerical verdict: {numerics_line(result)}")
+        print(f"Numerical verdict: {result.summary()}")
         print(f"  {result.verdict.summary}")
         print(f"  forcing period T0 = {fmt_value(result.numerics.forcing_period)}")
         line = floquet_line(result)
@@ -145,5 +122,5 @@ def cmd_check(args: argparse.Namespace) -> int:
     reasons = failures(result, rules, args.min_stability_margin)
     verdict = "FAIL" if reasons else "PASS"
     why = f" [{', '.join(reasons)}]" if reasons else ""
-    print(f"{verdict}: {numerics_line(result)}{why}")
+    print(f"{verdict}: {result.summary()}{why}")
     return EXIT_FAIL if reasons else EXIT_OK
