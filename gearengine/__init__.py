@@ -92,6 +92,7 @@ _SUBMODULES = frozenset(
         "engineering",
         "homoclinic",
         "jitcache",
+        "jobs",
         "jsonio",
         "lazyload",
         "model",
