@@ -162,12 +162,14 @@ def settings_text(settings: SimulationSettings) -> str:
 
 def windows_summary(windows: list[SpeedWindows]) -> list[str]:
     """Per level of the other axis, the impact and Melnikov windows in rpm, pass or fail:
-    "torque 40 N*m: drive-flank impacts 500-1100 rpm; Melnikov: chaos possible nowhere"."""
+    "windows at torque 40 N*m: tooth separation (drive-flank impacts) 500-1100 rpm; Melnikov:
+    chaos possible nowhere"."""
     out = []
     for w in windows:
         impacts = "; ".join(f"{IMPACT_LABELS[k]} {spans_text(v)}" for k, v in w.impacts.items())
         melnikov = spans_text(w.melnikov) if w.melnikov else "nowhere"
-        out.append(f"{level_text(w.level)}: {impacts or 'teeth always in contact'}; "
+        where = f" at {level_text(w.level)}" if w.level else ""
+        out.append(f"windows{where}: {impacts or 'teeth always in contact'}; "
                    f"Melnikov: chaos possible {melnikov}")  # fmt: skip
     return out
 
