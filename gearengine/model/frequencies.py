@@ -45,11 +45,31 @@ def rational(x: float, max_denominator: int) -> Fraction | None:
     return q if abs(float(q) - x) <= COMMENSURABILITY_TOLERANCE * abs(x) else None
 
 
-def _omega0(top: float, ratios: Sequence[Fraction]) -> float:
-    """Omega_0 = top gcd(p_i) / lcm(q_i) for frequencies top p_i / q_i."""
+def _gcd_lcm(ratios: Sequence[Fraction]) -> tuple[int, int]:
+    """(gcd, lcm) of ratios p_i / q_i: lcm of the q_i, gcd of the p_i lcm / q_i, so that the
+    frequencies top p_i / q_i are integer multiples of top gcd / lcm."""
     lcm = math.lcm(*(q.denominator for q in ratios))
-    numerators = [q.numerator * (lcm // q.denominator) for q in ratios]
-    return top * math.gcd(*numerators) / lcm
+    return math.gcd(*(q.numerator * (lcm // q.denominator) for q in ratios)), lcm
+
+
+def commensurability(
+    frequencies: list[float], max_denominator: int = MAX_DENOMINATOR
+) -> tuple[float, float]:
+    """(gcd, lcm) with Omega_0 = top * gcd / lcm, top the fastest frequency; (0, 1) when the
+    frequencies are incommensurate at that resolution, or when there are none.
+
+    Each ratio Omega_i / top is taken as the rational p_i / q_i with q_i <= ``max_denominator``
+    (``rational``); lcm is the lcm of the q_i and gcd that of the p_i lcm / q_i. Scaling every
+    frequency by one factor keeps the ratios, so one answer serves a whole running-speed scan.
+    """
+    freqs = sorted({f for f in frequencies if f > 0.0})
+    if not freqs:
+        return 0.0, 1.0
+    ratios = [rational(f / freqs[-1], max_denominator) for f in freqs]
+    if None in ratios:
+        return 0.0, 1.0
+    gcd, lcm = _gcd_lcm(ratios)  # type: ignore[arg-type]
+    return float(gcd), float(lcm)
 
 
 def common_frequency(
@@ -65,14 +85,10 @@ def common_frequency(
         Omega_0 (same units), the fastest frequency itself for a single one, ``None`` when the
         frequencies are incommensurate at that resolution. An empty list gives ``None``.
     """
-    freqs = sorted({f for f in frequencies if f > 0.0})
-    if not freqs:
+    gcd, lcm = commensurability(frequencies, max_denominator)
+    if gcd == 0.0:
         return None
-    top = freqs[-1]
-    ratios = [rational(f / top, max_denominator) for f in freqs]
-    if None in ratios:
-        return None
-    return _omega0(top, ratios)  # type: ignore[arg-type]
+    return max(frequencies) * int(gcd) / int(lcm)
 
 
 def _fundamental_ratios(params: GearParams) -> dict[str, Fraction] | None:
@@ -103,7 +119,8 @@ def poincare_frequency(params: GearParams) -> float | None:
         for r, _ in exc.active()
     ]
     top, top_ratio = max(terms, key=lambda t: (t[0], t[1]))
-    return _omega0(top, sorted({ratio / top_ratio for _, ratio in terms}))
+    gcd, lcm = _gcd_lcm(sorted({ratio / top_ratio for _, ratio in terms}))
+    return top * gcd / lcm
 
 
 def incommensurate_reason(params: GearParams) -> str:
