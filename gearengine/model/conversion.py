@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 from typing import Annotated
 
-from pydantic import BaseModel, Field
+from pydantic import Field
 
 from gearengine.model.params import (
     MAX_HARMONICS,
@@ -40,7 +40,7 @@ from gearengine.model.params import (
     GearParams,
     Harmonic,
     PiecewiseBacklash,
-    request_config,
+    StrictModel,
 )
 from gearengine.model.units import RADIUS_RATIO_TOLERANCE, TORQUE_BALANCE_TOLERANCE
 
@@ -50,11 +50,7 @@ SIValue = Annotated[float, Field(ge=-1.0e12, le=1.0e12, allow_inf_nan=False)]
 """A signed physical quantity in SI units, |value| <= 1e12."""
 
 
-class _Strict(BaseModel):
-    model_config = request_config()
-
-
-class _Phase(_Strict):
+class _Phase(StrictModel):
     phase: SIValue = Field(
         0.0, description="Phase angle phi_r of this harmonic [rad].", examples=[0.0]
     )
@@ -80,7 +76,7 @@ class TransmissionErrorHarmonic(_Phase):
     )
 
 
-class PhysicalGearData(_Strict):
+class PhysicalGearData(StrictModel):
     """A spur gear pair in SI units, the model of Eq. (1)-(6); gear a drives gear b."""
 
     inertia_a: Positive = Field(
@@ -187,7 +183,7 @@ CONVERSION_UNITS = {
 """Units of the numbers of a ``Conversion`` (/v1/conversions/physical)."""
 
 
-class Conversion(_Strict):
+class Conversion(StrictModel):
     """Result of ``to_dimensionless``: the parameters of Eq. (8) and the scales used."""
 
     params: GearParams = Field(description="Dimensionless parameters of Eq. (8)-(9).")

@@ -20,7 +20,6 @@ import math
 from typing import Annotated, Any, Literal
 
 from pydantic import (
-    BaseModel,
     Field,
     ModelWrapValidatorHandler,
     PrivateAttr,
@@ -31,6 +30,7 @@ from gearengine.model.errors import InputError
 from gearengine.model.params import (
     MAX_HARMONICS,
     Phase,
+    StrictModel,
     request_config,
 )
 from gearengine.model.units import (
@@ -49,11 +49,7 @@ from gearengine.model.units import (
 )
 
 
-class _Strict(BaseModel):
-    model_config = request_config()
-
-
-class Gear(_Strict):
+class Gear(StrictModel):
     """One gear: base radius and inertia directly, or its geometry (module, face width, ...)."""
 
     teeth: int = Field(ge=5, le=1000, description="Number of teeth z.", examples=[18])
@@ -94,28 +90,28 @@ class Gear(_Strict):
         }
 
 
-class StiffnessVariationHarmonic(_Strict):
+class StiffnessVariationHarmonic(StrictModel):
     """Harmonic r of the mesh stiffness at r x the mesh frequency (Eq. 4)."""
 
     amplitude: StiffnessVariation = Field(description="k_r.", examples=["1e7 N/m"])
     phase: Phase = Field(0.0, description="Phase, rad.")
 
 
-class ErrorHarmonic(_Strict):
+class ErrorHarmonic(StrictModel):
     """Harmonic r of the static transmission error (Eq. 5)."""
 
     amplitude: ErrorAmplitude = Field(description="e_r.", examples=["5 um"])
     phase: Phase = Field(0.0, description="Phase, rad.")
 
 
-class TorqueFluctuationHarmonic(_Strict):
+class TorqueFluctuationHarmonic(StrictModel):
     """Harmonic r of the driver-torque fluctuation (Eq. 3)."""
 
     amplitude: Torque = Field(description="T_pr.", examples=["4 N*m"])
     phase: Phase = Field(0.0, description="Phase, rad.")
 
 
-class Mesh(_Strict):
+class Mesh(StrictModel):
     """The tooth mesh: stiffness, damping and half backlash."""
 
     stiffness: MeshStiffness = Field(
@@ -142,7 +138,7 @@ class Mesh(_Strict):
         return self
 
 
-class TransmissionError(_Strict):
+class TransmissionError(StrictModel):
     """Static transmission error e(t) = sum e_r cos(r w_e t + phi_r)."""
 
     order: float | None = Field(
@@ -153,7 +149,7 @@ class TransmissionError(_Strict):
     harmonics: list[ErrorHarmonic] = Field(max_length=MAX_HARMONICS)
 
 
-class TorqueFluctuation(_Strict):
+class TorqueFluctuation(StrictModel):
     """Driver-torque fluctuation sum T_r cos(r w_p t + phi_r)."""
 
     order: float = Field(
@@ -181,7 +177,7 @@ EXAMPLE_DESIGN = {
 """The README's design (direct form)."""
 
 
-class Design(_Strict):
+class Design(StrictModel):
     """A spur-gear pair in physical units; the driver (gear a) drives the driven gear (b)."""
 
     model_config = request_config(EXAMPLE_DESIGN)

@@ -22,7 +22,7 @@ from pydantic.json_schema import JsonSchemaValue
 from pydantic_core import CoreSchema
 
 from gearengine.model import geometry
-from gearengine.model.backlash import collocation_fit
+from gearengine.model.backlash import paper_cubic
 from gearengine.model.conversion import (
     PhysicalGearData,
     StiffnessHarmonic,
@@ -199,7 +199,8 @@ def physical_data(design: Design) -> tuple[PhysicalGearData, dict[str, Derived],
 
 
 def _paper_cubic() -> CubicBacklash:
-    fit = collocation_fit(0.0)
+    """The paper's cubic law (``backlash.paper_cubic``) as a backlash of Eq. (9)."""
+    fit = paper_cubic()
     return CubicBacklash(a=fit.a, c=fit.c)
 
 

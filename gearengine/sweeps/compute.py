@@ -14,7 +14,7 @@ from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
 from gearengine.model.units import OUTPUTS, Scales, display_unit, in_display_unit, response_values
 from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
-from gearengine.numerics.bifurcations import Response, locate_bifurcations
+from gearengine.numerics.bifurcations import PointResponse, locate_bifurcations
 from gearengine.numerics.forcing import step_plan
 from gearengine.numerics.results import BatchPoint
 from gearengine.numerics.settings import SimulationSettings
@@ -123,12 +123,12 @@ def _line_bifurcations(
 ) -> list[SweepBifurcation]:
     """Bifurcation points of one continuation line, followed from its computed responses.
 
-    The line's points are reused (``Response``), so only Newton shooting, the location of each
+    The line's points are reused (``PointResponse``), so only Newton shooting, the location of each
     crossing and one simulation per crossing (the branch switch) are added. Incommensurate
     forcing has no Poincare period and so no multipliers: no points then.
     """
     responses = [
-        Response(
+        PointResponse(
             bp.classification,
             bp.period,
             bp.poincare[-1] if bp.poincare else None,
