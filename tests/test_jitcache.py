@@ -95,7 +95,7 @@ def test_importing_the_engine_with_a_moved_cache_writes_no_stamp(tmp_path: Path)
                     ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
     env = {**os.environ, "PYTHONPATH": str(copy), "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
     code = "import gearengine.numerics.kernels, gearengine.homoclinic as h; print(h.__file__)"
-    run = subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, check=True, timeout=300,
-                         capture_output=True, text=True)  # fmt: skip
+    run = subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, check=True,
+                         timeout=300, capture_output=True, text=True)  # fmt: skip
     assert run.stdout.startswith(str(copy))
     assert not list(copy.rglob(f"*{STAMP_SUFFIX}"))
