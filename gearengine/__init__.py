@@ -9,10 +9,10 @@ The public facade, short verbs on a design (as ChaosTools.jl):
     >>> analyze(Design.model_validate(doc["design"])).summary()   # one line; repr is short too
     >>> run_sweep(SweepRequest.model_validate(sweep)).to_pandas()  # pip install 'gearchaos[pandas]'
 
-Rooms (subpackages) follow the data flow: ``model`` -> ``homoclinic`` (the Melnikov analysis
-of the homoclinic orbits) -> ``numerics`` ->
-``analysis`` -> ``sweeps`` -> ``plots`` -> ``cli``; ``docs/architecture.md`` draws it. The
-engine imports no web code.
+Rooms (subpackages) follow the data flow, a diamond rather than a chain: ``model`` feeds both
+``homoclinic`` (the Melnikov analysis of the homoclinic orbits) and ``numerics``, which know
+nothing of each other; ``analysis`` and ``engineering`` join them, then ``sweeps`` -> ``plots``
+-> ``cli``; ``docs/architecture.md`` draws it. The engine imports no web code.
 """
 
 from __future__ import annotations

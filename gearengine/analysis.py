@@ -4,7 +4,8 @@ The Melnikov criterion is first order in the perturbation and only *necessary* f
 (a transverse homoclinic tangle may give transient chaos and a periodic attractor). The two
 verdicts are consistent unless the numerics find chaos where Melnikov rules it out.
 
-This module joins the melnikov and numerics rooms; it imports nothing else of the engine.
+This module joins the homoclinic (Melnikov) and numerics rooms on a request of the model room,
+and adds the engineering block (``engineering``: answers in gear units) for a design.
 """
 
 from __future__ import annotations

@@ -2,8 +2,9 @@
 
 Data flow: ``request`` (axes, validation) -> ``plan`` (chunks, cost) -> ``compute`` (each chunk's
 points through ``numerics.batch`` and the Melnikov verdict) -> ``results`` (documents) ->
-``export`` (JSON assembled from chunks, CSV, agreement table). Imports the model, melnikov and
-numerics rooms.
+``export`` (JSON assembled from chunks, CSV, agreement table); ``windows`` and ``gate`` read
+the results for speed windows and the CI gate. Imports the model, homoclinic and numerics rooms
+(and ``gearengine.jobs``, the job-kind registry it runs through).
 """
 
 from gearengine.sweeps.compute import compute_chunk, compute_chunk_json, run_local
