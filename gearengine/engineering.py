@@ -21,8 +21,6 @@ Every dimensionless number crosses to gear units through ``model.units.to_physic
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -31,7 +29,7 @@ from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
 from gearengine.model.aliases import with_speed_factor
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import Derived, DesignConversion
-from gearengine.model.units import OUTPUTS, Scales, response_values, to_physical
+from gearengine.model.units import OUTPUTS, Scales, in_si, response_values, to_physical
 from gearengine.numerics.results import NumericsResult
 
 WINDOW_SCAN = 240
@@ -159,9 +157,10 @@ def response(params: GearParams, num: NumericsResult, conv: DesignConversion) ->
             separation_fraction=float(np.mean(np.abs(x) <= 1.0)),
             back_flank_fraction=float(np.mean(x < -1.0)),
         )
-    omega_n = 1.0 / conv.time_scale_s
-    period_s = None if num.period is None else num.period * num.sampling_interval / omega_n
-    peak = num.spectrum_peaks[0].frequency * omega_n / (2 * math.pi) if num.spectrum_peaks else None
+    period = None if num.period is None else num.period * num.sampling_interval
+    period_s = None if period is None else in_si("time", period, scales)
+    peaks = num.spectrum_peaks
+    peak = to_physical("frequency", peaks[0].frequency, scales) if peaks else None
     shaft_hz = conv.speed_rpm / 60.0
     return Response(
         dte_peak_to_peak_um=values["dte"],
@@ -170,7 +169,7 @@ def response(params: GearParams, num: NumericsResult, conv: DesignConversion) ->
         static_force_n=scales.static_force,
         dynamic_factor=values["dynamic_factor"],
         contact=contact,
-        period_ms=None if period_s is None else 1e3 * period_s,
+        period_ms=None if period is None else to_physical("time", period, scales),
         period_mesh_periods=None if period_s is None else period_s * conv.mesh_frequency_hz,
         dominant_frequency_hz=peak,
         dominant_shaft_order=None if peak is None else peak / shaft_hz,
@@ -232,7 +231,7 @@ def engineering(
         natural_frequency_hz=conv.natural_frequency_hz,
         time_scale_s=conv.time_scale_s,
         mesh_frequency_hz=conv.mesh_frequency_hz,
-        half_backlash_um=conv.half_backlash_m * 1e6,
+        half_backlash_um=to_physical("displacement", 1.0, conv.scales),
         speed_rpm=conv.speed_rpm,
         speed_range_rpm=list(rpm_range),
         speed_windows_rpm=windows,

@@ -297,6 +297,15 @@ OUTPUTS: dict[str, OutputKind] = {
         lambda v, s: 2.0 * v * s.mesh_stiffness,
     ),
     "damping_ratio": OutputKind("damping ratio zeta = mu~", "1", "1", lambda v, s: v),
+    "displacement": OutputKind(
+        "displacement x~ = x b", "m", "um", lambda x, s: x * s.half_backlash, 1e6
+    ),
+    "time": OutputKind("time t = tau / omega_n", "s", "ms", lambda t, s: t / s.natural_frequency,
+                       1e3),
+    "frequency": OutputKind(
+        "frequency f = Omega omega_n / (2 pi)", "Hz", "Hz",
+        lambda w, s: w * s.natural_frequency / (2 * math.pi),
+    ),
 }  # fmt: skip
 """Output quantities by name: the physical meaning of a dimensionless result (beside the inputs'
 ``QUANTITIES``); the engineering block, sweep points, CSV columns, gate rules and plots read it."""
@@ -306,11 +315,16 @@ RESPONSES = ("dte", "dynamic_factor")
 beside its axes, the CSV's response columns, the gate's limits)."""
 
 
+def in_si(name: str, value: float, scales: Scales) -> float:
+    """The dimensionless ``value`` of output ``name`` in its SI unit (``OUTPUTS``)."""
+    return OUTPUTS[name].to_si(value, scales)
+
+
 def to_physical(name: str, value: float, scales: Scales) -> float:
     """The dimensionless ``value`` of output ``name`` in its display unit (``OUTPUTS``): the one
     crossing from a dimensionless result to a physical value."""
     kind = OUTPUTS[name]
-    si = kind.to_si(value, scales)
+    si = in_si(name, value, scales)
     return si if kind.display == 1.0 else si * kind.display
 
 
