@@ -1,6 +1,6 @@
 """The ``gearengine`` command line.
 
-    gearengine melnikov FILE [--json] [--method closed_form|quadrature]
+    gearengine melnikov FILE [--json] [--method closed_form|quadrature] [--mean-load ...]
     gearengine analyze FILE [--json]
     gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov] [--max-lle V]
         [--min-stability-margin X]
@@ -75,6 +75,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help='JSON file holding {"params": {...}} or {"design": {...}}, or -')
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
     p.add_argument("--method", choices=["closed_form", "quadrature"], default=None)
+    p.add_argument(
+        "--mean-load",
+        choices=["unperturbed", "perturbation"],
+        default=None,
+        help="where the mean force goes (default unperturbed; perturbation: the paper's)",
+    )
     p.set_defaults(func=lazy("gearengine.cli.melnikov", "cmd_melnikov"))
 
     p = sub.add_parser("analyze", help="Melnikov and numerical verdicts of a design")
