@@ -112,5 +112,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     reasons = failures(result, fail_on, args.max_lle, args.min_stability_margin)
     verdict = "FAIL" if reasons else "PASS"
     why = f" [{', '.join(reasons)}]" if reasons else ""
+    if "melnikov" in fail_on and result.melnikov.chaos_possible is None:
+        why += " (Melnikov: not applicable here, not judged)"
     print(f"{verdict}: {numerics_line(result)}{why}")
     return EXIT_FAIL if reasons else EXIT_OK

@@ -144,6 +144,9 @@ def print_report(report: EnvelopeReport) -> None:
     verdict = "PASS" if report.passed else "FAIL"
     print(f"{verdict}: {report.failing_points} of {report.points} operating points break "
           f"the rules ({rules_text(report.rules)})")  # fmt: skip
+    if "melnikov" in report.rules.fail_on and report.melnikov_not_judged:
+        print(f"  Melnikov could not judge {report.melnikov_not_judged} of {report.points} points "
+              "(the criterion does not apply above the critical torque)")  # fmt: skip
     for w in report.failures:
         print(f"  {window_text(w)}")
 
