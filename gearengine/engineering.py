@@ -288,7 +288,7 @@ def summary(
     t_crit = critical_torque(conv, mel)
     if over_critical(conv, mel) and t_crit is not None and mel.critical_mean_force:
         words = load_words(conv, mel.critical_mean_force, t_crit)
-        text = f"The Melnikov criterion does not apply: {words}."
+        text = f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion does not apply: {words}."
     else:
         here = "allows chaos" if mel.chaos_possible else "rules chaos out"
         text = (
