@@ -93,9 +93,9 @@ def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
             ax.contourf(g0, g1, judged, levels=[0.5, 1.5], colors="none", hatches=["//"])
         if np.nanmin(mel, initial=1.0) < 0.5 < np.nanmax(mel, initial=0.0):
             ax.contour(g0, g1, judged, levels=[0.5], colors="black", linewidths=1.6)
-        if not applies.all():
+        if applies.any() and not applies.all():  # a map wholly outside says so in the legend
             ax.contourf(g0, g1, (~applies).astype(float), levels=[0.5, 1.5], colors="none",
-                        hatches=[".."])  # fmt: skip
+                        hatches=["."])  # fmt: skip
     ax.set_xlabel(axis_label(ax0.parameter))
     ax.set_ylabel(axis_label(ax1.parameter))
     s = request.settings
@@ -116,9 +116,13 @@ def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
         Patch(facecolor="none", edgecolor="k", hatch="//",
               label="Melnikov criterion: chaos possible\n(black line: its boundary)"),
     ]  # fmt: skip
-    if not applies.all():
+    if not applies.any():
+        handles[-1] = Patch(facecolor="none", edgecolor="none", label=(
+            "Melnikov criterion: does not apply anywhere\non this map (mean load above the "
+            "critical\ntorque: no saddle, no homoclinic orbit)"))  # fmt: skip
+    elif not applies.all():
         words = "Melnikov criterion does not apply\n(mean load above the critical torque:\n"
-        handles.append(Patch(facecolor="none", edgecolor="k", hatch="..",
+        handles.append(Patch(facecolor="none", edgecolor="k", hatch=".",
                              label=words + "no saddle, no homoclinic orbit)"))  # fmt: skip
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
               title="response", title_fontsize=9, frameon=False)  # fmt: skip
