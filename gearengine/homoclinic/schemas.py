@@ -78,6 +78,12 @@ class ParameterThreshold(_Result):
         "phase shift by pi)."
     )
     relative_margin: float | None = Field(description="margin / |nearest| (null if nearest = 0).")
+    margin_in_force_scale: float | None = Field(
+        None,
+        description="The margin as the largest force it makes along the loops, over the force "
+        "scale F_crit of the unperturbed system (as perturbation_sizes): how far first-order "
+        "theory carries the threshold (null for Omega_e).",
+    )
     no_chaos: list[Bounds] = Field(
         description="Intervals of the parameter where neither branch changes sign."
     )
