@@ -57,8 +57,8 @@ def test_the_kernels_caches_are_stamped_with_their_current_sources() -> None:
             *numerics.glob("*.py"), numerics.parent / "periodicity.py",
             numerics.parent / "lyapunov.py", numerics.parent / "classify.py",
         ],
-        homoclinic / "__pycache__" / "kernels+batch": [
-            homoclinic / name for name in ("kernels.py", "batch.py", "extrema.py")
+        homoclinic / "__pycache__" / "kernels+batch+loops": [
+            homoclinic / name for name in ("kernels.py", "batch.py", "extrema.py", "loops.py")
         ],
     }  # fmt: skip
     for stem, sources in groups.items():
