@@ -29,6 +29,8 @@ from bench_map import GEAR_REF, gear_ref_seconds, map_doc, sweep_seconds
 from common import wait_ready  # benchmarks/common.py
 from report import write_section  # benchmarks/report.py (the script's own folder)
 
+from gearengine.numerics.simulation import warm_up
+
 ROOT = Path(__file__).resolve().parents[1]
 REPEATS = 2
 
@@ -50,6 +52,7 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--sizes", type=int, nargs="+", default=[100, 200])
     sizes = parser.parse_args().sizes
+    warm_up()  # numba's caches filled before the server loads them
     rows = []
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)

@@ -27,6 +27,7 @@ from bench_big_map import MB, free_port  # benchmarks/bench_big_map.py
 from common import wait_ready  # benchmarks/common.py
 from report import write_section  # benchmarks/report.py (the script's own folder)
 
+from gearengine.numerics.simulation import warm_up
 from gearengine.sweeps.export import to_csv
 from gearengine.sweeps.results import SweepResult
 
@@ -69,6 +70,7 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--num", type=int, default=300)
     num = parser.parse_args().num
+    warm_up()  # numba's caches filled before the server loads them
     rows = []
     with tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
