@@ -32,6 +32,8 @@ if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDE
         simulate_batch,
         warm_up,
     )
+    from gearengine.runup import RunupRequest, RunupResult
+    from gearengine.runup import run_local as run_runup
     from gearengine.sweeps import SweepRequest, SweepResult
     from gearengine.sweeps import run_local as run_sweep
 
@@ -41,6 +43,8 @@ __all__ = [
     "AnalysisResult",
     "GearParams",
     "MelnikovResult",
+    "RunupRequest",
+    "RunupResult",
     "SimulationSettings",
     "SweepRequest",
     "SweepResult",
@@ -49,6 +53,7 @@ __all__ = [
     "lyapunov",
     "melnikov",
     "poincare",
+    "run_runup",
     "run_sweep",
     "simulate",
     "simulate_batch",
@@ -62,6 +67,8 @@ _HOMES: dict[str, tuple[str, str]] = {
     "AnalysisResult": ("gearengine.analysis", "AnalysisResult"),
     "GearParams": ("gearengine.model.params", "GearParams"),
     "MelnikovResult": ("gearengine.homoclinic", "MelnikovResult"),
+    "RunupRequest": ("gearengine.runup", "RunupRequest"),
+    "RunupResult": ("gearengine.runup", "RunupResult"),
     "SimulationSettings": ("gearengine.numerics", "SimulationSettings"),
     "SweepRequest": ("gearengine.sweeps", "SweepRequest"),
     "SweepResult": ("gearengine.sweeps", "SweepResult"),
@@ -70,6 +77,7 @@ _HOMES: dict[str, tuple[str, str]] = {
     "lyapunov": ("gearengine.numerics", "lyapunov"),
     "melnikov": ("gearengine.homoclinic", "melnikov"),
     "poincare": ("gearengine.numerics", "poincare"),
+    "run_runup": ("gearengine.runup", "run_local"),
     "run_sweep": ("gearengine.sweeps", "run_local"),
     "simulate": ("gearengine.numerics", "simulate"),
     "simulate_batch": ("gearengine.numerics", "simulate_batch"),
@@ -93,6 +101,7 @@ _SUBMODULES = frozenset(
         "model",
         "numerics",
         "plots",
+        "runup",
         "sweeps",
     }
 )

@@ -64,7 +64,7 @@ __all__ = [
 
 _HERE = Path(__file__).parent
 drop_stale(  # before any kernel runs: numba loads a cached kernel on its first call
-    "adaptive,kink,lockstep,monodromy,smooth",
+    "adaptive,kink,lockstep,monodromy,phase,ramp,smooth",
     [*_HERE.glob("*.py"), _HERE.parent / "periodicity.py", _HERE.parent / "lyapunov.py"],
     _HERE / "__pycache__",
 )

@@ -8,10 +8,10 @@ import math
 import numpy as np
 from numba import njit
 
+from gearengine.numerics.kernels.phase import excitation_at
 from gearengine.numerics.kernels.smooth import (
     JIT_OPTIONS,
     SQRT1_2,
-    forcing_at,
     region,
     region_force,
     stiffness_at,
@@ -41,7 +41,7 @@ def _rk4_region(
     alpha: float,
     twomu: float,
     kc: np.ndarray,
-    fm: float,
+    fm: float | np.ndarray,
     fc: np.ndarray,
     t: float,
     dt: float,
@@ -50,10 +50,11 @@ def _rk4_region(
     dx: float,
     dv: float,
 ) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
-    """One RK4 step of length dt from time t in region ``reg``, forcing at absolute time."""
-    K0, F0 = forcing_at(t, kc, fm, fc)
-    K1, F1 = forcing_at(t + 0.5 * dt, kc, fm, fc)
-    K2, F2 = forcing_at(t + dt, kc, fm, fc)
+    """One RK4 step of length dt from time t in region ``reg``, forcing at absolute time
+    (stationary, float ``fm``) or on a speed ramp (``fm`` a ramp record, ``kernels.phase``)."""
+    K0, F0 = excitation_at(t, kc, fm, fc)
+    K1, F1 = excitation_at(t + 0.5 * dt, kc, fm, fc)
+    K2, F2 = excitation_at(t + dt, kc, fm, fc)
     a1, b1, c1, d1 = _rhs_region(reg, alpha, twomu, K0, F0, x, v, dx, dv)
     h2 = 0.5 * dt
     a2, b2, c2, d2 = _rhs_region(
@@ -80,7 +81,7 @@ def kink_step(
     alpha: float,
     twomu: float,
     kc: np.ndarray,
-    fm: float,
+    fm: float | np.ndarray,
     fc: np.ndarray,
     t: float,
     h: float,
