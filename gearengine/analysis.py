@@ -128,7 +128,7 @@ def analyze(request: AnalysisRequest) -> AnalysisResult:
 
 def answer_melnikov(request: MelnikovRequest) -> MelnikovResult:
     """The Melnikov verdict of a request; with a design, its params and engineering block."""
-    mel = melnikov(request.params, method=request.method)
+    mel = melnikov(request.params, method=request.method, mean_load=request.mean_load)
     conv = request.conversion
     if conv is None:
         return mel

@@ -79,8 +79,9 @@ def branch_table(name: str, branch: RunupBranch, result: RunupResult) -> list[st
             f"{impacts:>7s}  {_number(b.lle, '+8.4f')}{' chaotic' if b.chaotic else ''}"
         )
     for j in branch.jumps:
-        lag = "" if j.lag_rpm is None else (
-            f"; quasi-static at {j.quasi_static_speed_rpm:.0f} rpm, lag {j.lag_rpm:+.0f} rpm")  # fmt: skip
+        lag = ""
+        if j.lag_rpm is not None:
+            lag = f"; quasi-static at {j.quasi_static_speed_rpm:.0f} rpm, lag {j.lag_rpm:+.0f} rpm"
         lines.append(f"  jump at {j.speed_rpm:.0f} rpm: {j.from_um:.1f} -> {j.to_um:.1f} µm{lag}")
     return lines
 
