@@ -18,7 +18,7 @@ from gearengine.cli.documents import EXIT_OK, InvalidInputError, read_document, 
 from gearengine.cli.sweep import progress_bar
 from gearengine.jsonio import dumps
 from gearengine.runup.compute import run_local
-from gearengine.runup.request import RunupRequest
+from gearengine.runup.request import RunupRequest, validated
 from gearengine.runup.results import RunupBranch, RunupResult
 
 OPTIONS = {  # option -> (request field, unit of a bare number)
@@ -51,7 +51,7 @@ def runup_request(args: argparse.Namespace) -> RunupRequest:
         body["bin_rpm"] = args.bin
     if args.ensemble is not None:
         body["ensemble"] = {**body.get("ensemble", {}), "size": args.ensemble}
-    return validated_input(RunupRequest.model_validate, body, args.file)
+    return validated_input(validated, body, args.file)
 
 
 def _number(value: float | None, fmt: str) -> str:

@@ -24,6 +24,7 @@ from gearengine.numerics.classify import DIVERGENCE_BOUND
 from gearengine.numerics.kernels.ramp import run_ramp
 from gearengine.numerics.kernels.smooth import SQRT1_2
 from gearengine.runup.profile import RunupPlan, mid_speeds_rpm, runup_plan, segment_angle
+from gearengine.runup.reading import read_runup
 from gearengine.runup.request import RunupRequest, n_bins
 from gearengine.runup.results import RunupResult
 from gearengine.sweeps.plan import sweep_work
@@ -121,21 +122,29 @@ def compute_chunk(request: RunupRequest, index: int, chunk_points: int = 1) -> s
     """Chunk ``index`` as JSON text: a member's block table, or a quasi-static line."""
     members = request.ensemble.size
     if index < members:
-        return json.dumps(member_blocks(request, runup_plan(request), index))
+        return json.dumps({"member": index, "blocks": member_blocks(request, runup_plan(request),
+                                                                    index)})  # fmt: skip
     sweep = jobs.kind("sweep")
     return sweep.compute_chunk(quasi_static_request(request), index - members, 1)
 
 
 def assemble(request: RunupRequest, chunks: list[str]) -> RunupResult:
-    """The run-up's document from its chunks in index order."""
-    from gearengine.runup.reading import read_runup
+    """The run-up's document from its chunks in index order.
 
-    members = request.ensemble.size
-    tables = [json.loads(text) for text in chunks[:members]]
-    sweep = jobs.kind("sweep")
-    qs_request = quasi_static_request(request)
-    quasi = sweep.assemble(qs_request, chunks[members:])
-    return read_runup(request, runup_plan(request), tables, quasi)
+    Chunks say what they hold (a member's ``{"member": m, "blocks": ...}`` or a quasi-static
+    line), so the finished chunks of an unfinished job (``?partial=true``) assemble too: the
+    lowest member present is read as the nominal one, a missing line leaves its branch empty.
+    """
+    members: list[list] = []
+    lines: list[str] = []
+    for text in chunks:
+        doc = json.loads(text)
+        if isinstance(doc, dict) and "member" in doc:
+            members.append(doc["blocks"])
+        else:
+            lines.append(text)
+    quasi = jobs.kind("sweep").assemble(quasi_static_request(request), lines)
+    return read_runup(request, runup_plan(request), members, quasi)
 
 
 def run_local(

@@ -86,6 +86,8 @@ def with_lags(ramp: list[RunupJump], quasi: list[RunupJump], branch: Branch) -> 
 def _bins(request: RunupRequest, tables: list[np.ndarray], branch: Branch, lo: float,
           force_n: float, omega_n: float) -> list[tuple[int, RunupBin]]:  # fmt: skip
     """The bins of one branch in the order first reached, with their indices."""
+    if not tables:
+        return []
     sign = 1.0 if branch == "up" else -1.0
     nominal = tables[0]
     width = request.bin_rpm

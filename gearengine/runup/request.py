@@ -19,7 +19,8 @@ import itertools
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, BeforeValidator, Field, WithJsonSchema, model_validator
+from pydantic import BaseModel, BeforeValidator, Field, ValidationError, WithJsonSchema
+from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from gearengine.model.params import request_config
 from gearengine.model.reduction import ParamsOrDesign
@@ -33,6 +34,7 @@ from gearengine.model.units import (
     registry,
 )
 from gearengine.numerics.settings import SimulationSettings
+from gearengine.runup.profile import runup_plan
 
 MAX_RUNUP_STEPS = 200_000_000
 """Cap on the RK4 steps of one run-up (every ensemble member, the quasi-static sweep aside)."""
@@ -116,7 +118,7 @@ class RunupRequest(ParamsOrDesign):
     direction: RunupDirection = Field("up", description="up, down, or up then down.")
     points: (
         Annotated[
-            list[Annotated[tuple[Time, Speed], Field()]],
+            list[Annotated[tuple[Time, Speed], Field(strict=False)]],
             Field(min_length=2, max_length=MAX_PROFILE_POINTS),
         ]
         | None
@@ -146,45 +148,6 @@ class RunupRequest(ParamsOrDesign):
     )
     label: str | None = Field(None, max_length=200, description="The client's name for it.")
 
-    @model_validator(mode="after")
-    def _profile(self) -> RunupRequest:
-        if self.design is None:
-            raise ValueError("design: a run-up needs a design in physical units (its time scale)")
-        if self.design.backlash_law != "piecewise":
-            raise ValueError("design.backlash_law: run-ups integrate the piecewise law (Eq. 6)")
-        if self.points is not None:
-            if self.direction != "up":
-                raise ValueError("direction: a points profile says its own direction")
-            if any(v is not None for v in (self.from_speed, self.to_speed, self.rate,
-                                           self.duration)):  # fmt: skip
-                raise ValueError("points: give points or from_speed/to_speed/rate, not both")
-            times = [t for t, _ in self.points]
-            if times[0] != 0.0 or any(b <= a for a, b in itertools.pairwise(times)):
-                raise ValueError("points: times must start at 0 s and increase")
-            return self
-        if self.from_speed is None or self.to_speed is None:
-            raise ValueError("from_speed: give from_speed and to_speed (or points)")
-        if not self.from_speed < self.to_speed:
-            raise ValueError("to_speed: must be above from_speed (direction down runs down)")
-        if (self.rate is None) == (self.duration is None):
-            raise ValueError("rate: give rate or duration (one of them)")
-        return self
-
-    @model_validator(mode="after")
-    def _budget(self) -> RunupRequest:
-        from gearengine.runup.profile import runup_plan
-
-        steps = runup_plan(self).work(self.ensemble.size)
-        if steps > MAX_RUNUP_STEPS:
-            field = "points" if self.points is not None else (
-                "duration" if self.duration is not None else "rate")  # fmt: skip
-            raise ValueError(
-                f"{field}: this profile needs {steps} RK4 steps ({self.ensemble.size} members), "
-                f"over the budget of {MAX_RUNUP_STEPS}; shorten it, raise the rate or use "
-                "fewer ensemble members"
-            )
-        return self
-
     def leg_seconds(self) -> float:
         """Duration of one leg of a linear ramp [s]."""
         assert self.from_speed is not None and self.to_speed is not None
@@ -213,6 +176,72 @@ class RunupRequest(ParamsOrDesign):
     def duration_s(self) -> float:
         """Length of the profile [s]."""
         return self.knots()[-1][0]
+
+
+def request_errors(request: RunupRequest) -> list[InitErrorDetails]:
+    """Checks across fields, as pydantic error details naming each field: a design with the
+    piecewise law, one profile (points, or from/to with rate or duration), ordered speeds and
+    times, and the work budget (``MAX_RUNUP_STEPS``), all before any compute."""
+    errors: list[InitErrorDetails] = []
+
+    def add(loc: tuple[str | int, ...], message: str, value: object) -> None:
+        errors.append({"type": PydanticCustomError("runup", message), "loc": loc, "input": value})
+
+    design = request.design
+    if design is None:
+        add(("design",), "a run-up needs a design in physical units (its time scale)", None)
+    elif design.backlash_law != "piecewise":
+        add(("design", "backlash_law"), "run-ups integrate the piecewise law (Eq. 6)",
+            design.backlash_law)  # fmt: skip
+    ramp = {"from_speed": request.from_speed, "to_speed": request.to_speed,
+            "rate": request.rate, "duration": request.duration}  # fmt: skip
+    if request.points is not None:
+        for name, value in ramp.items():
+            if value is not None:
+                add((name,), "give points or a ramp (from_speed, to_speed, rate), not both", value)
+        if request.direction != "up":
+            add(("direction",), "a points profile says its own direction", request.direction)
+        times = [t for t, _ in request.points]
+        if times[0] != 0.0 or any(b <= a for a, b in itertools.pairwise(times)):
+            add(("points",), "times must start at 0 s and increase", times)
+    else:
+        for name in ("from_speed", "to_speed"):
+            if ramp[name] is None:
+                add((name,), "give from_speed and to_speed (or points)", None)
+        lo, hi = request.from_speed, request.to_speed
+        if lo is not None and hi is not None and not lo < hi:
+            add(("to_speed",), "must be above from_speed (direction down runs down)", hi)
+        if (request.rate is None) == (request.duration is None):
+            add(("rate",), "give rate or duration (one of them)", request.rate)
+    if errors:
+        return errors
+    try:
+        steps = runup_plan(request).work(request.ensemble.size)
+    except ValueError as exc:  # a torque ramp on a load-dependent stiffness
+        field, _, message = str(exc).partition(": ")
+        add((field,), message, getattr(request, field, None))
+        return errors
+    if steps > MAX_RUNUP_STEPS:
+        field = "points" if request.points is not None else (
+            "duration" if request.duration is not None else "rate")  # fmt: skip
+        add((field,), f"this profile needs {steps} RK4 steps ({request.ensemble.size} members), "
+            f"over the budget of {MAX_RUNUP_STEPS}; shorten it, raise the rate or use fewer "
+            "ensemble members", getattr(request, field))  # fmt: skip
+    return errors
+
+
+def checked(request: RunupRequest) -> RunupRequest:
+    """``request`` if ``request_errors`` finds nothing; else ``ValidationError`` naming each
+    field (the checks the API and the CLI share)."""
+    errors = request_errors(request)
+    if errors:
+        raise ValidationError.from_exception_data("RunupRequest", errors)
+    return request
+
+
+def validated(data: object) -> RunupRequest:
+    """Parse and check a run-up request document; raises ``ValidationError`` naming each field."""
+    return checked(RunupRequest.model_validate(data))
 
 
 def n_bins(lo_rpm: float, hi_rpm: float, width: float) -> int:
