@@ -120,6 +120,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--server", metavar="URL", help="run the envelope on a running service "
                    "(API key from GEARCHAOS_API_KEY)")  # fmt: skip
     p.add_argument("--max-lle", type=float, default=None, help="fail when the LLE exceeds V")
+    p.add_argument("--runup", type=float, default=None, metavar="RATE",
+                   help="envelope checks: also run up and down through --speed at RATE rpm/s "
+                   "at each torque level (same rules; chaos fails after 0.05 s)")  # fmt: skip
     p.add_argument(
         "--min-stability-margin",
         type=float,
