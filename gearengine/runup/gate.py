@@ -4,7 +4,7 @@ through the envelope's speed range at each torque level, failing on the envelope
 Rules on the bins of each branch (``sweeps.gate.Rules``): ``chaotic`` in ``fail_on`` fails a
 run of chaotic bins (ensemble FTLE clearly positive, or above ``max_lle`` when given) that lasts
 longer than ``chaos_seconds``: a ramp crossing a chaotic window quickly may pass, one lingering
-in it fails. ``impacts`` fails back-flank impacts, ``max_dte_um`` and ``max_dynamic_factor``
+in it fails. ``impacts`` fails back-flank impacts, ``separation`` any loss of contact, ``max_dte_um`` and ``max_dynamic_factor``
 their limits, each bin by itself. Failures name the branch and the speeds.
 """
 
@@ -32,6 +32,8 @@ def bin_failures(b: RunupBin, rules: Rules) -> list[str]:
     out = []
     if "impacts" in rules.fail_on and (b.back_flank_impacts or 0) > 0:
         out.append("back-flank impacts")
+    if "separation" in rules.fail_on and (b.separation_fraction or 0) > 0:
+        out.append("tooth separation")
     if rules.max_dte_um is not None and (
         b.dte_peak_to_peak_um is None or b.dte_peak_to_peak_um > rules.max_dte_um
     ):
