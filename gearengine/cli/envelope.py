@@ -212,6 +212,10 @@ def cmd_envelope(args: argparse.Namespace) -> int:
         chunk = max(1, request.n_points() // (4 * (os.cpu_count() or 1)))
         result = run_local(request, tick, chunk_points=chunk, workers=os.cpu_count() or 1)
     report = envelope_report(result, rules)
+    if getattr(args, "runup", None) is not None:  # run-ups through the range (runup.gate)
+        from gearengine.runup.gate import gate_envelope
+
+        report = validated_input(lambda r: gate_envelope(report, request, r), args.runup, "--runup")
     print_report(report)
     if args.json:
         Path(args.json).write_text(dumps(report))
