@@ -85,6 +85,7 @@ _SUBMODULES = frozenset(
         "analysis",
         "cli",
         "engineering",
+        "ensembles",
         "homoclinic",
         "jitcache",
         "jobs",
