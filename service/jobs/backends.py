@@ -16,6 +16,7 @@ from typing import Any, Protocol
 
 from gearengine.jobs import compute_chunk_json
 from service.jobs.store import Claim
+from service.lifetime import exit_with_parent
 
 
 class Backend(Protocol):
@@ -36,8 +37,11 @@ class Backend(Protocol):
         """Stop every worker, dropping unfinished work."""
 
 
-def _init_worker(threads: int) -> None:
-    """Pool worker start-up: share the cores fairly and load the kernels once."""
+def _init_worker(threads: int, parent: int) -> None:
+    """Pool worker start-up: end with the server (``parent``: a kill -9 of it must not leave
+    this process, and the resource tracker it holds open, behind), share the cores fairly and
+    load the kernels once."""
+    exit_with_parent(parent)
     import numba
 
     from gearengine.numerics.simulation import warm_up
@@ -65,7 +69,7 @@ class LocalPool:
             self.workers,
             mp_context=multiprocessing.get_context("spawn"),
             initializer=_init_worker,
-            initargs=(threads,),
+            initargs=(threads, os.getpid()),
         )
         # the workers start and warm up in the background (the server is ready meanwhile);
         # capacity() stays 0, so no chunk is claimed, until every one of them has answered
