@@ -33,7 +33,7 @@ from gearengine.ensembles.tolerances import (
     Variable,
     base_design,
     probability,
-    sample_params,
+    sample_design,
     sample_values,
     sobol_points,
     variables,
@@ -183,9 +183,9 @@ def compute_chunk(request: RobustnessRequest, index: int, rows: int) -> str:
     values = sample_values(variables_, request.unit_rows()[lo:hi])
     base = base_design(request.design)
     points = request.points() or [{}]
-    designs = [(p, v) for p in points for v in values]
-    params = [sample_params(base, {**v, **p}) for p, v in designs]
-    backlash = [design_with(base, {**v, **p}).mesh.half_backlash for p, v in designs]
+    designs = [sample_design(base, {**v, **p}) for p in points for v in values]
+    params = [convert_design(d).params for d in designs]
+    backlash = [d.mesh.half_backlash for d in designs]
     verdicts = simulate_batch(params, request.settings)
     runs = [_run(bp, pp, b) for bp, pp, b in zip(verdicts, params, backlash, strict=True)]
     per_point = [runs[i * len(values) : (i + 1) * len(values)] for i in range(len(points))]

@@ -28,7 +28,7 @@ from scipy import stats
 from scipy.stats import qmc
 
 from gearengine.model.design import ACCURACY_FIELD, BACKLASH_FIELD, Design, TransmissionError
-from gearengine.model.reduction import convert_design, half_backlash_band
+from gearengine.model.reduction import half_backlash_band
 from gearengine.model.standards import iso1328
 from gearengine.model.tolerances import Distribution, Normal, Triangular, Uniform
 from gearengine.sweeps.axes import design_with, si_value
@@ -72,13 +72,16 @@ class ToleranceError(ValueError):
 
 
 def base_design(design: Design) -> Design:
-    """The design the samples vary: with an accuracy class and no transmission error, a
-    mesh-frequency harmonic is added for the class to set."""
+    """The design the samples vary, without its tolerances (each sample is one built design);
+    with an accuracy class and no transmission error, a mesh-frequency harmonic is added for
+    the class to set."""
+    update: dict[str, object] = {"tolerances": None}
     tol = design.tolerances
     if tol is not None and tol.accuracy is not None and design.transmission_error is None:
-        mesh_error = TransmissionError.model_validate({"harmonics": [{"amplitude": 0.0}]})
-        return design.model_copy(update={"transmission_error": mesh_error})
-    return design
+        update["transmission_error"] = TransmissionError.model_validate(
+            {"harmonics": [{"amplitude": 0.0}]}
+        )
+    return design.model_copy(update=update)
 
 
 def _value(design: Design, path: str, value: object, what: str) -> float:
@@ -182,11 +185,6 @@ def sample_values(variables: list[Variable], unit: np.ndarray) -> list[dict[str,
 def sample_design(base: Design, values: dict[str, float]) -> Design:
     """The built design of one sample: ``base`` with the sampled values, re-validated."""
     return design_with(base, values)
-
-
-def sample_params(base: Design, values: dict[str, float]):
-    """Dimensionless parameters of one sample (``convert_design`` of ``sample_design``)."""
-    return convert_design(sample_design(base, values)).params
 
 
 def probability(k: int, n: int) -> dict[str, object]:
