@@ -15,6 +15,7 @@ from gearengine.sweeps.export import (
     csv_rows,
     points_of_chunk,
     result_json,
+    text_blocks,
     to_csv,
 )
 from gearengine.sweeps.plan import DEFAULT_CHUNK_POINTS, SweepPlan, sweep_work
@@ -47,6 +48,7 @@ __all__ = [
     "result_json",
     "run_local",
     "sweep_work",
+    "text_blocks",
     "to_csv",
     "validated",
 ]
