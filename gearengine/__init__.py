@@ -98,6 +98,7 @@ _SUBMODULES = frozenset(
         "analysis",
         "cli",
         "engineering",
+        "ensembles",
         "homoclinic",
         "jitcache",
         "jobs",

@@ -1,6 +1,6 @@
 """The ``gearengine`` command line.
 
-    gearengine melnikov FILE [--json] [--method closed_form|quadrature]
+    gearengine melnikov FILE [--json] [--method closed_form|quadrature] [--mean-load ...]
     gearengine analyze FILE [--json]
     gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov|impacts|separation]
         [--max-lle V] [--max-dte E] [--max-dynamic-factor F]
@@ -78,6 +78,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help='JSON file holding {"params": {...}} or {"design": {...}}, or -')
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
     p.add_argument("--method", choices=["closed_form", "quadrature"], default=None)
+    p.add_argument(
+        "--mean-load",
+        choices=["unperturbed", "perturbation"],
+        default=None,
+        help="where the mean force goes (default unperturbed; perturbation: the paper's)",
+    )
     p.set_defaults(func=lazy("gearengine.cli.melnikov", "cmd_melnikov"))
 
     p = sub.add_parser("analyze", help="Melnikov and numerical verdicts of a design")
@@ -133,7 +139,25 @@ def build_parser() -> argparse.ArgumentParser:
         help="fail when the response is periodic and its Floquet stability margin "
         "1 - max |lambda| is below X (or unavailable); one design only, not an envelope",
     )
+    p.add_argument("--max-probability", action="append", metavar="NAME=P",
+                   help="fail where the 95 %% upper bound of P(NAME) over the design's "
+                   "tolerances exceeds P (chaotic, impacts, back_flank; repeatable)")  # fmt: skip
+    p.add_argument("--samples", type=int, default=64, help="with --max-probability (default 64)")
+    p.add_argument("--seed", type=int, default=0, help="with --max-probability (default 0)")
     p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
+
+    p = sub.add_parser("robustness", help="probabilities over a design's tolerances, here")
+    p.add_argument("file", help='JSON file holding {"design": {..., "tolerances": {...}}}, or -')
+    p.add_argument("--speed", metavar="LOW:HIGH", help="driver speeds: rpm, or with units")
+    p.add_argument("--torque", metavar="LOW:HIGH", help="mean driver torques: N m, or with units")
+    p.add_argument("--speed-points", type=int, default=23, metavar="N", help="default 23")
+    p.add_argument("--torque-points", type=int, default=5, metavar="N", help="default 5")
+    p.add_argument("--samples", type=int, default=256, help="samples N, a power of 2 (256)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the Sobol samples (0)")
+    p.add_argument("--sensitivity", action="store_true", help="also Sobol indices (SALib)")
+    p.add_argument("--json", metavar="FILE", help="write the result (the API's document)")
+    p.add_argument("--plot", metavar="PNG", help="write the probability map")
+    p.set_defaults(func=lazy("gearengine.cli.robustness", "cmd_robustness"))
 
     p = sub.add_parser("sweep", help="run a sweep here, no server: JSON, CSV and PNG")
     p.add_argument("file", help="JSON file holding a sweep request (as POST /v1/sweeps), or -")
