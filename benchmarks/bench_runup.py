@@ -61,6 +61,7 @@ def main() -> None:
     base_ns = base / (periods * steps) * 1e9
     member_ns = member / member_steps * 1e9
     cores = os.cpu_count() or 1
+    load = os.getloadavg()[0]
     rows = [
         ("whole run-up job (`runup.run_local`, 2 threads)", whole, None),
         (f"one ensemble member ({member_steps:,} RK4 steps)", member, member_ns),
@@ -89,6 +90,8 @@ of {REPEATS}.
 | what | wall time, s | ns per RK4 step | ratio to stationary |
 | --- | ---: | ---: | ---: |
 {table}
+
+Load average (1 min) at the end of the run: {load:.1f} on {cores} cores.
 """,
     )
 
