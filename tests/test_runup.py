@@ -241,6 +241,8 @@ def test_the_service_job_is_the_cli_document(tmp_path: Path) -> None:
             result = http.get(f"{location}/result")
             assert result.status_code == 200
             assert result.content == out.read_bytes()
+            plot = http.get(f"{location}/plot", params={"format": "png"})
+            assert plot.status_code == 200 and plot.content[:4] == b"\x89PNG"
     finally:
         server.stop()
     assert dumps(run_local(validated(body))) == out.read_text()

@@ -76,7 +76,7 @@ def with_lags(ramp: list[RunupJump], quasi: list[RunupJump], branch: Branch) -> 
             out.append(j)
             continue
         q = min(same, key=lambda q: abs(q.speed_rpm - j.speed_rpm))
-        lag = sign * (j.speed_rpm - q.speed_rpm)
+        lag = sign * (j.speed_rpm - q.speed_rpm) + 0.0  # no -0
         out.append(j.model_copy(update={"quasi_static_speed_rpm": q.speed_rpm,
                                         "lag_rpm": shown(lag)}))  # fmt: skip
     return out
