@@ -20,7 +20,11 @@ from service.api.routes import (
     explorer,
     health,
     melnikov,
+<<<<<<< HEAD
+    runups,
+=======
     robustness,
+>>>>>>> wt-robustness
     sweeps,
     thresholds,
 )
@@ -30,6 +34,7 @@ from service.jobs.runtime import SweepJobs
 from service.limits import Limits
 from service.metrics import Metrics
 from service.middleware import AccessLog, BodyLimit
+from service.warmup import KernelWarmUp
 
 DESCRIPTION = """
 Periodic or chaotic? Answers for a spur-gear pair with backlash, time-varying mesh stiffness,
@@ -59,13 +64,13 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-        warmed = {"kernels": False}
-        ready_checks["kernels"] = lambda: warmed["kernels"]
-        await run_in_threadpool(_warm_up)
-        warmed["kernels"] = True
         jobs = app.state.sweep_jobs = await run_in_threadpool(SweepJobs.open, settings)
         ready_checks["job_store"] = jobs.ready
+        warming = app.state.warm_up = KernelWarmUp(jobs, settings)  # after the ready line
+        ready_checks["kernels"] = warming.done.is_set
+        warming.start()
         yield
+        await run_in_threadpool(warming.stop)
         await run_in_threadpool(jobs.close)
 
     app = FastAPIOffline(
@@ -95,7 +100,11 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(thresholds.router, tags=["melnikov"])
     app.include_router(analyses.router, tags=["analyses"])
     app.include_router(sweeps.router, tags=["sweeps"])
+<<<<<<< HEAD
+    app.include_router(runups.router, tags=["runups"])
+=======
     app.include_router(robustness.router, tags=["robustness"])
+>>>>>>> wt-robustness
     app.include_router(explorer.router)
     app.add_middleware(
         BodyLimit,
@@ -105,12 +114,3 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_middleware(AccessLog, metrics=app.state.metrics)
     logging.getLogger("gearchaos").setLevel(logging.INFO)
     return app
-
-
-def _warm_up() -> None:
-    """Compile or load every numba kernel once, so the first request is fast."""
-    from gearengine.homoclinic.batch import warm_up as warm_up_melnikov
-    from gearengine.numerics import warm_up
-
-    warm_up()
-    warm_up_melnikov()
