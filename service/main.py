@@ -20,11 +20,8 @@ from service.api.routes import (
     explorer,
     health,
     melnikov,
-<<<<<<< HEAD
-    runups,
-=======
     robustness,
->>>>>>> wt-robustness
+    runups,
     sweeps,
     thresholds,
 )
@@ -100,11 +97,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(thresholds.router, tags=["melnikov"])
     app.include_router(analyses.router, tags=["analyses"])
     app.include_router(sweeps.router, tags=["sweeps"])
-<<<<<<< HEAD
     app.include_router(runups.router, tags=["runups"])
-=======
     app.include_router(robustness.router, tags=["robustness"])
->>>>>>> wt-robustness
     app.include_router(explorer.router)
     app.add_middleware(
         BodyLimit,

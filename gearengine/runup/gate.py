@@ -4,8 +4,9 @@ through the envelope's speed range at each torque level, failing on the envelope
 Rules on the bins of each branch (``sweeps.gate.Rules``): ``chaotic`` in ``fail_on`` fails a
 run of chaotic bins (ensemble FTLE clearly positive, or above ``max_lle`` when given) that lasts
 longer than ``chaos_seconds``: a ramp crossing a chaotic window quickly may pass, one lingering
-in it fails. ``impacts`` fails back-flank impacts, ``separation`` any loss of contact, ``max_dte_um`` and ``max_dynamic_factor``
-their limits, each bin by itself. Failures name the branch and the speeds.
+in it fails. ``impacts`` fails back-flank impacts, ``separation`` any loss of contact,
+``max_dte_um`` and ``max_dynamic_factor`` their limits, each bin by itself. Failures name the
+branch and the speeds.
 """
 
 from __future__ import annotations
