@@ -153,6 +153,11 @@ def test_bad_tolerance_input_is_a_422_naming_the_field(
     assert any(field in e["path"] for e in r.json()["errors"]), r.json()
 
 
+def test_samples_must_be_a_power_of_two(client: TestClient) -> None:
+    r = client.post("/v1/robustness", json=doc(samples=100))
+    assert r.status_code == 422 and r.json()["errors"][0]["path"] == "samples"
+
+
 def test_an_accuracy_class_without_geometry_is_a_422(client: TestClient) -> None:
     d = doc()
     for gear, r_b, j in (("driver", "27 mm", "2e-4 kg*m^2"), ("driven", "78.7 mm", "1e-2 kg*m^2")):
