@@ -65,14 +65,14 @@ class ToleranceError(ValueError):
     """Bad tolerance input: ``field`` is the path inside ``design.tolerances``."""
 
     def __init__(self, field: str, message: str) -> None:
-        super().__init__(f"design.tolerances.{field}: {message}")
+        super().__init__(f"design.tolerances{'.' if field else ''}{field}: {message}")
         self.field, self.message = field, message
 
     def details(self) -> InitErrorDetails:
         """As a pydantic error detail (loc design.tolerances.<field>)."""
         return {
             "type": PydanticCustomError("tolerance", self.message),
-            "loc": ("design", "tolerances", self.field),
+            "loc": ("design", "tolerances", self.field) if self.field else ("design", "tolerances"),
             "input": self.field,
         }
 
