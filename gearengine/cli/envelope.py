@@ -30,23 +30,28 @@ from gearengine.cli.documents import (
 )
 from gearengine.cli.sweep import progress_bar
 from gearengine.jsonio import dumps
-from gearengine.sweeps.compute import run_local
-from gearengine.sweeps.gate import EnvelopeReport, Rules, envelope_report, junit_xml, window_text
+from gearengine.sweeps.gate import (
+    EnvelopeReport,
+    Rules,
+    check_envelope,
+    envelope_axis,
+    envelope_report,
+    envelope_sweep,
+    junit_xml,
+    window_text,
+)
 from gearengine.sweeps.request import SweepRequest, validated
 from gearengine.sweeps.results import SweepResult
 
-ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
-"""Integration settings of an envelope check unless the design file gives ``settings``."""
 POLL_SECONDS = 1.0
 
 
 def axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
-    """A sweep axis from "A:B" (bare numbers in ``unit``) or "52rad/s:628rad/s"."""
-    ends = text.split(":")
-    if len(ends) != 2 or not all(e.strip() for e in ends):
-        raise InvalidInputError([f"--{name}: give a range as LOW:HIGH, e.g. --{name} 500:6000"])
-    lo, hi = (e.strip() if any(c.isalpha() for c in e) else f"{e.strip()} {unit}" for e in ends)
-    return {"parameter": name, "start": lo, "stop": hi, "num": num}
+    """``sweeps.gate.envelope_axis``, its error naming the option."""
+    try:
+        return envelope_axis(name, text, unit, num)
+    except ValueError as exc:
+        raise InvalidInputError([f"--{name}: {exc}"]) from None
 
 
 def envelope_request(args: argparse.Namespace) -> SweepRequest:
@@ -62,8 +67,8 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
     ]
     if args.torque:
         axes.append(axis("torque", args.torque, "N*m", args.torque_points))
-    sweep = {"design": design, "settings": doc.get("settings", ENVELOPE_SETTINGS), "axes": axes,
-             "label": f"envelope check of {Path(args.file).name}"}  # fmt: skip
+    sweep = envelope_sweep(design, doc.get("settings"), axes,
+                           f"envelope check of {Path(args.file).name}")  # fmt: skip
     return validated_input(validated, sweep, args.file)
 
 
@@ -155,11 +160,9 @@ def cmd_envelope(args: argparse.Namespace) -> int:
     tick = progress(time.monotonic())
     if args.server:
         key = os.environ.get("GEARCHAOS_API_KEY")
-        result = run_on_server(args.server, request, key, tick)
+        report = envelope_report(run_on_server(args.server, request, key, tick), rules)
     else:
-        chunk = max(1, request.n_points() // (4 * (os.cpu_count() or 1)))
-        result = run_local(request, tick, chunk_points=chunk, workers=os.cpu_count() or 1)
-    report = envelope_report(result, rules)
+        report = check_envelope(request, rules, tick, workers=os.cpu_count() or 1)
     print_report(report)
     if args.json:
         Path(args.json).write_text(dumps(report))
