@@ -48,6 +48,7 @@ class JobKind:
 
 KINDS: dict[str, str] = {
     "sweep": "gearengine.sweeps.compute:SWEEP_JOB",
+    "remedies": "gearengine.ensembles.remedies:REMEDIES_JOB",
 }
 """Kind name -> ``module:attribute`` of its ``JobKind``."""
 
