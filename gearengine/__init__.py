@@ -21,6 +21,7 @@ from gearengine.lazyload import lazy_names
 
 if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDEs
     from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
+    from gearengine.ensembles.remedies import RemediesRequest, RemediesResult, remedies
     from gearengine.homoclinic import MelnikovResult, chaos_possible, melnikov, threshold_curve
     from gearengine.model.examples import PAPER_SECTION_41
     from gearengine.model.params import GearParams
@@ -41,6 +42,8 @@ __all__ = [
     "AnalysisResult",
     "GearParams",
     "MelnikovResult",
+    "RemediesRequest",
+    "RemediesResult",
     "SimulationSettings",
     "SweepRequest",
     "SweepResult",
@@ -49,6 +52,7 @@ __all__ = [
     "lyapunov",
     "melnikov",
     "poincare",
+    "remedies",
     "run_sweep",
     "simulate",
     "simulate_batch",
@@ -62,6 +66,8 @@ _HOMES: dict[str, tuple[str, str]] = {
     "AnalysisResult": ("gearengine.analysis", "AnalysisResult"),
     "GearParams": ("gearengine.model.params", "GearParams"),
     "MelnikovResult": ("gearengine.homoclinic", "MelnikovResult"),
+    "RemediesRequest": ("gearengine.ensembles.remedies", "RemediesRequest"),
+    "RemediesResult": ("gearengine.ensembles.remedies", "RemediesResult"),
     "SimulationSettings": ("gearengine.numerics", "SimulationSettings"),
     "SweepRequest": ("gearengine.sweeps", "SweepRequest"),
     "SweepResult": ("gearengine.sweeps", "SweepResult"),
@@ -70,6 +76,7 @@ _HOMES: dict[str, tuple[str, str]] = {
     "lyapunov": ("gearengine.numerics", "lyapunov"),
     "melnikov": ("gearengine.homoclinic", "melnikov"),
     "poincare": ("gearengine.numerics", "poincare"),
+    "remedies": ("gearengine.ensembles.remedies", "remedies"),
     "run_sweep": ("gearengine.sweeps", "run_local"),
     "simulate": ("gearengine.numerics", "simulate"),
     "simulate_batch": ("gearengine.numerics", "simulate_batch"),
@@ -85,6 +92,7 @@ _SUBMODULES = frozenset(
         "analysis",
         "cli",
         "engineering",
+        "ensembles",
         "homoclinic",
         "jitcache",
         "jobs",
