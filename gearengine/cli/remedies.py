@@ -22,7 +22,8 @@ from gearengine.cli.documents import (
     read_document,
     validated_input,
 )
-from gearengine.cli.envelope import progress, rules_of
+from gearengine.cli.envelope import rules_of
+from gearengine.cli.sweep import progress
 from gearengine.ensembles.remedies import RemediesRequest, RemediesResult, remedies
 from gearengine.jsonio import dumps
 
@@ -61,7 +62,8 @@ def print_result(result: RemediesResult) -> None:
 def cmd_remedies(args: argparse.Namespace) -> int:
     """Remedies of a failing envelope; exit 0 something passes, 1 nothing does, 2 invalid."""
     request = remedies_request(args)
-    result = remedies(request, progress(time.monotonic()), workers=os.cpu_count() or 1)
+    tick = progress(time.monotonic(), "remedies", "searches")
+    result = remedies(request, tick, workers=os.cpu_count() or 1)
     print_result(result)
     if args.json:
         Path(args.json).write_text(dumps(result))

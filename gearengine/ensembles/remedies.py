@@ -34,7 +34,14 @@ import math
 from collections.abc import Callable
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from gearengine import jobs
@@ -46,6 +53,7 @@ from gearengine.numerics.batch import threads_may_share_kernels
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.sweeps.axes import design_with, display_unit, in_display_unit, si_value
 from gearengine.sweeps.gate import (
+    ENVELOPE_SETTINGS,
     EnvelopeReport,
     Rules,
     check_envelope,
@@ -116,8 +124,10 @@ class RemediesRequest(Rules):
 
     design: Design = Field(description="The pair in physical units.")
     envelope: Envelope
-    settings: SimulationSettings | None = Field(
-        None, description="Integration settings of every envelope run (default: the gate's)."
+    settings: SimulationSettings = Field(
+        default_factory=lambda: SimulationSettings.model_validate(ENVELOPE_SETTINGS),
+        description="Integration settings of every envelope run, merged over the gate's light "
+        "settings (as a design file's settings in gearengine check).",
     )
     levers: list[LeverRange] | None = Field(
         None, max_length=MAX_LEVERS,
@@ -129,6 +139,11 @@ class RemediesRequest(Rules):
         description="Numerical bisection stops when its bracket is narrower than this fraction "
         "of the change (and of the value).",
     )  # fmt: skip
+
+    @field_validator("settings", mode="before")
+    @classmethod
+    def _over_the_gates(cls, given: object) -> object:
+        return {**ENVELOPE_SETTINGS, **given} if isinstance(given, dict) else given
 
     @model_validator(mode="after")
     def _checked(self) -> RemediesRequest:
@@ -147,8 +162,8 @@ class RemediesRequest(Rules):
         axes = [envelope_axis("speed", env.speed, "rpm", env.speed_points)]
         if env.torque is not None:
             axes.append(envelope_axis("torque", env.torque, "N*m", env.torque_points))
-        doc = envelope_sweep((design or self.design).model_dump(), None if self.settings is None
-                             else self.settings.model_dump(), axes, "remedies")  # fmt: skip
+        doc = envelope_sweep((design or self.design).model_dump(), self.settings.model_dump(),
+                             axes, "remedies")  # fmt: skip
         return SweepRequest.model_validate(doc)
 
 

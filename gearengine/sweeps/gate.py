@@ -4,7 +4,8 @@ that GitHub, GitLab and Jenkins show.
 
 Rules (``Rules``): ``fail_on`` classes (``chaotic`` fails chaotic and diverged points, ordered
 periodic < quasi_periodic < chaotic < diverged as in ``numerics.classify.SEVERITY``),
-``melnikov`` (the criterion allows chaos), ``impacts`` (back-flank contact); and numeric limits,
+``melnikov`` (the criterion allows chaos), ``impacts`` (back-flank contact), ``separation`` (the
+teeth separate: drive-flank impacts, or impacts on both flanks); and numeric limits,
 which add to the classes instead of replacing them: ``max_lle`` (per unit tau), ``max_dte_um``
 (dynamic transmission error peak to peak, µm), ``max_dynamic_factor`` (largest mesh force over
 the static force F~_m).
@@ -24,7 +25,7 @@ from gearengine.sweeps.request import SweepRequest
 from gearengine.sweeps.results import PhysicalValue, SpeedWindows, SweepPoint, SweepResult
 from gearengine.sweeps.windows import SPEED, runs
 
-FailOn = Literal["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts"]
+FailOn = Literal["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"]
 
 
 class Rules(BaseModel):
@@ -34,13 +35,18 @@ class Rules(BaseModel):
 
     fail_on: list[FailOn] = Field(
         default_factory=lambda: ["chaotic"],
-        description="Classes that fail (and anything worse), melnikov, impacts.",
+        description="Classes that fail (and anything worse), melnikov, impacts (back-flank "
+        "contact), separation (the teeth separate: drive-flank or back-flank impacts).",
     )
     max_lle: float | None = Field(None, description="Largest LLE allowed, per unit tau.")
     max_dte_um: float | None = Field(None, description="Largest DTE peak to peak [µm].")
     max_dynamic_factor: float | None = Field(
         None, description="Largest dynamic factor allowed: max mesh force / static force."
     )
+
+
+SEPARATING = ("single_sided", "double_sided")
+"""Impact regimes in which the teeth separate (``numerics.diagnostics.impact_regime``)."""
 
 
 def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
@@ -54,6 +60,8 @@ def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
         out.append("Melnikov: chaos possible")
     if "impacts" in rules.fail_on and p.impact_regime == "double_sided":
         out.append("back-flank impacts")
+    if "separation" in rules.fail_on and p.impact_regime in SEPARATING:
+        out.append("tooth separation")
     if rules.max_lle is not None and (p.lle is None or p.lle > rules.max_lle):
         out.append(f"LLE > {rules.max_lle:g}")
     dte = (p.physical or {}).get("dte")
@@ -68,7 +76,8 @@ def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
 
 
 ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
-"""Integration settings of an envelope check unless the design file gives ``settings``."""
+"""Light integration settings of an envelope check; a design file's ``settings`` are merged
+over them (adding ``random_initial_states`` keeps the 60 + 60 periods)."""
 
 
 def envelope_axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
@@ -83,11 +92,11 @@ def envelope_axis(name: str, text: str, unit: str, num: int) -> dict[str, object
     return {"parameter": name, "start": lo, "stop": hi, "num": num}
 
 
-def envelope_sweep(design: object, settings: object, axes: list[dict[str, object]],
-                   label: str) -> dict[str, object]:  # fmt: skip
+def envelope_sweep(design: object, settings: dict[str, object] | None,
+                   axes: list[dict[str, object]], label: str) -> dict[str, object]:  # fmt: skip
     """The sweep document of an envelope check: ``axes`` (``envelope_axis``) of ``design``
-    under ``settings`` (``ENVELOPE_SETTINGS`` when None)."""
-    return {"design": design, "settings": ENVELOPE_SETTINGS if settings is None else settings,
+    under ``settings`` merged over ``ENVELOPE_SETTINGS``."""
+    return {"design": design, "settings": {**ENVELOPE_SETTINGS, **(settings or {})},
             "axes": axes, "label": label}  # fmt: skip
 
 
