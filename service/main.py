@@ -20,6 +20,7 @@ from service.api.routes import (
     explorer,
     health,
     melnikov,
+    remedies,
     sweeps,
     thresholds,
 )
@@ -92,6 +93,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(thresholds.router, tags=["melnikov"])
     app.include_router(analyses.router, tags=["analyses"])
     app.include_router(sweeps.router, tags=["sweeps"])
+    app.include_router(remedies.router, tags=["remedies"])
     app.include_router(explorer.router)
     app.add_middleware(
         BodyLimit,

@@ -13,6 +13,7 @@ import copy
 import json
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import httpx
@@ -100,7 +101,7 @@ def test_each_value_passes_the_gate_and_ten_percent_short_fails(
     ]
 
 
-def test_melnikov_bound_is_where_the_service_stops_allowing_chaos(tmp_path: Path) -> None:
+def test_melnikov_bound_is_where_the_service_stops_allowing_chaos(server: Server) -> None:
     """At the bound /v1/melnikov rules chaos out (or does not apply) at every envelope point;
     1 % short of it (toward the design's value) it allows chaos somewhere."""
     doc = json.loads(EXAMPLE.read_text())
@@ -115,25 +116,21 @@ def test_melnikov_bound_is_where_the_service_stops_allowing_chaos(tmp_path: Path
     result = remedies(request)
     bounds = [r for r in result.remedies if r.bound == "melnikov"]
     assert {r.lever for r in bounds} == {te, "mesh.half_backlash"}
-    server = Server(tmp_path)
-    try:
-        for r in bounds:
-            short = r.to + 0.01 * abs(r.to) * (1 if r.from_ > r.to else -1)
-            verdicts = {}
-            for value in (r.to, short):
-                design = with_value(doc, r.lever, value, r.unit)["design"]
-                verdicts[value] = []
-                for point in envelope_points(request):
-                    at = {**design, "speed": f"{in_display_unit('speed', point['speed'])} rpm",
-                          "torque": f"{point['torque']!r} N*m"}  # fmt: skip
-                    body = httpx.post(f"{server.url}/v1/melnikov", json={"design": at},
-                                      timeout=30).json()  # fmt: skip
-                    verdicts[value].append(body["chaos_possible"])
-            assert True not in verdicts[r.to], r.lever
-            assert True in verdicts[short], r.lever
-            assert r.not_applicable_points == verdicts[r.to].count(None)
-    finally:
-        server.stop()
+    for r in bounds:
+        short = r.to + 0.01 * abs(r.to) * (1 if r.from_ > r.to else -1)
+        verdicts = {}
+        for value in (r.to, short):
+            design = with_value(doc, r.lever, value, r.unit)["design"]
+            verdicts[value] = []
+            for point in envelope_points(request):
+                at = {**design, "speed": f"{in_display_unit('speed', point['speed'])} rpm",
+                      "torque": f"{point['torque']!r} N*m"}  # fmt: skip
+                body = httpx.post(f"{server.url}/v1/melnikov", json={"design": at},
+                                  timeout=30).json()  # fmt: skip
+                verdicts[value].append(body["chaos_possible"])
+        assert True not in verdicts[r.to], r.lever
+        assert True in verdicts[short], r.lever
+        assert r.not_applicable_points == verdicts[r.to].count(None)
 
 
 def test_bisection_reports_a_non_monotone_response() -> None:
@@ -179,3 +176,66 @@ def test_cli_refuses_bad_input_before_compute() -> None:
                      "mesh.half_backlash=20um:5um")  # fmt: skip
     assert run.returncode == 2
     assert "envelope.speed:" in run.stderr and "levers[0].bounds:" in run.stderr
+
+
+SMALL = ["--speed", "4500:5000", "--speed-points", "2", "--torque", "2:11.5", "--torque-points",
+         "1", "--lever", "transmission_error.harmonics.0.amplitude=0um:10um"]  # fmt: skip
+
+
+def small_body() -> dict:
+    doc = json.loads(EXAMPLE.read_text())
+    return {"design": doc["design"], "settings": doc["settings"], "fail_on": ["chaotic"],
+            "envelope": {"speed": "4500:5000", "speed_points": 2, "torque": "2:11.5",
+                         "torque_points": 1},
+            "levers": [{"lever": "transmission_error.harmonics.0.amplitude",
+                        "bounds": ["0um", "10um"]}]}  # fmt: skip
+
+
+def finished(server: Server, url: str) -> dict:
+    for _ in range(600):
+        job = httpx.get(url, timeout=30).json()
+        if job["status"] not in ("queued", "running"):
+            return job
+        time.sleep(0.5)
+    raise AssertionError(f"{url} did not finish")
+
+
+def test_the_service_answers_the_clis_document_byte_for_byte(server: Server, tmp_path: Path
+                                                              ) -> None:  # fmt: skip
+    out = tmp_path / "remedies.json"
+    run = gearengine("remedies", str(EXAMPLE), *SMALL, "--fail-on", "chaotic", "--json", str(out))
+    assert run.returncode == 0, run.stderr
+    r = httpx.post(f"{server.url}/v1/remedies", json=small_body(), timeout=30)
+    assert r.status_code == 202, r.text
+    url = server.url + r.headers["location"]
+    assert finished(server, url)["status"] == "succeeded"
+    result = httpx.get(url + "/result", timeout=60)
+    assert result.content == out.read_bytes()
+    assert json.loads(result.content)["remedies"][0]["check"]["passed"]
+
+
+def test_cancelling_stops_the_job(server: Server) -> None:
+    body = {**small_body(), "levers": None}  # six levers: time to cancel between them
+    r = httpx.post(f"{server.url}/v1/remedies", json=body, timeout=30)
+    url = server.url + r.headers["location"]
+    cancelled = httpx.delete(url, timeout=30).json()
+    assert cancelled["status"] == "cancelled"
+    assert httpx.get(url + "/result", timeout=30).status_code == 409
+    assert finished(server, url)["status"] == "cancelled"
+
+
+@pytest.mark.parametrize(
+    ("change", "path"),
+    [
+        ({"levers": [{"lever": "mesh.half_backlash", "bounds": ["20 um", "5 um"]}]},
+         "levers[0].bounds"),
+        ({"levers": [{"lever": "mesh.half_backlash", "bounds": ["NaN um", "5 um"]}]},
+         "levers[0].bounds"),
+        ({"envelope": {"speed": "6000"}}, "envelope.speed"),
+        ({"envelope": {"speed": "500:6000", "torque": "2 kg:40 kg"}}, "envelope.torque"),
+    ],
+)  # fmt: skip
+def test_bad_requests_get_422_naming_the_field(server: Server, change: dict, path: str) -> None:
+    r = httpx.post(f"{server.url}/v1/remedies", json={**small_body(), **change}, timeout=30)
+    assert r.status_code == 422 and r.headers["content-type"] == "application/problem+json"
+    assert path in [e["path"] for e in r.json()["errors"]], r.json()

@@ -46,6 +46,7 @@ from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from gearengine import jobs
 from gearengine.homoclinic.thresholds import chaos_possible
+from gearengine.jsonio import message
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
@@ -256,15 +257,16 @@ class Combination(BaseModel):
     check: EnvelopeReport
 
 
-class LeverOutcome(BaseModel):
-    """A lever chunk's result: its remedies and unreachable bounds."""
+class ChunkOutcome(BaseModel):
+    """A chunk's result: a lever's remedies and unreachable bounds, or the combination."""
 
     model_config = ConfigDict(frozen=True)
 
     baseline: EnvelopeReport | None = Field(description="The design's own report (chunk 0).")
     passed_already: bool
-    remedies: list[Remedy]
-    unreachable: list[Unreachable]
+    remedies: list[Remedy] = []
+    unreachable: list[Unreachable] = []
+    combination: Combination | None = None
 
 
 class RemediesResult(BaseModel):
@@ -279,7 +281,10 @@ class RemediesResult(BaseModel):
     combination: Combination | None = Field(
         description="Two levers together, only when no single lever clears the envelope."
     )
-    check: EnvelopeReport = Field(description="The design's own envelope report.")
+    check: EnvelopeReport | None = Field(
+        description="The design's own envelope report (null only in a partial result without "
+        "the first chunk)."
+    )
 
 
 # --- levers ---------------------------------------------------------------------------------
@@ -384,7 +389,7 @@ def _lever_problem(design: Design, given: LeverRange) -> tuple[str, str] | None:
         try:
             ends.append(si_value(design, given.lever, bound))
         except ValidationError as exc:
-            msg = "; ".join(e["msg"] for e in exc.errors(include_url=False))
+            msg = "; ".join(message(e) for e in exc.errors(include_url=False))
             return "bounds", f"bounds[{k}]: {msg}"
     lo, hi = ends
     unit, factor = display_unit(given.lever)
@@ -569,17 +574,19 @@ def _why(bound: str, lever: Lever, samples: list[Sample], far: EnvelopeReport | 
 
 
 def _chunk(request: RemediesRequest, index: int, chunk_points: int = 1) -> str:
-    """Chunk ``index``: lever ``index`` (both bounds), or the combination (the last chunk)."""
+    """Chunk ``index``: lever ``index`` (both bounds), or the combination (the last chunk);
+    chunk 0 also carries the design's own report."""
     levers = request_levers(request)
     baseline = check_envelope(request.sweep(), request.rules())
+    out = ChunkOutcome(baseline=baseline if index == 0 else None, passed_already=baseline.passed)
+    if baseline.passed:
+        return out.model_dump_json()
     if index == len(levers):
-        combo = None if baseline.passed else combination(request, levers)
-        return "null" if combo is None else combo.model_dump_json()
-    found: tuple[list[Remedy], list[Unreachable]] = ([], [])
-    if not baseline.passed:
-        found = lever_outcome(request, levers[index], baseline)
-    return LeverOutcome(baseline=baseline if index == 0 else None, passed_already=baseline.passed,
-                        remedies=found[0], unreachable=found[1]).model_dump_json()  # fmt: skip
+        update = {"combination": combination(request, levers)}
+    else:
+        remedies, unreachable = lever_outcome(request, levers[index], baseline)
+        update = {"remedies": remedies, "unreachable": unreachable}
+    return out.model_copy(update=update).model_dump_json()
 
 
 def combination(request: RemediesRequest, levers: list[Lever]) -> Combination | None:
@@ -620,23 +627,25 @@ def combination(request: RemediesRequest, levers: list[Lever]) -> Combination | 
 
 
 def assemble(request: RemediesRequest, chunks: list[str]) -> RemediesResult:
-    """The ranked answer from the lever chunks (and the combination chunk)."""
-    outcomes = [LeverOutcome.model_validate_json(text) for text in chunks[:-1]]
-    combo = None if chunks[-1] == "null" else Combination.model_validate_json(chunks[-1])
-    baseline = outcomes[0].baseline if outcomes else None
-    if baseline is None:  # no lever at all: the combination chunk ran the baseline alone
-        baseline = check_envelope(request.sweep(), request.rules())
+    """The ranked answer from the chunks' outcomes (any subset of them, for a partial result)."""
+    outcomes = [ChunkOutcome.model_validate_json(text) for text in chunks]
+    baseline = next((o.baseline for o in outcomes if o.baseline is not None), None)
+    passed = any(o.passed_already for o in outcomes)
     remedies = sorted((r for o in outcomes for r in o.remedies), key=_cost)
     unreachable = [u for o in outcomes for u in o.unreachable]
+    combo = next((o.combination for o in outcomes if o.combination is not None), None)
     if any(r.bound == "numerical" for r in remedies):
-        combo = None
-    words = answer(baseline, remedies, unreachable, combo)
-    possible, blind = melnikov_failures(request.design, envelope_points(request), {})
-    if not baseline.passed and possible == 0:
-        na = f" (it does not apply at {blind} of {baseline.points} points)" if blind else ""
-        words += (f"; the Melnikov criterion rules out homoclinic chaos at every envelope point "
-                  f"already{na}, so it sets no bound")  # fmt: skip
-    return RemediesResult(passed_already=baseline.passed, answer=words, remedies=remedies,
+        combo = None  # a single lever clears it (past a far end that did not)
+    if passed:
+        words = "the design passes its envelope as it is"
+    else:
+        words = answer(remedies, unreachable, combo)
+        possible, blind = melnikov_failures(request.design, envelope_points(request), {})
+        if possible == 0:
+            na = f" (it does not apply at {blind} of them)" if blind else ""
+            words += (f"; the Melnikov criterion rules out homoclinic chaos at every envelope "
+                      f"point already{na}, so it sets no bound")  # fmt: skip
+    return RemediesResult(passed_already=passed, answer=words, remedies=remedies,
                           unreachable=unreachable, combination=combo,
                           check=baseline)  # fmt: skip
 
@@ -646,12 +655,10 @@ def _cost(r: Remedy) -> tuple[int, float]:
     return (r.bound != "numerical", abs(r.to - r.from_) / (abs(r.from_) or 1.0))
 
 
-def answer(baseline: EnvelopeReport, remedies: list[Remedy], unreachable: list[Unreachable],
+def answer(remedies: list[Remedy], unreachable: list[Unreachable],
            combo: Combination | None) -> str:  # fmt: skip
     """The ranked answer in words: each lever's numerical value, its Melnikov guarantee beside
     it, then what no value in range clears."""
-    if baseline.passed:
-        return f"the design passes its envelope as it is ({baseline.points} points)"
     by_lever: dict[tuple[str, bool], dict[str, Remedy]] = {}
     for r in remedies:
         by_lever.setdefault((r.lever, r.to > r.from_), {})[r.bound] = r
