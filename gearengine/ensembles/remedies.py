@@ -52,7 +52,13 @@ from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
 from gearengine.numerics.batch import threads_may_share_kernels
 from gearengine.numerics.settings import SimulationSettings
-from gearengine.sweeps.axes import design_with, display_unit, in_display_unit, si_value
+from gearengine.sweeps.axes import (
+    design_with,
+    display_unit,
+    field_value,
+    in_display_unit,
+    si_value,
+)
 from gearengine.sweeps.gate import (
     ENVELOPE_SETTINGS,
     EnvelopeReport,
@@ -189,6 +195,11 @@ class Lever(BaseModel):
     def unit(self) -> str:
         return display_unit(self.path)[0]
 
+    @property
+    def suffix(self) -> str:
+        """ " um" after a value, nothing for a dimensionless lever."""
+        return "" if self.unit == "1" else f" {self.unit}"
+
 
 class Sample(BaseModel):
     """One value tried: whether the envelope passed (numerical) or chaos was ruled out."""
@@ -218,6 +229,10 @@ class Remedy(BaseModel):
     not_applicable_points: int | None = Field(
         None, description="Melnikov: envelope points at ``to`` where the criterion does not "
         "apply (not judged; not failures).",
+    )  # fmt: skip
+    contact_ratio: float | None = Field(
+        None, description="With gear geometry: the transverse contact ratio at ``to`` (a "
+        "profile-shift lever moves it, and with it the stiffness variation)."
     )  # fmt: skip
     summary: str
     check: EnvelopeReport = Field(description="The envelope report of a run at ``to``.")
@@ -301,15 +316,10 @@ def default_levers(design: Design) -> list[Lever]:
     elif mesh.damping is not None and mesh.damping > 0:
         out.append(Lever(path="mesh.damping", start=mesh.damping,
                          end=DAMPING_FACTOR * mesh.damping))  # fmt: skip
-    harmonics = [
-        ("transmission_error.harmonics", design.transmission_error),
-        ("torque_fluctuation.harmonics", design.torque_fluctuation),
-    ]
-    for prefix, excitation in harmonics[:1]:
-        out += _to_zero(prefix, [] if excitation is None else excitation.harmonics)
+    te, tf = design.transmission_error, design.torque_fluctuation
+    out += _to_zero("transmission_error.harmonics", [] if te is None else te.harmonics)
     out += _to_zero("mesh.stiffness_harmonics", mesh.stiffness_harmonics or [])
-    for prefix, excitation in harmonics[1:]:
-        out += _to_zero(prefix, [] if excitation is None else excitation.harmonics)
+    out += _to_zero("torque_fluctuation.harmonics", [] if tf is None else tf.harmonics)
     b = mesh.half_backlash
     for end in BACKLASH_RANGE_UM:
         if not math.isclose(b, end * 1e-6):
@@ -337,12 +347,11 @@ def request_levers(request: RemediesRequest) -> list[Lever]:
 
 
 def _current(design: Design, path: str) -> float:
-    node: object = design.model_dump()
-    for key in path.split("."):
-        node = node[int(key)] if key.isdigit() else node[key]  # type: ignore[index]
-    if not isinstance(node, (int, float)) or isinstance(node, bool):
+    """The design's number at ``path`` (SI); TypeError if the field is not a number."""
+    value = field_value(design, path)
+    if not isinstance(value, (int, float)) or isinstance(value, bool):
         raise TypeError(f"{path} is not a number of the design")
-    return float(node)
+    return float(value)
 
 
 def request_errors(request: RemediesRequest) -> list[InitErrorDetails]:
@@ -374,6 +383,12 @@ def request_errors(request: RemediesRequest) -> list[InitErrorDetails]:
         if problem is not None:
             add(("levers", i, problem[0]), problem[1], getattr(given, problem[0]))
     return errors
+
+
+def contact_ratio(design: Design) -> float | None:
+    """The transverse contact ratio of a design with gear geometry (None without)."""
+    derived = convert_design(design).derived.get("contact_ratio")
+    return None if derived is None else float(derived.value)
 
 
 def _lever_problem(design: Design, given: LeverRange) -> tuple[str, str] | None:
@@ -467,10 +482,11 @@ def _narrow(rtol: float, lever: Lever) -> Callable[[float, float], bool]:
 def _words(path: str) -> str:
     """A lever's name in words: "damping ratio", "transmission error (harmonic 2)"."""
     names = {"damping_ratio": "damping ratio", "damping": "damping",
-             "half_backlash": "half backlash"}  # fmt: skip
+             "half_backlash": "half backlash", "profile_shift": "profile shift"}  # fmt: skip
     parts = path.split(".")
     if parts[-1] in names:
-        return names[parts[-1]]
+        gear = f"{parts[0]}'s " if parts[0] in ("driver", "driven") else ""
+        return gear + names[parts[-1]]
     kind = {"transmission_error": "transmission error", "stiffness_harmonics":
             "stiffness variation", "torque_fluctuation": "torque fluctuation"}  # fmt: skip
     for part in parts:
@@ -483,7 +499,7 @@ def _words(path: str) -> str:
 def _change(lever: Lever, to: float) -> str:
     """ "raise the damping ratio from 0.05 to 0.071" """
     verb = "raise" if lever.end > lever.start else "lower"
-    unit = "" if lever.unit == "1" else f" {lever.unit}"
+    unit = lever.suffix
     return (f"{verb} the {_words(lever.path)} from {lever.shown(lever.start):.4g} to "
             f"{lever.shown(to):.4g}{unit}")  # fmt: skip
 
@@ -515,7 +531,7 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
         possible, _ = melnikov_failures(request.design, points, {lever.path: value})
         return possible == 0, possible
 
-    searched = [f"{lever.shown(v):g} {lever.unit}" for v in (lever.start, lever.end)]
+    searched = [f"{lever.shown(v):g}{lever.suffix}" for v in (lever.start, lever.end)]
     remedies: list[Remedy] = []
     unreachable: list[Unreachable] = []
     for bound, test, samples, rtol, steps in (
@@ -541,6 +557,7 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
             unit=lever.unit, bound=bound, monotone=monotone,
             bracket=[lever.shown(fail), lever.shown(to)], samples=shown,
             not_applicable_points=blind, check=report,
+            contact_ratio=contact_ratio(design_with(request.design, {lever.path: to})),
             summary=_summary(bound, lever, to, monotone, report, blind),
         ))  # fmt: skip
     return remedies, unreachable
@@ -563,10 +580,10 @@ def _why(bound: str, lever: Lever, samples: list[Sample], far: EnvelopeReport | 
     values = ", ".join(f"{s.value:g}" for s in samples)
     if bound == "melnikov":
         return (f"the Melnikov criterion allows chaos somewhere in the envelope at every sampled "
-                f"{_words(lever.path)} ({values} {lever.unit})")  # fmt: skip
+                f"{_words(lever.path)} ({values}{lever.suffix})")  # fmt: skip
     assert far is not None
-    return (f"no sampled {_words(lever.path)} ({values} {lever.unit}) clears the envelope; at "
-            f"{lever.shown(lever.end):g} {lever.unit} {far.failing_points} of {far.points} points "
+    return (f"no sampled {_words(lever.path)} ({values}{lever.suffix}) clears the envelope; at "
+            f"{lever.shown(lever.end):g}{lever.suffix} {far.failing_points} of {far.points} points "
             "still fail")  # fmt: skip
 
 
@@ -640,8 +657,12 @@ def assemble(request: RemediesRequest, chunks: list[str]) -> RemediesResult:
         words = "the design passes its envelope as it is"
     else:
         words = answer(remedies, unreachable, combo)
-        possible, blind = melnikov_failures(request.design, envelope_points(request), {})
-        if possible == 0:
+        points = envelope_points(request)
+        possible, blind = melnikov_failures(request.design, points, {})
+        if blind == len(points):
+            words += ("; the Melnikov criterion does not apply at any envelope point (the load "
+                      "is above its critical torque throughout), so it sets no bound")  # fmt: skip
+        elif possible == 0:
             na = f" (it does not apply at {blind} of them)" if blind else ""
             words += (f"; the Melnikov criterion rules out homoclinic chaos at every envelope "
                       f"point already{na}, so it sets no bound")  # fmt: skip
