@@ -695,11 +695,10 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
         if num is not None:
             text += f" to {num.to:.4g}{unit} (numerically"
             text += ")" if num.monotone else ", not unique: the response is not monotone)"
-            if mel is not None:
-                text += f" or {mel.to:.4g}{unit} (Melnikov guarantee)"
-        elif mel is not None:
-            text += f" to {mel.to:.4g}{unit} (Melnikov guarantee only: the envelope check "\
-                "still fails there)"  # fmt: skip
+        if mel is not None:
+            outcome = "passes" if mel.check.passed else "still fails"
+            text += (f"{' or' if num else ' to'} {mel.to:.4g}{unit} (Melnikov guarantee against "
+                     f"homoclinic chaos; the envelope check {outcome} there)")  # fmt: skip
         parts.append(text)
     words = "; or ".join(parts) if parts else "no single lever clears the envelope"
     for u in unreachable:
