@@ -36,6 +36,8 @@ if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDE
         simulate_batch,
         warm_up,
     )
+    from gearengine.runup import RunupRequest, RunupResult
+    from gearengine.runup import run_local as run_runup
     from gearengine.sweeps import SweepRequest, SweepResult
     from gearengine.sweeps import run_local as run_sweep
 
@@ -48,6 +50,8 @@ __all__ = [
     "MelnikovResult",
     "RemediesRequest",
     "RemediesResult",
+    "RunupRequest",
+    "RunupResult",
     "SimulationSettings",
     "SweepRequest",
     "SweepResult",
@@ -57,6 +61,7 @@ __all__ = [
     "melnikov",
     "poincare",
     "remedies",
+    "run_runup",
     "run_sweep",
     "simulate",
     "simulate_batch",
@@ -73,6 +78,8 @@ _HOMES: dict[str, tuple[str, str]] = {
     "MelnikovResult": ("gearengine.homoclinic", "MelnikovResult"),
     "RemediesRequest": ("gearengine.ensembles.remedies", "RemediesRequest"),
     "RemediesResult": ("gearengine.ensembles.remedies", "RemediesResult"),
+    "RunupRequest": ("gearengine.runup", "RunupRequest"),
+    "RunupResult": ("gearengine.runup", "RunupResult"),
     "SimulationSettings": ("gearengine.numerics", "SimulationSettings"),
     "SweepRequest": ("gearengine.sweeps", "SweepRequest"),
     "SweepResult": ("gearengine.sweeps", "SweepResult"),
@@ -82,6 +89,7 @@ _HOMES: dict[str, tuple[str, str]] = {
     "melnikov": ("gearengine.homoclinic", "melnikov"),
     "poincare": ("gearengine.numerics", "poincare"),
     "remedies": ("gearengine.ensembles.remedies", "remedies"),
+    "run_runup": ("gearengine.runup", "run_local"),
     "run_sweep": ("gearengine.sweeps", "run_local"),
     "simulate": ("gearengine.numerics", "simulate"),
     "simulate_batch": ("gearengine.numerics", "simulate_batch"),
@@ -106,6 +114,7 @@ _SUBMODULES = frozenset(
         "model",
         "numerics",
         "plots",
+        "runup",
         "sweeps",
     }
 )

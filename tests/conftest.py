@@ -15,6 +15,7 @@ from pathlib import Path
 import httpx
 import psutil
 import pytest
+from fastapi import FastAPI
 from fastapi.testclient import TestClient
 
 from service.core.config import Settings
@@ -31,7 +32,17 @@ PAPER_PARAMS = {
 
 @pytest.fixture
 def client(tmp_path: Path) -> Iterator[TestClient]:
-    with TestClient(create_app(Settings(data_dir=tmp_path, workers=0))) as c:
+    with started(create_app(Settings(data_dir=tmp_path, workers=0))) as c:
+        yield c
+
+
+@contextlib.contextmanager
+def started(app: FastAPI) -> Iterator[TestClient]:
+    """A client of ``app`` once its kernels are warm and its dispatcher runs (the service warms
+    up in the background after its ready line, ``service.warmup``): what a test then measures
+    or waits for is the request's own work."""
+    with TestClient(app) as c:
+        app.state.warm_up.done.wait()
         yield c
 
 

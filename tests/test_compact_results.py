@@ -20,7 +20,7 @@ from gearengine.sweeps import compute_chunk_json, csv_rows, run_local, validated
 from service.core.config import Settings
 from service.jobs.store import DB_FILE, pack, unpack
 from service.main import create_app
-from tests.conftest import PAPER_PARAMS
+from tests.conftest import PAPER_PARAMS, started
 
 SHORT = {"transient_periods": 50, "record_periods": 50, "steps_per_period": 64}
 
@@ -64,7 +64,7 @@ def test_pack_round_trip_and_old_text_rows() -> None:
 def working(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[TestClient, Path]]:
     data = tmp_path_factory.mktemp("jobs")
     settings = Settings(data_dir=data, workers=1, sweep_chunk_points=4)
-    with TestClient(create_app(settings)) as c:
+    with started(create_app(settings)) as c:
         yield c, data
 
 

@@ -17,7 +17,6 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
-from fastapi.testclient import TestClient
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, root
 
@@ -35,7 +34,7 @@ from gearengine.sweeps import run_local, validated
 from service.core.config import Settings
 from service.main import create_app
 from tests._gear_cases import paper
-from tests.conftest import PAPER_PARAMS
+from tests.conftest import PAPER_PARAMS, started
 
 MU, FM, WE, A, C = 0.07, 0.01, 0.5, 0.1667, 0.1667
 CUBIC, PIECEWISE = 0, 1  # kernel codes of model.backlash.LAWS
@@ -415,7 +414,7 @@ def test_continuation_sweep_locates_the_cascade() -> None:
 def working(tmp_path_factory: pytest.TempPathFactory):
     """An app with an embedded dispatcher and one worker process (as test_sweeps_api)."""
     settings = Settings(data_dir=tmp_path_factory.mktemp("jobs"), workers=1)
-    with TestClient(create_app(settings)) as c:
+    with started(create_app(settings)) as c:
         yield c
 
 

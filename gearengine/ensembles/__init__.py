@@ -1,7 +1,9 @@
-"""Ensembles: questions whose answer is many runs of one design (coexisting attractors,
-manufacturing tolerances, remedies), each built from envelope checks or lanes of the lock-step
-kernels and returned with the runs that decide it. ``remedies`` searches the design levers
-(damping, transmission error, backlash, stiffness variation, torque ripple) for the smallest
-change that makes an operating envelope pass, with a Melnikov guarantee and a verified
-numerical bound per lever.
+"""Ensembles: one question answered by many runs of the engine (point x start x sample), each a
+lane of ``numerics.batch.run_lanes``. ``tolerances`` draws the gears that will actually be built
+(quasi-Monte Carlo samples of a design's tolerances) and turns their verdicts into probabilities
+with intervals; ``sensitivity`` says which tolerance matters (Sobol indices, SALib);
+``robustness`` makes the two a durable job kind of ``gearengine.jobs``. ``remedies`` searches
+the design levers (damping, transmission error, backlash, stiffness variation, torque ripple)
+for the smallest change that makes a failing operating envelope pass, with a Melnikov bound and
+a numerical bound verified by an envelope run per lever (its chunks are envelope checks).
 """

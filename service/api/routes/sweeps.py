@@ -23,6 +23,7 @@ from gearengine.sweeps import (
     chunk_points,
     csv_rows,
     result_json,
+    text_blocks,
 )
 from gearengine.sweeps.results import SpeedWindows
 from gearengine.sweeps.windows import SPEED, speed_windows
@@ -122,9 +123,10 @@ def get_result(
     sweep = SweepRequest.model_validate_json(jobs.store.request_json(job_id))
     axes = sweep.axes
     if format == "csv":
+        designed = sweep.design is not None
         name = f"sweep-{job_id}{'-partial' if missing else ''}.csv"
         return StreamingResponse(
-            csv_rows(axes, _stored_points(jobs, job_id), sweep.outputs, sweep.design is not None),
+            text_blocks(csv_rows(axes, _stored_points(jobs, job_id), sweep.outputs, designed)),
             media_type=CSV,
             headers={"Content-Disposition": f'attachment; filename="{name}"', **headers},
         )
