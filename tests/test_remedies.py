@@ -27,8 +27,11 @@ from gearengine.ensembles.remedies import (
     _narrow,
     _search,
     envelope_points,
+    iso1328_class,
     remedies,
 )
+from gearengine.model.design import Design
+from gearengine.model.standards import iso1328
 from gearengine.sweeps.axes import in_display_unit
 from tests.conftest import ROOT, Server
 
@@ -241,3 +244,27 @@ def test_bad_requests_get_422_naming_the_field(server: Server, change: dict, pat
     r = httpx.post(f"{server.url}/v1/remedies", json={**small_body(), **change}, timeout=30)
     assert r.status_code == 422 and r.headers["content-type"] == "application/problem+json"
     assert path in [e["path"] for e in r.json()["errors"]], r.json()
+
+
+def test_iso1328_class_that_delivers_a_transmission_error() -> None:
+    """The coarsest class whose profile tolerances bound the mesh harmonic at or below the
+    amplitude: bound(A) <= e < bound(A + 1), from ISO 1328-1:2013 Eq. (7)-(9)."""
+    design = Design.model_validate(json.loads((ROOT / "examples" / "design-geometry.json")
+                                              .read_text())["design"])  # fmt: skip
+    gears = (design.driver, design.driven)
+
+    def bound(grade: int) -> float:
+        return iso1328.mesh_error_bound(*(
+            iso1328.tolerances(grade, g.teeth, g.module * 1e3, g.face_width * 1e3).F_alpha
+            for g in gears
+        )) * 1e-6  # fmt: skip
+
+    for grade in range(1, 11):
+        between = 0.5 * (bound(grade) + bound(grade + 1))
+        assert iso1328_class(design, between) == grade
+        assert iso1328_class(design, bound(grade)) == grade
+    assert iso1328_class(design, 0.5 * bound(1)) is None
+    assert (
+        iso1328_class(Design.model_validate(json.loads(EXAMPLE.read_text())["design"]), 1e-5)
+        is None
+    )

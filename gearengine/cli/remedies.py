@@ -50,7 +50,8 @@ def print_result(result: RemediesResult) -> None:
     """The answer in words, then one line per remedy and per unreachable lever."""
     print(result.answer[0].upper() + result.answer[1:] + ".")
     for r in result.remedies:
-        print(f"  {r.bound:9s} {r.lever}: {r.from_:g} -> {r.to:.4g} {r.unit} "
+        unit = "" if r.unit == "1" else f" {r.unit}"
+        print(f"  {r.bound:9s} {r.lever}: {r.from_:g} -> {r.to:.4g}{unit} "
               f"({'monotone' if r.monotone else 'NOT monotone: not unique'}; check "
               f"{'PASS' if r.check.passed else 'FAIL'})")  # fmt: skip
     for u in result.unreachable:

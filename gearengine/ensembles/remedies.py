@@ -47,9 +47,10 @@ from pydantic_core import InitErrorDetails, PydanticCustomError
 from gearengine import jobs
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.jsonio import message
-from gearengine.model.design import EXAMPLE_DESIGN, Design
+from gearengine.model.design import ACCURACY_FIELD, EXAMPLE_DESIGN, Design
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
+from gearengine.model.standards import iso1328
 from gearengine.numerics.batch import threads_may_share_kernels
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.sweeps.axes import (
@@ -234,6 +235,11 @@ class Remedy(BaseModel):
         None, description="With gear geometry: the transverse contact ratio at ``to`` (a "
         "profile-shift lever moves it, and with it the stiffness variation)."
     )  # fmt: skip
+    iso1328_class: list[int | None] | None = Field(
+        None, description="A transmission-error lever of a design with gear geometry: [class at "
+        "from, class at to], the coarsest ISO 1328-1:2013 flank tolerance class whose profile "
+        "tolerances bound the mesh harmonic below the amplitude (null: none of 1-11 does)."
+    )  # fmt: skip
     summary: str
     check: EnvelopeReport = Field(description="The envelope report of a run at ``to``.")
 
@@ -389,6 +395,32 @@ def contact_ratio(design: Design) -> float | None:
     """The transverse contact ratio of a design with gear geometry (None without)."""
     derived = convert_design(design).derived.get("contact_ratio")
     return None if derived is None else float(derived.value)
+
+
+def iso1328_class(design: Design, amplitude: float) -> int | None:
+    """The coarsest ISO 1328-1:2013 flank tolerance class (1-11) whose total profile tolerances
+    of both gears bound the mesh-frequency transmission-error harmonic at or below ``amplitude``
+    [m] (``iso1328.mesh_error_bound``); None when no class does or the standard does not apply
+    (no geometry, or outside its range)."""
+    gears = (design.driver, design.driven)
+    if any(g.module is None or g.face_width is None for g in gears):
+        return None
+    for grade in range(11, 0, -1):
+        try:
+            profile = [iso1328.tolerances(grade, g.teeth, g.module * 1e3, g.face_width * 1e3)
+                       .F_alpha for g in gears]  # type: ignore[operator]  # fmt: skip
+        except ValueError:
+            return None
+        if iso1328.mesh_error_bound(*profile) * 1e-6 <= amplitude:
+            return grade
+    return None
+
+
+def accuracy_classes(design: Design, lever: Lever, to: float) -> list[int | None] | None:
+    """[class at from, class at to] of the transmission-error lever an accuracy class sets."""
+    if lever.path != ACCURACY_FIELD or iso1328_class(design, float("inf")) is None:
+        return None
+    return [iso1328_class(design, lever.start), iso1328_class(design, to)]
 
 
 def _lever_problem(design: Design, given: LeverRange) -> tuple[str, str] | None:
@@ -558,6 +590,7 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
             bracket=[lever.shown(fail), lever.shown(to)], samples=shown,
             not_applicable_points=blind, check=report,
             contact_ratio=contact_ratio(design_with(request.design, {lever.path: to})),
+            iso1328_class=accuracy_classes(request.design, lever, to),
             summary=_summary(bound, lever, to, monotone, report, blind),
         ))  # fmt: skip
     return remedies, unreachable
@@ -695,6 +728,9 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
         if num is not None:
             text += f" to {num.to:.4g}{unit} (numerically"
             text += ")" if num.monotone else ", not unique: the response is not monotone)"
+            if num.iso1328_class is not None:
+                grades = [str(c) if c else "finer than 1" for c in num.iso1328_class]
+                text += f" (ISO 1328 class {grades[0]} -> {grades[1]})"
         if mel is not None:
             outcome = "passes" if mel.check.passed else "still fails"
             text += (f"{' or' if num else ' to'} {mel.to:.4g}{unit} (Melnikov guarantee against "
