@@ -727,10 +727,10 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
         text = f"{verb} the {words} from {first.from_:.4g}"
         if num is not None:
             text += f" to {num.to:.4g}{unit} (numerically"
-            text += ")" if num.monotone else ", not unique: the response is not monotone)"
             if num.iso1328_class is not None:
                 grades = [str(c) if c else "finer than 1" for c in num.iso1328_class]
-                text += f" (ISO 1328 class {grades[0]} -> {grades[1]})"
+                text += f"; ISO 1328 class {grades[0]} -> {grades[1]}"
+            text += ")" if num.monotone else "; not unique: the response is not monotone)"
         if mel is not None:
             outcome = "passes" if mel.check.passed else "still fails"
             text += (f"{' or' if num else ' to'} {mel.to:.4g}{unit} (Melnikov guarantee against "
