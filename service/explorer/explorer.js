@@ -364,8 +364,17 @@ async function analyse() {
     $("analyse-status").textContent = "Done.";
     $("verdict").scrollIntoView({ block: "start" });
     loadFigure($("analysis-figure"), "/v1/analyses/plot", body);
-    thresholdSubject = subject;
-    loadThresholds();
+    thresholdSubject = result.melnikov.applicable ? subject : null;
+    if (thresholdSubject) {
+      loadThresholds();
+    } else {  // above the critical torque: no saddle, so no threshold curves to draw
+      const img = $("threshold-figure");
+      img.removeAttribute("src");
+      img.dataset.state = "failed";
+      const t = result.engineering && result.engineering.critical_torque_nm;
+      $("threshold-note").textContent = "(the Melnikov criterion does not apply at this load"
+        + (t ? ` — above the critical torque ${fmt(t, 3)} N·m` : "") + ": no threshold curves)";
+    }
   } catch (err) {
     showProblem(form, { detail: "the server did not answer: " + err.message });
     $("analyse-status").textContent = "";
