@@ -21,9 +21,10 @@ from gearengine.homoclinic.boundary import chaos_intervals_from, flips, strength
 from gearengine.homoclinic.grid import strength_grid
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
+from gearengine.model.units import display_unit
 from gearengine.plots.envelope import axis_label, envelope_map
 from gearengine.plots.style import LLE_LABEL, SYMBOLS, ImageFormat, figure_bytes
-from gearengine.sweeps.axes import display_unit, is_dimensionless, is_integer_field
+from gearengine.sweeps.axes import is_dimensionless, is_integer_field
 from gearengine.sweeps.export import agreement_table
 from gearengine.sweeps.request import SweepRequest
 from gearengine.sweeps.results import SweepBifurcation, SweepPoint
