@@ -6,9 +6,9 @@ num x num map of examples/chaos-map.json at 10 + 10 periods x 16 RK4 steps, once
 ``"outputs": ["classification", "period"]`` (the big-map benchmark's columns) and once with
 every output (64 Poincare numbers a row); each result is then streamed as CSV and as JSON
 (``GET /v1/sweeps/{id}/result``, httpx, written to a file), MB/s = bytes / seconds from request
-to last byte. The CLI row writes the CSV of the full result in process as ``gearengine sweep``
-does (``"".join(to_csv(result))``). Target (issue 20): >= 10 MB/s. Prints the load average;
-writes its section of benchmarks/README.md.
+to last byte, best of 2. The CLI row writes the CSV of the full result in process as
+``gearengine sweep`` does (``"".join(to_csv(result))``). Target (issue 20): >= 10 MB/s.
+Prints the load average; writes its section of benchmarks/README.md.
 """
 
 from __future__ import annotations
@@ -80,7 +80,8 @@ def main() -> None:
                                    ("every output", None)):  # fmt: skip
                 job = submit_and_wait(c, map_doc(num, outputs))
                 for fmt in ("csv", "json"):
-                    n, s = stream(c, job, fmt, tmp / f"result.{fmt}")
+                    n, s = min((stream(c, job, fmt, tmp / f"result.{fmt}") for _ in range(2)),
+                               key=lambda r: r[1])  # fmt: skip
                     rows.append((f"service {fmt.upper()}, {label}", n, s))
         result = SweepResult.model_validate_json((tmp / "result.json").read_text())
         t = time.perf_counter()
