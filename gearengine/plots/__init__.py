@@ -17,15 +17,24 @@ from gearengine.lazyload import lazy_names
 
 if TYPE_CHECKING:
     from gearengine.plots.analysis import analysis_figure, threshold_figure
+    from gearengine.plots.runup import runup_figure
     from gearengine.plots.style import MEDIA_TYPES, ImageFormat
     from gearengine.plots.sweep import sweep_figure
 
-__all__ = ["MEDIA_TYPES", "ImageFormat", "analysis_figure", "sweep_figure", "threshold_figure"]
+__all__ = [
+    "MEDIA_TYPES",
+    "ImageFormat",
+    "analysis_figure",
+    "runup_figure",
+    "sweep_figure",
+    "threshold_figure",
+]
 
 _HOMES = {
     "MEDIA_TYPES": ("gearengine.plots.style", "MEDIA_TYPES"),
     "ImageFormat": ("gearengine.plots.style", "ImageFormat"),
     "analysis_figure": ("gearengine.plots.analysis", "analysis_figure"),
+    "runup_figure": ("gearengine.plots.runup", "runup_figure"),
     "sweep_figure": ("gearengine.plots.sweep", "sweep_figure"),
     "threshold_figure": ("gearengine.plots.analysis", "threshold_figure"),
 }

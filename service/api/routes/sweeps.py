@@ -20,8 +20,8 @@ from gearengine.sweeps import (
     SweepResult,
     checked,
     chunk_bifurcations,
-    chunk_points,
     csv_rows,
+    points_of_chunk,
     result_json,
     text_blocks,
 )
@@ -69,12 +69,12 @@ def _stored_points(jobs: SweepJobs, job_id: str) -> Iterator[dict[str, object]]:
     model is built: ``csv_rows`` reads the fields by name), one chunk in memory at a time: the
     CSV of a million-point map streams at the speed of its writer."""
     for array in jobs.store.chunk_results(job_id):
-        yield from chunk_points(array)
+        yield from points_of_chunk(array)
 
 
 def _points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
     for array in jobs.store.chunk_results(job_id):
-        for item in chunk_points(array):
+        for item in points_of_chunk(array):
             yield SweepPoint.model_validate(item)
 
 
