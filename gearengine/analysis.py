@@ -4,7 +4,8 @@ The Melnikov criterion is first order in the perturbation and only *necessary* f
 (a transverse homoclinic tangle may give transient chaos and a periodic attractor). The two
 verdicts are consistent unless the numerics find chaos where Melnikov rules it out.
 
-This module joins the melnikov and numerics rooms; it imports nothing else of the engine.
+This module joins the homoclinic (Melnikov) and numerics rooms on a request of the model room,
+and adds the engineering block (``engineering``: answers in gear units) for a design.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from gearengine.engineering import IMPACT_WORDS, Engineering, engineering
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
 from gearengine.homoclinic.verdict import melnikov
 from gearengine.model.design import EXAMPLE_DESIGN, Design
+from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
@@ -200,7 +202,7 @@ def convert(request: DesignRequest) -> DesignReport:
     """The conversion of a design with its engineering block (Melnikov windows, thresholds)."""
     conv = request.conversion
     if conv is None:
-        raise ValueError("design: give a design (physical units) to convert")
+        raise InputError("design", "give a design (physical units) to convert")
     mel = melnikov(conv.params)
     return DesignReport(
         conversion=conv, engineering=engineering(conv, request.speed_rpm_range(), mel)

@@ -8,7 +8,6 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -31,6 +30,7 @@ from gearengine.runup.profile import ramp_forcing
 from gearengine.runup.reading import jumps
 from gearengine.runup.request import RunupRequest, validated
 from gearengine.sweeps.gate import Rules
+from tests._polling import poll
 from tests.conftest import ROOT, Server
 
 CI_DESIGN = json.loads((ROOT / "examples" / "ci" / "design.json").read_text())["design"]
@@ -238,10 +238,7 @@ def test_the_service_job_is_the_cli_document(tmp_path: Path) -> None:
             posted = http.post("/v1/runups", json=body)
             assert posted.status_code == 202
             location = posted.headers["location"]
-            deadline = time.monotonic() + 300
-            while http.get(location).json()["status"] in ("queued", "running"):
-                assert time.monotonic() < deadline
-                time.sleep(0.5)
+            poll(lambda: http.get(location).json(), timeout=300, interval=0.5)
             result = http.get(f"{location}/result")
             assert result.status_code == 200
             assert result.content == out.read_bytes()

@@ -31,11 +31,13 @@ from gearengine.cli.documents import (
 from gearengine.cli.sweep import progress
 from gearengine.jsonio import dumps
 from gearengine.numerics.settings import SimulationSettings
-from gearengine.sweeps.compute import run_local
 from gearengine.sweeps.gate import (
     EnvelopeReport,
     Rules,
+    check_envelope,
+    envelope_axis,
     envelope_report,
+    envelope_sweep,
     junit_xml,
     level_text,
     window_text,
@@ -43,19 +45,15 @@ from gearengine.sweeps.gate import (
 from gearengine.sweeps.request import SweepRequest, validated
 from gearengine.sweeps.results import SpeedWindows, SweepResult
 
-ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
-"""Light integration settings of an envelope check; a design file's ``settings`` are merged
-over them (adding ``random_initial_states`` keeps the 60 + 60 periods)."""
 POLL_SECONDS = 1.0
 
 
 def axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
-    """A sweep axis from "A:B" (bare numbers in ``unit``) or "52rad/s:628rad/s"."""
-    ends = text.split(":")
-    if len(ends) != 2 or not all(e.strip() for e in ends):
-        raise InvalidInputError([f"--{name}: give a range as LOW:HIGH, e.g. --{name} 500:6000"])
-    lo, hi = (e.strip() if any(c.isalpha() for c in e) else f"{e.strip()} {unit}" for e in ends)
-    return {"parameter": name, "start": lo, "stop": hi, "num": num}
+    """``sweeps.gate.envelope_axis``, its error naming the option."""
+    try:
+        return envelope_axis(name, text, unit, num)
+    except ValueError as exc:
+        raise InvalidInputError([f"--{name}: {exc}"]) from None
 
 
 def envelope_request(args: argparse.Namespace) -> SweepRequest:
@@ -74,8 +72,7 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
     settings = doc.get("settings", {})
     if not isinstance(settings, dict):
         raise InvalidInputError([f"{args.file}: settings must be an object"])
-    sweep = {"design": design, "settings": {**ENVELOPE_SETTINGS, **settings}, "axes": axes,
-             "label": f"envelope check of {Path(args.file).name}"}  # fmt: skip
+    sweep = envelope_sweep(design, settings, axes, f"envelope check of {Path(args.file).name}")
     return validated_input(validated, sweep, args.file)
 
 
@@ -207,11 +204,9 @@ def cmd_envelope(args: argparse.Namespace) -> int:
     tick = progress(time.monotonic(), "envelope")
     if args.server:
         key = os.environ.get("GEARCHAOS_API_KEY")
-        result = run_on_server(args.server, request, key, tick)
+        report = envelope_report(run_on_server(args.server, request, key, tick), rules)
     else:
-        chunk = max(1, request.n_points() // (4 * (os.cpu_count() or 1)))
-        result = run_local(request, tick, chunk_points=chunk, workers=os.cpu_count() or 1)
-    report = envelope_report(result, rules)
+        report = check_envelope(request, rules, tick, workers=os.cpu_count() or 1)
     if getattr(args, "runup", None) is not None:  # run-ups through the range (runup.gate)
         from gearengine.runup.gate import gate_envelope
 

@@ -29,7 +29,7 @@ from gearengine.ensembles.robustness import (
     checked,
     run_local,
 )
-from gearengine.sweeps.axes import display_unit
+from gearengine.model.units import display_unit
 
 GATED = ("chaotic", "quasi_periodic", "diverged", "impacts", "back_flank",
          "dynamic_factor_above_limit", "melnikov_chaos_possible")  # fmt: skip

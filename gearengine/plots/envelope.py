@@ -13,7 +13,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from gearengine.sweeps.axes import display_unit, is_dimensionless
+from gearengine.model.units import display_unit, field_label
+from gearengine.sweeps.axes import is_dimensionless
 from gearengine.sweeps.request import SweepRequest
 from gearengine.sweeps.results import SweepPoint
 
@@ -28,8 +29,6 @@ CLASSES: list[tuple[str, str]] = [
 ]
 """Response classes of the map, in legend order, with their colours."""
 
-AXIS_NAMES = {"speed": "driver speed", "torque": "mean driver torque"}
-
 
 def response_class(p: SweepPoint) -> int:
     """Index in ``CLASSES`` of a point's response."""
@@ -39,11 +38,9 @@ def response_class(p: SweepPoint) -> int:
 
 
 def axis_label(name: str) -> str:
-    """ "driver speed [rpm]", "mesh.half_backlash [um]", or the alias for a dimensionless axis."""
-    if is_dimensionless(name):
-        return f"{name} (dimensionless)"
-    unit, _ = display_unit(name)
-    return f"{AXIS_NAMES.get(name, name)} [{unit.replace('um', 'µm').replace('*', '·')}]"
+    """ "driver speed [rpm]", "half backlash [µm]" (``model.units.field_label``), or the alias
+    for a dimensionless axis."""
+    return f"{name} (dimensionless)" if is_dimensionless(name) else field_label(name)
 
 
 def _grid(request: SweepRequest) -> tuple[np.ndarray, np.ndarray]:

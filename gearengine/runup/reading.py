@@ -26,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from gearengine.engineering import speed_windows
-from gearengine.model.units import RPM
+from gearengine.model.units import RPM, shown
 from gearengine.numerics.classify import LLE_FLOOR
 from gearengine.runup.profile import Branch, RunupPlan
 from gearengine.runup.request import RunupRequest, n_bins
@@ -40,7 +40,6 @@ from gearengine.runup.results import (
     RunupMethod,
     RunupResult,
 )
-from gearengine.sweeps.axes import shown
 from gearengine.sweeps.results import SweepPoint, SweepResult
 
 JUMP_RATIO = 1.25

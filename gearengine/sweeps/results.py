@@ -20,10 +20,6 @@ class PhysicalValue(BaseModel):
     unit: str
 
 
-RESPONSE_UNITS = {"dte": "um", "dynamic_factor": "1"}
-"""The response entries of a design point's ``physical`` (beside its axes) and their units."""
-
-
 class SweepPoint(BaseModel):
     """Numerical and Melnikov verdicts of one point of the sweep."""
 

@@ -10,15 +10,16 @@ from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.jsonio import dumps
 from gearengine.numerics import work
 from gearengine.plots import MEDIA_TYPES, analysis_figure
-from service.api.deps import cached_compute, require_key
+from service.api.deps import AppLimits, AppMetrics, cached_compute, require_key
 from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
+from service.metrics import Metrics
 
 router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 
 
-def _analysis(request: Request, body: AnalysisRequest) -> AnalysisResult:
+def _analysis(metrics: Metrics, body: AnalysisRequest) -> AnalysisResult:
     result = analyze(body)
-    request.app.state.metrics.analyses.labels(result.numerics.classification).inc()
+    metrics.analyses.labels(result.numerics.classification).inc()
     return result
 
 
@@ -28,17 +29,19 @@ def _analysis(request: Request, body: AnalysisRequest) -> AnalysisResult:
     responses=CACHED,
     summary="Melnikov and numerical verdicts of one design",
 )
-async def post_analysis(body: AnalysisRequest, request: Request) -> Response:
+async def post_analysis(
+    body: AnalysisRequest, request: Request, limits: AppLimits, metrics: AppMetrics
+) -> Response:
     """Integrates Eq. (9) with RK4 and its tangent equation: period from Poincaré sections,
     largest Lyapunov exponent (Benettin), classification, gear diagnostics, and whether the
     result agrees with the Melnikov verdict. Work above the synchronous budget is refused with
     422; submit it to `/v1/sweeps`."""
-    request.app.state.limits.check_budget(work(body.params, body.settings))
+    limits.check_budget(work(body.params, body.settings))
     return await cached_compute(
         request,
         "analyses",
         body.model_dump_json(),
-        lambda: (dumps(_analysis(request, body)).encode(), JSON),
+        lambda: (dumps(_analysis(metrics, body)).encode(), JSON),
     )
 
 
@@ -51,15 +54,17 @@ async def post_analysis(body: AnalysisRequest, request: Request) -> Response:
 async def post_analysis_plot(
     body: AnalysisRequest,
     request: Request,
+    limits: AppLimits,
+    metrics: AppMetrics,
     format: Literal["png", "svg"] | None = FormatQuery,
 ) -> Response:
     """The paper's Figs. 7-11 for any design: (a) time history, (b) phase plane with the
     Poincaré points, (c) Poincaré section, (d) amplitude spectrum."""
     fmt = image_format(request, format)
-    request.app.state.limits.check_budget(work(body.params, body.settings))
+    limits.check_budget(work(body.params, body.settings))
     return await cached_compute(
         request,
         f"analyses/plot.{fmt}",
         body.model_dump_json(),
-        lambda: (analysis_figure(_analysis(request, body), fmt), MEDIA_TYPES[fmt]),
+        lambda: (analysis_figure(_analysis(metrics, body), fmt), MEDIA_TYPES[fmt]),
     )

@@ -20,8 +20,8 @@ from gearengine.sweeps import (
     SweepResult,
     checked,
     chunk_bifurcations,
-    chunk_points,
     csv_rows,
+    points_of_chunk,
     result_json,
     text_blocks,
 )
@@ -70,13 +70,13 @@ def _stored_points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
     time: the CSV of a million-point map streams at the speed of its writer, not of
     validation."""
     for array in jobs.store.chunk_results(job_id):
-        for item in chunk_points(array):
+        for item in points_of_chunk(array):
             yield SweepPoint.model_construct(**item)
 
 
 def _points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
     for array in jobs.store.chunk_results(job_id):
-        for item in chunk_points(array):
+        for item in points_of_chunk(array):
             yield SweepPoint.model_validate(item)
 
 
