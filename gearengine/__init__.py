@@ -8,7 +8,7 @@ The public facade, short verbs on a design (as ChaosTools.jl):
     True
 
 Rooms (subpackages) follow the data flow: ``model`` -> ``homoclinic`` (the Melnikov analysis
-of the homoclinic orbits) -> ``numerics`` ->
+of the homoclinic orbits) -> ``numerics`` -> ``ensembles`` (many starts of one design) ->
 ``analysis`` -> ``sweeps`` -> ``plots`` -> ``cli``; ``docs/architecture.md`` draws it. The
 engine imports no web code.
 """
@@ -21,6 +21,7 @@ from gearengine.lazyload import lazy_names
 
 if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDEs
     from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
+    from gearengine.ensembles.attractors import of_design as attractors
     from gearengine.homoclinic import MelnikovResult, chaos_possible, melnikov, threshold_curve
     from gearengine.model.examples import PAPER_SECTION_41
     from gearengine.model.params import GearParams
@@ -45,6 +46,7 @@ __all__ = [
     "SweepRequest",
     "SweepResult",
     "analyze",
+    "attractors",
     "chaos_possible",
     "lyapunov",
     "melnikov",
@@ -66,6 +68,7 @@ _HOMES: dict[str, tuple[str, str]] = {
     "SweepRequest": ("gearengine.sweeps", "SweepRequest"),
     "SweepResult": ("gearengine.sweeps", "SweepResult"),
     "analyze": ("gearengine.analysis", "analyze"),
+    "attractors": ("gearengine.ensembles.attractors", "of_design"),
     "chaos_possible": ("gearengine.homoclinic", "chaos_possible"),
     "lyapunov": ("gearengine.numerics", "lyapunov"),
     "melnikov": ("gearengine.homoclinic", "melnikov"),
@@ -85,6 +88,7 @@ _SUBMODULES = frozenset(
         "analysis",
         "cli",
         "engineering",
+        "ensembles",
         "homoclinic",
         "jitcache",
         "jsonio",

@@ -192,6 +192,17 @@ def response(params: GearParams, num: NumericsResult, conv: DesignConversion) ->
     )
 
 
+def dte_and_factor(
+    x_peak_to_peak: float | None, force_max: float | None, params: GearParams, b_m: float
+) -> tuple[float | None, float | None]:
+    """(DTE peak to peak [µm], dynamic factor) of a run from its dimensionless record: b times
+    max x - min x, and the largest mesh force over the static one (the scales b k_m cancel,
+    F / F_m = f_max / F~_m); None where the run has no record or the pair no static load."""
+    dte = None if x_peak_to_peak is None else x_peak_to_peak * b_m * 1e6
+    factor = None if force_max is None or params.mean_force <= 0 else force_max / params.mean_force
+    return dte, factor
+
+
 def _windows_text(windows: list[list[float]], rng: tuple[float, float]) -> str:
     if not windows:
         return f"allows no chaos at any speed from {rng[0]:,.0f} to {rng[1]:,.0f} rpm"

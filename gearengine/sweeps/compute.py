@@ -9,6 +9,7 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
+from gearengine.engineering import dte_and_factor
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
@@ -48,12 +49,8 @@ def _physical(
         if not is_dimensionless(name)
     }
     b = values.get("mesh.half_backlash", request.design.mesh.half_backlash)
-    response = {
-        "dte": None if bp.x_peak_to_peak is None else bp.x_peak_to_peak * b * 1e6,
-        "dynamic_factor": None  # F / F_m: the scales b k_m cancel
-        if bp.force_max is None or params.mean_force <= 0
-        else bp.force_max / params.mean_force,
-    }
+    dte, factor = dte_and_factor(bp.x_peak_to_peak, bp.force_max, params, b)
+    response = {"dte": dte, "dynamic_factor": factor}
     for key, unit in RESPONSE_UNITS.items():
         value = response[key]
         if value is not None:

@@ -25,7 +25,7 @@ from gearengine.model.design import Design
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import ParamsOrDesign
-from gearengine.numerics.settings import SimulationSettings
+from gearengine.numerics.settings import RequestSettings, SimulationSettings
 from gearengine.sweeps.axes import (
     axis_problem,
     changes_nothing,
@@ -117,7 +117,7 @@ class SweepRequest(ParamsOrDesign):
         }
     )
 
-    settings: SimulationSettings = Field(
+    settings: RequestSettings = Field(
         default_factory=SimulationSettings,
         description="Integration settings of every point (periods, steps, initial states).",
     )

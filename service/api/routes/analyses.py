@@ -16,6 +16,13 @@ from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, im
 router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 
 
+def check_analysis_budget(request: Request, body: AnalysisRequest) -> None:
+    """422 before any compute when the analysis (its starts and basin starts) is over the
+    synchronous budget; names settings.basins.starts when basins are asked for."""
+    field = "settings" if body.settings.basins is None else "settings.basins.starts"
+    request.app.state.limits.check_budget(work(body.params, body.settings), field=field)
+
+
 def _analysis(request: Request, body: AnalysisRequest) -> AnalysisResult:
     result = analyze(body)
     request.app.state.metrics.analyses.labels(result.numerics.classification).inc()
@@ -33,7 +40,7 @@ async def post_analysis(body: AnalysisRequest, request: Request) -> Response:
     largest Lyapunov exponent (Benettin), classification, gear diagnostics, and whether the
     result agrees with the Melnikov verdict. Work above the synchronous budget is refused with
     422; submit it to `/v1/sweeps`."""
-    request.app.state.limits.check_budget(work(body.params, body.settings))
+    check_analysis_budget(request, body)
     return await cached_compute(
         request,
         "analyses",
@@ -56,7 +63,7 @@ async def post_analysis_plot(
     """The paper's Figs. 7-11 for any design: (a) time history, (b) phase plane with the
     Poincaré points, (c) Poincaré section, (d) amplitude spectrum."""
     fmt = image_format(request, format)
-    request.app.state.limits.check_budget(work(body.params, body.settings))
+    check_analysis_budget(request, body)
     return await cached_compute(
         request,
         f"analyses/plot.{fmt}",
