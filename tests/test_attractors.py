@@ -201,3 +201,29 @@ def test_analysis_with_basins_over_http(client: TestClient) -> None:
         "basins"]["unsettled"] == 16  # fmt: skip
     for a in num["attractors"]:
         assert a["interval"][0] <= a["fraction"] <= a["interval"][1]
+
+
+SMALL = {
+    "params": {"damping": 0.07, "transmission_error": {"frequency": 0.5,
+               "harmonics": [{"amplitude": 0.25}]}},
+    "settings": {"transient_periods": 100, "record_periods": 100, "basins": {"starts": 16}},
+}  # fmt: skip
+
+
+def test_basin_picture_over_http_and_the_cli_say_the_same(
+    client: TestClient, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from gearengine.cli import main
+
+    r = client.post("/v1/analyses/basins/plot?format=png", json=SMALL)
+    assert r.status_code == 200 and r.headers["content-type"] == "image/png"
+    assert r.content[:8] == b"\x89PNG\r\n\x1a\n"
+    doc = tmp_path / "small.json"
+    doc.write_text(json.dumps(SMALL))
+    picture = tmp_path / "basins.png"
+    assert main(["basins", str(doc), "--json", "--plot", str(picture)]) == 0
+    assert capsys.readouterr().out.strip() == client.post("/v1/analyses", json=SMALL).text
+    assert picture.read_bytes() == r.content
+    assert main(["basins", str(doc), "--starts", "4"]) == 0
+    out = capsys.readouterr().out
+    assert "periodic" in out and "4 starts: 0 diverged" in out

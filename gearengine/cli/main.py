@@ -5,6 +5,7 @@
     gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov] [--max-lle V]
         [--min-stability-margin X]
     gearengine sweep FILE [--out DIR]
+    gearengine basins FILE [--starts N] [--json] [--plot FILE]
     gearengine convert FILE [--json]
 
 FILE holds ``{"params": {...}}`` or ``{"design": {...}}`` (physical units), and ``"settings"``
@@ -127,6 +128,15 @@ def build_parser() -> argparse.ArgumentParser:
         "1 - max |lambda| is below X (or unavailable)",
     )
     p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
+
+    p = sub.add_parser("basins", help="coexisting attractors of a design and their basins")
+    p.add_argument("file", help='JSON file holding {"params" or "design": {...}, "settings": '
+                   '{"basins": {...}}}, or -')  # fmt: skip
+    p.add_argument("--starts", type=int, default=None, metavar="N",
+                   help="number of starts (a square on a grid: 16, 64, 256)")  # fmt: skip
+    p.add_argument("--json", action="store_true", help="print the API's JSON response")
+    p.add_argument("--plot", metavar="FILE", help="write the basin picture (.png or .svg)")
+    p.set_defaults(func=lazy("gearengine.cli.basins", "cmd_basins"))
 
     p = sub.add_parser("sweep", help="run a sweep here, no server: JSON, CSV and PNG")
     p.add_argument("file", help="JSON file holding a sweep request (as POST /v1/sweeps), or -")

@@ -1,4 +1,5 @@
-"""POST /v1/analyses and /v1/analyses/plot: the numerical verdict next to the Melnikov verdict."""
+"""POST /v1/analyses, /v1/analyses/plot and /v1/analyses/basins/plot: the numerical verdict
+next to the Melnikov verdict, its figure, and the basin picture of its attractors."""
 
 from __future__ import annotations
 
@@ -9,7 +10,8 @@ from fastapi import APIRouter, Depends, Request, Response
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.jsonio import dumps
 from gearengine.numerics import work
-from gearengine.plots import MEDIA_TYPES, analysis_figure
+from gearengine.numerics.settings import BasinSettings
+from gearengine.plots import MEDIA_TYPES, analysis_figure, basins_figure
 from service.api.deps import cached_compute, require_key
 from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
 
@@ -69,4 +71,31 @@ async def post_analysis_plot(
         f"analyses/plot.{fmt}",
         body.model_dump_json(),
         lambda: (analysis_figure(_analysis(request, body), fmt), MEDIA_TYPES[fmt]),
+    )
+
+
+@router.post(
+    "/analyses/basins/plot",
+    response_class=Response,
+    responses=IMAGE_RESPONSES,
+    summary="Basin picture of a design: the starts (x, v) coloured by the attractor they reach",
+)
+async def post_basins_plot(
+    body: AnalysisRequest,
+    request: Request,
+    format: Literal["png", "svg"] | None = FormatQuery,
+) -> Response:
+    """The plane of initial states coloured by attractor, each attractor's strobes on top and
+    its basin fraction with a 95 % interval in the legend; axes in µm and mm/s for a design.
+    Without `settings.basins` the default basin settings are used (16 starts)."""
+    if body.settings.basins is None:
+        settings = body.settings.model_copy(update={"basins": BasinSettings()})
+        body = body.model_copy(update={"settings": settings})
+    fmt = image_format(request, format)
+    check_analysis_budget(request, body)
+    return await cached_compute(
+        request,
+        f"analyses/basins/plot.{fmt}",
+        body.model_dump_json(),
+        lambda: (basins_figure(_analysis(request, body), fmt), MEDIA_TYPES[fmt]),
     )
