@@ -91,6 +91,7 @@ _SUBMODULES = frozenset(
         "ensembles",
         "homoclinic",
         "jitcache",
+        "jobs",
         "jsonio",
         "lazyload",
         "model",

@@ -6,9 +6,9 @@ one-axis sweep locates the line's bifurcation points, carried in the chunk's out
 from __future__ import annotations
 
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
+from gearengine import jobs
 from gearengine.engineering import dte_and_factor
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.model.aliases import ALIASES, get_alias
@@ -22,7 +22,7 @@ from gearengine.sweeps.axes import display_unit, in_display_unit, is_dimensionle
 from gearengine.sweeps.axes import shown as rounded
 from gearengine.sweeps.export import chunk_json, result_json
 from gearengine.sweeps.export import chunk_points as points_of_chunk
-from gearengine.sweeps.plan import DEFAULT_CHUNK_POINTS, SweepPlan
+from gearengine.sweeps.plan import DEFAULT_CHUNK_POINTS, SweepPlan, sweep_work
 from gearengine.sweeps.request import SweepBranch, SweepRequest
 from gearengine.sweeps.results import (
     RESPONSE_UNITS,
@@ -178,11 +178,14 @@ def _carried(settings: SimulationSettings, bp: BatchPoint) -> SimulationSettings
     )
 
 
+def _chunk_text(request: SweepRequest, chunk_index: int, chunk_points: int) -> str:
+    return chunk_json(*_compute(request, chunk_index, chunk_points), request.outputs)
+
+
 def compute_chunk_json(request_json: str, chunk_index: int, chunk_points: int) -> str:
     """``compute_chunk`` on JSON text, returning the chunk's output (what workers exchange):
     a JSON array of points, or for a continuation line also its bifurcations (``chunk_json``)."""
-    request = SweepRequest.model_validate_json(request_json)
-    return chunk_json(*_compute(request, chunk_index, chunk_points), request.outputs)
+    return _chunk_text(SweepRequest.model_validate_json(request_json), chunk_index, chunk_points)
 
 
 def run_local(
@@ -191,7 +194,8 @@ def run_local(
     chunk_points: int | None = None,
     workers: int = 1,
 ) -> SweepResult:
-    """Compute every chunk in this process; ``progress_callback(done, total)`` in points.
+    """Compute every chunk in this process (``jobs.run_local``); ``progress_callback(done,
+    total)`` in points.
 
     ``workers`` > 1 computes chunks on that many threads: the kernels release the GIL
     (``nogil``), so one chunk's verdicts (Python) overlap another's integration. The result
@@ -204,23 +208,31 @@ def run_local(
     """
     if chunk_points is None:
         chunk_points = DEFAULT_CHUNK_POINTS if request.continuation else LOCAL_CHUNK_POINTS
-    plan = SweepPlan(request, chunk_points)
-    total, done = request.n_points(), 0
-    text = request.model_dump_json()
     if workers > 1 and not threads_may_share_kernels():
         workers = 1  # numba's workqueue layer: one kernel call at a time, or it aborts
-    with ThreadPoolExecutor(max(1, workers)) as pool:
-        futures = [pool.submit(compute_chunk_json, text, i, chunk_points)
-                   for i in range(plan.n_chunks())]  # fmt: skip
-        arrays = []
-        for i, future in enumerate(futures):
-            arrays.append(future.result())
-            done += len(plan.chunk(i).points)
-            if progress_callback is not None:
-                progress_callback(done, total)
+    result = jobs.run_local("sweep", request, progress_callback, chunk_points, workers)
+    assert isinstance(result, SweepResult)
+    return result
+
+
+def assemble(request: SweepRequest, arrays: list[str]) -> SweepResult:
+    """The ``SweepResult`` of a sweep from its chunks' outputs in index order (with speed
+    windows for a speed axis)."""
     windows = None  # only a speed axis has windows: else the points are not read back
     if any(a.parameter == SPEED for a in request.axes):
         points = [SweepPoint.model_validate(p) for text in arrays for p in points_of_chunk(text)]
         windows = speed_windows(request, points)
     text = "".join(result_json(request.axes, arrays, windows=windows))
     return SweepResult.model_validate_json(text)
+
+
+SWEEP_JOB = jobs.JobKind(
+    name="sweep",
+    request=SweepRequest,
+    chunk_points=DEFAULT_CHUNK_POINTS,
+    chunk_counts=lambda request, size: SweepPlan(request, size).point_counts(),
+    work=sweep_work,
+    compute_chunk=_chunk_text,
+    assemble=assemble,
+)
+"""Sweeps as a kind of job (``gearengine.jobs.KINDS``)."""
