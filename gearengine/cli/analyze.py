@@ -100,11 +100,12 @@ def cmd_check(args: argparse.Namespace) -> int:
     --torque, the gate over the operating envelope (``cli.envelope``)."""
     if args.speed or args.torque:
         return cmd_envelope(args)
-    if args.max_dte is not None or args.json or args.junit or args.server:
+    envelope_only = (args.max_dte, args.starts, args.min_basin)
+    if any(v is not None for v in envelope_only) or args.json or args.junit or args.server:
         raise InvalidInputError(
             [
-                "--max-dte, --json, --junit and --server check an envelope: give --speed "
-                "LOW:HIGH (rpm) and/or --torque LOW:HIGH (N m)"
+                "--max-dte, --starts, --min-basin, --json, --junit and --server check an "
+                "envelope: give --speed LOW:HIGH (rpm) and/or --torque LOW:HIGH (N m)"
             ]
         )
     result = analyze(read_request(args.file, AnalysisRequest))

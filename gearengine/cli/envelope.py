@@ -4,6 +4,9 @@ envelope.
 Sweeps the design over a grid of driver speeds (rpm unless a unit is given) and mean torques
 (N m unless a unit is given), checks every point against the rules (``sweeps.gate``), prints
 the failing windows, and exits 1 when any point fails, 0 when none does, 2 on invalid input.
+Each point runs ``--starts N`` initial states (default ``GATE_STARTS``, a grid over the
+default basin box) and every attractor found whose basin fraction is above ``--min-basin``
+(default: any) is checked; ``--starts 1`` checks the settings' own start only.
 ``--json FILE`` writes the report (with the API's sweep result in it), ``--junit FILE`` a
 JUnit XML report, ``--server URL`` runs the sweep on a running service (its queue, its
 workers) instead of in this process, with the same report.
@@ -13,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 import time
@@ -38,6 +42,10 @@ from gearengine.sweeps.results import SweepResult
 ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
 """Integration settings of an envelope check unless the design file gives ``settings``."""
 POLL_SECONDS = 1.0
+GATE_STARTS = 16
+"""Basin starts per operating point of the gate unless ``--starts`` or the file's
+``settings.basins`` say otherwise: a 4 x 4 grid over the default box (benchmarks/README.md has
+its cost); ``--starts 1`` checks the settings' own start alone, as before basins."""
 
 
 def axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
@@ -62,9 +70,27 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
     ]
     if args.torque:
         axes.append(axis("torque", args.torque, "N*m", args.torque_points))
-    sweep = {"design": design, "settings": doc.get("settings", ENVELOPE_SETTINGS), "axes": axes,
+    sweep = {"design": design, "settings": gate_settings(doc, args.starts), "axes": axes,
              "label": f"envelope check of {Path(args.file).name}"}  # fmt: skip
     return validated_input(validated, sweep, args.file)
+
+
+def gate_settings(doc: dict, starts: int | None) -> object:
+    """The file's settings (or ``ENVELOPE_SETTINGS``) with the gate's basin starts: ``starts``
+    (a grid when it is a square, else random draws), else the file's basins, else
+    ``GATE_STARTS``; ``starts`` 1 leaves basins out."""
+    settings = doc.get("settings", ENVELOPE_SETTINGS)
+    if not isinstance(settings, dict):
+        return settings  # the request's validation names the problem
+    if starts is None:
+        starts = None if settings.get("basins") is not None else GATE_STARTS
+    if starts is None:
+        return settings
+    if starts == 1:
+        return {k: v for k, v in settings.items() if k != "basins"}
+    basins = dict(settings.get("basins") or {})
+    basins.update(starts=starts, grid=math.isqrt(max(starts, 0)) ** 2 == starts)
+    return {**settings, "basins": basins}
 
 
 def _here(design: dict, name: str) -> str:
@@ -124,7 +150,8 @@ def rules_of(args: argparse.Namespace) -> Rules:
     """--fail-on classes (default chaotic; limits add to them, never replace them)."""
     return Rules(fail_on=args.fail_on or ["chaotic"], max_lle=args.max_lle,
                  max_dte_um=args.max_dte,
-                 max_dynamic_factor=getattr(args, "max_dynamic_factor", None))  # fmt: skip
+                 max_dynamic_factor=getattr(args, "max_dynamic_factor", None),
+                 min_basin=getattr(args, "min_basin", None))  # fmt: skip
 
 
 def rules_text(rules: Rules) -> str:
@@ -136,6 +163,8 @@ def rules_text(rules: Rules) -> str:
         parts.append(f"--max-dte {rules.max_dte_um:g} µm")
     if rules.max_dynamic_factor is not None:
         parts.append(f"--max-dynamic-factor {rules.max_dynamic_factor:g}")
+    if rules.min_basin is not None:
+        parts.append(f"--min-basin {rules.min_basin:g}")
     return ", ".join(parts)
 
 

@@ -114,6 +114,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-dynamic-factor", type=float, default=None, metavar="F",
                    help="fail where the largest dynamic mesh force exceeds F times the static "
                    "force (envelope checks)")  # fmt: skip
+    p.add_argument("--starts", type=int, default=None, metavar="N",
+                   help="envelope checks: basin starts per operating point (default 16; 1: "
+                   "the settings' own start only)")  # fmt: skip
+    p.add_argument("--min-basin", type=float, default=None, metavar="F",
+                   help="envelope checks: check only attractors whose basin fraction is above "
+                   "F (default: every attractor found)")  # fmt: skip
     p.add_argument("--json", metavar="FILE", help="write the envelope report (JSON)")
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
     p.add_argument("--server", metavar="URL", help="run the envelope on a running service "

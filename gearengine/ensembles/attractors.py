@@ -64,7 +64,13 @@ class Scales:
 
     @classmethod
     def of(cls, conv: DesignConversion) -> Scales:
-        return cls(conv.half_backlash_m, conv.half_backlash_m / conv.time_scale_s)
+        """The scales of a design's conversion."""
+        return cls.for_backlash(conv.half_backlash_m, conv)
+
+    @classmethod
+    def for_backlash(cls, b_m: float, conv: DesignConversion) -> Scales:
+        """The scales of a design with its half backlash set to ``b_m`` [m]."""
+        return cls(b_m, b_m / conv.time_scale_s)
 
 
 def scale_pair(scales: Scales | None) -> tuple[float, float]:
@@ -204,9 +210,42 @@ def attractors(
         The attractors, and the ``BasinCounts`` with each start's label (its attractor's index
         in the returned list, -1 diverged, -2 unsettled).
     """
+    return points_attractors([params], settings, [scales])[0]
+
+
+def points_attractors(
+    points: list[GearParams],
+    settings: SimulationSettings,
+    scales: list[Scales | None],
+) -> list[tuple[list[Attractor], BasinCounts]]:
+    """``attractors`` of many points at once (a sweep's chunk): all their basin starts are
+    lanes of one ``run_lanes`` call, so they share the lock-step kernel.
+
+    Args:
+        points: the parameter points, shape (P,).
+        settings: as for ``attractors``.
+        scales: per point, its scales or None, shape (P,).
+    """
     basins = settings.basins or BasinSettings()
-    starts = basin_starts(basins, scales)
-    points = run_lanes([params], [(0, s) for s in starts], settings)
+    starts = [basin_starts(basins, sc) for sc in scales]
+    lanes = [(i, s) for i, ss in enumerate(starts) for s in ss]
+    runs = run_lanes(points, lanes, settings)
+    out = []
+    for i, (params, sc) in enumerate(zip(points, scales, strict=True)):
+        mine = runs[i * len(starts[i]) : (i + 1) * len(starts[i])]
+        out.append(_group(params, settings, sc, basins, starts[i], mine))
+    return out
+
+
+def _group(
+    params: GearParams,
+    settings: SimulationSettings,
+    scales: Scales | None,
+    basins: BasinSettings,
+    starts: list[tuple[float, float]],
+    points: list[BatchPoint],
+) -> tuple[list[Attractor], BasinCounts]:
+    """The attractors and counts of one point's runs ``points`` from ``starts``."""
     commensurate = step_plan(params, settings.steps_per_period).omega0 is not None
     labels = cluster(points, commensurate)
     groups: dict[int, list] = {}
@@ -216,9 +255,8 @@ def attractors(
     found = [_attractor(m, len(starts), params, scales) for m in groups.values()]
     order = sorted(range(len(found)), key=lambda k: (severity(found[k].classification,
                    found[k].period), found[k].count), reverse=True)  # fmt: skip
-    rank = {old: new for new, old in enumerate(order)}
     keys = list(groups)
-    relabel = {keys[old]: new for old, new in rank.items()}
+    relabel = {keys[old]: new for new, old in enumerate(order)}
     found = _distinct_labels([found[k] for k in order])
     n = int(np.sqrt(len(starts)))
     counts = BasinCounts(
@@ -242,6 +280,27 @@ def _distinct_labels(found: list[Attractor]) -> list[Attractor]:
             a = a.model_copy(update={"label": f"{a.label} ({seen[a.label]})"})
         out.append(a)
     return out
+
+
+def follows(bp: BatchPoint, a: Attractor) -> bool:
+    """True when the run ``bp`` settled on the attractor ``a`` (the rule of ``cluster``)."""
+    if bp.classification != a.classification:
+        return False
+    rep = BatchPoint.model_construct(
+        classification=a.classification,
+        period=a.period,
+        poincare=a.strobes,
+        x_peak_to_peak=a.x_peak_to_peak,
+    )
+    return (same_orbit if a.period else same_cloud)(rep, bp)
+
+
+def coexisting(bp: BatchPoint, found: list[Attractor], counts: BasinCounts) -> list[str]:
+    """The attractors other than the one ``bp`` (a followed branch) settled on, as 'label from
+    NN % of starts' (largest basin first)."""
+    others = [a for a in found if not follows(bp, a)]
+    return [f"{a.label} from {percent(a.fraction)} of starts"
+            for a in sorted(others, key=lambda a: -a.count)]  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -10,6 +10,7 @@ from typing import Any
 
 from gearengine import jobs
 from gearengine.engineering import dte_and_factor
+from gearengine.ensembles.attractors import Scales, coexisting, points_attractors
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
@@ -65,9 +66,11 @@ def _point(
     branch: SweepBranch | None,
     params: GearParams,
     bp: BatchPoint,
+    basins: dict[str, Any],
 ) -> SweepPoint:
     """The sweep's point from the engine's verdict ``bp`` (typed and finite, built by
-    ``numerics.batch``), so ``model_construct`` skips a second validation (~0.05 ms a point)."""
+    ``numerics.batch``), so ``model_construct`` skips a second validation (~0.05 ms a point);
+    ``basins`` its attractors, basins and coexisting entries (empty without basins)."""
     possible = chaos_possible(params)
     return SweepPoint.model_construct(
         values={name: float(v) for name, v in values.items()},
@@ -84,6 +87,7 @@ def _point(
         force_max=bp.force_max,
         force_min=bp.force_min,
         **_physical(request, values, params, bp),
+        **basins,
     )
 
 
@@ -113,14 +117,40 @@ def _compute(
             (bp,) = simulate_batch([design], settings)
             verdicts.append(bp)
             settings = _carried(request.settings, bp)
+    ensembles = _basins(request, values, designs, verdicts)
     points = [
-        _point(request, v, chunk.branch, d, bp)
-        for v, d, bp in zip(values, designs, verdicts, strict=True)
+        _point(request, v, chunk.branch, d, bp, e)
+        for v, d, bp, e in zip(values, designs, verdicts, ensembles, strict=True)
     ]
     if not request.continuation or len(axes) != 1 or len(values) < 2:
         return points, None
     line = [v[axes[0].parameter] for v in values]
     return points, _line_bifurcations(request, line, designs, verdicts)
+
+
+def _basins(
+    request: SweepRequest,
+    values: list[dict[str, float]],
+    designs: list[GearParams],
+    verdicts: list[BatchPoint],
+) -> list[dict[str, Any]]:
+    """Per point, with ``settings.basins``: its attractors and basin counts
+    (``ensembles.attractors``, every point's starts in one ``run_lanes`` call) and, on a
+    continuation line, the attractors coexisting with the followed branch; else empty.
+
+    A box in units is read with the design's scales at each point's half backlash (the time
+    scale 1/omega_n of the design: speed and torque axes leave it unchanged)."""
+    if request.settings.basins is None:
+        return [{} for _ in designs]
+    conv = request.conversion
+    scales = [None if conv is None else Scales.for_backlash(
+        v.get("mesh.half_backlash", conv.half_backlash_m), conv) for v in values]  # fmt: skip
+    found = points_attractors(designs, request.settings, scales)
+    out: list[dict[str, Any]] = [{"attractors": a, "basins": c} for a, c in found]
+    if request.continuation:
+        for entry, bp in zip(out, verdicts, strict=True):
+            entry["coexisting"] = coexisting(bp, entry["attractors"], entry["basins"])
+    return out
 
 
 def _line_bifurcations(

@@ -13,6 +13,9 @@ from gearengine.sweeps.axes import display_unit, in_display_unit, is_dimensionle
 from gearengine.sweeps.request import SweepAxis
 from gearengine.sweeps.results import RESPONSE_UNITS, SweepBifurcation, SweepPoint, SweepResult
 
+BASIN_FIELDS = ("attractors", "basins", "coexisting")
+"""Point fields that exist only with settings.basins: left out of a point without them, so a
+sweep without basins keeps its bytes."""
 _LINE_HEAD = '{"bifurcations":'
 _LINE_POINTS = ',"points":['
 
@@ -26,7 +29,10 @@ def chunk_json(
     of a one-axis continuation sweep, ``{"bifurcations": [...], "points": [...]}``. With
     ``outputs`` (``SweepRequest.outputs``) a point holds values, branch and those fields only."""
     keep = None if outputs is None else {"values", "branch", *outputs}
-    array = ",".join(p.model_dump_json(include=keep) for p in points)
+    array = ",".join(
+        p.model_dump_json(include=keep, exclude={k for k in BASIN_FIELDS if getattr(p, k) is None})
+        for p in points
+    )
     if bifurcations is None:
         return "[" + array + "]"
     located = ",".join(b.model_dump_json() for b in bifurcations)

@@ -57,7 +57,7 @@ AxisValue = Annotated[
 SweepOutput = Literal[
     "classification", "period", "lle", "lle_stderr", "impact_regime", "melnikov_chaos_possible",
     "poincare_x", "x_peak_to_peak", "periods_run", "force_max", "force_min", "physical",
-    "dimensionless",
+    "dimensionless", "attractors", "basins", "coexisting",
 ]  # fmt: skip
 """A field of ``SweepPoint`` a sweep may keep (``SweepRequest.outputs``)."""
 
