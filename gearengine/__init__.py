@@ -2,10 +2,12 @@
 
 The public facade, short verbs on a design (as ChaosTools.jl):
 
-    >>> from gearengine import GearParams, melnikov, analyze, AnalysisRequest
+    >>> from gearengine import GearParams, Design, melnikov, analyze, run_sweep
     >>> p = GearParams.model_validate(PAPER_SECTION_41)
     >>> melnikov(p).chaos_possible
     True
+    >>> analyze(Design.model_validate(doc["design"])).summary()   # one line; repr is short too
+    >>> run_sweep(SweepRequest.model_validate(sweep)).to_pandas()  # pip install 'gearchaos[pandas]'
 
 Rooms (subpackages) follow the data flow: ``model`` -> ``homoclinic`` (the Melnikov analysis
 of the homoclinic orbits) -> ``numerics`` -> ``ensembles`` (many starts of one design) ->
@@ -23,6 +25,7 @@ if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDE
     from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
     from gearengine.ensembles.attractors import of_design as attractors
     from gearengine.homoclinic import MelnikovResult, chaos_possible, melnikov, threshold_curve
+    from gearengine.model.design import Design
     from gearengine.model.examples import PAPER_SECTION_41
     from gearengine.model.params import GearParams
     from gearengine.numerics import (
@@ -40,6 +43,7 @@ __all__ = [
     "PAPER_SECTION_41",
     "AnalysisRequest",
     "AnalysisResult",
+    "Design",
     "GearParams",
     "MelnikovResult",
     "SimulationSettings",
@@ -62,6 +66,7 @@ _HOMES: dict[str, tuple[str, str]] = {
     "PAPER_SECTION_41": ("gearengine.model.examples", "PAPER_SECTION_41"),
     "AnalysisRequest": ("gearengine.analysis", "AnalysisRequest"),
     "AnalysisResult": ("gearengine.analysis", "AnalysisResult"),
+    "Design": ("gearengine.model.design", "Design"),
     "GearParams": ("gearengine.model.params", "GearParams"),
     "MelnikovResult": ("gearengine.homoclinic", "MelnikovResult"),
     "SimulationSettings": ("gearengine.numerics", "SimulationSettings"),

@@ -14,11 +14,11 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from gearengine.engineering import Engineering, engineering
+from gearengine.engineering import IMPACT_WORDS, Engineering, engineering
 from gearengine.ensembles.attractors import Scales, attractors, coexistence, headline
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
 from gearengine.homoclinic.verdict import melnikov
-from gearengine.model.design import EXAMPLE_DESIGN
+from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
@@ -81,6 +81,32 @@ class AnalysisResult(BaseModel):
         None, description="With a design: the answer in gear-design units."
     )
 
+    def summary(self) -> str:
+        """The verdicts in one line: response, LLE, contact, Melnikov, and with a design the
+        DTE, dynamic factor and Melnikov speed windows (the gate's PASS or FAIL line)."""
+        num = self.numerics
+        kind = f"periodic {num.period}T" if num.period else num.classification
+        lle = "LLE n/a" if num.lle is None else f"LLE {num.lle:+.4g} ± {num.lle_stderr or 0:.2g}"
+        contact = IMPACT_WORDS.get(num.impact_regime or "", "no verdict on impacts")
+        mel = {True: "possible", False: "not possible", None: "n/a"}[self.melnikov.chaos_possible]
+        line = f"{kind} ({lle} per unit tau, {contact}), Melnikov: chaos {mel}"
+        eng = self.engineering
+        if eng is not None:
+            resp = eng.response
+            if resp is not None and resp.dte_peak_to_peak_um is not None:
+                line += f"; DTE {resp.dte_peak_to_peak_um:.3g} µm"
+            if resp is not None and resp.dynamic_factor is not None:
+                line += f", dynamic factor {resp.dynamic_factor:.3g}"
+            lo, hi = eng.speed_range_rpm
+            spans = ", ".join(f"{a:,.0f}-{b:,.0f}" for a, b in eng.speed_windows_rpm) or "nowhere"
+            line += f"; Melnikov chaos possible at {spans} rpm (scanned {lo:,.0f}-{hi:,.0f} rpm)"
+        return line
+
+    def __repr__(self) -> str:  # the full document is ~85 kB (time history, spectrum)
+        return f"AnalysisResult({self.summary()!r})"
+
+    __str__ = summary
+
 
 class MelnikovAnswer(MelnikovResult):
     """The /v1/melnikov contract: the verdict, and with a design its params and engineering."""
@@ -129,8 +155,20 @@ def verdict(mel: MelnikovResult, num: NumericsResult, min_fraction: float = 0.0)
     )
 
 
-def analyze(request: AnalysisRequest) -> AnalysisResult:
-    """Melnikov and numerical verdicts of one design (with a design, in its units too)."""
+def analyze(
+    request: AnalysisRequest | Design | GearParams, settings: SimulationSettings | None = None
+) -> AnalysisResult:
+    """Melnikov and numerical verdicts of one design (with a design, in its units too).
+
+    ``request`` is a whole request, or (the facade's short form) a ``Design`` in physical units
+    or dimensionless ``GearParams``, integrated with ``settings`` (default: the defaults of
+    ``SimulationSettings``); ``settings`` with a whole request is refused (it has its own).
+    """
+    if not isinstance(request, AnalysisRequest):
+        key = "design" if isinstance(request, Design) else "params"
+        request = AnalysisRequest(**{key: request}, settings=settings or SimulationSettings())
+    elif settings is not None:
+        raise TypeError("analyze: an AnalysisRequest carries its settings; give one or the other")
     mel = melnikov(request.params)
     num = simulate(request.params, request.settings)
     conv = request.conversion
@@ -150,7 +188,7 @@ def analyze(request: AnalysisRequest) -> AnalysisResult:
 
 def answer_melnikov(request: MelnikovRequest) -> MelnikovResult:
     """The Melnikov verdict of a request; with a design, its params and engineering block."""
-    mel = melnikov(request.params, method=request.method)
+    mel = melnikov(request.params, method=request.method, mean_load=request.mean_load)
     conv = request.conversion
     if conv is None:
         return mel

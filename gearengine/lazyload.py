@@ -31,6 +31,8 @@ def lazy_names(
         raise AttributeError(f"module {package!r} has no attribute {name!r}")
 
     def names() -> list[str]:
-        return sorted({*homes, *vars(sys.modules[package])})
+        """The public names and the module's dunders: not the imports of the facade itself
+        (``annotations``, ``TYPE_CHECKING``, ``lazy_names``) nor its submodules."""
+        return sorted({*homes, *(n for n in vars(sys.modules[package]) if n.startswith("__"))})
 
     return attribute, names

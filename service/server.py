@@ -23,6 +23,7 @@ from pathlib import Path
 import uvicorn
 
 from service.core.config import Settings
+from service.lifetime import exit_with_parent
 
 EXIT_STARTUP_FAILURE = 3
 """uvicorn could not start (the port is taken, the lifespan failed): uvicorn's own code."""
@@ -221,11 +222,6 @@ def serve_peer() -> None:
     with contextlib.suppress(OSError, AttributeError):  # Linux: killed when the parent dies
         ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
 
-    def watch_parent() -> None:  # elsewhere, and if the parent died before prctl
-        while os.getppid() == parent:
-            time.sleep(0.5)
-        os.kill(os.getpid(), signal.SIGKILL)
-
     all_up = threading.Event()
 
     def wait_go() -> None:
@@ -233,7 +229,7 @@ def serve_peer() -> None:
             os.read(spec["go"], 1)
         all_up.set()
 
-    threading.Thread(target=watch_parent, name="parent-watch", daemon=True).start()
+    exit_with_parent(parent)  # elsewhere, and if the parent died before prctl
     threading.Thread(target=wait_go, name="all-up", daemon=True).start()
     log_to_stderr()
     settings = Settings.model_validate(spec["settings"])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import socket
 import subprocess
@@ -12,6 +13,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import httpx
+import psutil
 import pytest
 from fastapi.testclient import TestClient
 
@@ -39,6 +41,11 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+ORPHAN_GRACE_SECONDS = 10.0
+"""How long a stopped server's children get to end on their own (pool workers poll their parent
+every 0.5 s, ``service.lifetime``) before the test kills them as orphans."""
+
+
 class Server:
     """A `gearengine serve` subprocess on loopback."""
 
@@ -50,9 +57,13 @@ class Server:
         cmd += ["--data-dir", str(data_dir), *extra]
         log_dir = Path(tempfile.mkdtemp(prefix="gearchaos-server-"))
         self.log = open(log_dir / f"server-{self.port}.log", "w")  # noqa: SIM115
+        # its own session: every process it starts (peers, pool workers, the resource
+        # tracker) keeps its process group, even orphaned by a kill -9, so stop() finds them
         self.proc = subprocess.Popen(
-            cmd, env={**os.environ, **(env or {})}, stdout=self.log, stderr=subprocess.STDOUT
-        )
+            cmd, env={**os.environ, **(env or {})}, stdout=self.log, stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )  # fmt: skip
+        self.orphans: list[str] = []
         self.wait_ready()
 
     def wait_ready(self, timeout: float = 120.0) -> None:
@@ -75,13 +86,31 @@ class Server:
         return Path(self.log.name).read_text()
 
     def stop(self) -> None:
+        """SIGTERM (SIGKILL after 20 s), then wait for the rest of its process group; what is
+        still alive after ``ORPHAN_GRACE_SECONDS`` is killed and named in ``orphans`` (the
+        processes a real server would have left behind)."""
         if self.proc.poll() is None:
             self.proc.terminate()
             try:
                 self.proc.wait(timeout=20)
             except subprocess.TimeoutExpired:
                 self.proc.kill()
+                self.proc.wait()
+        _, alive = psutil.wait_procs(self.group(), timeout=ORPHAN_GRACE_SECONDS)
+        for p in alive:
+            with contextlib.suppress(psutil.Error):
+                self.orphans.append(" ".join(p.cmdline()))
+                p.kill()
         self.log.close()
+
+    def group(self) -> list[psutil.Process]:
+        """The live processes of the server's process group (zombies are already dead)."""
+        out = []
+        for p in psutil.process_iter():
+            with contextlib.suppress(psutil.Error, ProcessLookupError):
+                if os.getpgid(p.pid) == self.proc.pid and p.status() != psutil.STATUS_ZOMBIE:
+                    out.append(p)
+        return out
 
 
 @pytest.fixture(scope="module")

@@ -1,7 +1,7 @@
 """The envelope gate with basins: every attractor of every operating point is checked.
 
-``tests/data/gate-starts-1/`` holds the report and JUnit XML of the gate before basins (commit
-6054600) on a small envelope of examples/envelope-map.json; ``--starts 1`` must give them back
+``tests/data/gate-starts-1/`` holds the report and JUnit XML of the gate before basins (branch
+main without them) on a small envelope of examples/envelope-map.json; ``--starts 1`` gives them
 byte for byte. With the default basin sample, the points that fail are exactly those where an
 attractor found independently (``gearengine.attractors`` at each point) is chaotic, and the
 report names it with its basin fraction.

@@ -74,7 +74,7 @@ def test_three_processes_answer_on_one_port_and_stop_together(tmp_path: Path) ->
 
 
 def test_killing_the_first_process_takes_the_others_with_it(tmp_path: Path) -> None:
-    """kill -9 of `gearengine serve` leaves no peer holding the port."""
+    """kill -9 of `gearengine serve` leaves no peer holding the port, and no process at all."""
     srv = Server(tmp_path / "data", None, "--http-processes", "2")
     try:
         others = peers(srv)
@@ -85,3 +85,5 @@ def test_killing_the_first_process_takes_the_others_with_it(tmp_path: Path) -> N
         assert port_free(srv.port)
     finally:
         srv.stop()
+    # the pool workers and the resource tracker end too (they used to live on, ~220 MB each)
+    assert srv.orphans == []

@@ -12,18 +12,11 @@ import argparse
 
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.cli.documents import EXIT_FAIL, EXIT_OK, InvalidInputError, read_request
-from gearengine.cli.envelope import cmd_envelope
+from gearengine.cli.envelope import cmd_envelope, physical_limits, rules_of
 from gearengine.cli.melnikov import fmt_value, render_engineering, render_melnikov
 from gearengine.jsonio import dumps
-from gearengine.numerics.classify import SEVERITY
-
-
-def numerics_line(r: AnalysisResult) -> str:
-    num = r.numerics
-    kind = f"periodic {num.period}T" if num.period else num.classification
-    lle = "LLE n/a" if num.lle is None else f"LLE {num.lle:+.4g} ± {num.lle_stderr or 0.0:.2g}"
-    mel = {True: "possible", False: "not possible", None: "n/a"}[r.melnikov.chaos_possible]
-    return f"{kind} ({lle} per unit tau, {num.impact_regime}), Melnikov: chaos {mel}"
+from gearengine.sweeps.gate import Rules, point_failures
+from gearengine.sweeps.results import RESPONSE_UNITS, PhysicalValue, SweepPoint
 
 
 def cmd_analyze(args: argparse.Namespace) -> int:
@@ -32,7 +25,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         print(dumps(result))
     else:
         print(render_melnikov(result.melnikov))
-        print(f"Numerical verdict: {numerics_line(result)}")
+        print(f"Numerical verdict: {result.summary()}")
         print(f"  {result.verdict.summary}")
         print(f"  forcing period T0 = {fmt_value(result.numerics.forcing_period)}")
         line = floquet_line(result)
@@ -74,21 +67,30 @@ def margin_failure(r: AnalysisResult, min_margin: float) -> str | None:
     return None
 
 
-def failures(
-    r: AnalysisResult, fail_on: list[str], max_lle: float | None, min_margin: float | None = None
-) -> list[str]:
-    """Reasons the design fails the gate (empty: pass)."""
-    worst = r.numerics.worst_case.classification
-    reasons = [
-        f"--fail-on {f}" for f in fail_on if f in SEVERITY and SEVERITY[worst] >= SEVERITY[f]
-    ]
-    if "impacts" in fail_on and r.numerics.impact_regime == "double_sided":
-        reasons.append("--fail-on impacts")
-    if "melnikov" in fail_on and r.melnikov.chaos_possible:
-        reasons.append("--fail-on melnikov")
-    lle = r.numerics.worst_case.lle
-    if max_lle is not None and (lle is None or lle > max_lle):
-        reasons.append(f"--max-lle {max_lle:g}")
+def gate_point(r: AnalysisResult) -> SweepPoint:
+    """The analysis as one operating point of the envelope gate (its worst start, its DTE and
+    dynamic factor in µm and 1), so one design and an envelope are judged by one set of rules,
+    ``sweeps.gate.point_failures``."""
+    worst = r.numerics.worst_case
+    resp = None if r.engineering is None else r.engineering.response
+    physical = {
+        key: PhysicalValue(value=value, unit=RESPONSE_UNITS[key])
+        for key, value in (
+            ("dte", None if resp is None else resp.dte_peak_to_peak_um),
+            ("dynamic_factor", None if resp is None else resp.dynamic_factor),
+        )
+        if value is not None
+    }
+    return SweepPoint(values={}, branch=None, classification=worst.classification,
+                      period=worst.period, lle=worst.lle, impact_regime=r.numerics.impact_regime,
+                      melnikov_chaos_possible=r.melnikov.chaos_possible,
+                      physical=physical or None)  # fmt: skip
+
+
+def failures(r: AnalysisResult, rules: Rules, min_margin: float | None = None) -> list[str]:
+    """Reasons the design fails the gate (empty: pass): the envelope's rules at its one point,
+    and the Floquet stability margin (one design only)."""
+    reasons = point_failures(gate_point(r), rules)
     margin = None if min_margin is None else margin_failure(r, min_margin)
     if margin is not None:
         reasons.append(margin)
@@ -100,18 +102,26 @@ def cmd_check(args: argparse.Namespace) -> int:
     --torque, the gate over the operating envelope (``cli.envelope``)."""
     if args.speed or args.torque:
         return cmd_envelope(args)
-    envelope_only = (args.max_dte, args.starts, args.min_basin)
-    if any(v is not None for v in envelope_only) or args.json or args.junit or args.server:
+    if args.starts is not None or args.min_basin is not None or args.json or args.junit or \
+            args.server:  # fmt: skip
         raise InvalidInputError(
             [
-                "--max-dte, --starts, --min-basin, --json, --junit and --server check an "
-                "envelope: give --speed LOW:HIGH (rpm) and/or --torque LOW:HIGH (N m)"
+                "--starts, --min-basin, --json, --junit and --server check an envelope: give "
+                "--speed LOW:HIGH (rpm) and/or --torque LOW:HIGH (N m)"
             ]
         )
-    result = analyze(read_request(args.file, AnalysisRequest))
-    fail_on = args.fail_on or ["chaotic"]  # the limits add to the classes, never replace them
-    reasons = failures(result, fail_on, args.max_lle, args.min_stability_margin)
+    request = read_request(args.file, AnalysisRequest)
+    rules = rules_of(args)
+    if request.design is None and physical_limits(rules):
+        raise InvalidInputError(
+            [
+                f"{args.file}: {', '.join(physical_limits(rules))} need a design in physical "
+                'units ({"design": {...}}); dimensionless params have no µm or static force'
+            ]
+        )
+    result = analyze(request)
+    reasons = failures(result, rules, args.min_stability_margin)
     verdict = "FAIL" if reasons else "PASS"
     why = f" [{', '.join(reasons)}]" if reasons else ""
-    print(f"{verdict}: {numerics_line(result)}{why}")
+    print(f"{verdict}: {result.summary()}{why}")
     return EXIT_FAIL if reasons else EXIT_OK

@@ -32,15 +32,24 @@ from gearengine.cli.documents import (
     read_document,
     validated_input,
 )
-from gearengine.cli.sweep import progress_bar
+from gearengine.cli.sweep import progress
 from gearengine.jsonio import dumps
+from gearengine.numerics.settings import SimulationSettings
 from gearengine.sweeps.compute import run_local
-from gearengine.sweeps.gate import EnvelopeReport, Rules, envelope_report, junit_xml, window_text
+from gearengine.sweeps.gate import (
+    EnvelopeReport,
+    Rules,
+    envelope_report,
+    junit_xml,
+    level_text,
+    window_text,
+)
 from gearengine.sweeps.request import SweepRequest, validated
-from gearengine.sweeps.results import SweepResult
+from gearengine.sweeps.results import SpeedWindows, SweepResult
 
 ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
-"""Integration settings of an envelope check unless the design file gives ``settings``."""
+"""Light integration settings of an envelope check; a design file's ``settings`` are merged
+over them (adding ``random_initial_states`` keeps the 60 + 60 periods)."""
 POLL_SECONDS = 1.0
 GATE_STARTS = 16
 """Basin starts per operating point of the gate unless ``--starts`` or the file's
@@ -70,18 +79,19 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
     ]
     if args.torque:
         axes.append(axis("torque", args.torque, "N*m", args.torque_points))
-    sweep = {"design": design, "settings": gate_settings(doc, args.starts), "axes": axes,
+    settings = doc.get("settings", {})
+    if not isinstance(settings, dict):
+        raise InvalidInputError([f"{args.file}: settings must be an object"])
+    sweep = {"design": design, "settings": gate_settings({**ENVELOPE_SETTINGS, **settings},
+             args.starts), "axes": axes,
              "label": f"envelope check of {Path(args.file).name}"}  # fmt: skip
     return validated_input(validated, sweep, args.file)
 
 
-def gate_settings(doc: dict, starts: int | None) -> object:
-    """The file's settings (or ``ENVELOPE_SETTINGS``) with the gate's basin starts: ``starts``
-    (a grid when it is a square, else random draws), else the file's basins, else
-    ``GATE_STARTS``; ``starts`` 1 leaves basins out."""
-    settings = doc.get("settings", ENVELOPE_SETTINGS)
-    if not isinstance(settings, dict):
-        return settings  # the request's validation names the problem
+def gate_settings(settings: dict, starts: int | None) -> dict:
+    """The gate's settings with its basin starts: ``starts`` (a grid when it is a square, else
+    random draws), else the file's basins, else ``GATE_STARTS``; ``starts`` 1 leaves basins
+    out."""
     if starts is None:
         starts = None if settings.get("basins") is not None else GATE_STARTS
     if starts is None:
@@ -99,22 +109,6 @@ def _here(design: dict, name: str) -> str:
     if value is None:
         raise InvalidInputError([f"--{name}: give a range, the design has no {name}"])
     return f"{value}:{value}"
-
-
-def progress(start: float) -> Callable[[int, int], None]:
-    """A bar on a terminal, plain lines (every 10 %) in a CI log."""
-    if sys.stderr.isatty():
-        return progress_bar(start)
-    shown = [-1]
-
-    def line(done: int, total: int) -> None:
-        tenth = 10 * done // max(total, 1)
-        if tenth > shown[0]:
-            shown[0] = tenth
-            elapsed = time.monotonic() - start
-            print(f"envelope: {done}/{total} points, {elapsed:.1f} s", file=sys.stderr)
-
-    return line
 
 
 def run_on_server(url: str, request: SweepRequest, key: str | None,
@@ -150,8 +144,14 @@ def rules_of(args: argparse.Namespace) -> Rules:
     """--fail-on classes (default chaotic; limits add to them, never replace them)."""
     return Rules(fail_on=args.fail_on or ["chaotic"], max_lle=args.max_lle,
                  max_dte_um=args.max_dte,
-                 max_dynamic_factor=getattr(args, "max_dynamic_factor", None),
+                 max_dynamic_factor=args.max_dynamic_factor,
                  min_basin=getattr(args, "min_basin", None))  # fmt: skip
+
+
+def physical_limits(rules: Rules) -> list[str]:
+    """The limits of ``rules`` that need a design in physical units (µm, static force)."""
+    names = {"--max-dte": rules.max_dte_um, "--max-dynamic-factor": rules.max_dynamic_factor}
+    return [name for name, limit in names.items() if limit is not None]
 
 
 def rules_text(rules: Rules) -> str:
@@ -175,13 +175,57 @@ def print_report(report: EnvelopeReport) -> None:
           f"the rules ({rules_text(report.rules)})")  # fmt: skip
     for w in report.failures:
         print(f"  {window_text(w)}")
+    for line in windows_summary(report.windows):
+        print(f"  {line}")
+
+
+def settings_text(settings: SimulationSettings) -> str:
+    """The integration settings that matter for cost and verdict, in one line."""
+    rand = settings.random_initial_states
+    starts = "" if rand is None else f", {rand.count} random starts (seed {rand.seed})"
+    return (f"settings: {settings.transient_periods} + {settings.record_periods} periods, "
+            f"{settings.steps_per_period} steps per period{starts}")  # fmt: skip
+
+
+def windows_summary(windows: list[SpeedWindows]) -> list[str]:
+    """Per level of the other axis, the impact and Melnikov windows in rpm, pass or fail:
+    "windows at torque 40 N*m: tooth separation (drive-flank impacts) 500-1100 rpm; Melnikov:
+    chaos possible nowhere"."""
+    out = []
+    for w in windows:
+        impacts = "; ".join(f"{IMPACT_LABELS[k]} {spans_text(v)}" for k, v in w.impacts.items())
+        melnikov = spans_text(w.melnikov) if w.melnikov else "nowhere"
+        where = f" at {level_text(w.level)}" if w.level else ""
+        out.append(f"windows{where}: {impacts or 'teeth always in contact'}; "
+                   f"Melnikov: chaos possible {melnikov}")  # fmt: skip
+    return out
+
+
+IMPACT_LABELS = {
+    "single_sided": "tooth separation (drive-flank impacts)",
+    "double_sided": "back-flank impacts",
+}
+"""Impact regimes of a speed window in the gate's words."""
+
+
+def spans_text(spans: list[list[float]]) -> str:
+    """ "500-1100, 3000 rpm": speed runs [first, last] in rpm."""
+    return ", ".join(f"{a:g}" if a == b else f"{a:g}-{b:g}" for a, b in spans) + " rpm"
 
 
 def cmd_envelope(args: argparse.Namespace) -> int:
     """The envelope gate; exit 0 pass, 1 fail, 2 invalid input."""
+    if args.min_stability_margin is not None:
+        raise InvalidInputError(
+            [
+                "--min-stability-margin checks one design (sweep points have no Floquet "
+                "multipliers): drop --speed/--torque, or check each operating point"
+            ]
+        )
     request = envelope_request(args)
     rules = rules_of(args)
-    tick = progress(time.monotonic())
+    print(settings_text(request.settings), file=sys.stderr)
+    tick = progress(time.monotonic(), "envelope")
     if args.server:
         key = os.environ.get("GEARCHAOS_API_KEY")
         result = run_on_server(args.server, request, key, tick)

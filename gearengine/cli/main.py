@@ -2,9 +2,10 @@
 
     gearengine melnikov FILE [--json] [--method closed_form|quadrature]
     gearengine analyze FILE [--json]
-    gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov] [--max-lle V]
+    gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov|impacts|separation]
+        [--max-lle V] [--max-dte E] [--max-dynamic-factor F]
         [--min-stability-margin X]
-    gearengine sweep FILE [--out DIR]
+    gearengine sweep FILE [--out DIR|-] [--format json|csv]
     gearengine basins FILE [--starts N] [--json] [--plot FILE]
     gearengine convert FILE [--json]
 
@@ -90,7 +91,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="CI gate: exit 1 when the design fails (0 pass, 2 invalid input)",
         description="--fail-on X fails on X or anything worse "
         "(periodic < quasi_periodic < chaotic < diverged); melnikov fails when a transverse "
-        "homoclinic tangle is possible; impacts on back-flank contact. Default: --fail-on "
+        "homoclinic tangle is possible; impacts on back-flank contact; separation when the "
+        "teeth separate (drive-flank impacts, or impacts on both flanks). Default: --fail-on "
         "chaotic; the limits (--max-lle, --max-dte, --max-dynamic-factor, --min-stability-margin) "
         "add to it. With "
         "--speed and/or --torque the whole operating envelope of a design is checked.",
@@ -101,7 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--fail-on",
         action="append",
-        choices=["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts"],
+        choices=["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"],
         help="repeatable",
     )
     p.add_argument("--speed", metavar="LOW:HIGH", help="driver speeds: rpm, or with units")
@@ -113,7 +115,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "(µm, or with a unit: 20um, 0.02mm)")  # fmt: skip
     p.add_argument("--max-dynamic-factor", type=float, default=None, metavar="F",
                    help="fail where the largest dynamic mesh force exceeds F times the static "
-                   "force (envelope checks)")  # fmt: skip
+                   "force")  # fmt: skip
     p.add_argument("--starts", type=int, default=None, metavar="N",
                    help="envelope checks: basin starts per operating point (default 16; 1: "
                    "the settings' own start only)")  # fmt: skip
@@ -131,7 +133,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         metavar="X",
         help="fail when the response is periodic and its Floquet stability margin "
-        "1 - max |lambda| is below X (or unavailable)",
+        "1 - max |lambda| is below X (or unavailable); one design only, not an envelope",
     )
     p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
 
@@ -146,7 +148,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("sweep", help="run a sweep here, no server: JSON, CSV and PNG")
     p.add_argument("file", help="JSON file holding a sweep request (as POST /v1/sweeps), or -")
-    p.add_argument("--out", default=".", help="directory for the outputs (default .)")
+    p.add_argument("--out", default=".", help="directory for the outputs (default .); - writes "
+                   "the result to standard output instead")  # fmt: skip
+    p.add_argument("--format", choices=["json", "csv"], default="json",
+                   help="with --out -: the JSON result (default) or the CSV table")  # fmt: skip
     p.set_defaults(func=lazy("gearengine.cli.sweep", "cmd_sweep"))
 
     p = sub.add_parser("convert", help="a design in physical units: parameters, derivations, rpm")

@@ -1,7 +1,10 @@
-"""``gearengine sweep FILE [--out DIR]``: run a sweep in this process, without a server.
+"""``gearengine sweep FILE [--out DIR|-] [--format json|csv]``: run a sweep in this process,
+without a server.
 
 Writes ``STEM.json`` (the API's result document), ``STEM.csv`` and ``STEM.png`` into DIR, STEM
-being FILE's name without extension; a progress bar goes to standard error.
+being FILE's name without extension; ``--out -`` writes only the JSON document (or with
+``--format csv`` the CSV) to standard output. Progress goes to standard error: a bar on a
+terminal, plain lines otherwise.
 """
 
 from __future__ import annotations
@@ -54,8 +57,25 @@ def read_sweep(path: str) -> SweepRequest:
     return validated_input(validated, read_document(path), path)
 
 
+def progress(start: float, label: str) -> Callable[[int, int], None]:
+    """Progress on standard error: a bar on a terminal, plain lines (every 10 %) when stderr is
+    a file or a CI log, which a carriage return would litter."""
+    if sys.stderr.isatty():
+        return progress_bar(start)
+    shown = [-1]
+
+    def line(done: int, total: int) -> None:
+        tenth = 10 * done // max(total, 1)
+        if tenth > shown[0]:
+            shown[0] = tenth
+            elapsed = time.monotonic() - start
+            print(f"{label}: {done}/{total} points, {elapsed:.1f} s", file=sys.stderr)
+
+    return line
+
+
 def progress_bar(start: float) -> Callable[[int, int], None]:
-    """A callback drawing ``[#####     ] done/total points, seconds`` on stderr."""
+    """A callback drawing ``[#####     ] done/total points, seconds`` on a terminal's stderr."""
 
     def draw(done: int, total: int) -> None:
         filled = BAR * done // max(total, 1)
@@ -74,12 +94,15 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 def _sweep(args: argparse.Namespace) -> int:
     request = read_sweep(args.file)
+    stem = "sweep" if args.file == "-" else Path(args.file).stem
+    result = run_local(request, progress(time.monotonic(), stem), workers=os.cpu_count() or 1)
+    csv = to_csv(result, request.outputs, design=request.design is not None)
+    if args.out == "-":  # stream one document to standard output, no files
+        sys.stdout.write("".join(csv) if args.format == "csv" else dumps(result) + "\n")
+        return EXIT_OK
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    stem = "sweep" if args.file == "-" else Path(args.file).stem
-    result = run_local(request, progress_bar(time.monotonic()), workers=os.cpu_count() or 1)
     (out / f"{stem}.json").write_text(dumps(result))
-    csv = to_csv(result, request.outputs, design=request.design is not None)
     (out / f"{stem}.csv").write_text("".join(csv))
     (out / f"{stem}.png").write_bytes(
         sweep_figure(request, result.points, "png", result.bifurcations)

@@ -17,13 +17,13 @@ from matplotlib.axes import Axes
 from matplotlib.colors import TwoSlopeNorm
 from matplotlib.figure import Figure
 
-from gearengine.homoclinic.boundary import chaos_intervals_from, flips
+from gearengine.homoclinic.boundary import chaos_intervals_from, flips, strength_at
+from gearengine.homoclinic.grid import strength_grid
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
 from gearengine.plots.envelope import axis_label, envelope_map
-from gearengine.plots.strength_grid import strength_grid
 from gearengine.plots.style import LLE_LABEL, SYMBOLS, ImageFormat, figure_bytes
-from gearengine.sweeps.axes import display_unit, is_dimensionless
+from gearengine.sweeps.axes import display_unit, is_dimensionless, is_integer_field
 from gearengine.sweeps.export import agreement_table
 from gearengine.sweeps.request import SweepRequest
 from gearengine.sweeps.results import SweepBifurcation, SweepPoint
@@ -124,8 +124,14 @@ def bifurcation(
         return request.point({name: v})
 
     # the boundary of the points themselves: each point's verdict is /v1/melnikov's for it
-    crossings = flips(path, lo, hi, PHYSICAL_BOUNDARY_GRID if physical else BOUNDARY_GRID)
-    chaos = chaos_intervals_from(path, [lo, *crossings, hi])
+    if request.design is not None and is_integer_field(request.design, name):
+        # a tooth count has no values between the grid's: no threshold to locate, only the
+        # verdict of each whole value, shaded over its unit cell
+        crossings: list[float] = []
+        chaos = [[v - 0.5, v + 0.5] for v in grid if strength_at(path(v)) > 0.0]
+    else:
+        crossings = flips(path, lo, hi, PHYSICAL_BOUNDARY_GRID if physical else BOUNDARY_GRID)
+        chaos = chaos_intervals_from(path, [lo, *crossings, hi])
     symbol = axis_label(name) if physical else SYMBOLS[name]
     for ax in (top, bottom):
         for e0, e1 in chaos:
@@ -174,7 +180,8 @@ def chaos_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
     fig.colorbar(mesh, ax=ax, label=LLE_LABEL + "; grey: diverged", shrink=0.9)
     g0 = np.linspace(v0.min(), v0.max(), BOUNDARY_GRID)
     g1 = np.linspace(v1.min(), v1.max(), BOUNDARY_GRID)
-    strength = strength_grid(request, g0, g1)
+    assert request.params is not None
+    strength = strength_grid(request.params, (ax0.parameter, ax1.parameter), g0, g1, request.point)
     if np.nanmin(strength) < 0.0 < np.nanmax(strength):
         ax.contourf(g0, g1, strength, levels=[0.0, np.inf], colors="none", hatches=["//"])
         ax.contour(g0, g1, strength, levels=[0.0], colors="black", linewidths=1.6)

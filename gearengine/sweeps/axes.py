@@ -80,16 +80,31 @@ def in_display_unit(path: str, si: float) -> float:
 
 
 def _set(tree: dict[str, Any], path: str, value: object) -> None:
+    """Set the field at ``path``; a whole float on an integer field (a grid value 19.0 of
+    ``driver.teeth``) is set as that integer, since the design refuses floats there."""
     *head, last = path.split(".")
     node: Any = tree
     for key in head:
         node = node[int(key)] if key.isdigit() else node[key]
-    if last.isdigit():
-        node[int(last)] = value
-    elif isinstance(node, dict) and last in node:
-        node[last] = value
-    else:
+    key: int | str = int(last) if last.isdigit() else last
+    if not last.isdigit() and not (isinstance(node, dict) and last in node):
         raise KeyError(last)
+    if _is_int(node[key]) and isinstance(value, float) and value.is_integer():
+        value = int(value)
+    node[key] = value
+
+
+def _is_int(value: object) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def is_integer_field(design: Design, path: str) -> bool:
+    """True when the design's field at ``path`` holds an integer (``driver.teeth``): its axis
+    values must be whole numbers."""
+    try:
+        return _is_int(_get(design.model_dump(), path))
+    except (KeyError, IndexError, TypeError):
+        return False
 
 
 def _get(tree: Any, path: str) -> Any:

@@ -4,7 +4,8 @@ that GitHub, GitLab and Jenkins show.
 
 Rules (``Rules``): ``fail_on`` classes (``chaotic`` fails chaotic and diverged points, ordered
 periodic < quasi_periodic < chaotic < diverged as in ``numerics.classify.SEVERITY``),
-``melnikov`` (the criterion allows chaos), ``impacts`` (back-flank contact); and numeric limits,
+``melnikov`` (the criterion allows chaos), ``impacts`` (back-flank contact), ``separation`` (the
+teeth separate: drive-flank impacts, or impacts on both flanks); and numeric limits,
 which add to the classes instead of replacing them: ``max_lle`` (per unit tau), ``max_dte_um``
 (dynamic transmission error peak to peak, µm), ``max_dynamic_factor`` (largest mesh force over
 the static force F~_m). With basins (``settings.basins``) every attractor of a point whose
@@ -30,7 +31,7 @@ from gearengine.sweeps.results import (
 )
 from gearengine.sweeps.windows import SPEED, runs
 
-FailOn = Literal["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts"]
+FailOn = Literal["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"]
 
 
 class Rules(BaseModel):
@@ -40,7 +41,8 @@ class Rules(BaseModel):
 
     fail_on: list[FailOn] = Field(
         default_factory=lambda: ["chaotic"],
-        description="Classes that fail (and anything worse), melnikov, impacts.",
+        description="Classes that fail (and anything worse), melnikov, impacts (back-flank "
+        "contact), separation (the teeth separate: drive-flank or back-flank impacts).",
     )
     max_lle: float | None = Field(None, description="Largest LLE allowed, per unit tau.")
     max_dte_um: float | None = Field(None, description="Largest DTE peak to peak [µm].")
@@ -56,6 +58,10 @@ class Rules(BaseModel):
     )
 
 
+SEPARATING = ("single_sided", "double_sided")
+"""Impact regimes in which the teeth separate (``numerics.diagnostics.impact_regime``)."""
+
+
 def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
     """The rules one point breaks, as short labels ("chaotic", "DTE > 20 µm", ...)."""
     out = []
@@ -67,6 +73,8 @@ def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
         out.append("Melnikov: chaos possible")
     if "impacts" in rules.fail_on and p.impact_regime == "double_sided":
         out.append("back-flank impacts")
+    if "separation" in rules.fail_on and p.impact_regime in SEPARATING:
+        out.append("tooth separation")
     if rules.max_lle is not None and (p.lle is None or p.lle > rules.max_lle):
         out.append(f"LLE > {rules.max_lle:g}")
     dte = (p.physical or {}).get("dte")

@@ -30,6 +30,7 @@ from gearengine.sweeps.axes import (
     axis_problem,
     changes_nothing,
     is_dimensionless,
+    is_integer_field,
     point_params,
     si_value,
 )
@@ -203,6 +204,13 @@ def request_errors(request: SweepRequest, max_points: int | None = None) -> list
     if errors:
         return errors
     grids = request.grids()
+    for i, (axis, grid) in enumerate(zip(request.axes, grids, strict=True)):
+        integer = request.design is not None and is_integer_field(request.design, axis.parameter)
+        if integer and not all(float(v).is_integer() for v in grid):
+            add(("axes", i, "num"), f"{axis.parameter} is an integer: choose num so that "
+                "(stop - start) / (num - 1) is a whole number", axis.num)  # fmt: skip
+    if errors:
+        return errors
     base = {a.parameter: g[0] for a, g in zip(request.axes, grids, strict=True)}
     for i, (axis, grid) in enumerate(zip(request.axes, grids, strict=True)):
         for end, value in (("start", grid[0]), ("stop", grid[-1])):

@@ -3,8 +3,9 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.numerics.results import Attractor, BasinCounts
@@ -175,3 +176,27 @@ class SweepResult(BaseModel):
         description="Sweeps over the driver speed: per level of the other axis, the speed "
         "intervals [rpm] of each response, of impacts and of Melnikov chaos; null otherwise.",
     )
+
+    def summary(self) -> str:
+        """The result in one line: axes, points, counts of each response, Melnikov."""
+        from gearengine.sweeps.tables import summary
+
+        return summary(self)
+
+    def __repr__(self) -> str:
+        return f"SweepResult({self.summary()!r})"
+
+    __str__ = summary
+
+    def to_pandas(self) -> Any:
+        """A ``pandas.DataFrame`` with the CSV's columns (``sweeps.tables.to_pandas``); pandas
+        is an optional extra: ``pip install 'gearchaos[pandas]'``."""
+        from gearengine.sweeps.tables import to_pandas
+
+        return to_pandas(self)
+
+    def grid(self, field: str, branch: str | None = None) -> tuple[list[np.ndarray], np.ndarray]:
+        """(axis values, values of ``field``) as numpy arrays (``sweeps.tables.grid``)."""
+        from gearengine.sweeps.tables import grid
+
+        return grid(self, field, branch)

@@ -1,8 +1,9 @@
 """Where chunks run: a local process pool or a Dask distributed cluster.
 
 Both hand back futures with ``done()``, ``result()`` and ``add_done_callback``; the dispatcher
-treats them alike. Workers only compute (``gearengine.sweeps.compute_chunk_json``); they never
-touch the store, so a worker that dies or hangs cannot corrupt it.
+treats them alike. Workers only compute (``gearengine.jobs.compute_chunk_json`` with the
+claim's kind, whatever the kind); they never touch the store, so a worker that dies or hangs
+cannot corrupt it.
 """
 
 from __future__ import annotations
@@ -13,8 +14,9 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Protocol
 
-from gearengine.sweeps import compute_chunk_json
+from gearengine.jobs import compute_chunk_json
 from service.jobs.store import Claim
+from service.lifetime import exit_with_parent
 
 
 class Backend(Protocol):
@@ -35,8 +37,11 @@ class Backend(Protocol):
         """Stop every worker, dropping unfinished work."""
 
 
-def _init_worker(threads: int) -> None:
-    """Pool worker start-up: share the cores fairly and load the kernels once."""
+def _init_worker(threads: int, parent: int) -> None:
+    """Pool worker start-up: end with the server (``parent``: a kill -9 of it must not leave
+    this process, and the resource tracker it holds open, behind), share the cores fairly and
+    load the kernels once."""
+    exit_with_parent(parent)
     import numba
 
     from gearengine.numerics.simulation import warm_up
@@ -64,7 +69,7 @@ class LocalPool:
             self.workers,
             mp_context=multiprocessing.get_context("spawn"),
             initializer=_init_worker,
-            initargs=(threads,),
+            initargs=(threads, os.getpid()),
         )
         # the workers start and warm up in the background (the server is ready meanwhile);
         # capacity() stays 0, so no chunk is claimed, until every one of them has answered
@@ -86,7 +91,7 @@ class LocalPool:
 
     def submit(self, claim: Claim) -> Future[str]:
         return self._pool.submit(
-            compute_chunk_json, claim.request_json, claim.index, claim.chunk_points
+            compute_chunk_json, claim.kind, claim.request_json, claim.index, claim.chunk_points
         )
 
     def recover(self, error: BaseException) -> None:
@@ -124,10 +129,11 @@ class DaskCluster:
     def submit(self, claim: Claim) -> Any:
         return self.client.submit(
             compute_chunk_json,
+            claim.kind,
             claim.request_json,
             claim.index,
             claim.chunk_points,
-            key=f"sweep-{claim.job_id}-{claim.index}-{claim.attempt}",
+            key=f"{claim.kind}-{claim.job_id}-{claim.index}-{claim.attempt}",
             pure=False,
         )
 

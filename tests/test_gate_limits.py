@@ -1,0 +1,106 @@
+"""Every limit of ``gearengine check`` on one design and on an envelope, or refused: none may be
+ignored (issue 26, items 2, 5 and 8)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import pytest
+
+from gearengine.cli.documents import InvalidInputError
+from gearengine.cli.envelope import envelope_request
+from gearengine.cli.main import build_parser, main
+from gearengine.sweeps.gate import Rules, point_failures
+from gearengine.sweeps.results import SweepPoint
+from tests.conftest import PAPER_PARAMS, ROOT
+
+LIGHT = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
+
+
+@pytest.fixture(scope="module")
+def geometry(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The README's geometry-form design (18/30 teeth, 3 mm, ISO 6336 stiffness) at 3000 rpm:
+    periodic 1T, teeth always in contact, DTE about 5 µm, dynamic factor about 1.07."""
+    doc = json.loads((ROOT / "examples" / "design-geometry.json").read_text())
+    path = tmp_path_factory.mktemp("gate") / "geometry.json"
+    path.write_text(json.dumps({**doc, "settings": LIGHT}))
+    return path
+
+
+def test_physical_limits_judge_one_design(geometry: Path, capsys: pytest.CaptureFixture) -> None:
+    """--max-dynamic-factor used to be ignored on one design (PASS with 1.07 > 1.01) and
+    --max-dte refused it (exit 2); both now judge the design's own response."""
+    assert main(["check", str(geometry)]) == 0
+    out = capsys.readouterr().out
+    factor = float(out.split("dynamic factor ")[1].split(";")[0])
+    dte = float(out.split("DTE ")[1].split(" µm")[0])
+    assert 1.01 < factor < 1.2 and 2.0 < dte < 20.0
+    assert main(["check", str(geometry), "--max-dynamic-factor", "1.01"]) == 1
+    assert "[dynamic factor > 1.01]" in capsys.readouterr().out
+    assert main(["check", str(geometry), "--max-dynamic-factor", "1.5"]) == 0
+    assert main(["check", str(geometry), "--max-dte", "2um"]) == 1
+    assert "[DTE > 2 µm]" in capsys.readouterr().out
+    assert main(["check", str(geometry), "--max-dte", "0.02mm"]) == 0
+
+
+def test_limits_that_cannot_apply_are_refused(
+    geometry: Path, tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """Refused before any compute (exit 2), never silently ignored."""
+    params = tmp_path / "params.json"
+    params.write_text(json.dumps({"params": PAPER_PARAMS}))
+    assert main(["check", str(params), "--max-dynamic-factor", "1.5"]) == 2
+    assert "--max-dynamic-factor need a design in physical units" in capsys.readouterr().err
+    assert main(["check", str(params), "--max-dte", "2um"]) == 2
+    # the stability margin used to be dropped without a word on an envelope (exit 0)
+    argv = ["check", str(geometry), "--speed", "1000:2000", "--min-stability-margin", "0.9"]
+    assert main(argv) == 2
+    assert "--min-stability-margin checks one design" in capsys.readouterr().err
+
+
+def test_separation_fails_drive_flank_impacts() -> None:
+    """--fail-on impacts counts back-flank contact only; separation counts every regime in
+    which the teeth come apart (drive-flank impacts too)."""
+
+    def point(regime: str) -> SweepPoint:
+        return SweepPoint(values={}, branch=None, classification="periodic", impact_regime=regime)
+
+    separation = Rules(fail_on=["diverged", "separation"])
+    impacts = Rules(fail_on=["diverged", "impacts"])
+    assert point_failures(point("single_sided"), separation) == ["tooth separation"]
+    assert point_failures(point("double_sided"), separation) == ["tooth separation"]
+    assert point_failures(point("no_impact"), separation) == []
+    assert point_failures(point("single_sided"), impacts) == []
+    args = build_parser().parse_args(["check", "x.json", "--fail-on", "separation"])
+    assert args.fail_on == ["separation"]
+
+
+def test_envelope_pass_line_names_impact_and_melnikov_windows(
+    geometry: Path, capsys: pytest.CaptureFixture
+) -> None:
+    argv = ["check", str(geometry), "--speed", "1000:3000", "--speed-points", "3",
+            "--fail-on", "separation"]  # fmt: skip
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    lines = captured.out.splitlines()
+    assert lines[0].startswith("PASS: 0 of 3 operating points")
+    assert lines[1] == "  windows: teeth always in contact; Melnikov: chaos possible nowhere"
+    assert "settings: 60 + 60 periods, 128 steps per period" in captured.err
+
+
+def test_envelope_settings_merge_over_the_light_defaults(tmp_path: Path) -> None:
+    """A settings block used to replace the light defaults with the full analysis ones (500 +
+    500 periods per start) when it gave only random starts."""
+    doc = json.loads((ROOT / "examples" / "design-geometry.json").read_text())
+    starts = {"count": 4, "box": [[-1.5, 1.5], [-0.5, 0.5]], "seed": 3}
+    path = tmp_path / "starts.json"
+    path.write_text(json.dumps({**doc, "settings": {"random_initial_states": starts}}))
+    args = argparse.Namespace(file=str(path), speed="1000:2000", speed_points=3, torque=None)
+    settings = envelope_request(args).settings
+    assert (settings.transient_periods, settings.record_periods) == (60, 60)
+    assert settings.steps_per_period == 128 and settings.random_initial_states.count == 4
+    path.write_text(json.dumps({**doc, "settings": [1]}))
+    with pytest.raises(InvalidInputError, match="settings must be an object"):
+        envelope_request(args)
