@@ -97,15 +97,20 @@ def test_basin_fractions_agree_with_gear_ref(tmp_path_factory: pytest.TempPathFa
     with ThreadPoolExecutor(2) as pool:
         runs = list(pool.map(lambda s: gear_ref_start(exe, args, s), starts))
     groups = reference_groups(runs)
-    assert counts.starts == 64 and counts.diverged == counts.unsettled == 0
+    assert counts.starts == 64 and counts.diverged == 0
     assert len(found) >= 3 and {a.classification for a in found} == {"periodic", "chaotic"}
     assert len(groups) == len(found)
     n = len(starts)
+    chaotic = next(k for k, a in enumerate(found) if a.classification == "chaotic")
     for g in groups:
-        k = g["members"][0]
+        k = next(m for m in g["members"] if counts.labels[m] >= 0)
         mine = found[counts.labels[k]]
-        assert [counts.labels[m] for m in g["members"]] == [counts.labels[k]] * len(g["members"])
         assert (mine.period or 0) == g["period"]
+        # a start on the chaotic attractor whose 60-interval LLE is not clearly positive is
+        # unsettled here (the kernels' forcing table and gear_ref's cos differ by rounding,
+        # and chaotic trajectories part): only there may the two disagree
+        differ = [m for m in g["members"] if counts.labels[m] != counts.labels[k]]
+        assert all(g["period"] == 0 and counts.labels[m] == -2 for m in differ)
         lo, hi = mine.interval
         assert lo <= len(g["members"]) / n <= hi
         lle = float(np.mean(g["lles"]))
@@ -113,6 +118,8 @@ def test_basin_fractions_agree_with_gear_ref(tmp_path_factory: pytest.TempPathFa
         if g["period"]:
             assert np.allclose(sorted(map(tuple, mine.strobes)), sorted(map(tuple, g["cycle"])),
                                atol=1e-6)  # fmt: skip
+    assert counts.unsettled <= 2 and found[chaotic].count + counts.unsettled == len(
+        next(g for g in groups if g["period"] == 0)["members"])  # fmt: skip
 
 
 def test_headline_is_the_worst_attractor_and_the_summary_names_the_others() -> None:
@@ -124,9 +131,9 @@ def test_headline_is_the_worst_attractor_and_the_summary_names_the_others() -> N
     assert result.verdict.chaotic and result.verdict.decided_by is not None
     assert result.verdict.decided_by.startswith("chaotic, double-sided impacts from")
     assert "of 64 starts" in result.verdict.summary and "periodic 1T" in result.verdict.summary
-    assert sum(a.count for a in num.attractors) == 64
+    assert sum(a.count for a in num.attractors) + num.basins.unsettled == 64
     assert all(a.dte_um is not None and a.dynamic_factor is not None for a in num.attractors)
-    assert sum(a.fraction for a in num.attractors) == pytest.approx(1.0)
+    assert sum(a.fraction for a in num.attractors) == pytest.approx(1 - num.basins.unsettled / 64)
     # a threshold above the chaotic basin leaves the verdict to the worst larger basin
     settings = {**SETTINGS, "basins": {"starts": 64, "min_fraction": worst.fraction}}
     request = multistable().model_copy(
