@@ -14,9 +14,11 @@ from matplotlib.patches import Patch
 from gearengine.analysis import AnalysisResult
 from gearengine.plots.style import ImageFormat, figure_bytes
 
-PALETTE = ["#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2",
-           "#17becf", "#bcbd22", "#7f7f7f"]  # fmt: skip
-"""Colours of the attractors in their order (worst first); more attractors cycle through it."""
+CHAOTIC_COLOURS = ["#d62728", "#ff9896", "#8c1c13"]
+"""Colours of chaotic (and quasi-periodic) attractors, in their order: reds, as on the maps."""
+REGULAR_COLOURS = ["#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
+                   "#bcbd22"]  # fmt: skip
+"""Colours of periodic attractors in their order; more attractors cycle through them."""
 DIVERGED_COLOUR, UNSETTLED_COLOUR = "#000000", "#d9d9d9"
 
 
@@ -40,7 +42,12 @@ def basins_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
         raise ValueError("settings.basins: the basin picture needs an analysis with basins")
     counts, found = num.basins, num.attractors
     fx, fv, xlabel, vlabel = basin_scales(result)
-    colours = [PALETTE[k % len(PALETTE)] for k in range(len(found))]
+    colours, seen = [], {True: 0, False: 0}
+    for a in found:
+        regular = a.classification == "periodic"
+        palette = REGULAR_COLOURS if regular else CHAOTIC_COLOURS
+        colours.append(palette[seen[regular] % len(palette)])
+        seen[regular] += 1
     cmap = ListedColormap([UNSETTLED_COLOUR, DIVERGED_COLOUR, *colours])
     index = np.asarray(counts.labels) + 2  # unsettled (-2) 0, diverged (-1) 1, attractor k k + 2
     (x0, x1), (v0, v1) = counts.box
