@@ -3,6 +3,7 @@ next to the Melnikov verdict, its figure, and the basin picture of its attractor
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Literal
 
 from fastapi import APIRouter, Depends, Request, Response
@@ -23,6 +24,23 @@ def check_analysis_budget(request: Request, body: AnalysisRequest) -> None:
     synchronous budget; names settings.basins.starts when basins are asked for."""
     field = "settings" if body.settings.basins is None else "settings.basins.starts"
     request.app.state.limits.check_budget(work(body.params, body.settings), field=field)
+
+
+async def _figure(
+    request: Request,
+    body: AnalysisRequest,
+    fmt: Literal["png", "svg"],
+    route: str,
+    draw: Callable[[AnalysisResult, Literal["png", "svg"]], bytes],
+) -> Response:
+    """A figure of the analysis of ``body``: budget checked first, then cached by route."""
+    check_analysis_budget(request, body)
+    return await cached_compute(
+        request,
+        f"{route}.{fmt}",
+        body.model_dump_json(),
+        lambda: (draw(_analysis(request, body), fmt), MEDIA_TYPES[fmt]),
+    )
 
 
 def _analysis(request: Request, body: AnalysisRequest) -> AnalysisResult:
@@ -64,14 +82,8 @@ async def post_analysis_plot(
 ) -> Response:
     """The paper's Figs. 7-11 for any design: (a) time history, (b) phase plane with the
     Poincaré points, (c) Poincaré section, (d) amplitude spectrum."""
-    fmt = image_format(request, format)
-    check_analysis_budget(request, body)
-    return await cached_compute(
-        request,
-        f"analyses/plot.{fmt}",
-        body.model_dump_json(),
-        lambda: (analysis_figure(_analysis(request, body), fmt), MEDIA_TYPES[fmt]),
-    )
+    return await _figure(request, body, image_format(request, format), "analyses/plot",
+                         analysis_figure)  # fmt: skip
 
 
 @router.post(
@@ -91,11 +103,5 @@ async def post_basins_plot(
     if body.settings.basins is None:
         settings = body.settings.model_copy(update={"basins": BasinSettings()})
         body = body.model_copy(update={"settings": settings})
-    fmt = image_format(request, format)
-    check_analysis_budget(request, body)
-    return await cached_compute(
-        request,
-        f"analyses/basins/plot.{fmt}",
-        body.model_dump_json(),
-        lambda: (basins_figure(_analysis(request, body), fmt), MEDIA_TYPES[fmt]),
-    )
+    return await _figure(request, body, image_format(request, format), "analyses/basins/plot",
+                         basins_figure)  # fmt: skip
