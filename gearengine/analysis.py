@@ -4,8 +4,9 @@ The Melnikov criterion is first order in the perturbation and only *necessary* f
 (a transverse homoclinic tangle may give transient chaos and a periodic attractor). The two
 verdicts are consistent unless the numerics find chaos where Melnikov rules it out.
 
-This module joins the melnikov and numerics rooms, and with ``settings.basins`` the
-attractors of ``ensembles.attractors``; it imports nothing else of the engine.
+This module joins the homoclinic (Melnikov) and numerics rooms on a request of the model room,
+and adds the engineering block (``engineering``: answers in gear units) for a design.
+With ``settings.basins`` it adds the attractors of ``ensembles.attractors``.
 """
 
 from __future__ import annotations
@@ -15,10 +16,11 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.engineering import IMPACT_WORDS, Engineering, engineering
-from gearengine.ensembles.attractors import Scales, attractors, coexistence, headline
+from gearengine.ensembles.attractors import attractors, coexistence, headline
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
 from gearengine.homoclinic.verdict import melnikov
 from gearengine.model.design import EXAMPLE_DESIGN, Design
+from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
@@ -88,8 +90,10 @@ class AnalysisResult(BaseModel):
         kind = f"periodic {num.period}T" if num.period else num.classification
         lle = "LLE n/a" if num.lle is None else f"LLE {num.lle:+.4g} ± {num.lle_stderr or 0:.2g}"
         contact = IMPACT_WORDS.get(num.impact_regime or "", "no verdict on impacts")
-        mel = {True: "possible", False: "not possible", None: "n/a"}[self.melnikov.chaos_possible]
-        line = f"{kind} ({lle} per unit tau, {contact}), Melnikov: chaos {mel}"
+        mel = {True: "chaos possible", False: "chaos not possible"}.get(
+            self.melnikov.chaos_possible, "not applicable, not judged"
+        )
+        line = f"{kind} ({lle} per unit tau, {contact}), Melnikov: {mel}"
         eng = self.engineering
         if eng is not None:
             resp = eng.response
@@ -99,7 +103,11 @@ class AnalysisResult(BaseModel):
                 line += f", dynamic factor {resp.dynamic_factor:.3g}"
             lo, hi = eng.speed_range_rpm
             spans = ", ".join(f"{a:,.0f}-{b:,.0f}" for a, b in eng.speed_windows_rpm) or "nowhere"
-            line += f"; Melnikov chaos possible at {spans} rpm (scanned {lo:,.0f}-{hi:,.0f} rpm)"
+            scanned = f"{spans} rpm (scanned {lo:,.0f}-{hi:,.0f} rpm)"
+            if eng.speed_windows_note and not eng.speed_windows_rpm:
+                line += f"; Melnikov speed windows: {eng.speed_windows_note}"
+            else:
+                line += f"; Melnikov chaos possible at {scanned}"
         return line
 
     def __repr__(self) -> str:  # the full document is ~85 kB (time history, spectrum)
@@ -174,7 +182,7 @@ def analyze(
     conv = request.conversion
     basins = request.settings.basins
     if basins is not None:
-        scales = None if conv is None else Scales.of(conv)
+        scales = None if conv is None else conv.scales
         found, counts = attractors(request.params, request.settings, scales)
         num = num.model_copy(update={"attractors": found, "basins": counts})
     min_fraction = 0.0 if basins is None else basins.min_fraction
@@ -216,7 +224,7 @@ def convert(request: DesignRequest) -> DesignReport:
     """The conversion of a design with its engineering block (Melnikov windows, thresholds)."""
     conv = request.conversion
     if conv is None:
-        raise ValueError("design: give a design (physical units) to convert")
+        raise InputError("design", "give a design (physical units) to convert")
     mel = melnikov(conv.params)
     return DesignReport(
         conversion=conv, engineering=engineering(conv, request.speed_rpm_range(), mel)

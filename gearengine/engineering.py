@@ -6,14 +6,23 @@ gives what a gearbox engineer asks:
 * ``speed_windows_rpm``: the driver speeds at which the Melnikov criterion allows chaos at the
   design's torque. A change of running speed scales every excitation frequency together (their
   ratios fixed; amplitudes F~_er = e_r / b and F~_pr do not depend on speed), so the windows are
-  the sign changes of the sign-change strength along that scaling, located by brentq;
-* the critical value of each control parameter in its unit, and ``margin_to_chaos``: positive
-  on the safe side, negative inside the chaos-possible region (Eqs. 23, 24 generalised);
+  the sign changes of the sign-change strength along that scaling, located by brentq; the scan
+  runs on past the requested range until the last window closes, or to ``WINDOW_BOUND`` times
+  the design speed, where an open window is reported as open-ended;
+* ``critical_torque_nm``: the mean driver torque T_crit at which the static mesh force reaches
+  F_crit of the cubic fit; above it the unperturbed system has no saddle and the criterion does
+  not apply (``docs/melnikov-under-load.md``);
+* the critical value of each control parameter in its unit, and ``margin_to_chaos``: the
+  threshold's margin in that unit, positive on the safe side, negative inside the
+  chaos-possible region (Eqs. 23, 24 generalised);
 * for analyses, the response: dynamic transmission error b (x_max - x_min), the dynamic mesh
   force b k_m [K(t) f_h(x) + 2 mu~ x'] and the dynamic factor (max force / static force F^_m),
   the fractions of time with the teeth apart (|x| <= 1) and on the back flank (x < -1), the
   response period and the dominant response frequency;
 * ``summary``: plain sentences for a design review.
+
+Every dimensionless number crosses to gear units through ``model.units.to_physical`` (the
+``OUTPUTS`` table) with the design's ``Scales``.
 """
 
 from __future__ import annotations
@@ -24,16 +33,21 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.homoclinic.boundary import chaos_intervals
+from gearengine.homoclinic.coefficients import MeanLoad
 from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
+from gearengine.homoclinic.thresholds import strength_at
 from gearengine.model.aliases import with_speed_factor
-from gearengine.model.backlash import LAWS
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import Derived, DesignConversion
-from gearengine.numerics.forcing import forcing_coefficients
+from gearengine.model.units import OUTPUTS, Scales, in_si, response_values, to_physical
 from gearengine.numerics.results import NumericsResult
 
 WINDOW_SCAN = 240
 """Speeds sampled in the Melnikov window scan before brentq refines each edge."""
+WINDOW_BOUND = 10.0
+"""The window scan goes on past the requested range, while the last window is open, up to this
+multiple of the design speed (beyond which no gear pair of the design runs): a window still
+open there is reported open-ended."""
 
 
 class _Doc(BaseModel):
@@ -49,7 +63,7 @@ class Critical(_Doc):
     nearest: float | None = Field(description="The critical value nearest to the design.")
     margin_to_chaos: float | None = Field(
         description="|value - nearest|, positive on the safe side, negative inside the "
-        "chaos-possible region."
+        "chaos-possible region (the threshold's margin in this unit)."
     )
     relative_margin: float | None = Field(description="margin_to_chaos / |nearest|.")
 
@@ -90,7 +104,19 @@ class Engineering(_Doc):
     speed_range_rpm: list[float] = Field(description="Driver speeds scanned [rpm].")
     speed_windows_rpm: list[list[float]] = Field(
         description="[low, high] driver speeds [rpm] where the Melnikov criterion allows chaos "
-        "at this torque (every excitation frequency scales with speed)."
+        "at this torque (every excitation frequency scales with speed); empty where the "
+        "criterion does not apply (above the critical torque)."
+    )
+    speed_windows_note: str | None = Field(
+        None,
+        description="Why there are no windows (not applicable above T_crit), or which window is "
+        "open-ended (still open at the end of the scan).",
+    )
+    critical_torque_nm: float | None = Field(
+        None,
+        description="T_crit [N m]: the mean driver torque below which the Melnikov criterion "
+        "applies (the static mesh force reaches F_crit of the cubic fit there; null without "
+        "one).",
     )
     critical: dict[str, Critical] = Field(description="Thresholds in physical units.")
     derived: dict[str, Derived]
@@ -99,11 +125,35 @@ class Engineering(_Doc):
     notes: list[str]
 
 
-def speed_windows(params: GearParams, speed_rpm: float, lo: float, hi: float) -> list[list[float]]:
+def _speed_path(params: GearParams, speed_rpm: float):
+    """The design at ``speed_rpm`` moved to each speed [rpm] (every frequency scaled)."""
+    return lambda rpm: with_speed_factor(params, rpm / speed_rpm)
+
+
+def speed_windows(
+    params: GearParams,
+    speed_rpm: float,
+    lo: float,
+    hi: float,
+    mean_load: MeanLoad = "unperturbed",
+    num: int = WINDOW_SCAN,
+) -> list[list[float]]:
     """Driver speeds [rpm] in [lo, hi] where some Melnikov branch changes sign: the design at
     ``speed_rpm`` moved to each speed by scaling every excitation frequency together."""
-    return chaos_intervals(lambda rpm: with_speed_factor(params, rpm / speed_rpm), lo, hi,
-                           WINDOW_SCAN)  # fmt: skip
+    return chaos_intervals(_speed_path(params, speed_rpm), lo, hi, num, mean_load)
+
+
+def window_scan_end(
+    params: GearParams, speed_rpm: float, hi: float, mean_load: MeanLoad = "unperturbed"
+) -> float:
+    """The end [rpm] of the window scan: ``hi``, doubled while the criterion still allows chaos
+    there, up to ``WINDOW_BOUND`` times the design speed."""
+    path = _speed_path(params, speed_rpm)
+    bound = max(hi, WINDOW_BOUND * speed_rpm)
+    top = hi
+    while top < bound and strength_at(path(top), mean_load=mean_load) > 0.0:
+        top = min(2.0 * top, bound)
+    return top
 
 
 IMPACT_WORDS = {
@@ -112,95 +162,97 @@ IMPACT_WORDS = {
     "double_sided": "impacts on both flanks (back-flank contact)",
 }
 
-SCALES = {
-    "F_e1": ("transmission_error_amplitude", "um"),
-    "F_p1": ("torque_fluctuation_amplitude", "N*m"),
-    "mu": ("damping_ratio", "1"),
-    "k_p1": ("stiffness_variation_amplitude", "N/m"),
+CONTROLS = {
+    "F_e1": "transmission_error_amplitude",
+    "F_p1": "torque_fluctuation_amplitude",
+    "mu": "damping_ratio",
+    "k_p1": "stiffness_variation_amplitude",
 }
-"""Control parameter -> (engineering name, unit)."""
+"""Control parameter -> its output quantity (``model.units.OUTPUTS``), the engineering name."""
 
 
-def _to_physical(name: str, value: float, conv: DesignConversion) -> float:
-    """A dimensionless control parameter in its physical unit (Eq. 8 inverted)."""
-    if name == "F_e1":
-        return value * conv.half_backlash_m * 1e6  # e_1 = F~_e1 b, in µm
-    if name == "F_p1":
-        return value / conv.torque_gain  # T_p1 = F~_p1 / (m r_a / (I_a b k_m))
-    if name == "k_p1":
-        return 2.0 * value * conv.mesh_stiffness_n_per_m  # k_1 = 2 k_m k~_p1
-    return value  # mu~ = zeta
-
-
-def critical(name: str, t: ParameterThreshold, conv: DesignConversion) -> Critical:
-    """One threshold in physical units with its signed margin to chaos."""
-    unit = SCALES[name][1]
-    crit = [_to_physical(name, v, conv) for v in t.critical_values]
-    value = None if t.value is None else _to_physical(name, t.value, conv)
-    nearest = None if t.nearest is None else _to_physical(name, t.nearest, conv)
+def critical(name: str, t: ParameterThreshold, scales: Scales) -> Critical:
+    """One threshold in physical units with its signed margin to chaos (the threshold's
+    margin, positive on the safe side, in this unit: every map of ``to_physical`` is linear)."""
+    output = CONTROLS[name]
+    unit = OUTPUTS[output].unit
+    crit = [to_physical(output, v, scales) for v in t.critical_values]
+    value = None if t.value is None else to_physical(output, t.value, scales)
+    nearest = None if t.nearest is None else to_physical(output, t.nearest, scales)
     margin = rel = None
-    if value is not None and nearest is not None:
-        safe = any(
-            (lo is None or t.value >= lo) and (hi is None or t.value <= hi)  # type: ignore[operator]
-            for lo, hi in t.no_chaos
-        )
-        margin = (1.0 if safe else -1.0) * abs(value - nearest)
+    if value is not None and nearest is not None and t.margin is not None:
+        margin = math.copysign(abs(value - nearest), t.margin)
         rel = margin / abs(nearest) if nearest else None
     return Critical(unit=unit, value=value, critical_values=crit, nearest=nearest,
                     margin_to_chaos=margin, relative_margin=rel)  # fmt: skip
 
 
-def mesh_force(params: GearParams, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Dimensionless mesh force K(tau) f_h(x) + 2 mu~ x' at the samples (Eq. 9's left side)."""
-    co = forcing_coefficients(params)
-    stiffness = 1.0 + np.cos(np.multiply.outer(t, co.k_omega) + co.k_phase) @ co.k_amp
-    f_h = LAWS[params.backlash.model].f_h(params.backlash, x)
-    return stiffness * f_h + 2.0 * params.damping * v
+def critical_torque(conv: DesignConversion, mel: MelnikovResult) -> float | None:
+    """T_crit [N m]: the mean driver torque whose static mesh force T / r_a (balanced torques,
+    Eq. 7) reaches F_crit b k_m; None without a critical load (no cubic with a, c > 0)."""
+    if mel.critical_mean_force is None:
+        return None
+    r_a = float(conv.derived["base_radius_driver"].value)  # type: ignore[arg-type]
+    return to_physical("mesh_force", mel.critical_mean_force, conv.scales) * r_a
+
+
+def over_critical(conv: DesignConversion, mel: MelnikovResult) -> bool:
+    """True when the design's mean load leaves no saddle (|F~_m| >= F_crit, mean load in the
+    unperturbed system): the criterion does not apply at this torque."""
+    return (
+        mel.mean_load == "unperturbed"
+        and mel.critical_mean_force is not None
+        and abs(conv.params.mean_force) >= mel.critical_mean_force
+    )
+
+
+def load_words(conv: DesignConversion, f_crit: float, t_crit: float) -> str:
+    """Why the criterion does not apply at this torque (F~_m >= F_crit), in gear words."""
+    fm, b_um = conv.params.mean_force, to_physical("displacement", 1.0, conv.scales)
+    torque = t_crit * abs(fm) / f_crit  # the static force is proportional to the torque
+    return (
+        f"under {torque:,.3g} N*m the mesh deflects {abs(fm) * b_um:.3g} µm statically (half "
+        f"backlash {b_um:.3g} µm) and the teeth stay in contact, beyond the reach of the "
+        f"backlash nonlinearity's saddle, which exists only below the critical torque "
+        f"{t_crit:,.3g} N*m; the homoclinic mechanism of chaos does not exist at this load; the "
+        "numerical verdict still applies"
+    )
 
 
 def response(params: GearParams, num: NumericsResult, conv: DesignConversion) -> Response:
-    """The response of an analysis in physical units (from its recorded time history)."""
-    static = conv.static_force_n
+    """The response of an analysis in physical units: DTE, mesh forces and dynamic factor from
+    the kernel's extremes over every step of the record (``model.units.response_values``, as a
+    sweep point's), the contact fractions from the recorded time history."""
+    scales = conv.scales
     hist = num.time_history
-    contact = force_max = force_min = factor = None
+    contact = None
+    forces = [None if f is None else to_physical("mesh_force", f, scales)
+              for f in (num.force_max, num.force_min)]  # fmt: skip
+    values = response_values(num.x_peak_to_peak, num.force_max, scales)
     if hist is not None and hist.x:
-        t, x, v = (np.asarray(a) for a in (hist.t, hist.x, hist.v))
-        force = mesh_force(params, t, x, v) * conv.half_backlash_m * conv.mesh_stiffness_n_per_m
-        force_max, force_min = float(force.max()), float(force.min())
-        factor = force_max / static if static > 0.0 else None
+        x = np.asarray(hist.x)
         contact = Contact(
             regime=num.impact_regime,
             separation_fraction=float(np.mean(np.abs(x) <= 1.0)),
             back_flank_fraction=float(np.mean(x < -1.0)),
         )
-    omega_n = 1.0 / conv.time_scale_s
-    period_s = None if num.period is None else num.period * num.sampling_interval / omega_n
-    peak = num.spectrum_peaks[0].frequency * omega_n / (2 * math.pi) if num.spectrum_peaks else None
+    period = None if num.period is None else num.period * num.sampling_interval
+    period_s = None if period is None else in_si("time", period, scales)
+    peaks = num.spectrum_peaks
+    peak = to_physical("frequency", peaks[0].frequency, scales) if peaks else None
     shaft_hz = conv.speed_rpm / 60.0
-    dte = num.x_peak_to_peak
     return Response(
-        dte_peak_to_peak_um=None if dte is None else dte * conv.half_backlash_m * 1e6,
-        dynamic_mesh_force_max_n=force_max,
-        dynamic_mesh_force_min_n=force_min,
-        static_force_n=static,
-        dynamic_factor=factor,
+        dte_peak_to_peak_um=values["dte"],
+        dynamic_mesh_force_max_n=forces[0],
+        dynamic_mesh_force_min_n=forces[1],
+        static_force_n=scales.static_force,
+        dynamic_factor=values["dynamic_factor"],
         contact=contact,
-        period_ms=None if period_s is None else 1e3 * period_s,
+        period_ms=None if period is None else to_physical("time", period, scales),
         period_mesh_periods=None if period_s is None else period_s * conv.mesh_frequency_hz,
         dominant_frequency_hz=peak,
         dominant_shaft_order=None if peak is None else peak / shaft_hz,
     )
-
-
-def dte_and_factor(
-    x_peak_to_peak: float | None, force_max: float | None, params: GearParams, b_m: float
-) -> tuple[float | None, float | None]:
-    """(DTE peak to peak [µm], dynamic factor) of a run from its dimensionless record: b times
-    max x - min x, and the largest mesh force over the static one (the scales b k_m cancel,
-    F / F_m = f_max / F~_m); None where the run has no record or the pair no static load."""
-    dte = None if x_peak_to_peak is None else x_peak_to_peak * b_m * 1e6
-    factor = None if force_max is None or params.mean_force <= 0 else force_max / params.mean_force
-    return dte, factor
 
 
 def _windows_text(windows: list[list[float]], rng: tuple[float, float]) -> str:
@@ -219,11 +271,27 @@ def summary(
     num: NumericsResult | None,
 ) -> str:
     """Two or three sentences an engineer can paste into a design review."""
-    here = "allows chaos" if mel.chaos_possible else "rules chaos out"
-    text = (
-        f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion {here}; at this torque it "
-        f"{_windows_text(windows, rng)}."
-    )
+    t_crit = critical_torque(conv, mel)
+    if over_critical(conv, mel) and t_crit is not None and mel.critical_mean_force:
+        words = load_words(conv, mel.critical_mean_force, t_crit)
+        text = f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion does not apply: {words}."
+    else:
+        here = "allows chaos" if mel.chaos_possible else "rules chaos out"
+        text = (
+            f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion {here}; at this torque it "
+            f"{_windows_text(windows, rng)}."
+        )
+        if (
+            t_crit is not None
+            and mel.mean_load == "perturbation"
+            and abs(conv.params.mean_force) >= (mel.critical_mean_force or math.inf)
+        ):
+            text += (
+                f" This is the paper's first-order answer outside its domain: above the critical "
+                f"torque {t_crit:,.3g} N*m the loaded system has no saddle."
+            )
+        elif t_crit is not None:
+            text += f" It applies below the critical torque {t_crit:,.3g} N*m."
     if num is not None and resp is not None:
         kind = f"periodic ({num.period}T)" if num.period else num.classification.replace("_", "-")
         text += f" The simulated response is {kind}"
@@ -247,24 +315,44 @@ def engineering(
 ) -> Engineering:
     """The engineering block of a design's Melnikov verdict (and analysis, given ``num``)."""
     params = conv.params
-    windows = speed_windows(params, conv.speed_rpm, *rpm_range)
+    t_crit = critical_torque(conv, mel)
+    note = None
+    lo, hi = rpm_range
+    if over_critical(conv, mel) and t_crit is not None:
+        windows: list[list[float]] = []
+        note = f"not applicable above T_crit = {t_crit:,.3g} N*m"
+    else:
+        top = window_scan_end(params, conv.speed_rpm, hi, mel.mean_load)
+        scan = WINDOW_SCAN if top == hi else math.ceil(WINDOW_SCAN * (top - lo) / (hi - lo))
+        windows = speed_windows(params, conv.speed_rpm, lo, top, mel.mean_load, scan)
+        hi = top
+        if windows and windows[-1][1] >= top and top > rpm_range[1]:
+            note = (
+                f"the window from {windows[-1][0]:,.0f} rpm is open-ended: chaos is still "
+                f"possible at {top:,.0f} rpm, {WINDOW_BOUND:g} x the design speed, where the "
+                "scan stops"
+            )
+        elif windows and windows[-1][1] >= top:
+            note = f"the window from {windows[-1][0]:,.0f} rpm reaches the end of the scan"
     crit = {
-        SCALES[name][0]: critical(name, t, conv)
+        CONTROLS[name]: critical(name, t, conv.scales)
         for name, t in mel.thresholds.items()
-        if name in SCALES and t.value is not None and (t.critical_values or t.note is None)
+        if name in CONTROLS and t.value is not None and (t.critical_values or t.note is None)
     }
     resp = None if num is None else response(params, num, conv)
     return Engineering(
         natural_frequency_hz=conv.natural_frequency_hz,
         time_scale_s=conv.time_scale_s,
         mesh_frequency_hz=conv.mesh_frequency_hz,
-        half_backlash_um=conv.half_backlash_m * 1e6,
+        half_backlash_um=to_physical("displacement", 1.0, conv.scales),
         speed_rpm=conv.speed_rpm,
-        speed_range_rpm=list(rpm_range),
+        speed_range_rpm=[lo, hi],
         speed_windows_rpm=windows,
+        speed_windows_note=note,
+        critical_torque_nm=t_crit,
         critical=crit,
         derived=conv.derived,
         response=resp,
-        summary=summary(conv, mel, windows, rpm_range, resp, num),
+        summary=summary(conv, mel, windows, (lo, hi), resp, num),
         notes=conv.notes,
     )

@@ -20,6 +20,9 @@ from service.api.routes import (
     explorer,
     health,
     melnikov,
+    remedies,
+    robustness,
+    runups,
     sweeps,
     thresholds,
 )
@@ -29,6 +32,7 @@ from service.jobs.runtime import SweepJobs
 from service.limits import Limits
 from service.metrics import Metrics
 from service.middleware import AccessLog, BodyLimit
+from service.warmup import KernelWarmUp
 
 DESCRIPTION = """
 Periodic or chaotic? Answers for a spur-gear pair with backlash, time-varying mesh stiffness,
@@ -43,6 +47,8 @@ torque fluctuation and transmission error (Farshidianfar & Saghafi 2014, Eq. 9).
 * **Figures** as PNG or SVG (`/v1/analyses/plot`, `/v1/thresholds/plot`).
 * **Sweeps**: bifurcation diagrams (one axis) and 2-D chaos maps (two axes) as durable jobs
   (`POST /v1/sweeps`, then poll, fetch `/result` as JSON or CSV and `/plot`).
+* **Robustness**: probabilities of chaos and rattle over a design's manufacturing tolerances
+  (ISO 1328 class, backlash band, distributions), with Sobol indices (`POST /v1/robustness`).
 
 Every error is RFC 9457 `application/problem+json` naming the bad field. With API keys
 configured, send `Authorization: Bearer KEY` or `X-API-Key: KEY`.
@@ -56,13 +62,13 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-        warmed = {"kernels": False}
-        ready_checks["kernels"] = lambda: warmed["kernels"]
-        await run_in_threadpool(_warm_up)
-        warmed["kernels"] = True
         jobs = app.state.sweep_jobs = await run_in_threadpool(SweepJobs.open, settings)
         ready_checks["job_store"] = jobs.ready
+        warming = app.state.warm_up = KernelWarmUp(jobs, settings)  # after the ready line
+        ready_checks["kernels"] = warming.done.is_set
+        warming.start()
         yield
+        await run_in_threadpool(warming.stop)
         await run_in_threadpool(jobs.close)
 
     app = FastAPIOffline(
@@ -92,6 +98,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(thresholds.router, tags=["melnikov"])
     app.include_router(analyses.router, tags=["analyses"])
     app.include_router(sweeps.router, tags=["sweeps"])
+    app.include_router(remedies.router, tags=["remedies"])
+    app.include_router(runups.router, tags=["runups"])
+    app.include_router(robustness.router, tags=["robustness"])
     app.include_router(explorer.router)
     app.add_middleware(
         BodyLimit,
@@ -101,12 +110,3 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.add_middleware(AccessLog, metrics=app.state.metrics)
     logging.getLogger("gearchaos").setLevel(logging.INFO)
     return app
-
-
-def _warm_up() -> None:
-    """Compile or load every numba kernel once, so the first request is fast."""
-    from gearengine.homoclinic.batch import warm_up as warm_up_melnikov
-    from gearengine.numerics import warm_up
-
-    warm_up()
-    warm_up_melnikov()

@@ -82,9 +82,10 @@ PEER_ENV = "GEARCHAOS_PEER"
 class Peers:
     """The other HTTP processes of ``gearengine serve --http-processes N`` (N > 1), each a
     ``python -m service.peer`` subprocess sharing the listening socket. Each writes one byte to
-    the ``up`` pipe once it accepts connections; when all have (``wait``), this process writes
-    one byte to each peer's ``go`` pipe and ``all_up`` is set: ``GET /v1/ready`` of every
-    process answers 200 only then, so a client that waited for ready finds all accepting."""
+    the ``up`` pipe once it accepts connections and its kernels are warm (``service.warmup``);
+    when all have (``wait``), this process writes one byte to each peer's ``go`` pipe and
+    ``all_up`` is set: ``GET /v1/ready`` of every process answers 200 only then, so a client
+    that waited for ready finds all accepting and warm."""
 
     processes: list[subprocess.Popen]
     up: int
@@ -130,7 +131,7 @@ class Peers:
             await asyncio.sleep(0.05)
         if count < len(self.processes) and not server.should_exit:
             logging.getLogger("gearchaos").warning(
-                "only %d of %d extra HTTP processes started", count, len(self.processes)
+                "only %d of %d extra HTTP processes ready", count, len(self.processes)
             )
         for fd in self.go:
             with contextlib.suppress(OSError):
@@ -162,8 +163,9 @@ class Peers:
 
 class AnnouncingServer(uvicorn.Server):
     """Prints ``ready_line`` to standard output once the socket listens. That is after the
-    lifespan's start-up (kernels warmed, job store open): uvicorn binds the socket only then,
-    so the lifespan itself would say it too early. With ``peers``, after they accept too."""
+    lifespan's start-up (job store open; the kernels warm up in the background after it,
+    ``service.warmup``): uvicorn binds the socket only then, so the lifespan itself would say
+    it too early. With ``peers``, it then waits for them (``Peers.wait``)."""
 
     def __init__(
         self, config: uvicorn.Config, settings: Settings, peers: Peers | None = None
@@ -175,10 +177,10 @@ class AnnouncingServer(uvicorn.Server):
     async def startup(self, sockets: list[socket.socket] | None = None) -> None:
         await super().startup(sockets)
         if self.started:
-            if self.peers is not None:
-                await self.peers.wait(self)
             port = self.servers[0].sockets[0].getsockname()[1]
             print(ready_line(self.settings, port), flush=True)
+            if self.peers is not None:
+                await self.peers.wait(self)
 
     async def shutdown(self, sockets: list[socket.socket] | None = None) -> None:
         """Peers shut down alongside this process, and are gone before it exits (uvicorn
@@ -192,7 +194,8 @@ class AnnouncingServer(uvicorn.Server):
 
 
 class _PeerServer(uvicorn.Server):
-    """A peer's uvicorn server: writes to its ``up`` pipe once it accepts connections."""
+    """A peer's uvicorn server: writes to its ``up`` pipe once it accepts connections and its
+    kernels are warm."""
 
     def __init__(self, config: uvicorn.Config, up: int) -> None:
         super().__init__(config)
@@ -201,7 +204,9 @@ class _PeerServer(uvicorn.Server):
     async def startup(self, sockets: list[socket.socket] | None = None) -> None:
         await super().startup(sockets)
         if self.started:
-            os.write(self.up, b"1")
+            warm = self.config.app.state.warm_up.done
+            threading.Thread(target=lambda: warm.wait() and os.write(self.up, b"1"),
+                             name="peer-up", daemon=True).start()  # fmt: skip
 
     async def shutdown(self, sockets: list[socket.socket] | None = None) -> None:
         """The queued log lines are written before uvicorn re-raises the parent's SIGTERM."""

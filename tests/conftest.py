@@ -15,23 +15,31 @@ from pathlib import Path
 import httpx
 import psutil
 import pytest
+from fastapi import FastAPI
 from fastapi.testclient import TestClient
 
+from gearengine.model.examples import PAPER_SECTION_41
 from service.core.config import Settings
 from service.main import create_app
 
 ROOT = Path(__file__).resolve().parents[1]
-PAPER_PARAMS = {
-    "damping": 0.07,
-    "mean_force": 0.01,
-    "backlash": {"model": "cubic", "a": 0.1667, "c": 0.1667},
-    "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 0.2, "phase": 0.0}]},
-}
+PAPER_PARAMS = PAPER_SECTION_41
+"""The paper's section 4.1 design (``model.examples``), the parameters most tests start from."""
 
 
 @pytest.fixture
 def client(tmp_path: Path) -> Iterator[TestClient]:
-    with TestClient(create_app(Settings(data_dir=tmp_path, workers=0))) as c:
+    with started(create_app(Settings(data_dir=tmp_path, workers=0))) as c:
+        yield c
+
+
+@contextlib.contextmanager
+def started(app: FastAPI) -> Iterator[TestClient]:
+    """A client of ``app`` once its kernels are warm and its dispatcher runs (the service warms
+    up in the background after its ready line, ``service.warmup``): what a test then measures
+    or waits for is the request's own work."""
+    with TestClient(app) as c:
+        app.state.warm_up.done.wait()
         yield c
 
 

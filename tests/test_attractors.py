@@ -22,7 +22,7 @@ from fastapi.testclient import TestClient
 from pydantic import ValidationError
 
 from gearengine.analysis import AnalysisRequest, analyze
-from gearengine.ensembles.attractors import Scales, attractors, basin_starts
+from gearengine.ensembles.attractors import attractors, basin_starts
 from gearengine.numerics.forcing import forcing_coefficients, step_plan
 from gearengine.numerics.settings import BasinSettings, SimulationSettings
 from tests._gear_cases import gear_ref_binary
@@ -90,7 +90,7 @@ def test_basin_fractions_agree_with_gear_ref(tmp_path_factory: pytest.TempPathFa
         pytest.skip("gcc or gear_ref.c not available")
     request = multistable()
     assert request.conversion is not None and request.params is not None
-    scales = Scales.of(request.conversion)
+    scales = request.conversion.scales
     found, counts = attractors(request.params, request.settings, scales)
     starts = basin_starts(request.settings.basins, scales)  # type: ignore[arg-type]
     args = gear_ref_args(request)
@@ -145,9 +145,9 @@ def test_headline_is_the_worst_attractor_and_the_summary_names_the_others() -> N
 def test_a_box_in_units_is_the_same_box_dimensionless() -> None:
     request = multistable()
     assert request.conversion is not None
-    scales = Scales.of(request.conversion)
-    b_um = scales.half_backlash_m * 1e6
-    v_mm_s = scales.velocity_m_s * 1e3
+    scales = request.conversion.scales
+    b_um = scales.half_backlash * 1e6
+    v_mm_s = scales.half_backlash * scales.natural_frequency * 1e3
     physical = BasinSettings.model_validate(
         {"starts": 16, "box": [[f"{-3 * b_um} um", f"{3 * b_um} um"],
                                [f"{-3 * v_mm_s} mm/s", f"{3 * v_mm_s} mm/s"]]}

@@ -216,6 +216,8 @@ def test_perturbation_sizes_and_caveat() -> None:
     assert result.perturbation_sizes is not None
     assert result.perturbation_sizes["transmission_error"] == pytest.approx(0.05 / F_CRIT)
     assert any("first-order theory is stretched" in n for n in result.notes)
+    fe1 = result.thresholds["F_e1"]  # the margin as a force, (Omega_e^2 dF_e1) / F_crit
+    assert fe1.margin_in_force_scale == pytest.approx(fe1.margin * 0.25 / F_CRIT)
     small = GearParams.model_validate(
         {**PAPER_PARAMS, "damping": 0.005,
          "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 0.01}]}}

@@ -11,7 +11,11 @@ from pathlib import Path
 import httpx
 import pytest
 
-from tests.conftest import Server, free_port
+from service.core.config import Settings
+from service.jobs.runtime import SweepJobs
+from service.main import create_app
+from service.warmup import KernelWarmUp
+from tests.conftest import Server, free_port, started
 
 
 def serve(*args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
@@ -85,3 +89,24 @@ def test_malformed_keys_file_is_refused_naming_the_line(tmp_path: Path) -> None:
     out = serve("--data-dir", str(tmp_path))
     assert out.returncode == 2
     assert "api_keys.sha256:2: not a sha256 hex digest" in out.stderr
+
+
+def test_the_ready_line_does_not_wait_for_the_kernels(tmp_path: Path) -> None:
+    """The lifespan's start-up only opens the store: the warm-up and then the dispatcher run
+    in the background (``service.warmup``); ``kernels`` turns true once both happened."""
+    app = create_app(Settings(data_dir=tmp_path, workers=1))
+    with started(app) as c:
+        assert app.state.sweep_jobs.dispatcher is not None
+        assert c.get("/v1/ready").json()["checks"] == {"job_store": True, "kernels": True}
+
+
+def test_no_dispatcher_starts_once_the_service_stops(tmp_path: Path) -> None:
+    """A service stopped while its kernels warm up never starts its pool workers."""
+    settings = Settings(data_dir=tmp_path, workers=1)
+    jobs = SweepJobs.open(settings)
+    warming = KernelWarmUp(jobs, settings)
+    warming.stop()
+    warming.start()
+    warming._thread.join()
+    assert jobs.dispatcher is None and not warming.done.is_set()
+    jobs.close()

@@ -6,7 +6,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -17,7 +16,8 @@ from fastapi.testclient import TestClient
 from gearengine.sweeps import compute_chunk_json, run_local, to_csv, validated
 from service.core.config import Settings
 from service.main import create_app
-from tests.conftest import PAPER_PARAMS
+from tests._polling import poll
+from tests.conftest import PAPER_PARAMS, started
 
 SHORT = {"transient_periods": 50, "record_periods": 50, "steps_per_period": 64}
 
@@ -119,7 +119,7 @@ def test_sweep_over_the_compute_budget_is_refused_before_it_is_stored(tmp_path: 
 
 def test_queue_cap_answers_429_with_retry_after(tmp_path: Path) -> None:
     settings = Settings(data_dir=tmp_path, workers=0, max_queued_jobs=2)
-    with TestClient(create_app(settings)) as c:
+    with started(create_app(settings)) as c:
         assert all(c.post("/v1/sweeps", json=body()).status_code == 202 for _ in range(2))
         r = c.post("/v1/sweeps", json=body())
         assert r.status_code == 429 and int(r.headers["retry-after"]) > 0
@@ -128,7 +128,7 @@ def test_queue_cap_answers_429_with_retry_after(tmp_path: Path) -> None:
 
 def test_jobs_are_owned_by_the_api_key(tmp_path: Path) -> None:
     settings = Settings(data_dir=tmp_path, workers=0, api_keys="key-a,key-b")
-    with TestClient(create_app(settings)) as c:
+    with started(create_app(settings)) as c:
         a, b = {"X-API-Key": "key-a"}, {"Authorization": "Bearer key-b"}
         assert c.post("/v1/sweeps", json=body()).status_code == 401
         job = c.post("/v1/sweeps", json=body(), headers=a).json()
@@ -148,18 +148,12 @@ def test_ready_checks_the_job_store(client: TestClient) -> None:
 def working(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestClient]:
     """An app with an embedded dispatcher and one worker process."""
     settings = Settings(data_dir=tmp_path_factory.mktemp("jobs"), workers=1, sweep_chunk_points=4)
-    with TestClient(create_app(settings)) as c:
+    with started(create_app(settings)) as c:
         yield c
 
 
 def wait(c: TestClient, job_id: str, timeout: float = 60.0) -> dict[str, Any]:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        job = c.get(f"/v1/sweeps/{job_id}").json()
-        if job["status"] not in ("queued", "running"):
-            return job
-        time.sleep(0.05)
-    raise TimeoutError(job_id)
+    return poll(lambda: c.get(f"/v1/sweeps/{job_id}").json(), timeout=timeout)
 
 
 def test_a_sweep_runs_to_the_same_result_as_run_local(working: TestClient) -> None:

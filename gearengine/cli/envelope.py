@@ -35,11 +35,13 @@ from gearengine.cli.documents import (
 from gearengine.cli.sweep import progress
 from gearengine.jsonio import dumps
 from gearengine.numerics.settings import SimulationSettings
-from gearengine.sweeps.compute import run_local
 from gearengine.sweeps.gate import (
     EnvelopeReport,
     Rules,
+    check_envelope,
+    envelope_axis,
     envelope_report,
+    envelope_sweep,
     junit_xml,
     level_text,
     window_text,
@@ -47,9 +49,6 @@ from gearengine.sweeps.gate import (
 from gearengine.sweeps.request import SweepRequest, validated
 from gearengine.sweeps.results import SpeedWindows, SweepResult
 
-ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
-"""Light integration settings of an envelope check; a design file's ``settings`` are merged
-over them (adding ``random_initial_states`` keeps the 60 + 60 periods)."""
 POLL_SECONDS = 1.0
 GATE_STARTS = 16
 """Basin starts per operating point of the gate unless ``--starts`` or the file's
@@ -58,12 +57,11 @@ its cost); ``--starts 1`` checks the settings' own start alone, as before basins
 
 
 def axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
-    """A sweep axis from "A:B" (bare numbers in ``unit``) or "52rad/s:628rad/s"."""
-    ends = text.split(":")
-    if len(ends) != 2 or not all(e.strip() for e in ends):
-        raise InvalidInputError([f"--{name}: give a range as LOW:HIGH, e.g. --{name} 500:6000"])
-    lo, hi = (e.strip() if any(c.isalpha() for c in e) else f"{e.strip()} {unit}" for e in ends)
-    return {"parameter": name, "start": lo, "stop": hi, "num": num}
+    """``sweeps.gate.envelope_axis``, its error naming the option."""
+    try:
+        return envelope_axis(name, text, unit, num)
+    except ValueError as exc:
+        raise InvalidInputError([f"--{name}: {exc}"]) from None
 
 
 def envelope_request(args: argparse.Namespace) -> SweepRequest:
@@ -82,9 +80,12 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
     settings = doc.get("settings", {})
     if not isinstance(settings, dict):
         raise InvalidInputError([f"{args.file}: settings must be an object"])
-    sweep = {"design": design, "settings": gate_settings({**ENVELOPE_SETTINGS, **settings},
-             args.starts), "axes": axes,
-             "label": f"envelope check of {Path(args.file).name}"}  # fmt: skip
+    sweep = envelope_sweep(
+        design,
+        gate_settings(settings, args.starts),
+        axes,
+        f"envelope check of {Path(args.file).name}",
+    )
     return validated_input(validated, sweep, args.file)
 
 
@@ -173,6 +174,9 @@ def print_report(report: EnvelopeReport) -> None:
     verdict = "PASS" if report.passed else "FAIL"
     print(f"{verdict}: {report.failing_points} of {report.points} operating points break "
           f"the rules ({rules_text(report.rules)})")  # fmt: skip
+    if "melnikov" in report.rules.fail_on and report.melnikov_not_judged:
+        print(f"  Melnikov could not judge {report.melnikov_not_judged} of {report.points} points "
+              "(the criterion does not apply above the critical torque)")  # fmt: skip
     for w in report.failures:
         print(f"  {window_text(w)}")
     for line in windows_summary(report.windows):
@@ -194,10 +198,13 @@ def windows_summary(windows: list[SpeedWindows]) -> list[str]:
     out = []
     for w in windows:
         impacts = "; ".join(f"{IMPACT_LABELS[k]} {spans_text(v)}" for k, v in w.impacts.items())
-        melnikov = spans_text(w.melnikov) if w.melnikov else "nowhere"
+        melnikov = f"chaos possible {spans_text(w.melnikov) if w.melnikov else 'nowhere'}"
+        if w.melnikov_not_applicable:  # above the critical torque
+            na = f"not applicable at {spans_text(w.melnikov_not_applicable)} (above T_crit)"
+            melnikov = f"{melnikov}, {na}" if w.melnikov else na
         where = f" at {level_text(w.level)}" if w.level else ""
         out.append(f"windows{where}: {impacts or 'teeth always in contact'}; "
-                   f"Melnikov: chaos possible {melnikov}")  # fmt: skip
+                   f"Melnikov: {melnikov}")  # fmt: skip
     return out
 
 
@@ -228,11 +235,13 @@ def cmd_envelope(args: argparse.Namespace) -> int:
     tick = progress(time.monotonic(), "envelope")
     if args.server:
         key = os.environ.get("GEARCHAOS_API_KEY")
-        result = run_on_server(args.server, request, key, tick)
+        report = envelope_report(run_on_server(args.server, request, key, tick), rules)
     else:
-        chunk = max(1, request.n_points() // (4 * (os.cpu_count() or 1)))
-        result = run_local(request, tick, chunk_points=chunk, workers=os.cpu_count() or 1)
-    report = envelope_report(result, rules)
+        report = check_envelope(request, rules, tick, workers=os.cpu_count() or 1)
+    if getattr(args, "runup", None) is not None:  # run-ups through the range (runup.gate)
+        from gearengine.runup.gate import gate_envelope
+
+        report = validated_input(lambda r: gate_envelope(report, request, r), args.runup, "--runup")
     print_report(report)
     if args.json:
         Path(args.json).write_text(dumps(report))

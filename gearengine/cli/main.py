@@ -1,11 +1,14 @@
 """The ``gearengine`` command line.
 
-    gearengine melnikov FILE [--json] [--method closed_form|quadrature]
+    gearengine melnikov FILE [--json] [--method closed_form|quadrature] [--mean-load ...]
     gearengine analyze FILE [--json]
     gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov|impacts|separation]
         [--max-lle V] [--max-dte E] [--max-dynamic-factor F]
         [--min-stability-margin X]
+    gearengine remedies FILE --speed A:B [--torque A:B] [check's rules] [--lever PATH=LO:HI]
     gearengine sweep FILE [--out DIR|-] [--format json|csv]
+    gearengine runup FILE --from 500 --to 6000 --rate 1000 [--direction up|down|up_down]
+        [--bin 50] [--json OUT] [--plot OUT.png]
     gearengine basins FILE [--starts N] [--json] [--plot FILE]
     gearengine convert FILE [--json]
 
@@ -54,6 +57,23 @@ def lazy(module: str, name: str) -> Command:
     return run
 
 
+def lever_range(text: str) -> dict[str, object]:
+    """``mesh.half_backlash=5um:200um`` as a lever range (bare numbers are SI units)."""
+    path, _, bounds = text.partition("=")
+    ends = [e.strip() for e in bounds.split(":")]
+    if not path.strip() or len(ends) != 2 or not all(ends):
+        raise argparse.ArgumentTypeError(f"{text!r}: give PATH=LOW:HIGH, e.g. "
+                                         "mesh.half_backlash=5um:200um")  # fmt: skip
+    return {"lever": path.strip(), "bounds": [_number_or_text(e) for e in ends]}
+
+
+def _number_or_text(text: str) -> float | str:
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
 def micrometres(text: str) -> float:
     """A length option in µm: a bare number is µm, "0.02 mm" is read with its unit."""
     try:
@@ -64,6 +84,28 @@ def micrometres(text: str) -> float:
         return parse_quantity(text, QUANTITIES["error"]) * 1e6
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -> None:
+    """The gate's rules and envelope options, shared by ``check`` and ``remedies``."""
+    p.add_argument(
+        "--fail-on",
+        action="append",
+        choices=["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"],
+        help="repeatable",
+    )
+    p.add_argument("--speed", metavar="LOW:HIGH", required=speed_required,
+                   help="driver speeds: rpm, or with units")  # fmt: skip
+    p.add_argument("--torque", metavar="LOW:HIGH", help="mean driver torques: N m, or with units")
+    p.add_argument("--speed-points", type=int, default=23, metavar="N", help="default 23")
+    p.add_argument("--torque-points", type=int, default=5, metavar="N", help="default 5")
+    p.add_argument("--max-dte", type=micrometres, default=None, metavar="E",
+                   help="fail where the dynamic transmission error (peak to peak) exceeds E "
+                   "(µm, or with a unit: 20um, 0.02mm)")  # fmt: skip
+    p.add_argument("--max-dynamic-factor", type=float, default=None, metavar="F",
+                   help="fail where the largest dynamic mesh force exceeds F times the static "
+                   "force")  # fmt: skip
+    p.add_argument("--max-lle", type=float, default=None, help="fail when the LLE exceeds V")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -77,6 +119,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help='JSON file holding {"params": {...}} or {"design": {...}}, or -')
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
     p.add_argument("--method", choices=["closed_form", "quadrature"], default=None)
+    p.add_argument(
+        "--mean-load",
+        choices=["unperturbed", "perturbation"],
+        default=None,
+        help="where the mean force goes (default unperturbed; perturbation: the paper's)",
+    )
     p.set_defaults(func=lazy("gearengine.cli.melnikov", "cmd_melnikov"))
 
     p = sub.add_parser("analyze", help="Melnikov and numerical verdicts of a design")
@@ -100,22 +148,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "file", help='JSON file holding {"params" or "design": {...}, "settings": {...}}, or -'
     )
-    p.add_argument(
-        "--fail-on",
-        action="append",
-        choices=["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"],
-        help="repeatable",
-    )
-    p.add_argument("--speed", metavar="LOW:HIGH", help="driver speeds: rpm, or with units")
-    p.add_argument("--torque", metavar="LOW:HIGH", help="mean driver torques: N m, or with units")
-    p.add_argument("--speed-points", type=int, default=23, metavar="N", help="default 23")
-    p.add_argument("--torque-points", type=int, default=5, metavar="N", help="default 5")
-    p.add_argument("--max-dte", type=micrometres, default=None, metavar="E",
-                   help="fail where the dynamic transmission error (peak to peak) exceeds E "
-                   "(µm, or with a unit: 20um, 0.02mm)")  # fmt: skip
-    p.add_argument("--max-dynamic-factor", type=float, default=None, metavar="F",
-                   help="fail where the largest dynamic mesh force exceeds F times the static "
-                   "force")  # fmt: skip
+    envelope_options(p)
     p.add_argument("--starts", type=int, default=None, metavar="N",
                    help="envelope checks: basin starts per operating point (default 16; 1: "
                    "the settings' own start only)")  # fmt: skip
@@ -126,7 +159,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
     p.add_argument("--server", metavar="URL", help="run the envelope on a running service "
                    "(API key from GEARCHAOS_API_KEY)")  # fmt: skip
-    p.add_argument("--max-lle", type=float, default=None, help="fail when the LLE exceeds V")
+    p.add_argument("--runup", type=float, default=None, metavar="RATE",
+                   help="envelope checks: also run up and down through --speed at RATE rpm/s "
+                   "at each torque level (same rules; chaos fails after 0.05 s)")  # fmt: skip
     p.add_argument(
         "--min-stability-margin",
         type=float,
@@ -135,6 +170,11 @@ def build_parser() -> argparse.ArgumentParser:
         help="fail when the response is periodic and its Floquet stability margin "
         "1 - max |lambda| is below X (or unavailable); one design only, not an envelope",
     )
+    p.add_argument("--max-probability", action="append", metavar="NAME=P",
+                   help="fail where the 95 %% upper bound of P(NAME) over the design's "
+                   "tolerances exceeds P (chaotic, impacts, back_flank; repeatable)")  # fmt: skip
+    p.add_argument("--samples", type=int, default=64, help="with --max-probability (default 64)")
+    p.add_argument("--seed", type=int, default=0, help="with --max-probability (default 0)")
     p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
 
     p = sub.add_parser("basins", help="coexisting attractors of a design and their basins")
@@ -146,6 +186,35 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", metavar="FILE", help="write the basin picture (.png or .svg)")
     p.set_defaults(func=lazy("gearengine.cli.basins", "cmd_basins"))
 
+    p = sub.add_parser(
+        "remedies",
+        help="what to change in a failing design, by how much (exit 1: nothing found)",
+        description="For each lever (damping, transmission error, half backlash down and up, "
+        "stiffness variation, torque fluctuation) the smallest change that makes the envelope "
+        "pass under the gate's rules, numerically (verified by a run) and by the Melnikov "
+        "criterion.",
+    )
+    p.add_argument("file", help='JSON file holding {"design": {...}, "settings": {...}}, or -')
+    envelope_options(p, speed_required=True)
+    p.add_argument("--lever", action="append", type=lever_range, metavar="PATH=LOW:HIGH",
+                   help="search this design field instead of the default levers, e.g. "
+                   "mesh.half_backlash=5um:200um (repeatable)")  # fmt: skip
+    p.add_argument("--json", metavar="FILE", help="write the result (as POST /v1/remedies)")
+    p.set_defaults(func=lazy("gearengine.cli.remedies", "cmd_remedies"))
+
+    p = sub.add_parser("robustness", help="probabilities over a design's tolerances, here")
+    p.add_argument("file", help='JSON file holding {"design": {..., "tolerances": {...}}}, or -')
+    p.add_argument("--speed", metavar="LOW:HIGH", help="driver speeds: rpm, or with units")
+    p.add_argument("--torque", metavar="LOW:HIGH", help="mean driver torques: N m, or with units")
+    p.add_argument("--speed-points", type=int, default=23, metavar="N", help="default 23")
+    p.add_argument("--torque-points", type=int, default=5, metavar="N", help="default 5")
+    p.add_argument("--samples", type=int, default=256, help="samples N, a power of 2 (256)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the Sobol samples (0)")
+    p.add_argument("--sensitivity", action="store_true", help="also Sobol indices (SALib)")
+    p.add_argument("--json", metavar="FILE", help="write the result (the API's document)")
+    p.add_argument("--plot", metavar="PNG", help="write the probability map")
+    p.set_defaults(func=lazy("gearengine.cli.robustness", "cmd_robustness"))
+
     p = sub.add_parser("sweep", help="run a sweep here, no server: JSON, CSV and PNG")
     p.add_argument("file", help="JSON file holding a sweep request (as POST /v1/sweeps), or -")
     p.add_argument("--out", default=".", help="directory for the outputs (default .); - writes "
@@ -153,6 +222,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=["json", "csv"], default="json",
                    help="with --out -: the JSON result (default) or the CSV table")  # fmt: skip
     p.set_defaults(func=lazy("gearengine.cli.sweep", "cmd_sweep"))
+
+    p = sub.add_parser("runup", help="run-up / run-down of a design: DTE, contact, FTLE, jumps")
+    p.add_argument("file", help='JSON file holding {"design": {...}} (and run-up fields), or -')
+    p.add_argument("--from", dest="from_speed", metavar="SPEED", help="lower speed (rpm)")
+    p.add_argument("--to", dest="to_speed", metavar="SPEED", help="upper speed (rpm)")
+    p.add_argument("--rate", metavar="RATE", help="ramp rate (rpm/s)")
+    p.add_argument("--duration", metavar="T", help="duration of each leg instead (s)")
+    p.add_argument("--direction", choices=["up", "down", "up_down"], default=None)
+    p.add_argument("--bin", type=float, default=None, metavar="RPM", help="bin width (50)")
+    p.add_argument("--to-torque", metavar="TORQUE", help="torque at the end (N m)")
+    p.add_argument("--ensemble", type=int, default=None, metavar="N", help="FTLE members (8)")
+    p.add_argument("--json", metavar="OUT", help="write the API's document")
+    p.add_argument("--plot", metavar="OUT", help="write the figure (.png or .svg)")
+    p.set_defaults(func=lazy("gearengine.cli.runup", "cmd_runup"))
 
     p = sub.add_parser("convert", help="a design in physical units: parameters, derivations, rpm")
     p.add_argument("file", help='JSON file holding {"design": {...}}, or - for stdin')

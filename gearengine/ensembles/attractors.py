@@ -29,10 +29,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gearengine.engineering import dte_and_factor
 from gearengine.model.design import Design
 from gearengine.model.params import GearParams
-from gearengine.model.reduction import DesignConversion, ParamsOrDesign
+from gearengine.model.reduction import ParamsOrDesign
+from gearengine.model.units import Scales, response_values
 from gearengine.numerics.batch import run_lanes
 from gearengine.numerics.classify import severity
 from gearengine.numerics.forcing import step_plan
@@ -53,29 +53,12 @@ IMPACT_TEXT = {"no_impact": "no impacts", "single_sided": "single-sided impacts"
                "double_sided": "double-sided impacts"}  # fmt: skip
 
 
-@dataclass(frozen=True)
-class Scales:
-    """What turns a dimensionless state into gear units: x = X / b, v = V / (b omega_n)."""
-
-    half_backlash_m: float
-    """b [m]."""
-    velocity_m_s: float
-    """b omega_n [m/s] (omega_n = 1 / time_scale_s)."""
-
-    @classmethod
-    def of(cls, conv: DesignConversion) -> Scales:
-        """The scales of a design's conversion."""
-        return cls.for_backlash(conv.half_backlash_m, conv)
-
-    @classmethod
-    def for_backlash(cls, b_m: float, conv: DesignConversion) -> Scales:
-        """The scales of a design with its half backlash set to ``b_m`` [m]."""
-        return cls(b_m, b_m / conv.time_scale_s)
-
-
 def scale_pair(scales: Scales | None) -> tuple[float, float]:
-    """(b [m], b omega_n [m/s]), or (1, 1) without a design."""
-    return (1.0, 1.0) if scales is None else (scales.half_backlash_m, scales.velocity_m_s)
+    """(b [m], b omega_n [m/s]): the SI length of one unit of x and of v = dx/dtau (Eq. 8), or
+    (1, 1) without a design."""
+    if scales is None:
+        return 1.0, 1.0
+    return scales.half_backlash, scales.half_backlash * scales.natural_frequency
 
 
 def basin_starts(basins: BasinSettings, scales: Scales | None) -> list[tuple[float, float]]:
@@ -174,7 +157,8 @@ def _attractor(
     impact = max((bp.impact_regime for _, bp in members), key=IMPACT_ORDER.__getitem__)
     dte = factor = None
     if scales is not None:
-        dte, factor = dte_and_factor(ptp, fmax, params, scales.half_backlash_m)
+        response = response_values(ptp, fmax, scales)
+        dte, factor = response["dte"], response["dynamic_factor"]
     return Attractor(
         label=describe(rep.classification, rep.period, impact),
         classification=rep.classification,
@@ -375,4 +359,4 @@ def of_design(
     base.for_request(request.design is not None)
     conv = request.conversion
     assert request.params is not None
-    return attractors(request.params, base, None if conv is None else Scales.of(conv))
+    return attractors(request.params, base, None if conv is None else conv.scales)

@@ -45,7 +45,11 @@ from gearengine.homoclinic.kernels import (
     unit_coefficient,
 )
 from gearengine.homoclinic.terms import packed_terms
-from gearengine.homoclinic.thresholds import CONTROL_PARAMETERS, parameter_threshold
+from gearengine.homoclinic.thresholds import (
+    CONTROL_PARAMETERS,
+    parameter_threshold,
+    signed_margin,
+)
 from gearengine.homoclinic.verdict import applicability
 from gearengine.model.aliases import get_alias
 from gearengine.model.backlash import melnikov_cubic
@@ -102,13 +106,15 @@ class MelnikovBatchResult(BaseModel):
     )
 
 
-def _margin(value: float, critical: Sequence[float]) -> Margin:
-    """``thresholds._threshold``'s margin: value - nearest, and over |nearest| (null if 0)."""
-    if not critical:
-        return {"margin": None, "relative_margin": None}
-    nearest = min(critical, key=lambda v: abs(value - v))
-    margin = value - nearest
-    return {"margin": margin, "relative_margin": margin / abs(nearest) if nearest != 0.0 else None}
+def _margin(
+    parameter: str, value: float, critical: Sequence[float], no_chaos: Sequence[Sequence]
+) -> Margin:
+    """``thresholds.signed_margin``: positive on the safe side (null without critical value)."""
+    _, margin, rel = signed_margin(parameter, value, critical, no_chaos)
+    return {"margin": margin, "relative_margin": rel}
+
+
+NO_MARGIN: Margin = {"margin": None, "relative_margin": None}
 
 
 @numba.njit(cache=True, nogil=True)
@@ -179,7 +185,7 @@ def design_verdict(p: GearParams, mean_load: MeanLoad = "unperturbed") -> BatchV
     if units is None:
         return {
             "chaos_possible": None,
-            "margins": {q: _margin(0.0, []) for q in CONTROL_PARAMETERS},
+            "margins": {q: NO_MARGIN for q in CONTROL_PARAMETERS},
         }
     chaos = False
     for br in BRANCH_SIGN:
@@ -230,15 +236,15 @@ def _simple_verdict(p, own, status, chaos, h, r) -> BatchVerdict | None:
     if status == 1:
         return {
             "chaos_possible": None,
-            "margins": {q: _margin(0.0, []) for q in CONTROL_PARAMETERS},
+            "margins": {q: NO_MARGIN for q in CONTROL_PARAMETERS},
         }
     amplitude = float(get_alias(p, own))
     mu = float(p.damping)
-    margins: dict[str, Margin] = {
-        q: {"margin": None, "relative_margin": None} for q in CONTROL_PARAMETERS
-    }
-    margins[own] = _margin(amplitude, [] if math.isnan(h) else [-float(h), float(h)])
-    margins["mu"] = _margin(mu, [] if math.isnan(r) else [float(r)])
+    margins: dict[str, Margin] = {q: NO_MARGIN for q in CONTROL_PARAMETERS}
+    if not math.isnan(h):  # neither branch changes sign for |F_1| <= H (Eq. 23)
+        margins[own] = _margin(own, amplitude, [-float(h), float(h)], [(-float(h), float(h))])
+    if not math.isnan(r):  # nor for mu >= R (Eq. 24)
+        margins["mu"] = _margin("mu", mu, [float(r)], [(float(r), None)])
     return {"chaos_possible": bool(chaos), "margins": margins}
 
 

@@ -46,10 +46,11 @@ def loop_extremes(a: float, c: float, fm: float) -> tuple[float, float]:
 
 
 def perturbation_sizes(
-    params: GearParams, a: float, c: float, fm: float, scale: float
+    params: GearParams, extremes: tuple[float, float], fm: float, scale: float
 ) -> dict[str, float]:
-    """Each given perturbation's size over the force scale ``scale`` (F_crit), by name."""
-    speed, force = loop_extremes(a, c, fm)
+    """Each given perturbation's size over the force scale ``scale`` (F_crit), by name;
+    ``extremes`` are the loops' ``loop_extremes`` and ``fm`` the load they carry."""
+    speed, force = extremes
     sizes = {"damping": 2.0 * params.damping * speed / scale}
     for name, exc in params.excitations():
         amps = [(r * exc.frequency, h.amplitude) for r, h in exc.active()]
@@ -63,6 +64,18 @@ def perturbation_sizes(
     if fm == 0.0 and params.mean_force != 0.0:
         sizes["mean_force"] = abs(params.mean_force) / scale
     return sizes
+
+
+def force_per_unit(
+    params: GearParams, parameter: str, extremes: tuple[float, float]
+) -> float | None:
+    """The largest force along the loops per unit of a control parameter (the weights of the
+    module docstring); None for a frequency. ``extremes`` are ``loop_extremes``."""
+    speed, force = extremes
+    if parameter == "F_e1":
+        exc = params.transmission_error
+        return None if exc is None else exc.frequency**2
+    return {"mu": 2.0 * speed, "k_p1": 2.0 * force, "F_p1": 1.0}.get(parameter)
 
 
 def caveat(sizes: dict[str, float], scale: float) -> str | None:

@@ -68,11 +68,22 @@ class ParameterThreshold(_Result):
     critical_values: list[float] = Field(
         description="Values where the overall verdict (either branch changes sign) flips."
     )
-    nearest: float | None = Field(description="The critical value nearest to the design.")
+    nearest: float | None = Field(
+        description="The critical value nearest to the design (for an amplitude, of its sign)."
+    )
     margin: float | None = Field(
-        description="value - nearest: signed distance to the nearest critical value."
+        description="|value - nearest|, positive on the safe side (neither branch changes sign "
+        "at the design's value), negative inside the chaos-possible region. For an amplitude the "
+        "nearest critical value of the design's own sign is taken (a negative amplitude is a "
+        "phase shift by pi)."
     )
     relative_margin: float | None = Field(description="margin / |nearest| (null if nearest = 0).")
+    margin_in_force_scale: float | None = Field(
+        None,
+        description="The margin as the largest force it makes along the loops, over the force "
+        "scale F_crit of the unperturbed system (as perturbation_sizes): how far first-order "
+        "theory carries the threshold (null for Omega_e).",
+    )
     no_chaos: list[Bounds] = Field(
         description="Intervals of the parameter where neither branch changes sign."
     )

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -184,15 +185,37 @@ def _ends(intervals: list[Interval], domain: Interval) -> list[float]:
     return sorted({e for i in intervals for e in (i.lo, i.hi) if e is not None and e not in bounds})
 
 
+AMPLITUDES = frozenset(_TERM_OF)
+"""Control parameters that are amplitudes: a negative amplitude is the same harmonic shifted by
+pi, so a design's amplitude reaches a critical value by growing or shrinking, not through 0."""
+
+
+def signed_margin(
+    parameter: str, value: float, critical: Sequence[float], no_chaos: Sequence[Sequence]
+) -> tuple[float | None, float | None, float | None]:
+    """(nearest, margin, relative_margin) of a design's value: the nearest critical value (for an
+    amplitude, the nearest of its own sign when there is one), the distance |value - nearest|
+    signed positive on the safe side (the value lies in a ``no_chaos`` interval [lo, hi], None
+    an open end) and negative inside the chaos-possible region, and margin / |nearest| (None if
+    nearest is 0). All None without a critical value."""
+    if not critical:
+        return None, None, None
+    pool = list(critical)
+    if parameter in AMPLITUDES and value != 0.0:
+        pool = [v for v in critical if (v > 0.0) == (value > 0.0)] or pool
+    nearest = min(pool, key=lambda v: abs(value - v))
+    safe = any((lo is None or value >= lo) and (hi is None or value <= hi) for lo, hi in no_chaos)
+    margin = abs(value - nearest) if safe else -abs(value - nearest)
+    return nearest, margin, margin / abs(nearest) if nearest != 0.0 else None
+
+
 def _threshold(
-    value: float | None, critical: list[float], no_chaos: list, **extra: object
+    parameter: str, value: float | None, critical: list[float], no_chaos: list, **extra: object
 ) -> ParameterThreshold:
-    """The threshold document: critical values and the design's margin to the nearest one."""
+    """The threshold document: critical values and the design's margin (``signed_margin``)."""
     nearest = margin = rel = None
-    if value is not None and critical:
-        nearest = min(critical, key=lambda v: abs(value - v))
-        margin = value - nearest
-        rel = margin / abs(nearest) if nearest != 0.0 else None
+    if value is not None:
+        nearest, margin, rel = signed_margin(parameter, value, critical, no_chaos)
     return ParameterThreshold(
         value=value,
         critical_values=critical,
@@ -240,7 +263,7 @@ def parameter_threshold(
         if family is None:
             exc = _TERM_OF[parameter]
             return _threshold(
-                value, [], [], note=f"{exc} is not given: no frequency for {parameter}"
+                parameter, value, [], [], note=f"{exc} is not given: no frequency for {parameter}"
             )
         sets[br] = _intersect(no_sign_change(*family), [domain])
         branches[br] = BranchThreshold(
@@ -249,6 +272,7 @@ def parameter_threshold(
         )
     overall = _intersect(sets["plus"], sets["minus"])
     return _threshold(
+        parameter,
         value,
         _ends(overall, domain),
         [(i.lo, i.hi) for i in overall],
@@ -277,12 +301,18 @@ def frequency_threshold(
     value = get_alias(params, "Omega_e")
     if value is None:
         return _threshold(
-            None, [], [], scan=scan, note="transmission_error is not given: no Omega_e to scan"
+            "Omega_e",
+            None,
+            [],
+            [],
+            scan=scan,
+            note="transmission_error is not given: no Omega_e to scan",
         )
     fm = loop_load(params, mean_load)
     found = _scan_compiled(params, a, c, fm, scan, value) if method == "closed_form" else None
     critical, no_chaos = found or _scan_python(params, a, c, scan, value, method, mean_load)
     return _threshold(
+        "Omega_e",
         value,
         critical,
         no_chaos,

@@ -20,8 +20,13 @@ from gearengine.homoclinic.coefficients import (
 )
 from gearengine.homoclinic.extrema import Extrema, extrema
 from gearengine.homoclinic.loops import saddle
-from gearengine.homoclinic.perturbations import caveat, perturbation_sizes
-from gearengine.homoclinic.schemas import BranchVerdict, MelnikovResult
+from gearengine.homoclinic.perturbations import (
+    caveat,
+    force_per_unit,
+    loop_extremes,
+    perturbation_sizes,
+)
+from gearengine.homoclinic.schemas import BranchVerdict, MelnikovResult, ParameterThreshold
 from gearengine.homoclinic.thresholds import (
     CONTROL_PARAMETERS,
     OMEGA_SCAN,
@@ -105,6 +110,20 @@ def applicability(
     return a, c, notes, units
 
 
+def _in_force_scale(
+    params: GearParams,
+    parameter: str,
+    t: ParameterThreshold,
+    extremes: tuple[float, float],
+    f_crit: float,
+) -> ParameterThreshold:
+    """``t`` with its margin measured in the force scale F_crit (``perturbations``)."""
+    unit = force_per_unit(params, parameter, extremes)
+    if t.margin is None or unit is None:
+        return t
+    return t.model_copy(update={"margin_in_force_scale": t.margin * unit / f_crit})
+
+
 def melnikov(
     params: GearParams,
     method: Method = "closed_form",
@@ -150,7 +169,8 @@ def melnikov(
             f"{f_crit:.4g}): the saddle sits at x_s = {saddle(a, c, fm):.6g} and the two "
             "homoclinic loops differ, so each has its own M and thresholds"
         )
-    sizes = perturbation_sizes(params, a, c, fm, f_crit)
+    extremes = loop_extremes(a, c, fm)
+    sizes = perturbation_sizes(params, extremes, fm, f_crit)
     stretched = caveat(sizes, f_crit)
     if stretched:
         notes.append(stretched)
@@ -160,8 +180,10 @@ def melnikov(
             f"{method} coefficients"
         )
     thresholds = {
-        p: parameter_threshold(params, p, a, c, method, units) for p in CONTROL_PARAMETERS
-    }
+        p: _in_force_scale(params, p, parameter_threshold(params, p, a, c, method, units),
+                           extremes, f_crit)
+        for p in CONTROL_PARAMETERS
+    }  # fmt: skip
     thresholds["Omega_e"] = frequency_threshold(params, a, c, omega_scan, method, mean_load)
     return MelnikovResult(
         applicable=True,

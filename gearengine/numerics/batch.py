@@ -59,10 +59,10 @@ def step_plans(points: Sequence[GearParams], steps_per_period: int) -> list[Step
     known: dict[tuple, StepPlan] = {}
     plans = []
     for p in points:
-        key = tuple(
+        key = (*(
             (name, exc.frequency, tuple(r for r, _ in exc.active()))
             for name, exc in p.excitations()
-        )
+        ), str(p.shaft_orders))  # fmt: skip
         if key not in known:
             known[key] = step_plan(p, steps_per_period)
         plans.append(known[key])
@@ -128,10 +128,12 @@ def _run_lanes(
         per = np.array([plans[i].period for i in members.tolist()])[inverse]
         mu = np.array([points[i].damping for i in members.tolist()])[inverse]
         starts = np.array([lanes[k][1] for k in ks], dtype=np.float64).reshape(-1, 2)
-        lanes_in = (
-            np.array([kt for kt, _ in tables])[inverse],
-            np.array([ft for _, ft in tables])[inverse],
-        )
+        x0, v0 = starts[:, 0].copy(), starts[:, 1].copy()
+        tabled = (
+            np.array([kt for kt, _ in tables]),
+            np.array([ft for _, ft in tables]),
+            inverse.astype(np.int64),
+        )  # one table per point, shared by its lanes
         streams = max(1, min(numba.get_num_threads(), -(-len(ks) // kernels.LANES)))
         shared = (per, N, settings.transient_periods, settings.record_periods, DIVERGENCE_BOUND,
                   settings.adaptive, streams, *lle_tolerances(settings))  # fmt: skip
@@ -139,16 +141,14 @@ def _run_lanes(
         if name == "cubic":
             a = np.array([lw.a for lw in laws])[inverse]
             c = np.array([lw.c for lw in laws])[inverse]
-            out = kernels.run_batch(a, c, mu, starts[:, 0].copy(), starts[:, 1].copy(),
-                                    *lanes_in, *shared)  # fmt: skip
+            out = kernels.run_batch(a, c, mu, x0, v0, *tabled, *shared)
         else:
             alpha = np.array([lw.alpha for lw in laws])[inverse]
-            kc, nk = padded_terms([f[0] for f in packed], inverse)
-            fc, nf = padded_terms([f[2] for f in packed], inverse)
-            fm = np.array([f[1] for f in packed])[inverse]
+            kc, nk = padded_terms([f[0] for f in packed])
+            fc, nf = padded_terms([f[2] for f in packed])
+            fm = np.array([f[1] for f in packed])
             out = kernels.run_kink_batch(
-                alpha, mu, starts[:, 0].copy(), starts[:, 1].copy(), *lanes_in, kc, nk, fm,
-                fc, nf, *shared,
+                alpha, mu, x0, v0, *tabled, kc, nk, fm, fc, nf, *shared
             )  # fmt: skip
         verdicts = lane_verdicts(out, per)
         strobes = last_strobes(out, list(range(len(ks))))
@@ -165,14 +165,14 @@ def lle_tolerances(settings: SimulationSettings) -> tuple[float, float]:
     return settings.lle_stderr_rel, settings.lle_stderr_abs
 
 
-def padded_terms(terms: list[np.ndarray], inverse: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Forcing coefficients of shape (3, n_i) of each point as one array (L, 3, max n_i) for
-    the L lanes of point ``inverse[lane]`` (zero padding), and the counts n_i per lane."""
+def padded_terms(terms: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Forcing coefficients of shape (3, n_i) of M points as one array (M, 3, max n_i), zero
+    padded, and the counts n_i, shape (M,)."""
     count = np.array([t.shape[1] for t in terms], dtype=np.int64)
     padded = np.zeros((len(terms), 3, max(1, int(count.max(initial=0)))))
     for m, t in enumerate(terms):
         padded[m, :, : t.shape[1]] = t
-    return padded[inverse], count[inverse]
+    return padded, count
 
 
 def simulate_batch(

@@ -148,6 +148,14 @@ class NumericsResult(_Result):
     impact_regime: str | None = Field(description="no_impact | single_sided | double_sided.")
     x_rms: float | None = Field(description="sqrt(mean x^2) over the record.")
     x_peak_to_peak: float | None = Field(description="max x - min x over the record.")
+    force_max: float | None = Field(
+        None,
+        description="Largest dimensionless mesh force K(t) f_h(x) + 2 mu x' over the record's "
+        "steps (the kernel's extremes, as a sweep point's); null if diverged.",
+    )
+    force_min: float | None = Field(
+        None, description="Smallest dimensionless mesh force over the record; null if diverged."
+    )
     spectrum_peaks: list[SpectrumPeak] = Field(description="Largest peaks of the spectrum of x.")
     poincare: list[list[float]] = Field(description="Last strobes [[x, v], ...] (<= 256).")
     time_history: TimeHistory | None = Field(description="Last 20 intervals, <= 2000 samples.")

@@ -19,6 +19,7 @@ from pydantic import (
     model_validator,
 )
 
+from gearengine.model.errors import InputError
 from gearengine.model.params import Finite, GearParams, request_config
 from gearengine.model.units import QUANTITIES, parse_quantity
 from gearengine.numerics.forcing import step_plan
@@ -65,7 +66,7 @@ class RandomStarts(BaseModel):
     def _ordered(self) -> RandomStarts:
         for name, (lo, hi) in zip(("x", "v"), self.box, strict=True):
             if lo > hi:
-                raise ValueError(f"box: {name} range [{lo}, {hi}] is reversed")
+                raise InputError("box", f"{name} range [{lo}, {hi}] is reversed")
         return self
 
 
@@ -321,11 +322,11 @@ def work(params: GearParams, settings: SimulationSettings) -> int:
 
 
 def check_work(settings: SimulationSettings, steps: int) -> None:
-    """Refuse (ValueError naming ``steps_per_period``) a run over ``MAX_TOTAL_STEPS``."""
+    """Refuse (``InputError`` naming ``steps_per_period``) a run over ``MAX_TOTAL_STEPS``."""
     total = run_steps(settings, steps)
     if total > MAX_TOTAL_STEPS:
-        raise ValueError(
-            f"steps_per_period: the excitation frequencies need {steps} RK4 steps per T0, "
-            f"{total} steps in all, over the cap {MAX_TOTAL_STEPS}; lower steps_per_period or "
-            "the periods"
+        raise InputError(
+            "steps_per_period",
+            f"the excitation frequencies need {steps} RK4 steps per T0, {total} steps in all, "
+            f"over the cap {MAX_TOTAL_STEPS}; lower steps_per_period or the periods",
         )

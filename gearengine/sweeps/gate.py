@@ -15,20 +15,17 @@ the attractors that broke it with their fractions.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Literal
 from xml.etree import ElementTree
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from gearengine.model.units import OUTPUTS, RESPONSES
 from gearengine.numerics.classify import SEVERITY
-from gearengine.sweeps.results import (
-    RESPONSE_UNITS,
-    PhysicalValue,
-    SpeedWindows,
-    SweepPoint,
-    SweepResult,
-)
+from gearengine.sweeps.compute import run_local
+from gearengine.sweeps.request import SweepRequest
+from gearengine.sweeps.results import PhysicalValue, SpeedWindows, SweepPoint, SweepResult
 from gearengine.sweeps.windows import SPEED, runs
 
 FailOn = Literal["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"]
@@ -103,7 +100,7 @@ def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
         for key, value in (("dte", a.dte_um), ("dynamic_factor", a.dynamic_factor)):
             physical.pop(key, None)
             if value is not None:
-                physical[key] = PhysicalValue(value=value, unit=RESPONSE_UNITS[key])
+                physical[key] = PhysicalValue(value=value, unit=OUTPUTS[key].unit)
         alone = p.model_copy(update={"classification": a.classification, "period": a.period,
                                      "lle": a.lle, "impact_regime": a.impact_regime,
                                      "physical": physical or None})  # fmt: skip
@@ -112,8 +109,42 @@ def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
     return out
 
 
-RESPONSE_KEYS = ("dte", "dynamic_factor")
-"""Keys of a point's ``physical`` that are responses, not axis levels."""
+ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
+"""Light integration settings of an envelope check; a design file's ``settings`` are merged
+over them (adding ``random_initial_states`` keeps the 60 + 60 periods)."""
+
+
+def envelope_axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
+    """A sweep axis from "A:B" (bare numbers in ``unit``) or "52rad/s:628rad/s".
+
+    Raises ValueError for text that is not a range.
+    """
+    ends = text.split(":")
+    if len(ends) != 2 or not all(e.strip() for e in ends):
+        raise ValueError("give a range as LOW:HIGH (two values and a colon, e.g. 500:6000)")
+    lo, hi = (e.strip() if any(c.isalpha() for c in e) else f"{e.strip()} {unit}" for e in ends)
+    return {"parameter": name, "start": lo, "stop": hi, "num": num}
+
+
+def envelope_sweep(design: object, settings: dict[str, object] | None,
+                   axes: list[dict[str, object]], label: str) -> dict[str, object]:  # fmt: skip
+    """The sweep document of an envelope check: ``axes`` (``envelope_axis``) of ``design``
+    under ``settings`` merged over ``ENVELOPE_SETTINGS``."""
+    return {"design": design, "settings": {**ENVELOPE_SETTINGS, **(settings or {})},
+            "axes": axes, "label": label}  # fmt: skip
+
+
+def check_envelope(
+    request: SweepRequest,
+    rules: Rules,
+    progress_callback: Callable[[int, int], None] | None = None,
+    workers: int = 1,
+) -> EnvelopeReport:
+    """The gate's report of one envelope sweep, computed in this process (``workers`` threads,
+    a quarter of a core's share of the points per chunk, as the CLI gate runs it)."""
+    chunk = max(1, request.n_points() // (4 * workers))
+    result = run_local(request, progress_callback, chunk_points=chunk, workers=workers)
+    return envelope_report(result, rules)
 
 
 class FailingWindow(BaseModel):
@@ -140,6 +171,11 @@ class EnvelopeReport(BaseModel):
     rules: Rules
     points: int = Field(description="Grid points checked.")
     failing_points: int
+    melnikov_not_judged: int = Field(
+        0,
+        description="Grid points where the Melnikov criterion does not apply (above the critical "
+        "torque, or no saddle): --fail-on melnikov never fails them.",
+    )
     failures: list[FailingWindow]
     windows: list[SpeedWindows] = Field(description="All response windows, failing or not.")
     sweep: SweepResult = Field(description="The sweep result (the API's document).")
@@ -147,7 +183,7 @@ class EnvelopeReport(BaseModel):
 
 def _level_key(p: SweepPoint) -> tuple:
     return tuple(sorted((k, v.value) for k, v in (p.physical or {}).items() if k not in
-                        (SPEED, *RESPONSE_KEYS)))  # fmt: skip
+                        (SPEED, *RESPONSES)))  # fmt: skip
 
 
 def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
@@ -160,9 +196,7 @@ def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
     failing = 0
     for row in rows.values():
         row.sort(key=lambda p: p.values[SPEED])
-        level = {
-            k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, *RESPONSE_KEYS)
-        }
+        level = {k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, *RESPONSES)}
         speeds = [p.physical[SPEED].value for p in row]  # type: ignore[index]
         found = [attractor_failures(p, rules) for p in row]
         broken = [[rule for rule, _ in f] for f in found]
@@ -179,6 +213,9 @@ def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
         rules=rules,
         points=sum(len(r) for r in rows.values()),
         failing_points=failing,
+        melnikov_not_judged=sum(
+            1 for r in rows.values() for p in r if p.melnikov_chaos_possible is None
+        ),
         failures=failures,
         windows=result.windows or [],
         sweep=result,

@@ -21,10 +21,6 @@ class PhysicalValue(BaseModel):
     unit: str
 
 
-RESPONSE_UNITS = {"dte": "um", "dynamic_factor": "1"}
-"""The response entries of a design point's ``physical`` (beside its axes) and their units."""
-
-
 class SweepPoint(BaseModel):
     """Numerical and Melnikov verdicts of one point of the sweep."""
 
@@ -151,6 +147,11 @@ class SpeedWindows(BaseModel):
     )
     melnikov: list[list[float]] = Field(
         description="Runs of grid speeds where the Melnikov criterion allows chaos."
+    )
+    melnikov_not_applicable: list[list[float]] = Field(
+        default_factory=list,
+        description="Runs of grid speeds where the Melnikov criterion does not apply (the mean "
+        "load is above the critical torque: no saddle, no homoclinic orbit).",
     )
 
 

@@ -21,15 +21,19 @@ class SweepJobs:
 
     @classmethod
     def open(cls, settings: Settings) -> SweepJobs:
-        """Open the store; start a dispatcher on Dask (``dask_scheduler``) or on a pool of
-        ``workers`` processes (none when workers == 0 and no Dask)."""
-        store = JobStore.in_dir(Path(settings.data_dir))
+        """Open the store of the data directory; no dispatcher until ``start_dispatcher``
+        (``service.warmup`` starts it once the kernels are compiled)."""
+        return cls(JobStore.in_dir(Path(settings.data_dir)), None)
+
+    def start_dispatcher(self, settings: Settings) -> None:
+        """Start a dispatcher on Dask (``dask_scheduler``) or on a pool of ``workers``
+        processes (none when workers == 0 and no Dask)."""
         backend = make_backend(settings.workers, settings.dask_scheduler)
-        dispatcher = None
         if backend is not None:
-            dispatcher = Dispatcher(store, backend, settings.lease_seconds, settings.max_retries)
+            dispatcher = Dispatcher(self.store, backend, settings.lease_seconds,
+                                    settings.max_retries)  # fmt: skip
             dispatcher.start()
-        return cls(store, dispatcher)
+            self.dispatcher = dispatcher
 
     def wake(self) -> None:
         """Tell the local dispatcher that there is work."""

@@ -69,7 +69,7 @@ __all__ = [
 
 _HERE = Path(__file__).parent
 drop_stale(  # before any kernel runs: numba loads a cached kernel on its first call
-    "adaptive,intervals,kink,kinklanes,lockstep,monodromy,smooth",
+    "adaptive,intervals,kink,kinklanes,lockstep,monodromy,phase,ramp,smooth",
     [
         *_HERE.glob("*.py"),
         *(_HERE.parent / f"{m}.py" for m in ("periodicity", "lyapunov", "classify")),

@@ -8,10 +8,10 @@ import math
 import numpy as np
 from numba import njit
 
+from gearengine.numerics.kernels.phase import excitation_at
 from gearengine.numerics.kernels.smooth import (
     JIT_OPTIONS,
     SQRT1_2,
-    forcing_at,
     forcing_table,
     region,
     region_force,
@@ -81,7 +81,7 @@ def _rk4_region(
     alpha: float,
     twomu: float,
     kc: np.ndarray,
-    fm: float,
+    fm: float | np.ndarray,
     fc: np.ndarray,
     t: float,
     dt: float,
@@ -90,10 +90,11 @@ def _rk4_region(
     dx: float,
     dv: float,
 ) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
-    """One RK4 step of length dt from time t in region ``reg``, forcing evaluated at t."""
-    K0, F0 = forcing_at(t, kc, fm, fc)
-    K1, F1 = forcing_at(t + 0.5 * dt, kc, fm, fc)
-    K2, F2 = forcing_at(t + dt, kc, fm, fc)
+    """One RK4 step of length dt from time t in region ``reg``, forcing evaluated at t:
+    stationary (float ``fm``) or on a speed ramp (``fm`` a ramp record, ``kernels.phase``)."""
+    K0, F0 = excitation_at(t, kc, fm, fc)
+    K1, F1 = excitation_at(t + 0.5 * dt, kc, fm, fc)
+    K2, F2 = excitation_at(t + dt, kc, fm, fc)
     return rk4_region_kf(reg, alpha, twomu, K0, F0, K1, F1, K2, F2, dt, x, v, dx, dv)
 
 
@@ -103,7 +104,7 @@ def kink_step(
     alpha: float,
     twomu: float,
     kc: np.ndarray,
-    fm: float,
+    fm: float | np.ndarray,
     fc: np.ndarray,
     t: float,
     h: float,
@@ -126,7 +127,7 @@ def kink_split(
     alpha: float,
     twomu: float,
     kc: np.ndarray,
-    fm: float,
+    fm: float | np.ndarray,
     fc: np.ndarray,
     t: float,
     h: float,

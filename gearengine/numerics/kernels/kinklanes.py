@@ -47,6 +47,7 @@ def run_kink_batch(
     v0: np.ndarray,
     Ktab: np.ndarray,
     Ftab: np.ndarray,
+    owner: np.ndarray,
     kc: np.ndarray,
     nk: np.ndarray,
     fm: np.ndarray,
@@ -76,10 +77,12 @@ def run_kink_batch(
     Args:
         alpha, mu, x0, v0, T: per-run slope of Eq. (8) inside the clearance, damping, initial
             state and period T0, shape (P,).
-        Ktab, Ftab: per-run forcing tables from ``forcing_table``, shape (P, 2N+1).
-        kc, fc: per-run forcing coefficients (``numerics.forcing.packed_forcing``) padded to
-            shapes (P, 3, max terms); nk, nf: their numbers of terms, shape (P,); fm: mean
-            force, shape (P,). The substeps of split steps evaluate the forcing from them.
+        Ktab, Ftab: forcing tables from ``forcing_table`` of the M parameter points, shape
+            (M, 2N+1); owner: the point of each run, shape (P,), values in 0..M-1.
+        kc, fc: forcing coefficients of the points (``numerics.forcing.packed_forcing``)
+            padded to shapes (M, 3, max terms); nk, nf: their numbers of terms, shape (M,);
+            fm: mean force, shape (M,). The substeps of split steps evaluate the forcing from
+            them.
         N, n_trans, n_rec, bound, adaptive, streams, lle_rel, lle_abs: as in ``run_batch``.
 
     Returns:
@@ -89,8 +92,8 @@ def run_kink_batch(
     xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf = new_outputs(P, n_rec)
     for stream in prange(streams):  # one call per stream: tuples stay out of the parfor
         _kink_stream(
-            stream, streams, alpha, mu, x0, v0, Ktab, Ftab, kc, nk, fm, fc, nf, T, N, n_trans,
-            n_rec, bound, adaptive, lle_rel, lle_abs,
+            stream, streams, alpha, mu, x0, v0, Ktab, Ftab, owner, kc, nk, fm, fc, nf, T, N,
+            n_trans, n_rec, bound, adaptive, lle_rel, lle_abs,
             xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf,
         )  # fmt: skip
     return xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf
@@ -106,6 +109,7 @@ def _kink_stream(
     v0,
     Ktab,
     Ftab,
+    owner,
     kc,
     nk,
     fm,
@@ -190,8 +194,8 @@ def _kink_stream(
             for counter in counters:
                 counter[lane] = 0
             for s in range(2 * N + 1):
-                Kl[s, lane] = Ktab[p, s]
-                Fl[s, lane] = Ftab[p, s]
+                Kl[s, lane] = Ktab[owner[p], s]
+                Fl[s, lane] = Ftab[owner[p], s]
             AL[lane] = alpha[p]
             TM[lane] = 2.0 * mu[p]
             H[lane] = T[p] / N
@@ -252,9 +256,10 @@ def _kink_stream(
                 p = PT[lane]
                 if not NEAR[lane] or p < 0:
                     continue
+                q = owner[p]
                 X1[lane], V1[lane], DX1[lane], DV1[lane], REG[lane] = kink_split(
-                    REG[lane], AL[lane], TM[lane], kc[p, :, : nk[p]], fm[p],
-                    fc[p, :, : nf[p]], j * H[lane], H[lane], X[lane], V[lane], DX[lane],
+                    REG[lane], AL[lane], TM[lane], kc[q, :, : nk[q]], fm[q],
+                    fc[q, :, : nf[q]], j * H[lane], H[lane], X[lane], V[lane], DX[lane],
                     DV[lane], X1[lane], V1[lane], DX1[lane], DV1[lane],
                 )  # fmt: skip
                 S[lane], O[lane] = _law_slope_offset(REG[lane], AL[lane])

@@ -29,6 +29,7 @@ def run_batch(
     v0: np.ndarray,
     Ktab: np.ndarray,
     Ftab: np.ndarray,
+    owner: np.ndarray,
     T: np.ndarray,
     N: int,
     n_trans: int,
@@ -63,7 +64,9 @@ def run_batch(
     Args:
         a, c, mu, x0, v0, T: per-point law coefficients, damping, initial state and period T0,
             shape (P,).
-        Ktab, Ftab: per-point forcing tables from ``forcing_table``, shape (P, 2N+1).
+        Ktab, Ftab: forcing tables from ``forcing_table`` of the M parameter points, shape
+            (M, 2N+1); owner: the point of each lane's run, shape (P,), values in 0..M-1 (the
+            runs of a point share its table).
         N, n_trans, n_rec, bound: as in ``run_rk4`` (shared by all points).
         adaptive: allow early stopping of periodic points (``kernels.adaptive``).
         streams: parallel streams of lanes (at most the number of threads is useful).
@@ -80,7 +83,7 @@ def run_batch(
     xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf = new_outputs(P, n_rec)
     for stream in prange(streams):  # one call per stream: tuples stay out of the parfor
         _cubic_stream(
-            stream, streams, a, c, mu, x0, v0, Ktab, Ftab, T, N, n_trans, n_rec, bound,
+            stream, streams, a, c, mu, x0, v0, Ktab, Ftab, owner, T, N, n_trans, n_rec, bound,
             adaptive, lle_rel, lle_abs,
             xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf,
         )  # fmt: skip
@@ -98,6 +101,7 @@ def _cubic_stream(
     v0,
     Ktab,
     Ftab,
+    owner,
     T,
     N,
     n_trans,
@@ -168,8 +172,8 @@ def _cubic_stream(
             for counter in counters:
                 counter[lane] = 0
             for s in range(2 * N + 1):
-                Kl[s, lane] = Ktab[p, s]
-                Fl[s, lane] = Ftab[p, s]
+                Kl[s, lane] = Ktab[owner[p], s]
+                Fl[s, lane] = Ftab[owner[p], s]
             A[lane] = a[p]
             C[lane] = c[p]
             TM[lane] = 2.0 * mu[p]

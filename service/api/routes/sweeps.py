@@ -20,9 +20,10 @@ from gearengine.sweeps import (
     SweepResult,
     checked,
     chunk_bifurcations,
-    chunk_points,
     csv_rows,
+    points_of_chunk,
     result_json,
+    text_blocks,
 )
 from gearengine.sweeps.results import SpeedWindows
 from gearengine.sweeps.windows import SPEED, speed_windows
@@ -69,13 +70,13 @@ def _stored_points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
     time: the CSV of a million-point map streams at the speed of its writer, not of
     validation."""
     for array in jobs.store.chunk_results(job_id):
-        for item in chunk_points(array):
+        for item in points_of_chunk(array):
             yield SweepPoint.model_construct(**item)
 
 
 def _points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
     for array in jobs.store.chunk_results(job_id):
-        for item in chunk_points(array):
+        for item in points_of_chunk(array):
             yield SweepPoint.model_validate(item)
 
 
@@ -122,9 +123,10 @@ def get_result(
     sweep = SweepRequest.model_validate_json(jobs.store.request_json(job_id))
     axes = sweep.axes
     if format == "csv":
+        designed = sweep.design is not None
         name = f"sweep-{job_id}{'-partial' if missing else ''}.csv"
         return StreamingResponse(
-            csv_rows(axes, _stored_points(jobs, job_id), sweep.outputs, sweep.design is not None),
+            text_blocks(csv_rows(axes, _stored_points(jobs, job_id), sweep.outputs, designed)),
             media_type=CSV,
             headers={"Content-Disposition": f'attachment; filename="{name}"', **headers},
         )
