@@ -57,6 +57,7 @@ const SETTINGS_FIELDS = [
   ["settings.transient_periods", "transient periods", "int", 500],
   ["settings.record_periods", "recorded periods", "int", 500],
   ["settings.steps_per_period", "steps per period", "int", 200],
+  ["settings.basins.starts", "basin starts (optional: 16, 64, 256)", "int", ""],
 ];
 const ENVELOPE_FIELDS = [
   ["axes[0].start", "speed from", "unit", "500 rpm"],
@@ -312,6 +313,23 @@ function showVerdict(result) {
   $("verdict-facts").replaceChildren(...facts(result).flatMap(([k, v]) => [el("dt", { text: k }), el("dd", { text: v })]));
 }
 
+// With settings.basins: one row per attractor and the basin picture.
+function showAttractors(result, body) {
+  const found = result.numerics.attractors;
+  $("basins").hidden = !found;
+  if (!found) return;
+  const b = result.numerics.basins;
+  const pct = (x) => `${(100 * x).toFixed(0)} %`;
+  const head = el("tr", {}, ...["attractor", "basin", "95 % interval", "starts", "LLE", "DTE µm"]
+    .map((t) => el("th", { text: t })));
+  const rows = found.map((a) => el("tr", {}, ...[a.label, pct(a.fraction),
+    `${pct(a.interval[0])} – ${pct(a.interval[1])}`, String(a.count), fmt(a.lle),
+    a.dte_um === null || a.dte_um === undefined ? "—" : fmt(a.dte_um, 3)].map((t) => el("td", { text: t }))));
+  $("attractors-table").replaceChildren(head, ...rows);
+  $("basins-count").textContent = `(${b.starts} starts, ${b.diverged} diverged, ${b.unsettled} unsettled)`;
+  loadFigure($("basins-figure"), "/v1/analyses/basins/plot", body);
+}
+
 // A figure fetched with the key (an <img src> could not send it); data-state tells tests
 // and styles whether it is loading, shown or failed.
 async function loadFigure(img, path, body, note) {
@@ -364,6 +382,7 @@ async function analyse() {
     $("analyse-status").textContent = "Done.";
     $("verdict").scrollIntoView({ block: "start" });
     loadFigure($("analysis-figure"), "/v1/analyses/plot", body);
+    showAttractors(result, body);
     thresholdSubject = result.melnikov.applicable ? subject : null;
     if (thresholdSubject) {
       loadThresholds();
