@@ -106,11 +106,12 @@ def cmd_check(args: argparse.Namespace) -> int:
         return cmd_probability_gate(args)
     if args.speed or args.torque:
         return cmd_envelope(args)
-    if args.json or args.junit or args.server:
+    if args.starts is not None or args.min_basin is not None or args.json or args.junit or \
+            args.server:  # fmt: skip
         raise InvalidInputError(
             [
-                "--json, --junit and --server check an envelope: give --speed LOW:HIGH (rpm) "
-                "and/or --torque LOW:HIGH (N m)"
+                "--starts, --min-basin, --json, --junit and --server check an envelope: give "
+                "--speed LOW:HIGH (rpm) and/or --torque LOW:HIGH (N m)"
             ]
         )
     request = read_request(args.file, AnalysisRequest)

@@ -112,6 +112,8 @@ QUANTITIES: dict[str, QuantityKind] = {
     "inertia": QuantityKind("inertia", "kg*m^2", 1e-9, 1e4, ("kg*cm^2", "kg*mm^2"), "2e-3 kg*m^2"),
     "damping": QuantityKind("damping", "N*s/m", 0.0, 1e7, (), "1100 N*s/m"),
     "angle": QuantityKind("angle", "rad", math.radians(10), math.radians(35), ("deg",), "20 deg"),
+    "displacement": QuantityKind("displacement", "m", 0.0, 1e-2, ("um", "mm"), "-30 um"),
+    "velocity": QuantityKind("velocity", "m/s", 0.0, 100.0, ("mm/s",), "200 mm/s"),
     "speed_rate": QuantityKind(
         "rate of change of shaft speed",
         "rad/s^2",
@@ -221,7 +223,6 @@ StiffnessVariation = quantity_type("stiffness_variation", allow_zero=True)
 Inertia = quantity_type("inertia")
 Damping = quantity_type("damping", allow_zero=True)
 Angle = quantity_type("angle")
-SpeedRate = quantity_type("speed_rate")
 Duration = quantity_type("duration")
 Time = quantity_type("duration", allow_zero=True)
 

@@ -187,6 +187,12 @@ def chaos_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
         ax.contourf(g0, g1, strength, levels=[0.0, np.inf], colors="none", hatches=["//"])
         ax.contour(g0, g1, strength, levels=[0.0], colors="black", linewidths=1.6)
     ax.plot([], [], c="black", lw=1.6, label="Melnikov boundary (hatched: chaos possible)")
+    outside = np.isnan(strength)  # no saddle there (|F_m| >= F_crit): the criterion does not apply
+    if outside.any():
+        ax.contourf(g0, g1, outside.astype(float), levels=[0.5, 1.5], colors="none",
+                    hatches=["."])  # fmt: skip
+        label = "Melnikov criterion does not apply (no saddle)"
+        ax.fill([], [], fill=False, hatch=".", label=label)
     ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
     ax.set_xlabel(f"{SYMBOLS[ax0.parameter]} (dimensionless)")
     ax.set_ylabel(f"{SYMBOLS[ax1.parameter]} (dimensionless)")

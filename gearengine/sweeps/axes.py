@@ -69,6 +69,11 @@ def _get(tree: Any, path: str) -> Any:
     return tree
 
 
+def field_value(design: Design, path: str) -> Any:
+    """The design's field at ``path`` (SI units); KeyError or IndexError for a missing one."""
+    return _get(design.model_dump(), path)
+
+
 def design_with(design: Design, values: dict[str, object]) -> Design:
     """``design`` with physical fields set (unit strings or SI numbers), re-validated.
 

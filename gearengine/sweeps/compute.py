@@ -9,6 +9,7 @@ from collections.abc import Callable
 from typing import Any
 
 from gearengine import jobs
+from gearengine.ensembles.attractors import coexisting, points_attractors
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
@@ -59,9 +60,11 @@ def _point(
     params: GearParams,
     scales: Scales | None,
     bp: BatchPoint,
+    basins: dict[str, Any],
 ) -> SweepPoint:
     """The sweep's point from the engine's verdict ``bp`` (typed and finite, built by
-    ``numerics.batch``), so ``model_construct`` skips a second validation (~0.05 ms a point)."""
+    ``numerics.batch``), so ``model_construct`` skips a second validation (~0.05 ms a point);
+    ``basins`` its attractors, basins and coexisting entries (empty without basins)."""
     possible = chaos_possible(params)
     return SweepPoint.model_construct(
         values={name: float(v) for name, v in values.items()},
@@ -78,6 +81,7 @@ def _point(
         force_max=bp.force_max,
         force_min=bp.force_min,
         **_physical(values, params, scales, bp),
+        **basins,
     )
 
 
@@ -108,14 +112,35 @@ def _compute(
             (bp,) = simulate_batch([design], settings)
             verdicts.append(bp)
             settings = _carried(request.settings, bp)
+    ensembles = _basins(request, scaled, verdicts)
     points = [
-        _point(v, chunk.branch, params, scales, bp)
-        for v, (params, scales), bp in zip(values, scaled, verdicts, strict=True)
+        _point(v, chunk.branch, params, scales, bp, e)
+        for v, (params, scales), bp, e in zip(values, scaled, verdicts, ensembles, strict=True)
     ]
     if not request.continuation or len(axes) != 1 or len(values) < 2:
         return points, None
     line = [v[axes[0].parameter] for v in values]
     return points, _line_bifurcations(request, line, designs, verdicts)
+
+
+def _basins(
+    request: SweepRequest,
+    scaled: list[tuple[GearParams, Scales | None]],
+    verdicts: list[BatchPoint],
+) -> list[dict[str, Any]]:
+    """Per point, with ``settings.basins``: its attractors and basin counts
+    (``ensembles.attractors``, every point's starts in one ``run_lanes`` call; a box in units
+    read with the point's own scales) and, on a continuation line, the attractors coexisting
+    with the followed branch; else empty."""
+    if request.settings.basins is None:
+        return [{} for _ in scaled]
+    designs = [params for params, _ in scaled]
+    found = points_attractors(designs, request.settings, [sc for _, sc in scaled])
+    out: list[dict[str, Any]] = [{"attractors": a, "basins": c} for a, c in found]
+    if request.continuation:
+        for entry, bp in zip(out, verdicts, strict=True):
+            entry["coexisting"] = coexisting(bp, entry["attractors"], entry["basins"])
+    return out
 
 
 def _line_bifurcations(

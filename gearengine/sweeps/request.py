@@ -26,7 +26,7 @@ from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import ParamsOrDesign
 from gearengine.model.units import Scales
-from gearengine.numerics.settings import SimulationSettings
+from gearengine.numerics.settings import RequestSettings, SimulationSettings
 from gearengine.sweeps.axes import (
     axis_problem,
     changes_nothing,
@@ -60,7 +60,7 @@ AxisValue = Annotated[
 SweepOutput = Literal[
     "classification", "period", "lle", "lle_stderr", "impact_regime", "melnikov_chaos_possible",
     "poincare_x", "x_peak_to_peak", "periods_run", "force_max", "force_min", "physical",
-    "dimensionless",
+    "dimensionless", "attractors", "basins", "coexisting",
 ]  # fmt: skip
 """A field of ``SweepPoint`` a sweep may keep (``SweepRequest.outputs``)."""
 
@@ -120,7 +120,7 @@ class SweepRequest(ParamsOrDesign):
         }
     )
 
-    settings: SimulationSettings = Field(
+    settings: RequestSettings = Field(
         default_factory=SimulationSettings,
         description="Integration settings of every point (periods, steps, initial states).",
     )
