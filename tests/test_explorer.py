@@ -251,7 +251,9 @@ def test_analyse_shows_the_verdict(page: Page) -> None:
     states = page.driver.execute_script(
         "return [...document.querySelectorAll('figure img')].map(i => i.dataset.state)"
     )
-    assert states == ["shown", "shown"]
+    # no threshold curves above the critical torque, and the note says why
+    assert states == ["shown", "failed"]
+    assert "above the critical torque 9.62 N·m" in page.text("#threshold-note")
     page.show("#verdict")
     page.screenshot("explorer-verdict.png", height=1150)
     page.assert_same_origin()

@@ -223,7 +223,6 @@ StiffnessVariation = quantity_type("stiffness_variation", allow_zero=True)
 Inertia = quantity_type("inertia")
 Damping = quantity_type("damping", allow_zero=True)
 Angle = quantity_type("angle")
-SpeedRate = quantity_type("speed_rate")
 Duration = quantity_type("duration")
 Time = quantity_type("duration", allow_zero=True)
 

@@ -5,7 +5,9 @@ and the table of agreement between the numerical and the Melnikov verdicts.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
+from functools import lru_cache
+from typing import Any
 
 import numpy as np
 from pydantic import BaseModel, Field, TypeAdapter
@@ -122,7 +124,7 @@ def to_csv(
 
 def csv_rows(
     axes: list[SweepAxis],
-    points: Iterable[SweepPoint],
+    points: Iterable[SweepPoint | PointFields],
     outputs: Sequence[str] | None = None,
     design: bool = False,
 ) -> Iterator[str]:
@@ -167,6 +169,11 @@ def text_blocks(parts: Iterable[str], size: int = STREAM_BLOCK) -> Iterator[str]
         yield "".join(block)
 
 
+PointFields = Mapping[str, Any]
+"""A point's fields by name: a ``SweepPoint``'s ``__dict__``, or a point of a stored chunk as
+its JSON object (``points_of_chunk``), whose nested documents are plain dicts."""
+
+
 def _physical_columns(
     names: list[str], outputs: Sequence[str] | None
 ) -> list[tuple[str, str, bool]]:
@@ -191,60 +198,72 @@ def _axis_title(name: str) -> str:
     return f"{name} [{field_unit(name).si}]"
 
 
+@lru_cache(maxsize=1 << 16)
 def _axis_cell(x: float) -> str:
-    """An axis value as a plain decimal (shortest that reads back to the same float)."""
+    """An axis value as a plain decimal (shortest that reads back to the same float), cached:
+    the values of an axis repeat on every line of a map."""
     return np.format_float_positional(x, trim="-")
 
 
-def _physical(p: SweepPoint, key: str, axis: bool) -> float | None:
+def _physical(p: PointFields, key: str, axis: bool) -> float | None:
     """A gear-unit cell: an axis value in its display unit (``in_display_unit``, as
-    ``physical`` holds it), or an entry of ``physical``, which points read back from the job
-    store unvalidated (``model_construct``) hold as plain dicts."""
+    ``physical`` holds it), or an entry of ``physical`` (a document, or a plain dict)."""
     if axis:
-        return in_display_unit(key, p.values[key])
-    entry = (p.physical or {}).get(key)
+        return in_display_unit(key, p["values"][key])
+    entry = (p.get("physical") or {}).get(key)
     if entry is None:
         return None
     return float(entry["value"] if isinstance(entry, dict) else entry.value)
 
 
 def _row(
-    p: SweepPoint, names: list[str], shown: list[tuple[str, bool]], fields: list[str]
+    point: SweepPoint | PointFields,
+    names: list[str],
+    shown: list[tuple[str, bool]],
+    fields: list[str],
 ) -> list[str]:
     """The text cells of a point's row: the axis values, the gear-unit values of ``shown``,
-    then each field. The floats (with the Poincaré numbers) are formatted in one
-    ``_json_numbers`` call, then taken in order."""
-    values = [getattr(p, f) for f in fields]
-    cells = [_axis_cell(_grid_value(p.values[n])) for n in names]
-    gear = [_physical(p, key, axis) for key, axis in shown]
-    cells += [_axis_cell(v) for (_, axis), v in zip(shown, gear, strict=True) if axis]
-    floats = [v for (_, axis), v in zip(shown, gear, strict=True) if not axis and v is not None]
-    for f, value in zip(fields, values, strict=True):
-        if f == "poincare_x":
-            floats.extend(value or [])
-        elif isinstance(value, float):
+    then each field (a field the point lacks is empty). The floats (with the Poincaré
+    numbers) are formatted in one ``_json_numbers`` call, then put in their cells."""
+    p = point.__dict__ if isinstance(point, SweepPoint) else point
+    cells = [_axis_cell(_grid_value(p["values"][n])) for n in names]
+    floats: list[float] = []
+    later: list[tuple[int, int]] = []  # (cell, count of numbers) filled after formatting
+    for key, axis in shown:
+        value = _physical(p, key, axis)
+        if axis:
+            cells.append(_axis_cell(value))
+            continue
+        if value is not None:
+            later.append((len(cells), 1))
             floats.append(value)
-    numbers = _json_numbers(floats)
-    k = 0
-    for (_, axis), v in zip(shown, gear, strict=True):
-        if not axis:
-            cells.append("" if v is None else numbers[k])
-            k += v is not None
-    for f, value in zip(fields, values, strict=True):
+        cells.append("")
+    for f in fields:
+        value = p.get(f)
         if f == "poincare_x":
-            n = len(value or [])
-            cells.append(" ".join(numbers[k : k + n]))
-            k += n
-        elif isinstance(value, float):
-            cells.append(numbers[k])
-            k += 1
-        elif isinstance(value, bool):
-            cells.append(str(value).lower())
+            later.append((len(cells), len(value or [])))
+            cells.append("")
+            floats.extend(value or [])
+        elif value is None:
+            cells.append("")
+        elif type(value) is float:
+            later.append((len(cells), 1))
+            cells.append("")
+            floats.append(value)
+        elif type(value) is bool:
+            cells.append("true" if value else "false")
         else:
-            cells.append("" if value is None else _text_cell(str(value)))
+            cells.append(_text_cell(str(value)))
+    if floats:
+        numbers = _json_numbers(floats)
+        k = 0
+        for cell, count in later:
+            cells[cell] = numbers[k] if count == 1 else " ".join(numbers[k : k + count])
+            k += count
     return cells
 
 
+@lru_cache(maxsize=1024)
 def _text_cell(text: str) -> str:
     """A text cell quoted as the csv module quotes it (RFC 4180), only when it must be. Numbers
     never need it, so the rows are joined without scanning their long Poincaré cells."""
@@ -263,6 +282,7 @@ def _json_numbers(values: list[float]) -> list[str]:
     return _FLOATS.dump_json(values).decode()[1:-1].split(",") if values else []
 
 
+@lru_cache(maxsize=1 << 16)
 def _grid_value(x: float) -> float:
     """An axis value as the decimal it stands for: ``numpy.linspace`` computes 0.204 as
     0.20400000000000001 (an ulp away); 15 significant digits snap it back, so the cell reads

@@ -383,8 +383,17 @@ async function analyse() {
     $("verdict").scrollIntoView({ block: "start" });
     loadFigure($("analysis-figure"), "/v1/analyses/plot", body);
     showAttractors(result, body);
-    thresholdSubject = subject;
-    loadThresholds();
+    thresholdSubject = result.melnikov.applicable ? subject : null;
+    if (thresholdSubject) {
+      loadThresholds();
+    } else {  // above the critical torque: no saddle, so no threshold curves to draw
+      const img = $("threshold-figure");
+      img.removeAttribute("src");
+      img.dataset.state = "failed";
+      const t = result.engineering && result.engineering.critical_torque_nm;
+      $("threshold-note").textContent = "(the Melnikov criterion does not apply at this load"
+        + (t ? ` — above the critical torque ${fmt(t, 3)} N·m` : "") + ": no threshold curves)";
+    }
   } catch (err) {
     showProblem(form, { detail: "the server did not answer: " + err.message });
     $("analyse-status").textContent = "";
@@ -532,11 +541,12 @@ async function drawEnvelope(id, result) {
       customdata: sel.map((p) => [
         p.classification.replace("_", "-"), p.period ? p.period + "T" : "none", fmt(p.lle), fmt(p.lle_stderr, 2),
         (p.impact_regime || "—").replace("_", "-"),
-        p.melnikov_chaos_possible === null ? "not applicable" : p.melnikov_chaos_possible ? "possible" : "ruled out",
+        p.melnikov_chaos_possible === null ? "not applicable (above T_crit)"
+          : p.melnikov_chaos_possible ? "chaos possible" : "chaos ruled out",
       ]),
       hovertemplate: "speed %{x:,.0f} rpm<br>torque %{y:,.1f} N·m"
         + "<br>class %{customdata[0]}, period %{customdata[1]}<br>LLE %{customdata[2]} ± %{customdata[3]}"
-        + "<br>impacts %{customdata[4]}<br>Melnikov: chaos %{customdata[5]}<extra></extra>",
+        + "<br>impacts %{customdata[4]}<br>Melnikov: %{customdata[5]}<extra></extra>",
       marker: { color: CLASS_COLORS[cls], size: 11, symbol: "square", line: { color: "white", width: 1 } },
     };
   }).filter((t) => t.x.length);
