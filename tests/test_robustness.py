@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import copy
 import json
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -26,6 +25,7 @@ from gearengine.ensembles.tolerances import (
 from gearengine.jobs import compute_chunk_json
 from service.core.config import Settings
 from service.main import create_app
+from tests._polling import poll
 from tests.conftest import PAPER_PARAMS
 
 SHORT = {"transient_periods": 100, "record_periods": 100}
@@ -186,13 +186,7 @@ def working(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestClient]:
 
 
 def wait(c: TestClient, url: str, timeout: float = 120.0) -> dict[str, Any]:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        job = c.get(url).json()
-        if job["status"] not in ("queued", "running"):
-            return job
-        time.sleep(0.1)
-    raise TimeoutError(url)
+    return poll(lambda: c.get(url).json(), timeout=timeout, interval=0.1)
 
 
 def test_a_robustness_job_over_http_equals_run_local(

@@ -42,9 +42,10 @@ from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.model.design import Design
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
+from gearengine.model.units import in_display_unit
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.settings import SimulationSettings, work
-from gearengine.sweeps.axes import axis_problem, design_with, in_display_unit, is_dimensionless
+from gearengine.sweeps.axes import axis_problem, design_with, is_dimensionless
 from gearengine.sweeps.request import SweepAxis
 
 CLASSES = ("periodic", "quasi_periodic", "chaotic", "diverged")
