@@ -251,7 +251,9 @@ def test_analyse_shows_the_verdict(page: Page) -> None:
     states = page.driver.execute_script(
         "return [...document.querySelectorAll('figure img')].map(i => i.dataset.state)"
     )
-    assert states == ["shown", "shown"]
+    # no threshold curves above the critical torque, and the note says why
+    assert states == ["shown", "failed"]
+    assert "above the critical torque 9.62 N·m" in page.text("#threshold-note")
     page.show("#verdict")
     page.screenshot("explorer-verdict.png", height=1150)
     page.assert_same_origin()
@@ -417,4 +419,22 @@ def test_the_geometry_form_derives_the_gears(page: Page) -> None:
     page.field("analyse", by="id").click()
     page.wait(lambda d: page.text("#verdict-summary"))
     assert "Dynamic factor" in page.text("#verdict-facts")
+    page.assert_same_origin()
+
+
+def test_basins_show_the_attractors_and_their_picture(page: Page) -> None:
+    page.open()
+    page.type("settings.basins.starts", "16")
+    page.field("analyse", by="id").click()  # 500 + 500 periods from 16 starts: over the budget
+    page.wait(lambda d: "settings.basins.starts" in page.text("#refused"))
+    page.type("settings.transient_periods", "30")
+    page.type("settings.record_periods", "30")
+    page.field("analyse", by="id").click()
+    table = page.wait(lambda d: page.text("#attractors-table"))
+    assert "95 % interval" in table and "periodic" in table
+    assert "16 starts" in page.text("#basins-count")
+    page.figures_done()
+    page.wait(lambda d: page.field("basins-figure", by="id").get_attribute("data-state") == "shown")
+    page.show("#basins")
+    page.screenshot("explorer-basins.png", height=1400)
     page.assert_same_origin()

@@ -32,7 +32,7 @@ from gearengine.ensembles.remedies import (
 )
 from gearengine.model.design import Design
 from gearengine.model.standards import iso1328
-from gearengine.sweeps.axes import in_display_unit
+from gearengine.model.units import in_display_unit
 from tests.conftest import ROOT, Server
 
 EXAMPLE = ROOT / "examples" / "envelope-map.json"

@@ -4,6 +4,9 @@ envelope.
 Sweeps the design over a grid of driver speeds (rpm unless a unit is given) and mean torques
 (N m unless a unit is given), checks every point against the rules (``sweeps.gate``), prints
 the failing windows, and exits 1 when any point fails, 0 when none does, 2 on invalid input.
+Each point runs ``--starts N`` initial states (default ``GATE_STARTS``, a grid over the
+default basin box) and every attractor found whose basin fraction is above ``--min-basin``
+(default: any) is checked; ``--starts 1`` checks the settings' own start only.
 ``--json FILE`` writes the report (with the API's sweep result in it), ``--junit FILE`` a
 JUnit XML report, ``--server URL`` runs the sweep on a running service (its queue, its
 workers) instead of in this process, with the same report.
@@ -13,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 import time
@@ -46,6 +50,10 @@ from gearengine.sweeps.request import SweepRequest, validated
 from gearengine.sweeps.results import SpeedWindows, SweepResult
 
 POLL_SECONDS = 1.0
+GATE_STARTS = 16
+"""Basin starts per operating point of the gate unless ``--starts`` or the file's
+``settings.basins`` say otherwise: a 4 x 4 grid over the default box (benchmarks/README.md has
+its cost); ``--starts 1`` checks the settings' own start alone, as before basins."""
 
 
 def axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
@@ -72,8 +80,28 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
     settings = doc.get("settings", {})
     if not isinstance(settings, dict):
         raise InvalidInputError([f"{args.file}: settings must be an object"])
-    sweep = envelope_sweep(design, settings, axes, f"envelope check of {Path(args.file).name}")
+    sweep = envelope_sweep(
+        design,
+        gate_settings(settings, args.starts),
+        axes,
+        f"envelope check of {Path(args.file).name}",
+    )
     return validated_input(validated, sweep, args.file)
+
+
+def gate_settings(settings: dict, starts: int | None) -> dict:
+    """The gate's settings with its basin starts: ``starts`` (a grid when it is a square, else
+    random draws), else the file's basins, else ``GATE_STARTS``; ``starts`` 1 leaves basins
+    out."""
+    if starts is None:
+        starts = None if settings.get("basins") is not None else GATE_STARTS
+    if starts is None:
+        return settings
+    if starts == 1:
+        return {k: v for k, v in settings.items() if k != "basins"}
+    basins = dict(settings.get("basins") or {})
+    basins.update(starts=starts, grid=math.isqrt(max(starts, 0)) ** 2 == starts)
+    return {**settings, "basins": basins}
 
 
 def _here(design: dict, name: str) -> str:
@@ -117,7 +145,8 @@ def rules_of(args: argparse.Namespace) -> Rules:
     """--fail-on classes (default chaotic; limits add to them, never replace them)."""
     return Rules(fail_on=args.fail_on or ["chaotic"], max_lle=args.max_lle,
                  max_dte_um=args.max_dte,
-                 max_dynamic_factor=args.max_dynamic_factor)  # fmt: skip
+                 max_dynamic_factor=args.max_dynamic_factor,
+                 min_basin=getattr(args, "min_basin", None))  # fmt: skip
 
 
 def physical_limits(rules: Rules) -> list[str]:
@@ -135,6 +164,8 @@ def rules_text(rules: Rules) -> str:
         parts.append(f"--max-dte {rules.max_dte_um:g} µm")
     if rules.max_dynamic_factor is not None:
         parts.append(f"--max-dynamic-factor {rules.max_dynamic_factor:g}")
+    if rules.min_basin is not None:
+        parts.append(f"--min-basin {rules.min_basin:g}")
     return ", ".join(parts)
 
 

@@ -9,6 +9,7 @@
     gearengine sweep FILE [--out DIR|-] [--format json|csv]
     gearengine runup FILE --from 500 --to 6000 --rate 1000 [--direction up|down|up_down]
         [--bin 50] [--json OUT] [--plot OUT.png]
+    gearengine basins FILE [--starts N] [--json] [--plot FILE]
     gearengine convert FILE [--json]
 
 FILE holds ``{"params": {...}}`` or ``{"design": {...}}`` (physical units), and ``"settings"``
@@ -148,6 +149,12 @@ def build_parser() -> argparse.ArgumentParser:
         "file", help='JSON file holding {"params" or "design": {...}, "settings": {...}}, or -'
     )
     envelope_options(p)
+    p.add_argument("--starts", type=int, default=None, metavar="N",
+                   help="envelope checks: basin starts per operating point (default 16; 1: "
+                   "the settings' own start only)")  # fmt: skip
+    p.add_argument("--min-basin", type=float, default=None, metavar="F",
+                   help="envelope checks: check only attractors whose basin fraction is above "
+                   "F (default: every attractor found)")  # fmt: skip
     p.add_argument("--json", metavar="FILE", help="write the envelope report (JSON)")
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
     p.add_argument("--server", metavar="URL", help="run the envelope on a running service "
@@ -169,6 +176,15 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--samples", type=int, default=64, help="with --max-probability (default 64)")
     p.add_argument("--seed", type=int, default=0, help="with --max-probability (default 0)")
     p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
+
+    p = sub.add_parser("basins", help="coexisting attractors of a design and their basins")
+    p.add_argument("file", help='JSON file holding {"params" or "design": {...}, "settings": '
+                   '{"basins": {...}}}, or -')  # fmt: skip
+    p.add_argument("--starts", type=int, default=None, metavar="N",
+                   help="number of starts (a square on a grid: 16, 64, 256)")  # fmt: skip
+    p.add_argument("--json", action="store_true", help="print the API's JSON response")
+    p.add_argument("--plot", metavar="FILE", help="write the basin picture (.png or .svg)")
+    p.set_defaults(func=lazy("gearengine.cli.basins", "cmd_basins"))
 
     p = sub.add_parser(
         "remedies",

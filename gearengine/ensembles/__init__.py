@@ -6,4 +6,6 @@ with intervals; ``sensitivity`` says which tolerance matters (Sobol indices, SAL
 the design levers (damping, transmission error, backlash, stiffness variation, torque ripple)
 for the smallest change that makes a failing operating envelope pass, with a Melnikov bound and
 a numerical bound verified by an envelope run per lever (its chunks are envelope checks).
+``attractors`` groups many starts of one design by the orbit they settle on: coexisting
+attractors and their basin fractions.
 """

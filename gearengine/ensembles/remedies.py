@@ -51,15 +51,10 @@ from gearengine.model.design import ACCURACY_FIELD, EXAMPLE_DESIGN, Design
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
 from gearengine.model.standards import iso1328
+from gearengine.model.units import display_unit, in_display_unit
 from gearengine.numerics.batch import threads_may_share_kernels
 from gearengine.numerics.settings import SimulationSettings
-from gearengine.sweeps.axes import (
-    design_with,
-    display_unit,
-    field_value,
-    in_display_unit,
-    si_value,
-)
+from gearengine.sweeps.axes import design_with, field_value, si_value
 from gearengine.sweeps.gate import (
     ENVELOPE_SETTINGS,
     EnvelopeReport,

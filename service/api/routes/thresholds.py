@@ -12,7 +12,7 @@ from gearengine.homoclinic.thresholds import curve_of
 from gearengine.jsonio import dumps
 from gearengine.model.aliases import get_alias
 from gearengine.plots import MEDIA_TYPES, threshold_figure
-from service.api.deps import cached_compute, require_key
+from service.api.deps import AppLimits, cached_compute, require_key
 from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
 
 router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
@@ -29,10 +29,10 @@ def _design_frequency(body: ThresholdsRequest) -> float | None:
     responses=CACHED,
     summary="Threshold curves of a control parameter over a frequency range",
 )
-async def post_thresholds(body: ThresholdsRequest, request: Request) -> Response:
+async def post_thresholds(body: ThresholdsRequest, request: Request, limits: AppLimits) -> Response:
     """Where each Melnikov branch starts or stops changing sign as a frequency is swept
     (paper Figs. 5, 12, 18): per frequency, the intervals of the parameter without chaos."""
-    request.app.state.limits.check_curve(body)
+    limits.check_curve(body)
     return await cached_compute(
         request,
         "thresholds",
@@ -50,12 +50,13 @@ async def post_thresholds(body: ThresholdsRequest, request: Request) -> Response
 async def post_threshold_plot(
     body: ThresholdsRequest,
     request: Request,
+    limits: AppLimits,
     format: Literal["png", "svg"] | None = FormatQuery,
 ) -> Response:
     """The paper's Figs. 5, 12, 18: critical values of the parameter against the frequency,
     the band without chaos shaded, the design's value marked."""
     fmt = image_format(request, format)
-    request.app.state.limits.check_curve(body)
+    limits.check_curve(body)
     return await cached_compute(
         request,
         f"thresholds/plot.{fmt}",
