@@ -606,7 +606,9 @@ function offerFix(id, result) {
 async function fixIt() {
   const [s, t] = fixing.axes;
   const envelope = { speed: `${s.start}:${s.stop}`, speed_points: s.num, torque: `${t.start}:${t.stop}`, torque_points: t.num };
-  const body = { design: fixing.design, settings: fixing.settings, envelope, fail_on: ["chaotic"] };
+  // the starts of the map shown (its basins, else its one start), not the CI gate's default
+  const starts = (fixing.settings && fixing.settings.basins && fixing.settings.basins.starts) || 1;
+  const body = { design: fixing.design, settings: fixing.settings, envelope, starts, fail_on: ["chaotic"] };
   $("fix-it").disabled = true;
   let res;
   try {
