@@ -342,6 +342,42 @@ def test_an_envelope_can_be_cancelled(page: Page) -> None:
     page.assert_same_origin()
 
 
+def test_a_chaotic_envelope_offers_how_do_i_fix_it(page: Page) -> None:
+    """The rattling pair of examples/envelope-map.json over its chaotic band: the envelope
+    offers remedies (POST /v1/remedies), and shows the answer and a map at each remedy."""
+    from selenium.webdriver.common.by import By
+
+    page.open()
+    rattling = {
+        "design.mesh.half_backlash": "10 um",
+        "design.transmission_error.harmonics[0].amplitude": "10 um",
+        "design.torque_fluctuation.harmonics[0].amplitude": "0.5 N*m",
+        "envelope.axes[0].start": "4500 rpm",
+        "envelope.axes[0].stop": "5000 rpm",
+        "envelope.axes[0].num": "2",
+        "envelope.axes[1].start": "2 N*m",
+        "envelope.axes[1].stop": "11.5 N*m",
+        "envelope.axes[1].num": "2",
+        "envelope.settings.transient_periods": "60",
+        "envelope.settings.record_periods": "60",
+    }
+    for path, value in rattling.items():
+        page.type(path, value)
+    page.field("map-range", by="id").click()
+    page.wait(lambda d: page.text("#envelope-status") == "succeeded")
+    fix = page.wait(lambda d: page.field("fix-it", by="id").is_displayed() and
+                    page.field("fix-it", by="id"))  # fmt: skip
+    fix.click()
+    answer = page.wait(lambda d: page.text("#fix-answer"), timeout=900)
+    assert "(numerically)" in answer and "transmission error" in answer, answer
+    maps = page.wait(lambda d: d.find_elements(By.CSS_SELECTOR, "#fix-maps .scatterlayer"))
+    assert len(maps) == len(page.driver.find_elements(By.CSS_SELECTOR, "#fix-maps figure"))
+    assert "the envelope passes" in page.text("#fix-maps")
+    page.show("#fix")
+    page.screenshot("explorer-remedies.png", height=1400)
+    page.assert_same_origin()
+
+
 def test_without_the_key_the_page_says_so(page: Page) -> None:
     page.open(key=None)
     page.field("analyse", by="id").click()
