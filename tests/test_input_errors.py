@@ -4,14 +4,23 @@ read the field from the object, never from the message's text."""
 from __future__ import annotations
 
 import copy
+import json
+from pathlib import Path
 
+import pytest
 from fastapi.testclient import TestClient
 
+from gearengine.homoclinic.thresholds import threshold_curve
 from gearengine.jsonio import error_lines
 from gearengine.model.design import EXAMPLE_DESIGN
 from gearengine.model.errors import InputError
+from gearengine.model.examples import PAPER_SECTION_41
+from gearengine.model.params import GearParams
 from gearengine.model.reduction import ParamsOrDesign
+from gearengine.model.standards.backlash import half_backlash_band
 from service.api.deps import engine_refusal
+
+ROBUSTNESS_EXAMPLE = Path(__file__).parents[1] / "examples" / "robustness-gears.json"
 
 
 def test_a_design_s_inconsistent_radii_name_the_field(client: TestClient) -> None:
@@ -43,3 +52,43 @@ def test_the_refusal_takes_the_path_from_the_object_not_the_text() -> None:
     assert [e.path for e in problem.errors] == ["steps_per_period"]
     assert problem.errors[0].pointer == "/steps_per_period"
     assert engine_refusal(InputError("", "no field: refused")).problem.errors == []
+
+
+def test_an_iso1328_input_outside_its_range_names_the_gear_s_field(client: TestClient) -> None:
+    """Raised by the standard inside the design's conversion: before, path "(body)", pointer "/"."""
+    design = json.loads(ROBUSTNESS_EXAMPLE.read_text())["design"]  # ISO 1328 class 7
+    design["driven"]["module"] = design["driver"]["module"] = "80 mm"
+    r = client.post("/v1/analyses", json={"design": design})
+    assert r.status_code == 422
+    (error,) = r.json()["errors"]
+    assert (error["path"], error["pointer"]) == ("design.driver.module", "/design/driver/module")
+    assert error["message"].startswith("module: 80 is outside the range of ISO 1328-1:2013")
+
+
+@pytest.mark.parametrize(
+    ("backlash", "mean_force", "path"),
+    [({"model": "cubic", "a": -1.0}, 0.1, "params.backlash"), (None, 50.0, "params.mean_force")],
+)
+def test_threshold_refusals_are_typed(
+    client: TestClient, backlash: dict | None, mean_force: float, path: str
+) -> None:
+    """The engine raises ``InputError`` (no message prefix to parse); the 422 says where."""
+    params = {**PAPER_SECTION_41, "mean_force": mean_force}
+    params |= {"backlash": backlash} if backlash else {}
+    with pytest.raises(InputError) as raised:
+        threshold_curve(GearParams.model_validate(params), "F_e1", num=3)
+    assert raised.value.path == path and not raised.value.message.startswith(path)
+    r = client.post("/v1/thresholds", json={"params": params})
+    assert r.status_code == 422
+    (error,) = r.json()["errors"]
+    assert error == {
+        "path": path,
+        "pointer": "/" + path.replace(".", "/"),
+        "message": raised.value.message,
+    }
+
+
+def test_a_backlash_band_out_of_order_is_typed() -> None:
+    with pytest.raises(InputError) as raised:
+        half_backlash_band(120e-6, 80e-6, 0.35)
+    assert raised.value.path == "design.tolerances.backlash"

@@ -28,6 +28,7 @@ from scipy import stats
 from scipy.stats import qmc
 
 from gearengine.model.design import ACCURACY_FIELD, BACKLASH_FIELD, Design, TransmissionError
+from gearengine.model.errors import InputError
 from gearengine.model.reduction import half_backlash_band
 from gearengine.model.standards import iso1328
 from gearengine.model.tolerances import Distribution, Normal, Triangular, Uniform
@@ -151,8 +152,8 @@ def variables(design: Design) -> list[Variable]:
             assert gear.module is not None and gear.face_width is not None
             try:
                 t = iso1328.tolerances(grade, gear.teeth, gear.module * 1e3, gear.face_width * 1e3)
-            except ValueError as exc:
-                raise ToleranceError("accuracy", str(exc)) from None
+            except InputError as exc:
+                raise ToleranceError("accuracy", exc.message) from None
             profile.append(t.F_alpha)
         e_max = iso1328.mesh_error_bound(*profile) * 1e-6
         out.append(Variable(ACCURACY_FIELD, f"ISO 1328 class {grade}: mesh-frequency TE "

@@ -35,6 +35,7 @@ from gearengine.homoclinic.schemas import (
 from gearengine.homoclinic.terms import packed_terms
 from gearengine.model.aliases import get_alias, with_alias, with_aliases
 from gearengine.model.backlash import melnikov_cubic
+from gearengine.model.errors import InputError
 from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash
 
 CONTROL_PARAMETERS = ("F_e1", "mu", "k_p1", "F_p1")
@@ -394,8 +395,9 @@ def threshold_curve(
 ) -> ThresholdCurve:
     """Critical values of ``parameter`` for ``num`` values of a frequency in [start, stop].
 
-    Raises ValueError, its message starting with the request field at fault (``parameter``,
-    ``frequency_parameter`` or ``params.backlash``), when no curve can be drawn.
+    Raises ``InputError`` naming the request field at fault (``parameter``,
+    ``frequency_parameter``, ``params.backlash`` or ``params.mean_force``) when no curve can be
+    drawn.
 
     Args:
         params: the design; its other parameters stay fixed.
@@ -406,18 +408,22 @@ def threshold_curve(
     """
     a, c, notes = melnikov_cubic(params.backlash)
     if not saddle_loop(a, c):
-        raise ValueError(
-            f"params.backlash: the Melnikov criterion needs a > 0 and c > 0 (got a = {a}, c = {c})"
+        raise InputError(
+            "params.backlash",
+            f"the Melnikov criterion needs a > 0 and c > 0 (got a = {a}, c = {c})",
         )
     fm = loop_load(params, mean_load)
     if not saddle_loop(a, c, fm):
-        raise ValueError(
-            f"params.mean_force: F_m = {fm:g} is at or above F_crit = "
+        raise InputError(
+            "params.mean_force",
+            f"F_m = {fm:g} is at or above F_crit = "
             f"{critical_mean_force(a, c):.6g}: no saddle, the Melnikov criterion does not apply "
-            "(mean_load: perturbation gives the paper's first-order treatment)"
+            "(mean_load: perturbation gives the paper's first-order treatment)",
         )
     if get_alias(params, frequency_parameter) is None:
-        raise ValueError(f"frequency_parameter: {frequency_parameter}: its excitation is not given")
+        raise InputError(
+            "frequency_parameter", f"{frequency_parameter}: its excitation is not given"
+        )
     omegas = [float(w) for w in np.linspace(start, stop, num)]
     rows = [
         parameter_threshold(
@@ -426,7 +432,7 @@ def threshold_curve(
         for w in omegas
     ]
     if any(r.note for r in rows):
-        raise ValueError(f"parameter: {next(r.note for r in rows if r.note)}")
+        raise InputError("parameter", next(r.note for r in rows if r.note))
     return ThresholdCurve(
         parameter=parameter,
         frequency_parameter=frequency_parameter,

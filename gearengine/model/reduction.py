@@ -220,7 +220,9 @@ def tolerance_derived(design: Design) -> dict[str, Derived]:
         profile = {}
         for role, gear in (("driver", design.driver), ("driven", design.driven)):
             assert gear.module is not None and gear.face_width is not None
-            values = iso1328.tolerances(grade, gear.teeth, gear.module * 1e3, gear.face_width * 1e3)
+            values = iso1328.tolerances(
+                grade, gear.teeth, gear.module * 1e3, gear.face_width * 1e3, role
+            )
             profile[role] = values.F_alpha
             for name, formula in iso1328.FORMULAS.items():
                 out[f"{name}_{role}"] = Derived(

@@ -163,18 +163,13 @@ async def cached_compute(
 
 
 def engine_refusal(exc: ValueError) -> ProblemError:
-    """422 for a ValueError of the engine; an ``InputError`` names its field (typed)."""
-    path = exc.path if isinstance(exc, InputError) else _untyped_path(str(exc))
-    errors = [FieldError(path=path, pointer="/" + path.replace(".", "/"), message=str(exc))]
-    return ProblemError(422, "refused", "Refused by the engine", str(exc), errors if path else [])
-
-
-def _untyped_path(message: str) -> str:
-    """The field of an untyped ValueError whose message starts "field: ". Only
-    ``homoclinic.thresholds.threshold_curve`` still raises those (its rewrite, issue 19 item 4,
-    is to raise ``InputError``); then this goes."""
-    head = message.split(":", 1)[0]
-    return head if head.replace(".", "").replace("_", "").isalnum() and head != message else ""
+    """422 for a ValueError of the engine; an ``InputError`` names its field (typed, never
+    read from the message's text)."""
+    errors = []
+    if isinstance(exc, InputError) and exc.path:
+        pointer = "/" + exc.path.replace(".", "/")
+        errors = [FieldError(path=exc.path, pointer=pointer, message=exc.message)]
+    return ProblemError(422, "refused", "Refused by the engine", str(exc), errors)
 
 
 def _if_none_match(request: Request) -> set[str]:

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import math
 
+from gearengine.model.errors import InputError
+
 
 def half_backlash(circumferential: float, operating_pressure_angle: float) -> float:
     """b = j_t cos(alpha_wt) / 2 [m] from the circumferential backlash j_t [m] and the operating
@@ -26,10 +28,12 @@ def half_backlash(circumferential: float, operating_pressure_angle: float) -> fl
 def half_backlash_band(
     j_min: float, j_max: float, operating_pressure_angle: float
 ) -> tuple[float, float]:
-    """(b_min, b_max) [m] of a circumferential band [j_min, j_max] [m]; ValueError unless
-    0 < j_min < j_max."""
+    """(b_min, b_max) [m] of a circumferential band [j_min, j_max] [m]; ``InputError``
+    (``design.tolerances.backlash``) unless 0 < j_min < j_max."""
     if not 0.0 < j_min < j_max:
-        raise ValueError("tolerances.backlash: give 0 < min < max (circumferential backlash)")
+        raise InputError(
+            "design.tolerances.backlash", "give 0 < min < max (circumferential backlash)"
+        )
     return (
         half_backlash(j_min, operating_pressure_angle),
         half_backlash(j_max, operating_pressure_angle),

@@ -17,13 +17,16 @@ Rounding (5.2.3): the unrounded values enter (9) and (12); each tolerance is the
 10 µm to the nearest integer, from 5 µm to 10 µm to the nearest 0.5 µm, below 5 µm to the
 nearest 0.1 µm. Range of validity (clause 1): 1 <= A <= 11, 5 <= z <= 1000, 5 mm <= d <= 15 000
 mm, 0.5 mm <= m_n <= 70 mm, 4 mm <= b <= 1200 mm, helix angle <= 45 deg (spur gears here: 0).
-Outside it the standard says nothing, so ``tolerances`` refuses (ValueError naming the input).
+Outside it the standard says nothing, so ``tolerances`` refuses (``InputError`` naming the
+design's field).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+from gearengine.model.errors import InputError
 
 STANDARD = "ISO 1328-1:2013"
 
@@ -35,6 +38,15 @@ RANGES: dict[str, tuple[float, float]] = {
     "face_width": (4.0, 1200.0),
 }
 """Range of validity of clause 1 (lengths in mm)."""
+
+FIELDS: dict[str, str] = {
+    "class": "tolerances.accuracy",
+    "teeth": "{gear}.teeth",
+    "reference_diameter": "{gear}.module",
+    "module": "{gear}.module",
+    "face_width": "{gear}.face_width",
+}
+"""The design's field (under ``design``) each input of clause 1 comes from (d = m_n z)."""
 
 
 def class_step(tolerance_class: int) -> float:
@@ -77,17 +89,21 @@ FORMULAS: dict[str, str] = {
 """Each tolerance's formula (ISO 1328-1:2013, 5.3), for the ``source`` of derived values."""
 
 
-def check_range(name: str, value: float) -> None:
-    """Refuse ``value`` outside clause 1's range for ``name`` (ValueError naming it)."""
+def check_range(name: str, value: float, gear: str = "driver") -> None:
+    """Refuse ``value`` outside clause 1's range for ``name`` of the ``gear`` (driver or driven):
+    ``InputError`` at its design field (``FIELDS``)."""
     lo, hi = RANGES[name]
     if not lo <= value <= hi:
-        raise ValueError(
+        raise InputError(
+            "design." + FIELDS[name].format(gear=gear),
             f"{name}: {value:g} is outside the range of {STANDARD} ({lo:g} to {hi:g}"
-            f"{' mm' if name not in ('class', 'teeth') else ''}); the standard does not apply"
+            f"{' mm' if name not in ('class', 'teeth') else ''}); the standard does not apply",
         )
 
 
-def tolerances(tolerance_class: int, teeth: int, module_mm: float, face_width_mm: float):
+def tolerances(
+    tolerance_class: int, teeth: int, module_mm: float, face_width_mm: float, gear: str = "driver"
+):
     """The flank tolerances of a spur gear of class ``tolerance_class`` (1..11).
 
     Args:
@@ -95,17 +111,18 @@ def tolerances(tolerance_class: int, teeth: int, module_mm: float, face_width_mm
         teeth: number of teeth z.
         module_mm: normal module m_n [mm]; the reference diameter is d = m_n z [mm].
         face_width_mm: face width b [mm].
+        gear: which gear of the design it is ("driver" or "driven"), for the error's field.
 
     Returns:
         ``FlankTolerances`` [µm], Eq. (5)-(12) of ISO 1328-1:2013, 5.3, rounded by 5.2.3.
 
     Raises:
-        ValueError: an input outside the range of validity (clause 1), naming it.
+        InputError: an input outside the range of validity (clause 1), at its design field.
     """
     d = module_mm * teeth
     for name, value in (("class", tolerance_class), ("teeth", teeth), ("module", module_mm),
                         ("face_width", face_width_mm), ("reference_diameter", d)):  # fmt: skip
-        check_range(name, value)
+        check_range(name, value, gear)
     s, m, b = class_step(tolerance_class), module_mm, face_width_mm
     raw = {
         "f_pT": (0.001 * d + 0.4 * m + 5.0) * s,
