@@ -5,11 +5,14 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 
+from gearengine.homoclinic.extrema import extrema
+from gearengine.homoclinic.verdict import melnikov
 from gearengine.model.aliases import with_aliases
 from gearengine.model.design import Design
-from gearengine.model.frequencies import MAX_DENOMINATOR, poincare_frequency
+from gearengine.model.frequencies import MAX_DENOMINATOR, forcing_period, poincare_frequency
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import convert_design
 from gearengine.numerics.forcing import step_plan
@@ -86,3 +89,19 @@ def test_an_amplitude_axis_keeps_the_design_s_period_a_frequency_axis_searches()
     shaft = params.torque.frequency
     assert poincare_frequency(with_aliases(params, {"F_e1": 0.05})) == pytest.approx(shaft)
     assert with_aliases(params, {"Omega_p": 2 * shaft}).shaft_orders is None
+
+
+def test_the_melnikov_result_shows_the_design_s_period() -> None:
+    """The verdict's T0 and its extrema come from the design's shaft orders (before: the search
+    over 5 z x shaft gave no period, and the extrema were the supremum)."""
+    design = geometry_design(23) | {"torque": "10 N*m"}  # 50 N m: no saddle, not applicable
+    params = convert_design(Design.model_validate(design)).params
+    assert forcing_period(params.active_frequencies()) is None  # what the search finds
+    result = melnikov(params)
+    assert result.forcing_period == pytest.approx(2.0 * math.pi / params.torque.frequency, 1e-12)
+    assert {b.extrema for b in result.branches.values()} == {"exact"}
+    m = result.coefficients["plus"].trig_sum()
+    exact = extrema(m, result.forcing_period)
+    assert extrema(m).method == "supremum" and extrema(m).minimum.value <= exact.minimum.value
+    assert result.branches["plus"].min == exact.minimum.value
+    assert m(np.array([exact.minimum.tau0]))[0] == pytest.approx(exact.minimum.value, abs=1e-12)

@@ -54,6 +54,7 @@ from gearengine.homoclinic.verdict import applicability
 from gearengine.model.aliases import get_alias
 from gearengine.model.backlash import melnikov_cubic
 from gearengine.model.examples import PAPER_SECTION_41
+from gearengine.model.frequencies import poincare_period
 from gearengine.model.params import GearParams, request_config
 
 MAX_DESIGNS = 10_000
@@ -187,9 +188,9 @@ def design_verdict(p: GearParams, mean_load: MeanLoad = "unperturbed") -> BatchV
             "chaos_possible": None,
             "margins": {q: NO_MARGIN for q in CONTROL_PARAMETERS},
         }
-    chaos = False
+    chaos, period = False, poincare_period(p)
     for br in BRANCH_SIGN:
-        ext = extrema(active_only(units[br], p).trig_sum())
+        ext = extrema(active_only(units[br], p).trig_sum(), period)
         chaos = chaos or ext.minimum.value < 0.0 < ext.maximum.value
     margins: dict[str, Margin] = {}
     for q in CONTROL_PARAMETERS:

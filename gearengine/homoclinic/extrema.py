@@ -104,8 +104,12 @@ def maximum(
     return Extremum(float(polished[j]), float(tau[j] % period))
 
 
-def extrema(m: TrigSum) -> Extrema:
-    """min and max over tau0: exact when commensurate, supremum/infimum otherwise."""
+def extrema(m: TrigSum, period: float | None = None) -> Extrema:
+    """min and max over tau0: exact when commensurate, supremum/infimum otherwise.
+
+    ``period``: a common period of the frequencies known beforehand (a design's exact T0,
+    ``model.frequencies.poincare_period``); None searches one from the frequencies.
+    """
     active = m.amplitudes != 0.0
     if not active.any():
         const = Extremum(m.offset, None)
@@ -113,7 +117,7 @@ def extrema(m: TrigSum) -> Extrema:
     m = TrigSum(m.offset, m.amplitudes[active], m.frequencies[active], m.phases[active])
     if m.amplitudes.size == 1:
         return _single(m)
-    period = _period(tuple(m.frequencies.tolist()))
+    period = _period(tuple(m.frequencies.tolist())) if period is None else period
     if period is None:
         spread = float(np.abs(m.amplitudes).sum())
         return Extrema(

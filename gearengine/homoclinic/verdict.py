@@ -36,7 +36,7 @@ from gearengine.homoclinic.thresholds import (
     unit_coefficients,
 )
 from gearengine.model.backlash import melnikov_cubic
-from gearengine.model.frequencies import forcing_period
+from gearengine.model.frequencies import poincare_period
 from gearengine.model.params import GearParams
 
 
@@ -145,8 +145,8 @@ def melnikov(
         return not_applicable(a, c, method, notes, mean_load)
     fm, f_crit = loop_load(params, mean_load), critical_mean_force(a, c)
     coefs = {br: active_only(units[br], params) for br in BRANCH_SIGN}
-    branches = {br: branch_verdict(extrema(coefs[br].trig_sum())) for br in BRANCH_SIGN}
-    period = forcing_period(params.active_frequencies())
+    period = poincare_period(params)
+    branches = {br: branch_verdict(extrema(coefs[br].trig_sum(), period)) for br in BRANCH_SIGN}
     if any(b.extrema == "supremum" for b in branches.values()):
         notes.append(
             "the active frequencies are incommensurate (no ratio p/q with q <= 64): min and max "

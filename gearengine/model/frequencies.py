@@ -123,6 +123,12 @@ def poincare_frequency(params: GearParams) -> float | None:
     return top * gcd / lcm
 
 
+def poincare_period(params: GearParams) -> float | None:
+    """T0 = 2 pi / Omega_0 of the forcing of ``params`` (``poincare_frequency``), or None."""
+    omega0 = poincare_frequency(params)
+    return None if omega0 is None else 2.0 * math.pi / omega0
+
+
 def incommensurate_reason(params: GearParams) -> str:
     """Why ``poincare_frequency`` found no common period, in words."""
     if params.shaft_orders is not None:
