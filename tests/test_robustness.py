@@ -15,7 +15,7 @@ from fastapi.testclient import TestClient
 
 from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.ensembles import sensitivity
-from gearengine.ensembles.robustness import RobustnessRequest, checked, run_local
+from gearengine.ensembles.robustness import RobustnessRequest, checked, compute_chunk, run_local
 from gearengine.ensembles.tolerances import (
     base_design,
     probability,
@@ -65,13 +65,20 @@ def test_probabilities_equal_the_single_analysis_of_each_sample(
     study: tuple[RobustnessRequest, Any],
 ) -> None:
     """Each sample drawn again and analysed alone (``analyze``, the /v1/analyses path): the
-    counts of every class and event equal the study's."""
+    counts of every class and event equal the study's, and each run's DTE and dynamic factor
+    are the analysis's numbers (one definition, ``model.units.response_values``; before: rounded
+    to 6 decimals on their own)."""
     request, result = study
     base = base_design(request.design)
+    (runs,) = json.loads(compute_chunk(request, 0, 16))["runs"]
     counts = dict.fromkeys(("periodic", "quasi_periodic", "chaotic", "impacts", "melnikov"), 0)
-    for values in sample_values(request.variables(), request.unit_rows()):
+    for run, values in zip(
+        runs, sample_values(request.variables(), request.unit_rows()), strict=True
+    ):
         design = sample_design(base, values).model_dump(exclude={"tolerances"})
         one = analyze(AnalysisRequest.model_validate({"design": design, "settings": SHORT}))
+        response = one.engineering.response  # type: ignore[union-attr]
+        assert run[3:] == [response.dte_peak_to_peak_um, response.dynamic_factor]
         counts[one.numerics.classification] = counts.get(one.numerics.classification, 0) + 1
         counts["impacts"] += one.numerics.impact_regime in ("single_sided", "double_sided")
         counts["melnikov"] += bool(one.melnikov.chaos_possible)

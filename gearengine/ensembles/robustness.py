@@ -42,7 +42,7 @@ from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.model.design import Design
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
-from gearengine.model.units import in_display_unit
+from gearengine.model.units import Scales, in_display_unit, response_values
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.settings import SimulationSettings, work
 from gearengine.sweeps.axes import axis_problem, design_with, is_dimensionless
@@ -165,13 +165,18 @@ def robustness_work(request: RobustnessRequest) -> int:
     return request.n_rows() * sum(per_point)
 
 
-def _run(bp: Any, params: Any, half_backlash: float) -> list[Any]:
-    dte = None if bp.x_peak_to_peak is None else round(bp.x_peak_to_peak * half_backlash * 1e6, 6)
-    dyn = None
-    if bp.force_max is not None and params.mean_force > 0:
-        dyn = round(bp.force_max / params.mean_force, 6)
+def _run(bp: Any, params: Any, scales: Scales) -> list[Any]:
+    """One run's row: class, contact, Melnikov verdict, DTE [um] and dynamic factor (the one
+    definition, ``model.units.response_values``)."""
+    response = response_values(bp.x_peak_to_peak, bp.force_max, scales)
     contact = CONTACTS.index(bp.impact_regime) if bp.impact_regime in CONTACTS else None
-    return [CLASSES.index(bp.classification), contact, chaos_possible(params), dte, dyn]
+    return [
+        CLASSES.index(bp.classification),
+        contact,
+        chaos_possible(params),
+        response["dte"],
+        response["dynamic_factor"],
+    ]
 
 
 def compute_chunk(request: RobustnessRequest, index: int, rows: int) -> str:
@@ -185,10 +190,10 @@ def compute_chunk(request: RobustnessRequest, index: int, rows: int) -> str:
     base = base_design(request.design)
     points = request.points() or [{}]
     designs = [sample_design(base, {**v, **p}) for p in points for v in values]
-    params = [convert_design(d).params for d in designs]
-    backlash = [d.mesh.half_backlash for d in designs]
+    conversions = [convert_design(d) for d in designs]
+    params = [c.params for c in conversions]
     verdicts = simulate_batch(params, request.settings)
-    runs = [_run(bp, pp, b) for bp, pp, b in zip(verdicts, params, backlash, strict=True)]
+    runs = [_run(bp, c.params, c.scales) for bp, c in zip(verdicts, conversions, strict=True)]
     per_point = [runs[i * len(values) : (i + 1) * len(values)] for i in range(len(points))]
     return json.dumps({"index": index, "first_row": lo, "runs": per_point}, separators=(",", ":"))
 

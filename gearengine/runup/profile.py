@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 
 from gearengine.model.params import GearParams
-from gearengine.model.units import RPM
+from gearengine.model.units import RPM, in_si
 from gearengine.numerics.forcing import packed_forcing
 from gearengine.sweeps.axes import point_params
 
@@ -163,7 +163,7 @@ def runup_plan(request: RunupRequest) -> RunupPlan:
     ra = float(conv.derived["base_radius_driver"].value)  # type: ignore[arg-type]
     rb = float(conv.derived["base_radius_driven"].value)  # type: ignore[arg-type]
     ib = float(conv.derived["inertia_driven"].value)  # type: ignore[arg-type]
-    force_scale = conv.half_backlash_m * conv.mesh_stiffness_n_per_m
+    force_scale = in_si("mesh_force", 1.0, conv.scales)  # N per unit force, b k_m
     knots = request.knots()
     segments: list[Segment] = []
     if request.settle_periods > 0:

@@ -26,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from gearengine.engineering import speed_windows
-from gearengine.model.units import RPM, shown
+from gearengine.model.units import RPM, Scales, shown, to_physical
 from gearengine.numerics.classify import LLE_FLOOR
 from gearengine.runup.profile import Branch, RunupPlan
 from gearengine.runup.request import RunupRequest, n_bins
@@ -102,7 +102,7 @@ def with_lags(ramp: list[RunupJump], quasi: list[RunupJump], branch: Branch) -> 
 
 
 def _bins(request: RunupRequest, tables: list[np.ndarray], branch: Branch, lo: float,
-          force_n: float, omega_n: float) -> list[tuple[int, RunupBin]]:  # fmt: skip
+          scales: Scales) -> list[tuple[int, RunupBin]]:  # fmt: skip
     """The bins of one branch in the order first reached, with their indices."""
     if not tables:
         return []
@@ -121,7 +121,7 @@ def _bins(request: RunupRequest, tables: list[np.ndarray], branch: Branch, lo: f
         span = [lo + k * width, min(lo + (k + 1) * width, request.speed_range()[1] / RPM)]
         lle = stderr = None
         logs = np.array([t[block_ids, LOG].sum() for t in tables if len(t)])
-        tau = float(((mine[:, T1] - mine[:, T0]).sum()) * omega_n)
+        tau = float(((mine[:, T1] - mine[:, T0]).sum()) * scales.natural_frequency)
         if ok and len(logs) == len(tables) and np.isfinite(logs).all() and tau > 0:
             rates = logs / tau
             lle = float(rates.mean())
@@ -133,16 +133,18 @@ def _bins(request: RunupRequest, tables: list[np.ndarray], branch: Branch, lo: f
             back = float(mine[:, BACK].sum() / steps)
             contact = "both_flanks" if back > 0 else ("no_contact" if sep > 0 else "drive_flank")
         factor = None
-        if ok and (mine[:, FM] > 0).all():
-            factor = shown(float((mine[:, FMAX] / mine[:, FM]).max()))
-        b_um = request.design.mesh.half_backlash * 1e6  # type: ignore[union-attr]
+        if ok and (mine[:, FM] > 0).all():  # each block at its own mean force (a torque ramp)
+            blocks = zip(mine[:, FMAX].tolist(), mine[:, FM].tolist(), strict=True)
+            factor = shown(max(to_physical("dynamic_factor", f, scales.at(fm)) for f, fm in blocks))
+        dte = float(mine[:, XMAX].max() - mine[:, XMIN].min())
         out.append((k, RunupBin(
             speed_rpm=[shown(span[0]), shown(span[1])],
             time_s=[shown(float(mine[:, T0].min())), shown(float(mine[:, T1].max()))],
-            dte_peak_to_peak_um=shown(float(mine[:, XMAX].max() - mine[:, XMIN].min()) * b_um)
+            dte_peak_to_peak_um=shown(to_physical("dte", dte, scales)) if ok else None,
+            force_max_n=shown(to_physical("mesh_force", float(mine[:, FMAX].max()), scales))
             if ok else None,
-            force_max_n=shown(float(mine[:, FMAX].max()) * force_n) if ok else None,
-            force_min_n=shown(float(mine[:, FMIN].min()) * force_n) if ok else None,
+            force_min_n=shown(to_physical("mesh_force", float(mine[:, FMIN].min()), scales))
+            if ok else None,
             dynamic_factor=factor,
             separation_fraction=None if sep is None else shown(sep),
             back_flank_fraction=None if back is None else shown(back),
@@ -187,9 +189,8 @@ def read_runup(
     assert design is not None and conv is not None and params is not None
     arrays = [np.array(t, dtype=float).reshape(-1, 15) for t in tables]
     lo, hi = (w / RPM for w in request.speed_range())
-    b_um = design.mesh.half_backlash * 1e6
-    force_n = conv.half_backlash_m * conv.mesh_stiffness_n_per_m
-    omega_n = 1.0 / conv.time_scale_s
+    scales = conv.scales
+    b_um = to_physical("dte", 1.0, scales)  # one half backlash b in the DTE's unit
     qs = QuasiStatic(
         up=_quasi_branch(quasi.points, "up", b_um),
         down=_quasi_branch(quasi.points, "down", b_um),
@@ -198,7 +199,7 @@ def read_runup(
     )
     branches: dict[str, RunupBranch | None] = {"up": None, "down": None}
     for branch in ("up", "down"):
-        bins = _bins(request, arrays, branch, lo, force_n, omega_n)
+        bins = _bins(request, arrays, branch, lo, scales)
         if not bins:
             continue
         found = jumps(_edges(bins, branch), [b.dte_peak_to_peak_um for _, b in bins], b_um)
