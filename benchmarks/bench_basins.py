@@ -30,9 +30,10 @@ PAPER = {"damping": 0.07, "mean_force": 0.01,
 
 
 NOTE = (
-    "A basin start is a lane of the lock-step kernels with no diagnostics (spectrum, time histo"
-    "ry, Floquet), so it costs a fraction of a one-start analysis; the gate's default of 16 sta"
-    "rts per point (the least the issue allows) is what its cost makes affordable in a CI job."
+    "A basin start is a lane of the lock-step kernels with no diagnostics (spectrum, time "
+    "history, Floquet), so it costs a fraction of a one-start analysis; the gate's default of "
+    "16 starts per point (the least the issue allows) is what its cost makes affordable in a "
+    "CI job."
 )
 
 

@@ -422,6 +422,40 @@ def test_the_geometry_form_derives_the_gears(page: Page) -> None:
     page.assert_same_origin()
 
 
+def test_a_probability_map_runs_on_the_queue_and_can_be_cancelled(page: Page) -> None:
+    """The tolerances form: an ISO class needs the geometry form (the 422 says so); in the
+    geometry form a small study shows its progress and draws the map; a long one is cancelled."""
+    from selenium.webdriver.common.by import By
+
+    page.open()
+    small = {
+        "envelope.axes[0].num": "3",
+        "envelope.axes[1].num": "2",
+        "envelope.settings.transient_periods": "30",
+        "envelope.settings.record_periods": "30",
+        "robustness.samples": "4",
+    }
+    for path, value in small.items():
+        page.type(path, value)
+    page.field("study-range", by="id").click()  # direct form: no module for the class
+    page.wait(lambda d: "tolerances.accuracy" in page.text("#robustness-problem"))
+    page.driver.find_element("css selector", "input[name=form-mode][value=geometry]").click()
+    page.field("study-range", by="id").click()
+    page.wait(lambda d: re.search(r"\d+ / 24 runs", page.text("#robustness")))
+    page.wait(lambda d: page.text("#robustness-status") == "succeeded")
+    page.wait(lambda d: d.find_elements(By.CSS_SELECTOR, "#robustness-map .heatmaplayer, "
+                                        "#robustness-map .hm"))  # fmt: skip
+    page.show("#robustness")
+    page.screenshot("explorer-robustness.png", height=900)
+    page.type("envelope.settings.transient_periods", "3000")
+    page.type("robustness.samples", "64")
+    page.field("study-range", by="id").click()
+    page.wait(lambda d: page.text("#robustness-status") in ("queued", "running"))
+    page.field("cancel-study", by="id").click()
+    page.wait(lambda d: page.text("#robustness-status") == "cancelled")
+    page.assert_same_origin()
+
+
 def test_basins_show_the_attractors_and_their_picture(page: Page) -> None:
     page.open()
     page.type("settings.basins.starts", "16")

@@ -78,3 +78,49 @@ def test_the_default_gate_fails_where_any_attractor_is_chaotic_and_names_it(
     assert large < len(expected)
     main(["check", "envelope-map.json", *SMALL, "--min-basin", "0.99", "--json", "m.json"])
     assert json.loads((envelope / "m.json").read_text())["failing_points"] == large
+
+
+def test_continuation_names_the_attractors_beside_the_followed_branch() -> None:
+    from gearengine.sweeps.compute import run_local
+    from gearengine.sweeps.request import validated
+
+    design = json.loads(ENVELOPE.read_text())["design"]
+    doc = {"design": {**design, "torque": "2 N*m"},
+           "settings": {**ENVELOPE_SETTINGS, "basins": {"starts": 16}},
+           "axes": [{"parameter": "speed", "start": "5750 rpm", "stop": "6000 rpm", "num": 2}],
+           "continuation": True, "direction": "both"}  # fmt: skip
+    result = run_local(validated(doc))
+    assert [p.branch for p in result.points] == ["up", "up", "down", "down"]
+    for p in result.points:
+        assert p.attractors is not None and p.coexisting is not None
+        names = {f"{a.label} from" for a in p.attractors}
+        # every other attractor is named, the followed one (its class among them) is not
+        assert len(p.coexisting) == len(p.attractors) - 1 or (
+            len(p.coexisting) == len(p.attractors)
+            and p.classification not in {a.classification for a in p.attractors}
+        )
+        assert all(any(c.startswith(n) for n in names) for c in p.coexisting)
+    assert any(p.coexisting for p in result.points)  # 5,750 rpm: several attractors
+
+
+def test_the_envelope_map_hatches_where_attractors_coexist() -> None:
+    from matplotlib.patches import Rectangle
+
+    from gearengine.plots.envelope import COEXIST_COLOUR, envelope_map
+    from gearengine.sweeps.compute import run_local
+    from gearengine.sweeps.request import validated
+
+    design = json.loads(ENVELOPE.read_text())["design"]
+    axes = [{"parameter": "speed", "start": "5750 rpm", "stop": "6000 rpm", "num": 2},
+            {"parameter": "torque", "start": "2 N*m", "stop": "21 N*m", "num": 2}]  # fmt: skip
+    doc = {"design": design, "settings": {**ENVELOPE_SETTINGS, "basins": {"starts": 16}},
+           "axes": axes}  # fmt: skip
+    request = validated(doc)
+    result = run_local(request)
+    several = sum(len(p.attractors or []) > 1 for p in result.points)
+    assert several >= 1
+    ax = envelope_map(request, result.points).axes[0]
+    hatched = [r for r in ax.patches if isinstance(r, Rectangle) and r.get_hatch()]
+    assert len(hatched) == several
+    assert all(r.get_edgecolor()[:3] == pytest.approx((0x6A / 255, 0x3D / 255, 0x9A / 255))
+               for r in hatched) and COEXIST_COLOUR == "#6a3d9a"  # fmt: skip
