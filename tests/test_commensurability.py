@@ -7,6 +7,7 @@ import math
 
 import pytest
 
+from gearengine.model.aliases import with_aliases
 from gearengine.model.design import Design
 from gearengine.model.frequencies import MAX_DENOMINATOR, poincare_frequency
 from gearengine.model.params import GearParams
@@ -78,3 +79,10 @@ def test_truly_incommensurate_forcing_says_so() -> None:
     params = convert_design(Design.model_validate(design)).params
     note = step_plan(params, 64).notes[0]
     assert "truly incommensurate" in note
+
+
+def test_an_amplitude_axis_keeps_the_design_s_period_a_frequency_axis_searches() -> None:
+    params = convert_design(Design.model_validate(geometry_design(97))).params
+    shaft = params.torque.frequency
+    assert poincare_frequency(with_aliases(params, {"F_e1": 0.05})) == pytest.approx(shaft)
+    assert with_aliases(params, {"Omega_p": 2 * shaft}).shaft_orders is None

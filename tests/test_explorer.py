@@ -342,6 +342,42 @@ def test_an_envelope_can_be_cancelled(page: Page) -> None:
     page.assert_same_origin()
 
 
+def test_a_chaotic_envelope_offers_how_do_i_fix_it(page: Page) -> None:
+    """The rattling pair of examples/envelope-map.json over its chaotic band: the envelope
+    offers remedies (POST /v1/remedies), and shows the answer and a map at each remedy."""
+    from selenium.webdriver.common.by import By
+
+    page.open()
+    rattling = {
+        "design.mesh.half_backlash": "10 um",
+        "design.transmission_error.harmonics[0].amplitude": "10 um",
+        "design.torque_fluctuation.harmonics[0].amplitude": "0.5 N*m",
+        "envelope.axes[0].start": "4500 rpm",
+        "envelope.axes[0].stop": "5000 rpm",
+        "envelope.axes[0].num": "2",
+        "envelope.axes[1].start": "2 N*m",
+        "envelope.axes[1].stop": "11.5 N*m",
+        "envelope.axes[1].num": "2",
+        "envelope.settings.transient_periods": "60",
+        "envelope.settings.record_periods": "60",
+    }
+    for path, value in rattling.items():
+        page.type(path, value)
+    page.field("map-range", by="id").click()
+    page.wait(lambda d: page.text("#envelope-status") == "succeeded")
+    fix = page.wait(lambda d: page.field("fix-it", by="id").is_displayed() and
+                    page.field("fix-it", by="id"))  # fmt: skip
+    fix.click()
+    answer = page.wait(lambda d: page.text("#fix-answer"), timeout=900)
+    assert "(numerically)" in answer and "transmission error" in answer, answer
+    maps = page.wait(lambda d: d.find_elements(By.CSS_SELECTOR, "#fix-maps .scatterlayer"))
+    assert len(maps) == len(page.driver.find_elements(By.CSS_SELECTOR, "#fix-maps figure"))
+    assert "the envelope passes" in page.text("#fix-maps")
+    page.show("#fix")
+    page.screenshot("explorer-remedies.png", height=1400)
+    page.assert_same_origin()
+
+
 def test_without_the_key_the_page_says_so(page: Page) -> None:
     page.open(key=None)
     page.field("analyse", by="id").click()
@@ -383,6 +419,40 @@ def test_the_geometry_form_derives_the_gears(page: Page) -> None:
     page.field("analyse", by="id").click()
     page.wait(lambda d: page.text("#verdict-summary"))
     assert "Dynamic factor" in page.text("#verdict-facts")
+    page.assert_same_origin()
+
+
+def test_a_probability_map_runs_on_the_queue_and_can_be_cancelled(page: Page) -> None:
+    """The tolerances form: an ISO class needs the geometry form (the 422 says so); in the
+    geometry form a small study shows its progress and draws the map; a long one is cancelled."""
+    from selenium.webdriver.common.by import By
+
+    page.open()
+    small = {
+        "envelope.axes[0].num": "3",
+        "envelope.axes[1].num": "2",
+        "envelope.settings.transient_periods": "30",
+        "envelope.settings.record_periods": "30",
+        "robustness.samples": "4",
+    }
+    for path, value in small.items():
+        page.type(path, value)
+    page.field("study-range", by="id").click()  # direct form: no module for the class
+    page.wait(lambda d: "tolerances.accuracy" in page.text("#robustness-problem"))
+    page.driver.find_element("css selector", "input[name=form-mode][value=geometry]").click()
+    page.field("study-range", by="id").click()
+    page.wait(lambda d: re.search(r"\d+ / 24 runs", page.text("#robustness")))
+    page.wait(lambda d: page.text("#robustness-status") == "succeeded")
+    page.wait(lambda d: d.find_elements(By.CSS_SELECTOR, "#robustness-map .heatmaplayer, "
+                                        "#robustness-map .hm"))  # fmt: skip
+    page.show("#robustness")
+    page.screenshot("explorer-robustness.png", height=900)
+    page.type("envelope.settings.transient_periods", "3000")
+    page.type("robustness.samples", "64")
+    page.field("study-range", by="id").click()
+    page.wait(lambda d: page.text("#robustness-status") in ("queued", "running"))
+    page.field("cancel-study", by="id").click()
+    page.wait(lambda d: page.text("#robustness-status") == "cancelled")
     page.assert_same_origin()
 
 

@@ -17,8 +17,7 @@ import pytest
 
 import gearengine
 from gearengine.cli import main
-from gearengine.cli.envelope import GATE_STARTS
-from gearengine.sweeps.gate import ENVELOPE_SETTINGS
+from gearengine.sweeps.gate import ENVELOPE_SETTINGS, GATE_STARTS
 from tests.conftest import ROOT
 
 GOLDEN = ROOT / "tests" / "data" / "gate-starts-1"

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import sys
 import time
@@ -42,6 +41,7 @@ from gearengine.sweeps.gate import (
     envelope_axis,
     envelope_report,
     envelope_sweep,
+    gate_settings,
     junit_xml,
     level_text,
     window_text,
@@ -50,10 +50,6 @@ from gearengine.sweeps.request import SweepRequest, validated
 from gearengine.sweeps.results import SpeedWindows, SweepResult
 
 POLL_SECONDS = 1.0
-GATE_STARTS = 16
-"""Basin starts per operating point of the gate unless ``--starts`` or the file's
-``settings.basins`` say otherwise: a 4 x 4 grid over the default box (benchmarks/README.md has
-its cost); ``--starts 1`` checks the settings' own start alone, as before basins."""
 
 
 def axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
@@ -87,21 +83,6 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
         f"envelope check of {Path(args.file).name}",
     )
     return validated_input(validated, sweep, args.file)
-
-
-def gate_settings(settings: dict, starts: int | None) -> dict:
-    """The gate's settings with its basin starts: ``starts`` (a grid when it is a square, else
-    random draws), else the file's basins, else ``GATE_STARTS``; ``starts`` 1 leaves basins
-    out."""
-    if starts is None:
-        starts = None if settings.get("basins") is not None else GATE_STARTS
-    if starts is None:
-        return settings
-    if starts == 1:
-        return {k: v for k, v in settings.items() if k != "basins"}
-    basins = dict(settings.get("basins") or {})
-    basins.update(starts=starts, grid=math.isqrt(max(starts, 0)) ** 2 == starts)
-    return {**settings, "basins": basins}
 
 
 def _here(design: dict, name: str) -> str:

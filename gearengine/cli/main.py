@@ -106,6 +106,12 @@ def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -
                    help="fail where the largest dynamic mesh force exceeds F times the static "
                    "force")  # fmt: skip
     p.add_argument("--max-lle", type=float, default=None, help="fail when the LLE exceeds V")
+    p.add_argument("--starts", type=int, default=None, metavar="N",
+                   help="envelope checks: basin starts per operating point (default 16; 1: "
+                   "the settings' own start only)")  # fmt: skip
+    p.add_argument("--min-basin", type=float, default=None, metavar="F",
+                   help="envelope checks: check only attractors whose basin fraction is above "
+                   "F (default: every attractor found)")  # fmt: skip
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -149,12 +155,6 @@ def build_parser() -> argparse.ArgumentParser:
         "file", help='JSON file holding {"params" or "design": {...}, "settings": {...}}, or -'
     )
     envelope_options(p)
-    p.add_argument("--starts", type=int, default=None, metavar="N",
-                   help="envelope checks: basin starts per operating point (default 16; 1: "
-                   "the settings' own start only)")  # fmt: skip
-    p.add_argument("--min-basin", type=float, default=None, metavar="F",
-                   help="envelope checks: check only attractors whose basin fraction is above "
-                   "F (default: every attractor found)")  # fmt: skip
     p.add_argument("--json", metavar="FILE", help="write the envelope report (JSON)")
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
     p.add_argument("--server", metavar="URL", help="run the envelope on a running service "

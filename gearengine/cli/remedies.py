@@ -41,6 +41,8 @@ def remedies_request(args: argparse.Namespace) -> RemediesRequest:
             **rules_of(args).model_dump(exclude_none=True)}  # fmt: skip
     if "settings" in doc:
         body["settings"] = doc["settings"]
+    if args.starts is not None:
+        body["starts"] = args.starts
     if args.lever:
         body["levers"] = args.lever
     return validated_input(RemediesRequest.model_validate, body, args.file)

@@ -57,11 +57,13 @@ from gearengine.numerics.settings import SimulationSettings
 from gearengine.sweeps.axes import design_with, field_value, si_value
 from gearengine.sweeps.gate import (
     ENVELOPE_SETTINGS,
+    GATE_STARTS,
     EnvelopeReport,
     Rules,
     check_envelope,
     envelope_axis,
     envelope_sweep,
+    gate_settings,
 )
 from gearengine.sweeps.plan import sweep_work
 from gearengine.sweeps.request import SweepRequest, validated
@@ -137,6 +139,11 @@ class RemediesRequest(Rules):
         description="Levers to search instead of the default ones (damping, transmission error, "
         "half backlash down and up, stiffness variation, torque fluctuation).",
     )  # fmt: skip
+    starts: int | None = Field(
+        None, ge=1, le=1024,
+        description="Basin starts per operating point, as the gate's --starts (default: the "
+        f"gate's {GATE_STARTS}, or settings.basins; 1: the settings' own start only).",
+    )  # fmt: skip
     tolerance: float = Field(
         0.02, gt=0.0, le=0.2,
         description="Numerical bisection stops when its bracket is narrower than this fraction "
@@ -165,8 +172,8 @@ class RemediesRequest(Rules):
         axes = [envelope_axis("speed", env.speed, "rpm", env.speed_points)]
         if env.torque is not None:
             axes.append(envelope_axis("torque", env.torque, "N*m", env.torque_points))
-        doc = envelope_sweep((design or self.design).model_dump(), self.settings.model_dump(),
-                             axes, "remedies")  # fmt: skip
+        settings = gate_settings(self.settings.model_dump(exclude_none=True), self.starts)
+        doc = envelope_sweep((design or self.design).model_dump(), settings, axes, "remedies")
         return SweepRequest.model_validate(doc)
 
 

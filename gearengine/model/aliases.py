@@ -50,8 +50,12 @@ def with_alias(params: GearParams, name: str, value: float) -> GearParams:
 
 
 def with_aliases(params: GearParams, values: dict[str, float]) -> GearParams:
-    """A copy of ``params`` with several aliases set at once, validated (see ``with_alias``)."""
-    return GearParams.model_validate(aliased_data(params.model_dump(), values))
+    """A copy of ``params`` with several aliases set at once, validated (see ``with_alias``).
+    A design's shaft orders (``GearParams.shaft_orders``) stay while no frequency is set."""
+    copy = GearParams.model_validate(aliased_data(params.model_dump(), values))
+    if any(_alias(name)[1] == "frequency" for name in values):
+        return copy
+    return copy.with_shaft_orders(params.shaft_orders)
 
 
 def aliased_data(data: dict, values: dict[str, float]) -> dict:

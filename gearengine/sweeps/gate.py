@@ -15,6 +15,7 @@ the attractors that broke it with their fractions.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from typing import Literal
 from xml.etree import ElementTree
@@ -112,6 +113,27 @@ def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
 ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
 """Light integration settings of an envelope check; a design file's ``settings`` are merged
 over them (adding ``random_initial_states`` keeps the 60 + 60 periods)."""
+
+
+GATE_STARTS = 16
+"""Basin starts per operating point of the gate unless ``--starts`` or the file's
+``settings.basins`` say otherwise: a 4 x 4 grid over the default box (benchmarks/README.md has
+its cost); ``--starts 1`` checks the settings' own start alone, as before basins."""
+
+
+def gate_settings(settings: dict, starts: int | None) -> dict:
+    """The gate's settings with its basin starts: ``starts`` (a grid when it is a square, else
+    random draws), else the file's basins, else ``GATE_STARTS``; ``starts`` 1 leaves basins
+    out."""
+    if starts is None:
+        starts = None if settings.get("basins") is not None else GATE_STARTS
+    if starts is None:
+        return settings
+    if starts == 1:
+        return {k: v for k, v in settings.items() if k != "basins"}
+    basins = dict(settings.get("basins") or {})
+    basins.update(starts=starts, grid=math.isqrt(max(starts, 0)) ** 2 == starts)
+    return {**settings, "basins": basins}
 
 
 def envelope_axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:

@@ -456,7 +456,7 @@ async function mapRange() {
     return;
   }
   const job = await res.json();
-  rememberJob({ id: job.id, label, design, settings: env.settings, created: Date.now(), status: job.status });
+  rememberJob({ id: job.id, label, design, settings: env.settings, axes, created: Date.now(), status: job.status });
   watchJob(job.id);
 }
 
@@ -529,9 +529,22 @@ const pointSpeed = (p) => (p.physical && p.physical.speed ? p.physical.speed.val
 const pointTorque = (p) => (p.physical && p.physical.torque ? p.physical.torque.value : p.values.torque);
 
 async function drawEnvelope(id, result) {
-  const Plotly = await loadPlotly();
   $("envelope-progress-row").hidden = true;
   $("envelope-hint").hidden = false;
+  const map = $("envelope-map");
+  await drawMap(map, result, 420);
+  map.on("plotly_click", (ev) => {
+    const hit = ev.points.find((p) => p.data.type === "scatter");
+    if (hit) openPoint(id, hit.x, hit.y);
+  });
+  showWindows(result.windows);
+  offerFix(id, result);
+}
+
+// A speed x torque map of a sweep result into ``map``: one marker per point by class, the
+// Melnikov region shaded.
+async function drawMap(map, result, height) {
+  const Plotly = await loadPlotly();
   const pts = result.points.map((p) => ({ ...p, rpm: pointSpeed(p), nm: pointTorque(p) }));
   const traces = Object.keys(CLASS_COLORS).map((cls) => {
     const sel = pts.filter((p) => p.classification === cls);
@@ -566,18 +579,68 @@ async function drawEnvelope(id, result) {
     });
   }
   const layout = {
-    margin: { l: 60, r: 10, t: 10, b: 50 }, height: 420,
+    margin: { l: 60, r: 10, t: 10, b: 50 }, height,
     xaxis: { title: { text: "driver speed [rpm]" }, zeroline: false },
     yaxis: { title: { text: "driver torque [N·m]" }, zeroline: false },
     legend: { orientation: "h", y: -0.18 }, hovermode: "closest",
   };
-  const map = $("envelope-map");
   await Plotly.newPlot(map, traces, layout, { displaylogo: false, responsive: true });
-  map.on("plotly_click", (ev) => {
-    const hit = ev.points.find((p) => p.data.type === "scatter");
-    if (hit) openPoint(id, hit.x, hit.y);
-  });
-  showWindows(result.windows);
+}
+
+// ---------------------------------------------------------------- remedies
+let fixing = null; // the failing envelope "How do I fix it?" searches: {design, settings, axes}
+
+function offerFix(id, result) {
+  const job = recentJobs().find((j) => j.id === id);
+  const failing = result.points.some((p) => ["chaotic", "diverged"].includes(p.classification));
+  const axes = job && (job.axes || result.axes);
+  fixing = failing && axes && axes.length === 2 ? { design: job.design, settings: job.settings, axes } : null;
+  $("fix").hidden = !fixing;
+  $("fix-status").textContent = "";
+  $("fix-answer").textContent = "";
+  $("fix-maps").replaceChildren();
+}
+
+// POST /v1/remedies under the gate's default rule (--fail-on chaotic), then the ranked answer
+// and the map at each remedy (the envelope report's sweep).
+async function fixIt() {
+  const [s, t] = fixing.axes;
+  const envelope = { speed: `${s.start}:${s.stop}`, speed_points: s.num, torque: `${t.start}:${t.stop}`, torque_points: t.num };
+  // the starts of the map shown (its basins, else its one start), not the CI gate's default
+  const starts = (fixing.settings && fixing.settings.basins && fixing.settings.basins.starts) || 1;
+  const body = { design: fixing.design, settings: fixing.settings, envelope, starts, fail_on: ["chaotic"] };
+  $("fix-it").disabled = true;
+  let res;
+  try {
+    res = await api("POST", "/v1/remedies", body);
+  } catch (err) {
+    res = null;
+    $("fix-answer").textContent = "the server did not answer: " + err.message;
+  }
+  if (res && !res.ok) $("fix-answer").textContent = (await problemOf(res)).detail;
+  if (!res || !res.ok) { $("fix-it").disabled = false; return; }
+  pollFix((await res.json()).id);
+}
+
+async function pollFix(id) {
+  const res = await api("GET", `/v1/remedies/${id}`);
+  const job = res.ok ? await res.json() : { status: "unavailable", progress: { done: 0, total: 0 } };
+  $("fix-status").textContent = `${job.status} · ${job.progress.done} / ${job.progress.total} searches`;
+  if (job.status === "queued" || job.status === "running") {
+    setTimeout(() => pollFix(id), 1000);
+    return;
+  }
+  $("fix-it").disabled = false;
+  if (job.status !== "succeeded") return;
+  const result = await (await api("GET", `/v1/remedies/${id}/result`)).json();
+  $("fix-answer").textContent = result.answer.charAt(0).toUpperCase() + result.answer.slice(1) + ".";
+  for (const r of result.remedies) {
+    const map = el("div", { class: "fix-map", "aria-label": `map at ${r.lever} = ${r.to} ${r.unit}` });
+    const verdict = r.check.passed ? "the envelope passes" : `${r.check.failing_points} points still fail`;
+    const caption = `${r.bound}: ${r.lever} ${r.from} → ${fmt(r.to)} ${r.unit === "1" ? "" : r.unit} (${verdict})`;
+    $("fix-maps").append(el("figure", {}, el("figcaption", { text: caption }), map));
+    await drawMap(map, r.check.sweep, 300);
+  }
 }
 
 // The windows table: per torque level, the speed intervals [rpm] of each response, of tooth
@@ -668,6 +731,7 @@ async function start() {
   $("design-form").addEventListener("submit", (e) => { e.preventDefault(); analyse(); });
   $("envelope-form").addEventListener("submit", (e) => { e.preventDefault(); mapRange(); });
   $("cancel-sweep").addEventListener("click", cancelSweep);
+  $("fix-it").addEventListener("click", fixIt);
   $("threshold-parameter").addEventListener("change", loadThresholds);
   listJobs();
   document.body.dataset.ready = "true"; // for tests: the form is built and prefilled
