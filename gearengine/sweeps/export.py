@@ -17,10 +17,6 @@ from gearengine.sweeps.axes import is_dimensionless
 from gearengine.sweeps.request import SweepAxis
 from gearengine.sweeps.results import SweepBifurcation, SweepPoint, SweepResult
 
-BASIN_FIELDS = ("attractors", "basins", "coexisting")
-"""Point fields that exist only with settings.basins: left out of a point without them, so a
-sweep without basins keeps its bytes."""
-
 
 def chunk_json(
     points: Iterable[SweepPoint],
@@ -33,16 +29,7 @@ def chunk_json(
     whole document. With ``outputs`` (``SweepRequest.outputs``) a point holds values, branch
     and those fields only."""
     keep = None if outputs is None else {"values", "branch", *outputs}
-    array = (
-        "["
-        + ",".join(
-            p.model_dump_json(
-                include=keep, exclude={k for k in BASIN_FIELDS if getattr(p, k) is None}
-            )
-            for p in points
-        )
-        + "]"
-    )
+    array = "[" + ",".join(p.model_dump_json(include=keep) for p in points) + "]"
     if bifurcations is None:
         return array
     return array + "\n[" + ",".join(b.model_dump_json() for b in bifurcations) + "]"

@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, SerializerFunctionWrapHandler, model_serializer
 
 from gearengine.numerics.results import Attractor, BasinCounts
 from gearengine.sweeps.request import SweepAxis, SweepBranch
@@ -19,6 +19,10 @@ class PhysicalValue(BaseModel):
 
     value: float
     unit: str
+
+
+BASIN_FIELDS = ("attractors", "basins", "coexisting")
+"""Point fields that exist only with settings.basins (left out of a point without them)."""
 
 
 class SweepPoint(BaseModel):
@@ -94,6 +98,16 @@ class SweepPoint(BaseModel):
         description="Continuation with settings.basins: the attractors other than the followed "
         "branch's found at this point, as 'label from NN % of starts'; null otherwise.",
     )
+
+    @model_serializer(mode="wrap")
+    def _without_absent_basins(self, handler: SerializerFunctionWrapHandler):
+        """Leave out ``BASIN_FIELDS`` that are null: a sweep without basins keeps its bytes,
+        and the stored, streamed and dumped points agree."""
+        data = handler(self)
+        for key in BASIN_FIELDS:
+            if key in data and data[key] is None:
+                del data[key]
+        return data
 
 
 class SweepBifurcation(BaseModel):
