@@ -393,6 +393,7 @@ DISPLAY_UNITS: dict[str, FieldUnit] = {
     "pressure_angle": FieldUnit("rad", "deg", 180.0 / math.pi),
     "order": FieldUnit("1", "1"),
     "profile_shift": FieldUnit("1", "1"),
+    "teeth": FieldUnit("1", "1"),
     "phase": FieldUnit("rad", "rad"),
 }
 """Units of a design's fields by the most specific name in their path
