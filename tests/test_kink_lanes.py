@@ -7,6 +7,8 @@ import pytest
 
 from gearengine.model.params import GearParams
 from gearengine.numerics.batch import run_lanes
+from gearengine.numerics.kernels.adaptive import ADAPT_LLE_MIN_RECORD
+from gearengine.numerics.lyapunov import BLOCKS
 from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate
@@ -92,7 +94,8 @@ def test_chaotic_lane_stops_once_its_lle_is_known(point: GearParams) -> None:
     (early,) = run_lanes([point], [(0, (0.01, 0.01))], adaptive_settings)
     assert fixed.classification == early.classification == "chaotic"
     assert fixed.periods_run == 1000
-    assert 600 <= early.periods_run < 1000 and (early.periods_run - 500) % 10 == 0
+    assert 500 + ADAPT_LLE_MIN_RECORD <= early.periods_run < 1000
+    assert (early.periods_run - 500) % BLOCKS == 0
     tol = max(adaptive_settings.lle_stderr_abs, adaptive_settings.lle_stderr_rel * early.lle)
     assert early.lle_stderr <= tol
     assert abs(early.lle - fixed.lle) <= 3.0 * early.lle_stderr

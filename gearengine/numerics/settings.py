@@ -224,7 +224,7 @@ class SimulationSettings(BaseModel):
         True,
         description="Sweeps and batches: let a run stop early (numerics.kernels.adaptive) once "
         "its strobes repeat with a period <= 12 over the last 120 intervals and its LLE has "
-        "converged below zero, or, chaotic and quasi-periodic runs, once at least 100 intervals "
+        "converged below zero, or, chaotic and quasi-periodic runs, once at least 200 intervals "
         "are recorded, the LLE's standard error over the 10 blocks of the record so far is "
         "below max(lle_stderr_abs, lle_stderr_rel |lle|) and the verdict is clear by 3 of them "
         "at three checks 10 intervals apart; "

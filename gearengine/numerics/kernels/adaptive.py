@@ -96,9 +96,11 @@ ADAPT_LLE_REL = 0.1
 """Standard error relative to |lle| that counts as converged (10 %): the per-interval logs of
 an orbit whose multipliers are complex (a focus) oscillate, so their block estimates scatter by
 a few per cent of lle even when the orbit has settled."""
-ADAPT_LLE_MIN_RECORD = 100
-"""Recorded intervals before the LLE rule applies (blocks of at least 10 intervals, several
-correlation times of the chaotic responses of Eq. 9)."""
+ADAPT_LLE_MIN_RECORD = 200
+"""Recorded intervals before the LLE rule applies (blocks of at least 20 intervals, several
+correlation times of the chaotic responses of Eq. 9). At 100 the stated stderr covered the
+fixed-length LLE within 3 stderr on 98.8 % of the chaotic points of the 200 x 200 map (the
+misses mostly intermittent responses), at 200 on 99.2 % (benchmarks/README.md)."""
 ADAPT_LLE_CONFIRM = 3
 """Consecutive checks (every ``BLOCKS`` intervals) at which the LLE tests must hold: a single
 check stops too often where the 10-block stderr happens to be low (it has 9 degrees of
