@@ -19,13 +19,14 @@ gives what a gearbox engineer asks:
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.homoclinic.boundary import chaos_intervals
 from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
-from gearengine.model.aliases import with_speed_factor
+from gearengine.model.aliases import get_alias, with_speed_factor
 from gearengine.model.backlash import LAWS
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import Derived, DesignConversion
@@ -119,6 +120,30 @@ SCALES = {
     "k_p1": ("stiffness_variation_amplitude", "N/m"),
 }
 """Control parameter -> (engineering name, unit)."""
+
+
+@dataclass(frozen=True)
+class ThresholdUnits:
+    """A threshold figure's axes in gear units: every excitation frequency scales with the
+    driver speed, so a frequency Omega is the speed ``rpm_per_frequency * Omega``; each control
+    parameter is linear in its physical value (``_to_physical``)."""
+
+    rpm_per_frequency: float
+    parameter_label: str
+    parameter_scale: float
+
+
+def threshold_units(
+    conv: DesignConversion, parameter: str, frequency_parameter: str
+) -> ThresholdUnits | None:
+    """The gear units of the threshold curves of a design (None: the swept frequency's
+    excitation is absent, so the speed of a frequency is not defined)."""
+    omega = get_alias(conv.params, frequency_parameter)
+    if not omega:
+        return None
+    name, unit = SCALES[parameter]
+    label = name.replace("_", " ") + ("" if unit == "1" else f" [{unit.replace('um', 'µm')}]")
+    return ThresholdUnits(conv.speed_rpm / omega, label, _to_physical(parameter, 1.0, conv))
 
 
 def _to_physical(name: str, value: float, conv: DesignConversion) -> float:
