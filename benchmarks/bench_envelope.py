@@ -10,7 +10,10 @@ conversion), 60 + 60 periods of 128 RK4 steps, the check's default settings. The
 timed twice: the whole command (a fresh process: imports, cached kernels, conversion of every
 point, Melnikov verdicts, report) and the sweep alone in this process. A second row times the
 command on the README design as it is (piecewise law, three excitations), which gear_ref's
-batch cannot run. Best of 3; writes its section of benchmarks/README.md.
+batch cannot run, and rows time that design (``examples/ci/design.json``) in process too: with
+its one start and with 64 random starts per point (``random_initial_states``, box x in
+[-1.5, 1.5], v in [-0.5, 0.5], seed 0; one run). Best of 3; prints the load average; writes its
+section of benchmarks/README.md.
 """
 
 from __future__ import annotations
@@ -55,6 +58,25 @@ def sweep_doc(design: dict) -> dict:
     return {"design": design, "settings": ENVELOPE_SETTINGS, "axes": axes}
 
 
+def readme_design() -> dict:
+    return json.loads((ROOT / "examples" / "ci" / "design.json").read_text())["design"]
+
+
+def in_process_seconds(design: dict, starts: int, repeats: int) -> float:
+    """Best wall time of the envelope sweep of ``design`` in this process (every core), with
+    ``starts`` random initial states per point when more than one."""
+    doc = sweep_doc(design)
+    if starts > 1:
+        box = [[-1.5, 1.5], [-0.5, 0.5]]
+        rand = {"count": starts, "box": box, "seed": 0}
+        doc["settings"] = {**doc["settings"], "random_initial_states": rand}
+    req = validated(doc)
+    cores = os.cpu_count() or 1
+    chunk = max(1, req.n_points() // (4 * cores))
+    run_local(validated(sweep_doc(design)), chunk_points=chunk, workers=cores)  # warm
+    return best_of(lambda: run_local(req, chunk_points=chunk, workers=cores), repeats)
+
+
 def command_seconds(design: dict, tmp: Path) -> float:
     path = tmp / "design.json"
     path.write_text(json.dumps({"design": design}))
@@ -93,20 +115,24 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp_dir:
         tmp = Path(tmp_dir)
         ref = gear_ref_seconds(tmp)
-        req = validated(sweep_doc(cubic_te_design()))
         cores = os.cpu_count() or 1
-        chunk = max(1, req.n_points() // (4 * cores))
-        run_local(req, chunk_points=chunk, workers=cores)  # warm
-        sweep = best_of(lambda: run_local(req, chunk_points=chunk, workers=cores), REPEATS)
+        sweep = in_process_seconds(cubic_te_design(), 1, REPEATS)
         command = command_seconds(cubic_te_design(), tmp)
-        readme = command_seconds(copy.deepcopy(EXAMPLE_DESIGN), tmp)
+        readme = command_seconds(readme_design(), tmp)
+        readme_sweep = in_process_seconds(readme_design(), 1, REPEATS)
+        readme_64 = in_process_seconds(readme_design(), 64, 1)
     n = SPEEDS[2] * TORQUES[2]
+    load = os.getloadavg()[0]
     rows = [
         f"| sweep of the {n} points in process, {cores} threads | {sweep:.2f} s | "
         f"{ref:.2f} s | {sweep / ref:.1f}x |",
         f"| whole `gearengine check` command (new process) | {command:.2f} s | {ref:.2f} s | "
         f"{command / ref:.1f}x |",
-        f"| whole command, README design (piecewise law, 3 excitations) | {readme:.2f} s | – | – |",
+        f"| README design (examples/ci/design.json: piecewise law, 3 excitations), sweep in "
+        f"process | {readme_sweep:.2f} s | – | – |",
+        f"| whole command, README design | {readme:.2f} s | – | – |",
+        f"| README design, 64 random starts per point, sweep in process (one run) | "
+        f"{readme_64:.2f} s | – | – |",
     ]
     write_section(
         "envelope",
@@ -114,9 +140,12 @@ def main() -> None:
         f"Default grid {SPEEDS[2]} speeds x {TORQUES[2]} torques, 60 + 60 periods of 128 RK4 "
         "steps; the README design with its transmission error only and the cubic law, so that "
         "gear_ref --simd --batch (one call per torque level over the speeds) runs the same "
-        "points. Best of 3, `benchmarks/bench_envelope.py`.\n\n"
+        "points. Best of 3, `benchmarks/bench_envelope.py`. Targets (issue 20) for the README "
+        "design: <= 0.4 s in process, <= 1.5 s as a whole command, <= 6 s in process with 64 "
+        "starts per point.\n\n"
         "| what | gearengine | gear_ref --simd --batch | ratio |\n|---|---:|---:|---:|\n"
-        + "\n".join(rows),
+        + "\n".join(rows)
+        + f"\n\nLoad average (1 min) at the end of the run: {load:.1f} on {cores} cores.",
     )
     print("\n".join(rows))
 

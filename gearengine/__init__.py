@@ -35,6 +35,8 @@ if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDE
         simulate_batch,
         warm_up,
     )
+    from gearengine.runup import RunupRequest, RunupResult
+    from gearengine.runup import run_local as run_runup
     from gearengine.sweeps import SweepRequest, SweepResult
     from gearengine.sweeps import run_local as run_sweep
 
@@ -45,6 +47,8 @@ __all__ = [
     "Design",
     "GearParams",
     "MelnikovResult",
+    "RunupRequest",
+    "RunupResult",
     "SimulationSettings",
     "SweepRequest",
     "SweepResult",
@@ -53,6 +57,7 @@ __all__ = [
     "lyapunov",
     "melnikov",
     "poincare",
+    "run_runup",
     "run_sweep",
     "simulate",
     "simulate_batch",
@@ -67,6 +72,8 @@ _HOMES: dict[str, tuple[str, str]] = {
     "Design": ("gearengine.model.design", "Design"),
     "GearParams": ("gearengine.model.params", "GearParams"),
     "MelnikovResult": ("gearengine.homoclinic", "MelnikovResult"),
+    "RunupRequest": ("gearengine.runup", "RunupRequest"),
+    "RunupResult": ("gearengine.runup", "RunupResult"),
     "SimulationSettings": ("gearengine.numerics", "SimulationSettings"),
     "SweepRequest": ("gearengine.sweeps", "SweepRequest"),
     "SweepResult": ("gearengine.sweeps", "SweepResult"),
@@ -75,6 +82,7 @@ _HOMES: dict[str, tuple[str, str]] = {
     "lyapunov": ("gearengine.numerics", "lyapunov"),
     "melnikov": ("gearengine.homoclinic", "melnikov"),
     "poincare": ("gearengine.numerics", "poincare"),
+    "run_runup": ("gearengine.runup", "run_local"),
     "run_sweep": ("gearengine.sweeps", "run_local"),
     "simulate": ("gearengine.numerics", "simulate"),
     "simulate_batch": ("gearengine.numerics", "simulate_batch"),
@@ -90,6 +98,7 @@ _SUBMODULES = frozenset(
         "analysis",
         "cli",
         "engineering",
+        "ensembles",
         "homoclinic",
         "jitcache",
         "jobs",
@@ -98,6 +107,7 @@ _SUBMODULES = frozenset(
         "model",
         "numerics",
         "plots",
+        "runup",
         "sweeps",
     }
 )

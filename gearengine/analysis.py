@@ -78,8 +78,10 @@ class AnalysisResult(BaseModel):
         kind = f"periodic {num.period}T" if num.period else num.classification
         lle = "LLE n/a" if num.lle is None else f"LLE {num.lle:+.4g} ± {num.lle_stderr or 0:.2g}"
         contact = IMPACT_WORDS.get(num.impact_regime or "", "no verdict on impacts")
-        mel = {True: "possible", False: "not possible", None: "n/a"}[self.melnikov.chaos_possible]
-        line = f"{kind} ({lle} per unit tau, {contact}), Melnikov: chaos {mel}"
+        mel = {True: "chaos possible", False: "chaos not possible"}.get(
+            self.melnikov.chaos_possible, "not applicable, not judged"
+        )
+        line = f"{kind} ({lle} per unit tau, {contact}), Melnikov: {mel}"
         eng = self.engineering
         if eng is not None:
             resp = eng.response
@@ -89,7 +91,11 @@ class AnalysisResult(BaseModel):
                 line += f", dynamic factor {resp.dynamic_factor:.3g}"
             lo, hi = eng.speed_range_rpm
             spans = ", ".join(f"{a:,.0f}-{b:,.0f}" for a, b in eng.speed_windows_rpm) or "nowhere"
-            line += f"; Melnikov chaos possible at {spans} rpm (scanned {lo:,.0f}-{hi:,.0f} rpm)"
+            scanned = f"{spans} rpm (scanned {lo:,.0f}-{hi:,.0f} rpm)"
+            if eng.speed_windows_note and not eng.speed_windows_rpm:
+                line += f"; Melnikov speed windows: {eng.speed_windows_note}"
+            else:
+                line += f"; Melnikov chaos possible at {scanned}"
         return line
 
     def __repr__(self) -> str:  # the full document is ~85 kB (time history, spectrum)
@@ -166,7 +172,7 @@ def analyze(
 
 def answer_melnikov(request: MelnikovRequest) -> MelnikovResult:
     """The Melnikov verdict of a request; with a design, its params and engineering block."""
-    mel = melnikov(request.params, method=request.method)
+    mel = melnikov(request.params, method=request.method, mean_load=request.mean_load)
     conv = request.conversion
     if conv is None:
         return mel

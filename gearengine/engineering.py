@@ -6,9 +6,15 @@ gives what a gearbox engineer asks:
 * ``speed_windows_rpm``: the driver speeds at which the Melnikov criterion allows chaos at the
   design's torque. A change of running speed scales every excitation frequency together (their
   ratios fixed; amplitudes F~_er = e_r / b and F~_pr do not depend on speed), so the windows are
-  the sign changes of the sign-change strength along that scaling, located by brentq;
-* the critical value of each control parameter in its unit, and ``margin_to_chaos``: positive
-  on the safe side, negative inside the chaos-possible region (Eqs. 23, 24 generalised);
+  the sign changes of the sign-change strength along that scaling, located by brentq; the scan
+  runs on past the requested range until the last window closes, or to ``WINDOW_BOUND`` times
+  the design speed, where an open window is reported as open-ended;
+* ``critical_torque_nm``: the mean driver torque T_crit at which the static mesh force reaches
+  F_crit of the cubic fit; above it the unperturbed system has no saddle and the criterion does
+  not apply (``docs/melnikov-under-load.md``);
+* the critical value of each control parameter in its unit, and ``margin_to_chaos``: the
+  threshold's margin in that unit, positive on the safe side, negative inside the
+  chaos-possible region (Eqs. 23, 24 generalised);
 * for analyses, the response: dynamic transmission error b (x_max - x_min), the dynamic mesh
   force b k_m [K(t) f_h(x) + 2 mu~ x'] and the dynamic factor (max force / static force F^_m),
   the fractions of time with the teeth apart (|x| <= 1) and on the back flank (x < -1), the
@@ -25,7 +31,9 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.homoclinic.boundary import chaos_intervals
+from gearengine.homoclinic.coefficients import MeanLoad
 from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
+from gearengine.homoclinic.thresholds import strength_at
 from gearengine.model.aliases import get_alias, with_speed_factor
 from gearengine.model.backlash import LAWS
 from gearengine.model.params import GearParams
@@ -35,6 +43,10 @@ from gearengine.numerics.results import NumericsResult
 
 WINDOW_SCAN = 240
 """Speeds sampled in the Melnikov window scan before brentq refines each edge."""
+WINDOW_BOUND = 10.0
+"""The window scan goes on past the requested range, while the last window is open, up to this
+multiple of the design speed (beyond which no gear pair of the design runs): a window still
+open there is reported open-ended."""
 
 
 class _Doc(BaseModel):
@@ -50,7 +62,7 @@ class Critical(_Doc):
     nearest: float | None = Field(description="The critical value nearest to the design.")
     margin_to_chaos: float | None = Field(
         description="|value - nearest|, positive on the safe side, negative inside the "
-        "chaos-possible region."
+        "chaos-possible region (the threshold's margin in this unit)."
     )
     relative_margin: float | None = Field(description="margin_to_chaos / |nearest|.")
 
@@ -91,7 +103,19 @@ class Engineering(_Doc):
     speed_range_rpm: list[float] = Field(description="Driver speeds scanned [rpm].")
     speed_windows_rpm: list[list[float]] = Field(
         description="[low, high] driver speeds [rpm] where the Melnikov criterion allows chaos "
-        "at this torque (every excitation frequency scales with speed)."
+        "at this torque (every excitation frequency scales with speed); empty where the "
+        "criterion does not apply (above the critical torque)."
+    )
+    speed_windows_note: str | None = Field(
+        None,
+        description="Why there are no windows (not applicable above T_crit), or which window is "
+        "open-ended (still open at the end of the scan).",
+    )
+    critical_torque_nm: float | None = Field(
+        None,
+        description="T_crit [N m]: the mean driver torque below which the Melnikov criterion "
+        "applies (the static mesh force reaches F_crit of the cubic fit there; null without "
+        "one).",
     )
     critical: dict[str, Critical] = Field(description="Thresholds in physical units.")
     derived: dict[str, Derived]
@@ -100,11 +124,35 @@ class Engineering(_Doc):
     notes: list[str]
 
 
-def speed_windows(params: GearParams, speed_rpm: float, lo: float, hi: float) -> list[list[float]]:
+def _speed_path(params: GearParams, speed_rpm: float):
+    """The design at ``speed_rpm`` moved to each speed [rpm] (every frequency scaled)."""
+    return lambda rpm: with_speed_factor(params, rpm / speed_rpm)
+
+
+def speed_windows(
+    params: GearParams,
+    speed_rpm: float,
+    lo: float,
+    hi: float,
+    mean_load: MeanLoad = "unperturbed",
+    num: int = WINDOW_SCAN,
+) -> list[list[float]]:
     """Driver speeds [rpm] in [lo, hi] where some Melnikov branch changes sign: the design at
     ``speed_rpm`` moved to each speed by scaling every excitation frequency together."""
-    return chaos_intervals(lambda rpm: with_speed_factor(params, rpm / speed_rpm), lo, hi,
-                           WINDOW_SCAN)  # fmt: skip
+    return chaos_intervals(_speed_path(params, speed_rpm), lo, hi, num, mean_load)
+
+
+def window_scan_end(
+    params: GearParams, speed_rpm: float, hi: float, mean_load: MeanLoad = "unperturbed"
+) -> float:
+    """The end [rpm] of the window scan: ``hi``, doubled while the criterion still allows chaos
+    there, up to ``WINDOW_BOUND`` times the design speed."""
+    path = _speed_path(params, speed_rpm)
+    bound = max(hi, WINDOW_BOUND * speed_rpm)
+    top = hi
+    while top < bound and strength_at(path(top), mean_load=mean_load) > 0.0:
+        top = min(2.0 * top, bound)
+    return top
 
 
 IMPACT_WORDS = {
@@ -158,21 +206,50 @@ def _to_physical(name: str, value: float, conv: DesignConversion) -> float:
 
 
 def critical(name: str, t: ParameterThreshold, conv: DesignConversion) -> Critical:
-    """One threshold in physical units with its signed margin to chaos."""
+    """One threshold in physical units with its signed margin to chaos (the threshold's
+    margin, positive on the safe side, in this unit: every map of ``_to_physical`` is linear)."""
     unit = SCALES[name][1]
     crit = [_to_physical(name, v, conv) for v in t.critical_values]
     value = None if t.value is None else _to_physical(name, t.value, conv)
     nearest = None if t.nearest is None else _to_physical(name, t.nearest, conv)
     margin = rel = None
-    if value is not None and nearest is not None:
-        safe = any(
-            (lo is None or t.value >= lo) and (hi is None or t.value <= hi)  # type: ignore[operator]
-            for lo, hi in t.no_chaos
-        )
-        margin = (1.0 if safe else -1.0) * abs(value - nearest)
+    if value is not None and nearest is not None and t.margin is not None:
+        margin = math.copysign(abs(value - nearest), t.margin)
         rel = margin / abs(nearest) if nearest else None
     return Critical(unit=unit, value=value, critical_values=crit, nearest=nearest,
                     margin_to_chaos=margin, relative_margin=rel)  # fmt: skip
+
+
+def critical_torque(conv: DesignConversion, mel: MelnikovResult) -> float | None:
+    """T_crit [N m]: the mean driver torque whose static mesh force T / r_a (balanced torques,
+    Eq. 7) reaches F_crit b k_m; None without a critical load (no cubic with a, c > 0)."""
+    if mel.critical_mean_force is None:
+        return None
+    r_a = float(conv.derived["base_radius_driver"].value)  # type: ignore[arg-type]
+    return mel.critical_mean_force * conv.half_backlash_m * conv.mesh_stiffness_n_per_m * r_a
+
+
+def over_critical(conv: DesignConversion, mel: MelnikovResult) -> bool:
+    """True when the design's mean load leaves no saddle (|F~_m| >= F_crit, mean load in the
+    unperturbed system): the criterion does not apply at this torque."""
+    return (
+        mel.mean_load == "unperturbed"
+        and mel.critical_mean_force is not None
+        and abs(conv.params.mean_force) >= mel.critical_mean_force
+    )
+
+
+def load_words(conv: DesignConversion, f_crit: float, t_crit: float) -> str:
+    """Why the criterion does not apply at this torque (F~_m >= F_crit), in gear words."""
+    fm, b_um = conv.params.mean_force, conv.half_backlash_m * 1e6
+    torque = t_crit * abs(fm) / f_crit  # the static force is proportional to the torque
+    return (
+        f"under {torque:,.3g} N*m the mesh deflects {abs(fm) * b_um:.3g} µm statically (half "
+        f"backlash {b_um:.3g} µm) and the teeth stay in contact, beyond the reach of the "
+        f"backlash nonlinearity's saddle, which exists only below the critical torque "
+        f"{t_crit:,.3g} N*m; the homoclinic mechanism of chaos does not exist at this load; the "
+        "numerical verdict still applies"
+    )
 
 
 def mesh_force(params: GearParams, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -233,11 +310,27 @@ def summary(
     num: NumericsResult | None,
 ) -> str:
     """Two or three sentences an engineer can paste into a design review."""
-    here = "allows chaos" if mel.chaos_possible else "rules chaos out"
-    text = (
-        f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion {here}; at this torque it "
-        f"{_windows_text(windows, rng)}."
-    )
+    t_crit = critical_torque(conv, mel)
+    if over_critical(conv, mel) and t_crit is not None and mel.critical_mean_force:
+        words = load_words(conv, mel.critical_mean_force, t_crit)
+        text = f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion does not apply: {words}."
+    else:
+        here = "allows chaos" if mel.chaos_possible else "rules chaos out"
+        text = (
+            f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion {here}; at this torque it "
+            f"{_windows_text(windows, rng)}."
+        )
+        if (
+            t_crit is not None
+            and mel.mean_load == "perturbation"
+            and abs(conv.params.mean_force) >= (mel.critical_mean_force or math.inf)
+        ):
+            text += (
+                f" This is the paper's first-order answer outside its domain: above the critical "
+                f"torque {t_crit:,.3g} N*m the loaded system has no saddle."
+            )
+        elif t_crit is not None:
+            text += f" It applies below the critical torque {t_crit:,.3g} N*m."
     if num is not None and resp is not None:
         kind = f"periodic ({num.period}T)" if num.period else num.classification.replace("_", "-")
         text += f" The simulated response is {kind}"
@@ -261,7 +354,25 @@ def engineering(
 ) -> Engineering:
     """The engineering block of a design's Melnikov verdict (and analysis, given ``num``)."""
     params = conv.params
-    windows = speed_windows(params, conv.speed_rpm, *rpm_range)
+    t_crit = critical_torque(conv, mel)
+    note = None
+    lo, hi = rpm_range
+    if over_critical(conv, mel) and t_crit is not None:
+        windows: list[list[float]] = []
+        note = f"not applicable above T_crit = {t_crit:,.3g} N*m"
+    else:
+        top = window_scan_end(params, conv.speed_rpm, hi, mel.mean_load)
+        scan = WINDOW_SCAN if top == hi else math.ceil(WINDOW_SCAN * (top - lo) / (hi - lo))
+        windows = speed_windows(params, conv.speed_rpm, lo, top, mel.mean_load, scan)
+        hi = top
+        if windows and windows[-1][1] >= top and top > rpm_range[1]:
+            note = (
+                f"the window from {windows[-1][0]:,.0f} rpm is open-ended: chaos is still "
+                f"possible at {top:,.0f} rpm, {WINDOW_BOUND:g} x the design speed, where the "
+                "scan stops"
+            )
+        elif windows and windows[-1][1] >= top:
+            note = f"the window from {windows[-1][0]:,.0f} rpm reaches the end of the scan"
     crit = {
         SCALES[name][0]: critical(name, t, conv)
         for name, t in mel.thresholds.items()
@@ -274,11 +385,13 @@ def engineering(
         mesh_frequency_hz=conv.mesh_frequency_hz,
         half_backlash_um=conv.half_backlash_m * 1e6,
         speed_rpm=conv.speed_rpm,
-        speed_range_rpm=list(rpm_range),
+        speed_range_rpm=[lo, hi],
         speed_windows_rpm=windows,
+        speed_windows_note=note,
+        critical_torque_nm=t_crit,
         critical=crit,
         derived=conv.derived,
         response=resp,
-        summary=summary(conv, mel, windows, rpm_range, resp, num),
+        summary=summary(conv, mel, windows, (lo, hi), resp, num),
         notes=conv.notes,
     )

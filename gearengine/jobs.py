@@ -48,6 +48,8 @@ class JobKind:
 
 KINDS: dict[str, str] = {
     "sweep": "gearengine.sweeps.compute:SWEEP_JOB",
+    "runup": "gearengine.runup.compute:RUNUP_JOB",
+    "robustness": "gearengine.ensembles.robustness:ROBUSTNESS_JOB",
 }
 """Kind name -> ``module:attribute`` of its ``JobKind``."""
 

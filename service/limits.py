@@ -5,8 +5,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+from pydantic import BaseModel
+
+from gearengine import jobs
 from gearengine.homoclinic.schemas import ThresholdsRequest
-from gearengine.sweeps import SweepRequest, sweep_work
 from service.core.config import Settings
 from service.errors import FieldError, ProblemError
 
@@ -52,15 +54,16 @@ class Limits:
                 kind="over-budget",
             )
 
-    def check_sweep(self, body: SweepRequest) -> None:
-        """Refuse a sweep whose total work is over the per-sweep budget."""
-        steps = sweep_work(body)
+    def check_job(self, kind: str, body: BaseModel, noun: str, path: str = "axes") -> None:
+        """Refuse a job whose total work (its kind's ``work``, in RK4 steps) is over the per-job
+        budget (max_sweep_steps, for jobs of every kind); ``path`` is the field to shrink."""
+        steps = jobs.kind(kind).work(body)
         cap = self.settings.max_sweep_steps
         if steps > cap:
             raise over_limit(
-                "axes",
-                f"this sweep needs {steps} RK4 steps, over the budget of {cap} steps per "
-                "sweep (max_sweep_steps); use fewer points, periods or steps per period",
+                path,
+                f"this {noun} needs {steps} RK4 steps, over the budget of {cap} steps per "
+                f"{noun} (max_sweep_steps); use fewer points, periods or steps per period",
                 kind="over-budget",
             )
 

@@ -20,6 +20,8 @@ from service.api.routes import (
     explorer,
     health,
     melnikov,
+    robustness,
+    runups,
     sweeps,
     thresholds,
 )
@@ -44,6 +46,8 @@ torque fluctuation and transmission error (Farshidianfar & Saghafi 2014, Eq. 9).
 * **Figures** as PNG or SVG (`/v1/analyses/plot`, `/v1/thresholds/plot`).
 * **Sweeps**: bifurcation diagrams (one axis) and 2-D chaos maps (two axes) as durable jobs
   (`POST /v1/sweeps`, then poll, fetch `/result` as JSON or CSV and `/plot`).
+* **Robustness**: probabilities of chaos and rattle over a design's manufacturing tolerances
+  (ISO 1328 class, backlash band, distributions), with Sobol indices (`POST /v1/robustness`).
 
 Every error is RFC 9457 `application/problem+json` naming the bad field. With API keys
 configured, send `Authorization: Bearer KEY` or `X-API-Key: KEY`.
@@ -93,6 +97,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(thresholds.router, tags=["melnikov"])
     app.include_router(analyses.router, tags=["analyses"])
     app.include_router(sweeps.router, tags=["sweeps"])
+    app.include_router(runups.router, tags=["runups"])
+    app.include_router(robustness.router, tags=["robustness"])
     app.include_router(explorer.router)
     app.add_middleware(
         BodyLimit,

@@ -55,23 +55,32 @@ def test_adaptive_verdicts_agree_with_the_fixed_length_run(map_40: tuple[list, l
     stopped = [a for a in adaptive if a.periods_run < 1000]
     assert len(stopped) > len(adaptive) // 2  # most points settle early
     assert min(a.periods_run for a in stopped) >= ADAPT_SETTLE + ADAPT_WINDOW
-    assert all(a.classification == "periodic" for a in stopped)
+    assert all(a.classification == "periodic" for a in stopped if a.periods_run <= 500)
 
 
-def test_chaotic_points_run_to_the_end_unchanged(map_40: tuple[list, list]) -> None:
+def test_chaotic_points_stop_once_their_lle_is_known(map_40: tuple[list, list]) -> None:
     adaptive, fixed = map_40
+    settings = SimulationSettings()
     chaotic = [(a, f) for a, f in zip(adaptive, fixed, strict=True)
                if f.classification == "chaotic"]  # fmt: skip
     assert len(chaotic) > 100
+    early = [(a, f) for a, f in chaotic if a.periods_run < 1000]
+    assert len(early) > len(chaotic) // 2
+    within = 0
     for a, f in chaotic:
-        assert a.periods_run == 1000 and a.lle == f.lle and a.lle_stderr == f.lle_stderr
-        assert a.force_max == f.force_max and a.poincare == f.poincare
+        if a.periods_run == 1000:  # not known before the end: the fixed-length run's numbers
+            assert a.lle == f.lle and a.lle_stderr == f.lle_stderr and a.poincare == f.poincare
+            continue
+        assert a.classification == "chaotic" and a.periods_run >= 600
+        assert a.lle_stderr <= max(settings.lle_stderr_abs, settings.lle_stderr_rel * a.lle)
+        within += abs(a.lle - f.lle) <= 3.0 * a.lle_stderr
+    assert within >= 0.99 * len(early)
 
 
 def test_early_stopped_record_is_the_settled_window(map_40: tuple[list, list]) -> None:
     adaptive, fixed = map_40
     for a, f in zip(adaptive, fixed, strict=True):
-        if a.periods_run < 1000:
+        if a.periods_run <= 500:  # stopped in the transient by the periodic rule
             assert a.lle < 0 and a.lle == pytest.approx(f.lle, abs=0.02)
             assert len(a.poincare) == 64
             assert a.force_max == pytest.approx(f.force_max, rel=1e-3, abs=1e-6)
@@ -118,7 +127,7 @@ def test_kink_kernel_mesh_force() -> None:
     lw = law(p)
     plan = step_plan(p, settings.steps_per_period)
     out = kernels.run_kink(lw.alpha, p.damping, 0.01, 0.01, *packed_forcing(p), plan.period,
-                           plan.steps, 30, 20, 1, 1e6)  # fmt: skip
+                           plan.steps, 30, 20, 1, 1e6, True)  # fmt: skip
     assert (out[10], out[11]) == (bp.force_min, bp.force_max)
     x, v = out[3], out[4]  # brute force: K = 1 (no stiffness harmonics), f_h of Eq. (8)
     fh = np.where(x > 1, x - 1, np.where(x < -1, x + 1, 0.0))

@@ -37,6 +37,11 @@ def design(**changes: object) -> dict:
     return d
 
 
+LIGHT = design(torque="3 N*m", **{"torque_fluctuation.harmonics.0.amplitude": "1 N*m"})
+"""The README's pair lightly loaded (3 N m, below its critical torque 9.62 N m): rattle-prone,
+where the Melnikov criterion applies (examples/design-light-load.json)."""
+
+
 # --- parsing and plausibility ------------------------------------------------------------------
 
 
@@ -173,10 +178,10 @@ def test_geometry_form_derives_radii_inertia_and_iso_stiffness() -> None:
 
 
 def test_speed_windows_agree_with_melnikov_at_every_edge() -> None:
-    req = MelnikovRequest.model_validate({"design": EXAMPLE_DESIGN})
+    req = MelnikovRequest.model_validate({"design": LIGHT})
     answer = answer_melnikov(req)
     windows = answer.engineering.speed_windows_rpm
-    assert windows, "the README design has a Melnikov window"
+    assert windows, "the lightly loaded design has a Melnikov window"
     lo, hi = answer.engineering.speed_range_rpm
     for a, b in windows:
         for edge, inside in ((a, +1), (b, -1)):
@@ -189,12 +194,13 @@ def test_speed_windows_agree_with_melnikov_at_every_edge() -> None:
 
 
 def test_margin_to_chaos_sign_follows_the_verdict() -> None:
-    safe = answer_melnikov(MelnikovRequest.model_validate({"design": EXAMPLE_DESIGN}))
+    safe = answer_melnikov(MelnikovRequest.model_validate({"design": LIGHT}))
     assert safe.chaos_possible is False
     te = safe.engineering.critical["transmission_error_amplitude"]
     assert te.unit == "um" and te.value == pytest.approx(5.0) and te.margin_to_chaos > 0
     assert te.nearest == pytest.approx(te.value + te.margin_to_chaos)
-    big = design(**{"transmission_error.harmonics.0.amplitude": f"{te.nearest * 1.1} um"})
+    big = copy.deepcopy(LIGHT)
+    big["transmission_error"]["harmonics"][0]["amplitude"] = f"{te.nearest * 1.1} um"
     unsafe = answer_melnikov(MelnikovRequest.model_validate({"design": big}))
     assert unsafe.chaos_possible is True
     assert unsafe.engineering.critical["transmission_error_amplitude"].margin_to_chaos < 0
@@ -284,8 +290,10 @@ def test_every_endpoint_answers_a_design(client: TestClient) -> None:
     assert ana["params"] == mel["params"]
     plot = client.post("/v1/analyses/plot", json={**body, "settings": {"record_periods": 50}})
     assert plot.headers["content-type"] == "image/png"
-    curve = client.post("/v1/thresholds", json={**body, "parameter": "mu", "num": 5})
+    curve = client.post("/v1/thresholds", json={"design": LIGHT, "parameter": "mu", "num": 5})
     assert curve.status_code == 200 and len(curve.json()["frequencies"]) == 5
+    loaded = client.post("/v1/thresholds", json={**body, "parameter": "mu", "num": 5})
+    assert loaded.status_code == 422 and "mean_force" in loaded.text  # above T_crit
     conv = client.post("/v1/conversions/design", json=body).json()
     assert conv["conversion"]["params"] == mel["params"]
     sweep = {**body, "settings": {"transient_periods": 10, "record_periods": 10},
@@ -298,6 +306,6 @@ def test_speed_windows_of_a_scan_without_flips() -> None:
     assert speed_windows(p, 1500.0, 100.0, 200.0) == []
     assert convert(
         __import__("gearengine.analysis", fromlist=["DesignRequest"]).DesignRequest.model_validate(
-            {"design": EXAMPLE_DESIGN}
+            {"design": LIGHT}
         )
     ).engineering.speed_windows_rpm

@@ -86,13 +86,17 @@ def submit(srv: Server) -> tuple[dict[str, Any], str]:
     return job, f"{srv.url}/v1/sweeps/{job['id']}"
 
 
-def test_kill9_server_mid_sweep_then_restart_resumes(
-    data_dir: Path, reference: dict[str, Any]
-) -> None:
+def crash_and_resume(
+    data_dir: Path, route: str, body: dict[str, Any], done: int, reference: dict[str, Any],
+    timeout: float = 120.0,
+) -> tuple[str, list[tuple[int, str]]]:  # fmt: skip
+    """POST ``body`` to ``route``; once ``done`` units are committed, kill -9 the server and its
+    workers; restart it on the same data directory and check that the job succeeds with
+    ``reference`` as its result. Returns the job id and the commits made before the crash."""
     srv = Server(data_dir, ENV)
     try:
-        job, url = submit(srv)
-        seen = poll(url, lambda j: j["progress"]["done"] >= 3 * CHUNK_POINTS)
+        job = httpx.post(f"{srv.url}{route}", json=body, timeout=30).json()
+        seen = poll(f"{srv.url}{route}/{job['id']}", lambda j: j["progress"]["done"] >= done)
         assert seen["status"] == "running"
         children = pool_workers(srv)
         os.kill(srv.proc.pid, signal.SIGKILL)
@@ -101,15 +105,22 @@ def test_kill9_server_mid_sweep_then_restart_resumes(
     finally:
         srv.stop()
     before = JobStore.in_dir(data_dir).commit_log(job["id"])
-    assert 3 <= len(before) < N_CHUNKS
     again = Server(data_dir, ENV)
     try:
-        url = f"{again.url}/v1/sweeps/{job['id']}"
-        assert poll(url, finished)["status"] == "succeeded"
+        url = f"{again.url}{route}/{job['id']}"
+        assert poll(url, finished, timeout)["status"] == "succeeded"
         assert httpx.get(url + "/result", timeout=30).json() == reference
     finally:
         again.stop()
-    log = assert_committed_once(data_dir, job["id"])
+    return job["id"], before
+
+
+def test_kill9_server_mid_sweep_then_restart_resumes(
+    data_dir: Path, reference: dict[str, Any]
+) -> None:
+    job_id, before = crash_and_resume(data_dir, "/v1/sweeps", SWEEP, 3 * CHUNK_POINTS, reference)
+    assert 3 <= len(before) < N_CHUNKS
+    log = assert_committed_once(data_dir, job_id)
     assert log[: len(before)] == before and len({owner for _, owner in log}) == 2
 
 

@@ -53,12 +53,14 @@ def test_the_kernels_caches_are_stamped_with_their_current_sources() -> None:
     numerics = Path(kernels.__file__).parent
     homoclinic = Path(gearengine.homoclinic.__file__).parent
     groups = {
-        numerics / "__pycache__" / "adaptive+kink+lockstep+monodromy+smooth": [
+        numerics / "__pycache__" / (
+            "adaptive+intervals+kink+kinklanes+lockstep+monodromy+phase+ramp+smooth"
+        ): [
             *numerics.glob("*.py"), numerics.parent / "periodicity.py",
-            numerics.parent / "lyapunov.py",
+            numerics.parent / "lyapunov.py", numerics.parent / "classify.py",
         ],
-        homoclinic / "__pycache__" / "kernels+batch": [
-            homoclinic / name for name in ("kernels.py", "batch.py", "extrema.py")
+        homoclinic / "__pycache__" / "kernels+batch+loops": [
+            homoclinic / name for name in ("kernels.py", "batch.py", "extrema.py", "loops.py")
         ],
     }  # fmt: skip
     for stem, sources in groups.items():

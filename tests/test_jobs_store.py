@@ -185,3 +185,32 @@ def test_a_locked_database_makes_writers_wait_not_fail(store: JobStore, tmp_path
     release.join()
     holder.close()
     assert waited >= 0.9 and store.get(job, None).status == "queued"
+
+
+def test_a_store_from_before_job_kinds_gains_the_kind_column(tmp_path: Path) -> None:
+    """An existing jobs.sqlite3 without ``kind``: opened, every old job is a sweep and is
+    claimed as one; jobs of another kind are told apart by every read."""
+    old = sqlite3.connect(tmp_path / "jobs.sqlite3")
+    old.executescript(
+        "CREATE TABLE jobs (id TEXT PRIMARY KEY, owner TEXT, status TEXT NOT NULL, "
+        "request_json TEXT NOT NULL, chunk_points INTEGER NOT NULL, total_chunks INTEGER NOT "
+        "NULL, total_points INTEGER NOT NULL, created_at REAL NOT NULL, started_at REAL, "
+        "finished_at REAL, error TEXT);"
+        "INSERT INTO jobs VALUES ('old', NULL, 'queued', '{}', 2, 1, 2, 1.0, NULL, NULL, NULL);"
+    )
+    old.close()
+    store = JobStore.in_dir(tmp_path)
+    store._db().execute(
+        "INSERT INTO chunks (job_id, idx, n_points, status) VALUES ('old', 0, 2, 'pending')"
+    )
+    other = store.submit(None, '{"doc": 2}', [1], 1, 10, kind="robustness").id
+    assert (
+        store.get("old", None, "sweep") is not None and store.get("old", None, "robustness") is None
+    )
+    assert store.get(other, None, "sweep") is None and store.get(other, None).id == other
+    assert [j.id for j in store.list(None, None, 10, 0, "robustness")[0]] == [other]
+    assert store.cancel(other, None, "sweep") is None and store.get(other, None).status == "queued"
+    assert [(c.job_id, c.kind) for c in store.claim("w", LEASE, 3, 5)] == [
+        ("old", "sweep"),
+        (other, "robustness"),
+    ]

@@ -14,6 +14,8 @@ from gearengine.model.aliases import with_alias, with_aliases
 from gearengine.model.params import GearParams
 
 OMEGAS = np.linspace(0.05, 3.0, 14)
+PAPER_LOAD = "perturbation"
+"""The paper's treatment of the mean force (section 3.1), under which its numbers reproduce."""
 SHAPES = [(0.1667, 0.1667), (1.0, 0.5), (0.3, 2.0), (2.0, 0.2)]
 KINDS = ["stiffness", "torque", "transmission_error"]
 
@@ -141,19 +143,19 @@ def test_printed_stiffness_term_is_right_only_when_a_is_one() -> None:
 
 def test_paper_fe1_threshold_at_omega_half() -> None:
     """Omega_e = 0.5, mu = 7 (epsilon = 0.01: mu~ = 0.07): f_e1 >= 19.59 (paper: 'f_e1 >= 20')."""
-    t = melnikov(te_only(0.2, 0.5, 0.07)).thresholds["F_e1"]
+    t = melnikov(te_only(0.2, 0.5, 0.07), mean_load=PAPER_LOAD).thresholds["F_e1"]
     assert t.critical_values == pytest.approx([-0.19588, 0.19588], abs=5e-5)
-    scaled = melnikov(te_only(20.0, 0.5, 7.0)).thresholds["F_e1"]
+    scaled = melnikov(te_only(20.0, 0.5, 7.0), mean_load=PAPER_LOAD).thresholds["F_e1"]
     assert scaled.nearest == pytest.approx(19.59, abs=5e-3)
 
 
 def test_paper_mu_threshold_at_omega_07() -> None:
     """Omega_e = 0.7, f_e1 = 30: chaos possible for mu <= 13.86 (15 outside, 13.5 and 12 in)."""
-    r = melnikov(te_only(0.3, 0.7, 0.15))
+    r = melnikov(te_only(0.3, 0.7, 0.15), mean_load=PAPER_LOAD)
     assert r.thresholds["mu"].nearest == pytest.approx(0.1386, abs=5e-5)
     assert r.chaos_possible is False
-    assert melnikov(te_only(0.3, 0.7, 0.135)).chaos_possible is True
-    assert melnikov(te_only(0.3, 0.7, 0.12)).chaos_possible is True
+    assert melnikov(te_only(0.3, 0.7, 0.135), mean_load=PAPER_LOAD).chaos_possible is True
+    assert melnikov(te_only(0.3, 0.7, 0.12), mean_load=PAPER_LOAD).chaos_possible is True
 
 
 def test_eq23_and_eq24_closed_forms() -> None:
@@ -166,14 +168,14 @@ def test_eq23_and_eq24_closed_forms() -> None:
             / (math.pi * omega**3 * c * math.sqrt(a))
             * math.cosh(math.pi * omega / (2 * math.sqrt(a)))
         )  # fmt: skip
-        t = melnikov(te_only(0.1, omega, mu)).thresholds
+        t = melnikov(te_only(0.1, omega, mu), mean_load=PAPER_LOAD).thresholds
         assert t["F_e1"].critical_values == pytest.approx([-f1, f1], rel=1e-10)
         fe = 0.3
         mu1 = (
             3 * c / (8 * a**2) * math.sqrt(2 * a / c) * fe * math.pi
             / math.cosh(math.pi * omega / (2 * math.sqrt(a))) * omega**3
         )  # fmt: skip
-        t = melnikov(te_only(fe, omega, 0.1)).thresholds
+        t = melnikov(te_only(fe, omega, 0.1), mean_load=PAPER_LOAD).thresholds
         assert t["mu"].critical_values == pytest.approx([mu1], rel=1e-10)
 
 
@@ -189,9 +191,13 @@ def test_verdict_flips_across_each_threshold() -> None:
 
 def test_omega_scan_critical_frequencies_flip_the_verdict() -> None:
     params = te_only(0.2, 0.5, 0.07)
-    crit = melnikov(params).thresholds["Omega_e"].critical_values
+    crit = melnikov(params, mean_load=PAPER_LOAD).thresholds["Omega_e"].critical_values
     assert crit == pytest.approx([0.4912, 1.1813], abs=1e-4)
     for om in crit:
+        lo, hi = te_only(0.2, om - 1e-6, 0.07), te_only(0.2, om + 1e-6, 0.07)
+        flags = [melnikov(p, mean_load=PAPER_LOAD).chaos_possible for p in (lo, hi)]
+        assert flags[0] != flags[1]
+    for om in melnikov(params).thresholds["Omega_e"].critical_values:  # loaded: its own flips
         lo, hi = te_only(0.2, om - 1e-6, 0.07), te_only(0.2, om + 1e-6, 0.07)
         assert melnikov(lo).chaos_possible != melnikov(hi).chaos_possible
 
@@ -241,7 +247,7 @@ def test_piecewise_law_uses_the_paper_cubic_fit() -> None:
 
 def test_commensurate_extrema_are_attained_and_exact() -> None:
     r = melnikov(RICH)
-    coef = mk.melnikov_coefficients(RICH, 0.1667, 0.1667, "plus")
+    coef = mk.melnikov_coefficients(RICH, 0.1667, 0.1667, "plus", fm=RICH.mean_force)
     taus = np.linspace(0.0, r.forcing_period, 400_001)
     values = coef(taus)
     b = r.branches["plus"]

@@ -69,11 +69,11 @@ def legend_labels(fig: Figure) -> list[str]:
 
 
 def test_threshold_figure_marks_the_design_and_labels_each_line(drawn: list[Figure]) -> None:
-    fig = curve_figure(drawn, PAPER_PARAMS, 0.5)
+    fig = curve_figure(drawn, {**PAPER_PARAMS, "mean_force": 0.0}, 0.5)
     labels = legend_labels(fig)
     design = [line for line in fig.axes[0].lines if line.get_label().startswith("design:")]
     assert len(design) == 1 and list(design[0].get_xydata()[0]) == [0.5, 0.2]
-    # symmetric forcing: the two branches are one line, so one entry
+    # no mean load, symmetric forcing: the two branches are one line, so one entry
     assert sum("threshold" in label for label in labels) == 1
     # a mean force with a second harmonic splits the branches: two lines, two entries
     split = {

@@ -28,7 +28,8 @@ def test_units_put_the_design_at_its_speed_and_amplitude() -> None:
 
 
 def test_the_figure_of_a_design_is_drawn_in_gear_units(client: TestClient) -> None:
-    svg = client.post("/v1/thresholds/plot?format=svg", json={"design": EXAMPLE_DESIGN}).text
+    body = {"design": EXAMPLE_DESIGN, "mean_load": "perturbation"}  # F_m above F_crit
+    svg = client.post("/v1/thresholds/plot?format=svg", json=body).text
     assert "driver speed [rpm]" in svg and "transmission error amplitude [µm]" in svg
     assert "dimensionless frequency" not in svg
     svg = client.post("/v1/thresholds/plot?format=svg", json={"params": PAPER_PARAMS}).text

@@ -99,7 +99,12 @@ def failures(r: AnalysisResult, rules: Rules, min_margin: float | None = None) -
 
 def cmd_check(args: argparse.Namespace) -> int:
     """CI gate: exit 0 pass, 1 fail, 2 invalid input; one summary line. With --speed or
-    --torque, the gate over the operating envelope (``cli.envelope``)."""
+    --torque, the gate over the operating envelope (``cli.envelope``); with --max-probability,
+    over the design's tolerances (``cli.robustness``)."""
+    if args.max_probability:
+        from gearengine.cli.robustness import cmd_probability_gate
+
+        return cmd_probability_gate(args)
     if args.speed or args.torque:
         return cmd_envelope(args)
     if args.json or args.junit or args.server:

@@ -146,6 +146,9 @@ def print_report(report: EnvelopeReport) -> None:
     verdict = "PASS" if report.passed else "FAIL"
     print(f"{verdict}: {report.failing_points} of {report.points} operating points break "
           f"the rules ({rules_text(report.rules)})")  # fmt: skip
+    if "melnikov" in report.rules.fail_on and report.melnikov_not_judged:
+        print(f"  Melnikov could not judge {report.melnikov_not_judged} of {report.points} points "
+              "(the criterion does not apply above the critical torque)")  # fmt: skip
     for w in report.failures:
         print(f"  {window_text(w)}")
     for line in windows_summary(report.windows):
@@ -167,10 +170,13 @@ def windows_summary(windows: list[SpeedWindows]) -> list[str]:
     out = []
     for w in windows:
         impacts = "; ".join(f"{IMPACT_LABELS[k]} {spans_text(v)}" for k, v in w.impacts.items())
-        melnikov = spans_text(w.melnikov) if w.melnikov else "nowhere"
+        melnikov = f"chaos possible {spans_text(w.melnikov) if w.melnikov else 'nowhere'}"
+        if w.melnikov_not_applicable:  # above the critical torque
+            na = f"not applicable at {spans_text(w.melnikov_not_applicable)} (above T_crit)"
+            melnikov = f"{melnikov}, {na}" if w.melnikov else na
         where = f" at {level_text(w.level)}" if w.level else ""
         out.append(f"windows{where}: {impacts or 'teeth always in contact'}; "
-                   f"Melnikov: chaos possible {melnikov}")  # fmt: skip
+                   f"Melnikov: {melnikov}")  # fmt: skip
     return out
 
 
@@ -206,6 +212,10 @@ def cmd_envelope(args: argparse.Namespace) -> int:
         chunk = max(1, request.n_points() // (4 * (os.cpu_count() or 1)))
         result = run_local(request, tick, chunk_points=chunk, workers=os.cpu_count() or 1)
     report = envelope_report(result, rules)
+    if getattr(args, "runup", None) is not None:  # run-ups through the range (runup.gate)
+        from gearengine.runup.gate import gate_envelope
+
+        report = validated_input(lambda r: gate_envelope(report, request, r), args.runup, "--runup")
     print_report(report)
     if args.json:
         Path(args.json).write_text(dumps(report))

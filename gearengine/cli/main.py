@@ -1,11 +1,13 @@
 """The ``gearengine`` command line.
 
-    gearengine melnikov FILE [--json] [--method closed_form|quadrature]
+    gearengine melnikov FILE [--json] [--method closed_form|quadrature] [--mean-load ...]
     gearengine analyze FILE [--json]
     gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov|impacts|separation]
         [--max-lle V] [--max-dte E] [--max-dynamic-factor F]
         [--min-stability-margin X]
     gearengine sweep FILE [--out DIR|-] [--format json|csv]
+    gearengine runup FILE --from 500 --to 6000 --rate 1000 [--direction up|down|up_down]
+        [--bin 50] [--json OUT] [--plot OUT.png]
     gearengine convert FILE [--json]
 
 FILE holds ``{"params": {...}}`` or ``{"design": {...}}`` (physical units), and ``"settings"``
@@ -76,6 +78,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help='JSON file holding {"params": {...}} or {"design": {...}}, or -')
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
     p.add_argument("--method", choices=["closed_form", "quadrature"], default=None)
+    p.add_argument(
+        "--mean-load",
+        choices=["unperturbed", "perturbation"],
+        default=None,
+        help="where the mean force goes (default unperturbed; perturbation: the paper's)",
+    )
     p.set_defaults(func=lazy("gearengine.cli.melnikov", "cmd_melnikov"))
 
     p = sub.add_parser("analyze", help="Melnikov and numerical verdicts of a design")
@@ -120,6 +128,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--server", metavar="URL", help="run the envelope on a running service "
                    "(API key from GEARCHAOS_API_KEY)")  # fmt: skip
     p.add_argument("--max-lle", type=float, default=None, help="fail when the LLE exceeds V")
+    p.add_argument("--runup", type=float, default=None, metavar="RATE",
+                   help="envelope checks: also run up and down through --speed at RATE rpm/s "
+                   "at each torque level (same rules; chaos fails after 0.05 s)")  # fmt: skip
     p.add_argument(
         "--min-stability-margin",
         type=float,
@@ -128,7 +139,25 @@ def build_parser() -> argparse.ArgumentParser:
         help="fail when the response is periodic and its Floquet stability margin "
         "1 - max |lambda| is below X (or unavailable); one design only, not an envelope",
     )
+    p.add_argument("--max-probability", action="append", metavar="NAME=P",
+                   help="fail where the 95 %% upper bound of P(NAME) over the design's "
+                   "tolerances exceeds P (chaotic, impacts, back_flank; repeatable)")  # fmt: skip
+    p.add_argument("--samples", type=int, default=64, help="with --max-probability (default 64)")
+    p.add_argument("--seed", type=int, default=0, help="with --max-probability (default 0)")
     p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
+
+    p = sub.add_parser("robustness", help="probabilities over a design's tolerances, here")
+    p.add_argument("file", help='JSON file holding {"design": {..., "tolerances": {...}}}, or -')
+    p.add_argument("--speed", metavar="LOW:HIGH", help="driver speeds: rpm, or with units")
+    p.add_argument("--torque", metavar="LOW:HIGH", help="mean driver torques: N m, or with units")
+    p.add_argument("--speed-points", type=int, default=23, metavar="N", help="default 23")
+    p.add_argument("--torque-points", type=int, default=5, metavar="N", help="default 5")
+    p.add_argument("--samples", type=int, default=256, help="samples N, a power of 2 (256)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the Sobol samples (0)")
+    p.add_argument("--sensitivity", action="store_true", help="also Sobol indices (SALib)")
+    p.add_argument("--json", metavar="FILE", help="write the result (the API's document)")
+    p.add_argument("--plot", metavar="PNG", help="write the probability map")
+    p.set_defaults(func=lazy("gearengine.cli.robustness", "cmd_robustness"))
 
     p = sub.add_parser("sweep", help="run a sweep here, no server: JSON, CSV and PNG")
     p.add_argument("file", help="JSON file holding a sweep request (as POST /v1/sweeps), or -")
@@ -137,6 +166,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--format", choices=["json", "csv"], default="json",
                    help="with --out -: the JSON result (default) or the CSV table")  # fmt: skip
     p.set_defaults(func=lazy("gearengine.cli.sweep", "cmd_sweep"))
+
+    p = sub.add_parser("runup", help="run-up / run-down of a design: DTE, contact, FTLE, jumps")
+    p.add_argument("file", help='JSON file holding {"design": {...}} (and run-up fields), or -')
+    p.add_argument("--from", dest="from_speed", metavar="SPEED", help="lower speed (rpm)")
+    p.add_argument("--to", dest="to_speed", metavar="SPEED", help="upper speed (rpm)")
+    p.add_argument("--rate", metavar="RATE", help="ramp rate (rpm/s)")
+    p.add_argument("--duration", metavar="T", help="duration of each leg instead (s)")
+    p.add_argument("--direction", choices=["up", "down", "up_down"], default=None)
+    p.add_argument("--bin", type=float, default=None, metavar="RPM", help="bin width (50)")
+    p.add_argument("--to-torque", metavar="TORQUE", help="torque at the end (N m)")
+    p.add_argument("--ensemble", type=int, default=None, metavar="N", help="FTLE members (8)")
+    p.add_argument("--json", metavar="OUT", help="write the API's document")
+    p.add_argument("--plot", metavar="OUT", help="write the figure (.png or .svg)")
+    p.set_defaults(func=lazy("gearengine.cli.runup", "cmd_runup"))
 
     p = sub.add_parser("convert", help="a design in physical units: parameters, derivations, rpm")
     p.add_argument("file", help='JSON file holding {"design": {...}}, or - for stdin')

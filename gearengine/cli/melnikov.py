@@ -1,4 +1,4 @@
-"""``gearengine melnikov FILE [--json] [--method closed_form|quadrature]``: the Melnikov
+"""``gearengine melnikov FILE [--json] [--method ...] [--mean-load ...]``: the Melnikov
 verdict as a readable table, or the API's JSON."""
 
 from __future__ import annotations
@@ -51,6 +51,8 @@ def render_melnikov(r: MelnikovResult) -> str:
 def render_engineering(eng: Engineering) -> str:
     """The engineering block of a design as readable lines (gear units)."""
     windows = ", ".join(f"{a:,.0f}-{b:,.0f}" for a, b in eng.speed_windows_rpm) or "none"
+    if eng.speed_windows_note:
+        windows += f" ({eng.speed_windows_note})"
     lo, hi = eng.speed_range_rpm
     lines = [
         f"In gear units (f_n = {eng.natural_frequency_hz:.6g} Hz, mesh "
@@ -58,6 +60,11 @@ def render_engineering(eng: Engineering) -> str:
         f"  Melnikov speed windows [rpm] (scanned {lo:,.0f}-{hi:,.0f}): {windows}",
         f"  {'parameter':<36} {'value':>12} {'nearest critical':>17} {'margin to chaos':>16}",
     ]
+    if eng.critical_torque_nm is not None:
+        lines.insert(
+            2, f"  critical torque T_crit = {eng.critical_torque_nm:,.4g} N*m (the criterion "
+            "applies below it)"
+        )  # fmt: skip
     for name, c in eng.critical.items():
         lines.append(
             f"  {name + ' [' + c.unit + ']':<36} {fmt_value(c.value):>12} "
@@ -72,6 +79,8 @@ def cmd_melnikov(args: argparse.Namespace) -> int:
     req = read_request(args.file, MelnikovRequest)
     if args.method:
         req = req.model_copy(update={"method": args.method})
+    if getattr(args, "mean_load", None):
+        req = req.model_copy(update={"mean_load": args.mean_load})
     result = answer_melnikov(req)
     if args.json:
         print(dumps(result))

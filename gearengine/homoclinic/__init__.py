@@ -30,10 +30,11 @@ __all__ = [
 ]
 
 _HERE = Path(__file__).parent
-# batch's compiled verdict calls kernels.py's and freezes extrema.NEGLIGIBLE (gearengine.jitcache
-# says why this matters); numba loads a cached kernel on its first call, so this runs first
+# batch's compiled verdict calls kernels.py's, which call loops.py's, and freezes
+# extrema.NEGLIGIBLE and kernels' row numbers (gearengine.jitcache says why this matters); numba
+# loads a cached kernel on its first call, so this runs first
 drop_stale(
-    "kernels,batch",
-    [_HERE / "kernels.py", _HERE / "batch.py", _HERE / "extrema.py"],
+    "kernels,batch,loops",
+    [_HERE / "kernels.py", _HERE / "batch.py", _HERE / "extrema.py", _HERE / "loops.py"],
     _HERE / "__pycache__",
 )

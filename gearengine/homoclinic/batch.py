@@ -27,11 +27,31 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 from typing_extensions import TypedDict  # pydantic needs it on Python < 3.12
 
-from gearengine.homoclinic.coefficients import BRANCH_SIGN, active_only, saddle_loop
+from gearengine.homoclinic.coefficients import (
+    BRANCH_SIGN,
+    MeanLoad,
+    active_only,
+    loop_load,
+    saddle_loop,
+)
 from gearengine.homoclinic.extrema import NEGLIGIBLE, extrema
-from gearengine.homoclinic.kernels import KIND, damping_unit, unit_coefficient
-from gearengine.homoclinic.thresholds import CONTROL_PARAMETERS, parameter_threshold
+from gearengine.homoclinic.kernels import (
+    AMPLITUDE,
+    FUNDAMENTAL,
+    HARMONIC,
+    KIND_ROW,
+    MU,
+    damping_unit,
+    unit_coefficient,
+)
+from gearengine.homoclinic.terms import packed_terms
+from gearengine.homoclinic.thresholds import (
+    CONTROL_PARAMETERS,
+    parameter_threshold,
+    signed_margin,
+)
 from gearengine.homoclinic.verdict import applicability
+from gearengine.model.aliases import get_alias
 from gearengine.model.backlash import melnikov_cubic
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
@@ -67,6 +87,11 @@ class MelnikovBatchRequest(BaseModel):
         description=f"Dimensionless parameters of Eq. (9), one per design (1 to {MAX_DESIGNS}).",
         examples=[[PAPER_SECTION_41]],
     )
+    mean_load: MeanLoad = Field(
+        "unperturbed",
+        description="Where the mean force goes, as in POST /v1/melnikov (unperturbed: null "
+        "verdicts where |F_m| >= F_crit).",
+    )
 
 
 class MelnikovBatchResult(BaseModel):
@@ -81,68 +106,86 @@ class MelnikovBatchResult(BaseModel):
     )
 
 
-def _margin(value: float, critical: Sequence[float]) -> Margin:
-    """``thresholds._threshold``'s margin: value - nearest, and over |nearest| (null if 0)."""
-    if not critical:
-        return {"margin": None, "relative_margin": None}
-    nearest = min(critical, key=lambda v: abs(value - v))
-    margin = value - nearest
-    return {"margin": margin, "relative_margin": margin / abs(nearest) if nearest != 0.0 else None}
+def _margin(
+    parameter: str, value: float, critical: Sequence[float], no_chaos: Sequence[Sequence]
+) -> Margin:
+    """``thresholds.signed_margin``: positive on the safe side (null without critical value)."""
+    _, margin, rel = signed_margin(parameter, value, critical, no_chaos)
+    return {"margin": margin, "relative_margin": rel}
+
+
+NO_MARGIN: Margin = {"margin": None, "relative_margin": None}
 
 
 @numba.njit(cache=True, nogil=True)
-def _simple(kind, freq, amp, mu, a, c):  # pragma: no cover - compiled
-    """Per design: (status, chaos, amplitude critical H, mu critical R).
+def _one_loop(kind, freq, amp, system, s):  # pragma: no cover - compiled
+    """(status, chaos, H, R) of ``_simple`` on homoclinic branch s alone."""
+    au = damping_unit(system, s)
+    bu = unit_coefficient(kind, freq, system, s)
+    if not (math.isfinite(au) and abs(au) < 1e150 and math.isfinite(bu) and abs(bu) < 1e150):
+        return 1, False, np.nan, np.nan
+    big_a, big_b = au * system[MU], bu * amp
+    chaos = big_a - abs(big_b) < 0.0 < big_a + abs(big_b)
+    if abs(big_a) < NEGLIGIBLE or abs(au) < NEGLIGIBLE or abs(bu) < NEGLIGIBLE:
+        return 2, chaos, np.nan, np.nan
+    h = -big_a / abs(bu)
+    if not (math.isfinite(h) and h != 0.0):
+        return 2, chaos, np.nan, np.nan
+    r = np.nan
+    if abs(big_b) >= NEGLIGIBLE:
+        rj = -(0.0 + abs(big_b)) / au
+        if not math.isfinite(rj):
+            return 2, chaos, h, np.nan
+        if rj != 0.0:
+            r = rj
+    return 0, chaos, h, r
 
+
+@numba.njit(cache=True, nogil=True)
+def _simple(terms, systems):  # pragma: no cover - compiled
+    """Per design j: (status, chaos, amplitude critical H, mu critical R) of the one-term
+    packed form (``homoclinic.terms``) column ``terms[:, j]`` on ``systems[j]``.
+
+    Branch s keeps one sign for |F_1| <= H_s and for mu >= R_s; neither branch changes sign on
+    the intersection, so H = min_s H_s and R = max_s R_s (the branches are alike for F_m = 0).
     status 0: closed forms valid (critical F_1 = -/+H unless H is NaN, mu critical R unless NaN);
     1: not applicable (M overflows, as ``verdict.applicability``); 2: take the per-design path.
     """
-    n = kind.size
+    n = terms.shape[1]
     status = np.zeros(n, dtype=np.int8)
     chaos = np.zeros(n, dtype=np.bool_)
     h, r = np.full(n, np.nan), np.full(n, np.nan)
     for j in range(n):
-        au = damping_unit(a[j], c[j])
-        bu = unit_coefficient(kind[j], freq[j], a[j], c[j], 1.0)
-        if not (math.isfinite(au) and abs(au) < 1e150 and math.isfinite(bu) and abs(bu) < 1e150):
-            status[j] = 1
-            continue
-        big_a, big_b = au * mu[j], bu * amp[j]
-        chaos[j] = big_a - abs(big_b) < 0.0 < big_a + abs(big_b)
-        if abs(big_a) < NEGLIGIBLE or abs(au) < NEGLIGIBLE or abs(bu) < NEGLIGIBLE:
-            status[j] = 2
-            continue
-        hj = -big_a / abs(bu)
-        if not (math.isfinite(hj) and hj != 0.0):
-            status[j] = 2
-            continue
-        h[j] = hj
-        if abs(big_b) >= NEGLIGIBLE:
-            rj = -(0.0 + abs(big_b)) / au
-            if not math.isfinite(rj):
-                status[j] = 2
-                continue
-            if rj != 0.0:
-                r[j] = rj
+        kind = int(terms[KIND_ROW, j])
+        freq = terms[HARMONIC, j] * terms[FUNDAMENTAL, j]
+        worst = 0
+        for s in (1.0, -1.0):
+            st, ch, hs, rs = _one_loop(kind, freq, terms[AMPLITUDE, j], systems[j], s)
+            worst = 1 if st == 1 or worst == 1 else max(worst, st)
+            chaos[j] = chaos[j] or ch
+            if not math.isnan(hs):
+                h[j] = hs if math.isnan(h[j]) else min(h[j], hs)
+            if not math.isnan(rs):
+                r[j] = rs if math.isnan(r[j]) else max(r[j], rs)
+        status[j] = worst
     return status, chaos, h, r
 
 
-def _simple_row(p: GearParams) -> tuple[str, float, float] | None:
-    """(excitation, Omega, F_1) when ``p`` has one excitation with at most one harmonic."""
+def _simple_row(p: GearParams) -> str | None:
+    """The excitation's name when ``p`` has one excitation with at most one harmonic."""
     given = [(name, exc) for name, exc in p.excitations()]
     if len(given) != 1 or len(given[0][1].harmonics) > 1 or p.damping == 0.0:
         return None
-    name, exc = given[0]
-    return name, exc.frequency, exc.harmonics[0].amplitude if exc.harmonics else 0.0
+    return given[0][0]
 
 
-def design_verdict(p: GearParams) -> BatchVerdict:
+def design_verdict(p: GearParams, mean_load: MeanLoad = "unperturbed") -> BatchVerdict:
     """One design on the full path: ``melnikov``'s verdict and parameter thresholds."""
-    a, c, _, units = applicability(p)
+    a, c, _, units = applicability(p, mean_load=mean_load)
     if units is None:
         return {
             "chaos_possible": None,
-            "margins": {q: _margin(0.0, []) for q in CONTROL_PARAMETERS},
+            "margins": {q: NO_MARGIN for q in CONTROL_PARAMETERS},
         }
     chaos = False
     for br in BRANCH_SIGN:
@@ -155,7 +198,9 @@ def design_verdict(p: GearParams) -> BatchVerdict:
     return {"chaos_possible": chaos, "margins": margins}
 
 
-def melnikov_batch(designs: Sequence[GearParams]) -> list[BatchVerdict]:
+def melnikov_batch(
+    designs: Sequence[GearParams], mean_load: MeanLoad = "unperturbed"
+) -> list[BatchVerdict]:
     """Verdict and control-parameter margins of every design, in order.
 
     Equal to ``melnikov(p).chaos_possible`` and ``melnikov(p).thresholds[q].margin`` /
@@ -163,39 +208,43 @@ def melnikov_batch(designs: Sequence[GearParams]) -> list[BatchVerdict]:
     designs run together in one compiled pass; the others one by one (see the module docstring).
     """
     out: list[BatchVerdict | None] = [None] * len(designs)
-    rows, where = [], []
+    packs, where = [], []
     for i, p in enumerate(designs):
         simple = _simple_row(p)
         a, c, _ = melnikov_cubic(p.backlash)
-        if simple is None or not saddle_loop(a, c):
-            out[i] = design_verdict(p)
+        fm = loop_load(p, mean_load)
+        if simple is None or not saddle_loop(a, c, fm):
+            out[i] = design_verdict(p, mean_load)
             continue
-        name, omega, amplitude = simple
-        rows.append((KIND[name], omega, amplitude, p.damping, a, c))
-        where.append((i, _PARAMETER_OF[name]))
-    if rows:
-        table = np.array(rows, dtype=float)
-        status, chaos, h, r = _simple(table[:, 0].astype(np.int64), *table[:, 1:].T)
+        packs.append(packed_terms(p, a, c, fm, inactive=True))
+        where.append((i, _PARAMETER_OF[simple]))
+    if packs:
+        terms = np.concatenate([q.terms for q in packs], axis=1)
+        systems = np.stack([q.system for q in packs])
+        status, chaos, h, r = _simple(terms, systems)
         for k, (i, own) in enumerate(where):
-            out[i] = _simple_verdict(designs[i], own, status[k], chaos[k], h[k], r[k], table[k])
+            verdict = _simple_verdict(designs[i], own, status[k], chaos[k], h[k], r[k])
+            out[i] = design_verdict(designs[i], mean_load) if verdict is None else verdict
     return out  # type: ignore[return-value]
 
 
-def _simple_verdict(p, own, status, chaos, h, r, row) -> BatchVerdict:
-    """The verdict of a one-excitation design from the compiled closed forms."""
+def _simple_verdict(p, own, status, chaos, h, r) -> BatchVerdict | None:
+    """The verdict of a one-excitation design from the compiled closed forms; None to take the
+    per-design path."""
     if status == 2:
-        return design_verdict(p)
+        return None
     if status == 1:
         return {
             "chaos_possible": None,
-            "margins": {q: _margin(0.0, []) for q in CONTROL_PARAMETERS},
+            "margins": {q: NO_MARGIN for q in CONTROL_PARAMETERS},
         }
-    amplitude, mu = float(row[2]), float(row[3])
-    margins: dict[str, Margin] = {
-        q: {"margin": None, "relative_margin": None} for q in CONTROL_PARAMETERS
-    }
-    margins[own] = _margin(amplitude, [] if math.isnan(h) else [-float(h), float(h)])
-    margins["mu"] = _margin(mu, [] if math.isnan(r) else [float(r)])
+    amplitude = float(get_alias(p, own))
+    mu = float(p.damping)
+    margins: dict[str, Margin] = {q: NO_MARGIN for q in CONTROL_PARAMETERS}
+    if not math.isnan(h):  # neither branch changes sign for |F_1| <= H (Eq. 23)
+        margins[own] = _margin(own, amplitude, [-float(h), float(h)], [(-float(h), float(h))])
+    if not math.isnan(r):  # nor for mu >= R (Eq. 24)
+        margins["mu"] = _margin("mu", mu, [float(r)], [(float(r), None)])
     return {"chaos_possible": bool(chaos), "margins": margins}
 
 

@@ -16,7 +16,12 @@ has the units of the inputs). Every term is a sinusoid in tau0 (derivation in
     B (torque)    = s sqrt(2/c) pi Omega sech(sigma) F_pr                   Omega = r Omega_p
     B (trans. err)= s sqrt(2/c) pi Omega^3 sech(sigma) F_er                 Omega = r Omega_e
 
-The mean force F_m contributes nothing (the integral of y_h vanishes). The stiffness term differs
+Treated as a perturbation (the paper's F~_m = eps f_m, ``mean_load="perturbation"``), the mean
+force F_m contributes nothing (the integral of y_h vanishes). By default it belongs to the
+unperturbed system, x'' = a x - c x^3 + F_m (``mean_load="unperturbed"``): the saddle moves to
+x_s, the two loops become asymmetric (``loops``) and each coefficient is the same Eq. (18)
+integral along the loaded loop; |F_m| >= F_crit leaves no saddle (``docs/melnikov-under-load.md``).
+The stiffness term differs
 from the paper's printed Eq. (19), which is wrong unless a = 1: quadrature of Eq. (18) agrees with
 the form above (tests/test_melnikov.py).
 
@@ -36,21 +41,40 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
+from gearengine.homoclinic import kernels, loops
 from gearengine.homoclinic.extrema import TrigSum
+from gearengine.homoclinic.terms import system_array
 from gearengine.model.params import GearParams
 
 HomoclinicBranch = Literal["plus", "minus"]
 """The two homoclinic orbits of Eq. (15): plus (x_h > 0) and minus (x_h < 0)."""
 BRANCH_SIGN: dict[HomoclinicBranch, float] = {"plus": 1.0, "minus": -1.0}
 Method = Literal["closed_form", "quadrature"]
+MeanLoad = Literal["unperturbed", "perturbation"]
+"""Where the mean force F_m goes: in the unperturbed system x'' = a x - c x^3 + F_m (default), or
+a first-order perturbation that drops out of M (the paper's treatment, section 3.1)."""
 
 
-def saddle_loop(a: float, c: float) -> bool:
-    """True when x'' = a x - c x^3 has a saddle at 0 with homoclinic loops: a > 0 and c > 0.
+def loop_load(params: GearParams | dict, mean_load: MeanLoad) -> float:
+    """The mean force carried by the unperturbed system: F_m, or 0 as a perturbation (of
+    ``params`` or of their dumped, unvalidated data)."""
+    if mean_load == "perturbation":
+        return 0.0
+    return float(params["mean_force"] if isinstance(params, dict) else params.mean_force)
+
+
+def critical_mean_force(a: float, c: float) -> float:
+    """F_crit = (2a/3) sqrt(a/(3c)) (``loops.critical_load``), for a > 0 and c > 0."""
+    return float(loops.critical_load(a, c))
+
+
+def saddle_loop(a: float, c: float, fm: float = 0.0) -> bool:
+    """True when x'' = a x - c x^3 + F_m has a saddle with homoclinic loops: a > 0, c > 0 and
+    |F_m| < F_crit.
 
     The one domain check of the Melnikov criterion; without a saddle loop it does not apply.
     """
-    return a > 0.0 and c > 0.0
+    return a > 0.0 and c > 0.0 and abs(fm) < critical_mean_force(a, c)
 
 
 class Term(BaseModel):
@@ -101,70 +125,78 @@ class BranchCoefficients(BaseModel):
 # --- Homoclinic orbit, Eq. (15) ---------------------------------------------------------------
 
 
-def homoclinic_orbit(t: np.ndarray | float, a: float, c: float, branch: HomoclinicBranch) -> tuple:
-    """(x_h, y_h) of Eq. (15) at dimensionless time t on the given branch."""
+def homoclinic_orbit(
+    t: np.ndarray | float, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
+) -> tuple:
+    """(x_h, y_h) at dimensionless time t on the given loop: Eq. (15) for F_m = 0, else the
+    loaded loop x_s + u_s(t) of ``loops`` (u_s = s P / (cosh(k t) + cos theta_s))."""
     s = BRANCH_SIGN[branch]
-    z = math.sqrt(a) * np.asarray(t, dtype=float)
-    e = np.exp(-np.abs(z))
-    sech = 2.0 * e / (1.0 + e * e)  # overflow-free sech(z)
-    x = s * math.sqrt(2.0 * a / c) * sech
-    y = -s * math.sqrt(2.0 / c) * a * sech * np.tanh(z)
-    return x, y
+    if fm == 0.0:
+        z = math.sqrt(a) * np.asarray(t, dtype=float)
+        e = np.exp(-np.abs(z))
+        sech = 2.0 * e / (1.0 + e * e)  # overflow-free sech(z)
+        x = s * math.sqrt(2.0 * a / c) * sech
+        y = -s * math.sqrt(2.0 / c) * a * sech * np.tanh(z)
+        return x, y
+    xs, alpha, p, cos_t, _ = loops.loop_shape(a, c, fm, s)
+    z = math.sqrt(alpha) * np.abs(np.asarray(t, dtype=float))
+    e = np.exp(-z)  # overflow-free: cosh z + cos = (1 + 2 cos e + e^2) / (2 e)
+    den = 1.0 + 2.0 * cos_t * e + e * e
+    u = s * p * 2.0 * e / den
+    du = -s * p * math.sqrt(alpha) * 2.0 * e * (1.0 - e * e) / den**2  # u' for t >= 0
+    return xs + u, np.sign(np.asarray(t, dtype=float)) * du
 
 
-# --- Closed form, corrected Eq. (19) ----------------------------------------------------------
+# --- Closed form, corrected Eq. (19), compiled in ``kernels`` ------------------------------------
 
 
-def _sech(z: float) -> float:
-    e = math.exp(-abs(z))
-    return 2.0 * e / (1.0 + e * e)
+def _system(a: float, c: float, fm: float = 0.0) -> np.ndarray:
+    """The unperturbed system (a, c, F_m) in the kernels' packed ``system`` form."""
+    return system_array(0.0, a, c, fm, 0.0, 1.0)
 
 
-def _csch(z: float) -> float:
-    e = math.exp(-abs(z))
-    return 2.0 * e / (1.0 - e * e)
+def damping_coefficient(
+    a: float, c: float, fm: float = 0.0, branch: HomoclinicBranch = "plus"
+) -> float:
+    """dA/dmu = -(8/3) a^(3/2) / c, from -2 mu * integral of y_h^2 (Eq. 19, first term); on the
+    given loaded loop for F_m != 0."""
+    return float(kernels.damping_unit(_system(a, c, fm), BRANCH_SIGN[branch]))
 
 
-def damping_coefficient(a: float, c: float) -> float:
-    """dA/dmu = -(8/3) a^(3/2) / c, from -2 mu * integral of y_h^2 (Eq. 19, first term)."""
-    return -8.0 / 3.0 * a**1.5 / c
-
-
-def stiffness_coefficient(omega: float, a: float, c: float) -> float:
+def stiffness_coefficient(omega: float, a: float, c: float, fm: float = 0.0) -> float:
     """B per unit k_pr: pi Omega^2 (2a - Omega^2) / (3c) csch(pi Omega / (2 sqrt a)).
 
-    Corrected stiffness term of Eq. (19); the same for both branches.
+    Corrected stiffness term of Eq. (19); the same for both branches when F_m = 0 (the loaded
+    loops' on plus, ``kernels.unit_coefficient``, otherwise).
     """
-    return (
-        math.pi
-        * omega**2
-        * (2.0 * a - omega**2)
-        / (3.0 * c)
-        * _csch(math.pi * omega / (2.0 * math.sqrt(a)))
-    )
+    return float(kernels.unit_coefficient(kernels.STIFFNESS, omega, _system(a, c, fm), 1.0))
 
 
-def torque_coefficient(omega: float, a: float, c: float, branch: HomoclinicBranch) -> float:
+def torque_coefficient(
+    omega: float, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
+) -> float:
     """B per unit F_pr: s sqrt(2/c) pi Omega sech(pi Omega / (2 sqrt a)) (Eq. 19)."""
-    sigma = math.pi * omega / (2.0 * math.sqrt(a))
-    return BRANCH_SIGN[branch] * math.sqrt(2.0 / c) * math.pi * omega * _sech(sigma)
+    s = BRANCH_SIGN[branch]
+    return float(kernels.unit_coefficient(kernels.TORQUE, omega, _system(a, c, fm), s))
 
 
 def transmission_error_coefficient(
-    omega: float, a: float, c: float, branch: HomoclinicBranch
+    omega: float, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
 ) -> float:
     """B per unit F_er: s sqrt(2/c) pi Omega^3 sech(pi Omega / (2 sqrt a)) (Eq. 19).
 
     The forcing amplitude is Omega^2 F_er (Eq. 9), hence Omega^3.
     """
-    return omega**2 * torque_coefficient(omega, a, c, branch)
+    s = BRANCH_SIGN[branch]
+    kind = kernels.TRANSMISSION_ERROR
+    return float(kernels.unit_coefficient(kind, omega, _system(a, c, fm), s))
 
 
 # --- Quadrature of Eq. (18), term by term -------------------------------------------------------
 
 
 def _weight(
-    excitation: str, a: float, c: float, branch: HomoclinicBranch
+    excitation: str, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
 ) -> Callable[[float], float]:
     """The odd function w(t) with term(tau0) = amplitude * integral w(t) cos(Omega(t+tau0)+phi).
 
@@ -173,7 +205,7 @@ def _weight(
     """
 
     def w(t: float) -> float:
-        x, y = homoclinic_orbit(t, a, c, branch)
+        x, y = homoclinic_orbit(t, a, c, branch, fm)
         if excitation == "stiffness":
             return float(2.0 * y * (a * x - c * x**3))
         return float(y)
@@ -197,47 +229,50 @@ def _quad(f: Callable[[float], float], t_max: float, **weight: object) -> float:
 
 
 def quadrature_coefficient(
-    excitation: str, omega: float, a: float, c: float, branch: HomoclinicBranch
+    excitation: str, omega: float, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
 ) -> float:
     """B per unit amplitude by numerical quadrature of Eq. (18) (QUADPACK QAWO).
 
     w(t) is odd, so integral w(t) cos(Omega(t + tau0) + phi) dt = -sin(Omega tau0 + phi) *
     2 integral_0^inf w(t) sin(Omega t) dt; B is the factor of sin(Omega tau0 + phi).
     """
-    w = _weight(excitation, a, c, branch)
-    t_max = 80.0 / math.sqrt(a)  # w decays like exp(-sqrt(a) t); the tail is below 1e-34
+    w = _weight(excitation, a, c, branch, fm)
+    t_max = _t_max(a, c, fm)
     value = _quad(w, t_max, weight="sin", wvar=omega)
     scale = omega**2 if excitation == "transmission_error" else 1.0
     return -2.0 * value * scale
 
 
-def quadrature_damping(a: float, c: float) -> float:
-    """dA/dmu = -2 * integral y_h^2 dt by quadrature (Eq. 18)."""
-    w = _weight("torque", a, c, "plus")
-    value = _quad(lambda t: w(t) ** 2, 80.0 / math.sqrt(a))
+def _t_max(a: float, c: float, fm: float) -> float:
+    """80 / k, k = sqrt(alpha) the saddle's rate: w decays like exp(-k t), the tail is < 1e-34."""
+    return 80.0 / math.sqrt(a - 3.0 * c * loops.saddle(a, c, fm) ** 2)
+
+
+def quadrature_damping(
+    a: float, c: float, fm: float = 0.0, branch: HomoclinicBranch = "plus"
+) -> float:
+    """dA/dmu = -2 * integral y_h^2 dt by quadrature (Eq. 18) on the given loop (both loops
+    give the same value for F_m = 0 only)."""
+    w = _weight("torque", a, c, branch, fm)
+    value = _quad(lambda t: w(t) ** 2, _t_max(a, c, fm))
     return -4.0 * value
 
 
-_CLOSED_FORM: dict[str, Callable[[float, float, float, HomoclinicBranch], float]] = {
-    "stiffness": lambda om, a, c, br: stiffness_coefficient(om, a, c),
-    "torque": torque_coefficient,
-    "transmission_error": transmission_error_coefficient,
-}
-
-
 def closed_form_coefficient(
-    excitation: str, omega: float, a: float, c: float, branch: HomoclinicBranch
+    excitation: str, omega: float, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
 ) -> float:
-    """B per unit amplitude from the corrected closed form of Eq. (19)."""
-    return _CLOSED_FORM[excitation](omega, a, c, branch)
+    """B per unit amplitude from the corrected closed form of Eq. (19) (loaded: ``loops``)."""
+    kind, s = kernels.KIND[excitation], BRANCH_SIGN[branch]
+    return float(kernels.unit_coefficient(kind, omega, _system(a, c, fm), s))
 
 
 @dataclass(frozen=True)
 class CoefficientMethod:
-    """How the coefficients of M are obtained: the damping part and each sinusoid per unit."""
+    """How the coefficients of M are obtained: the damping part (a, c, F_m) and each sinusoid
+    per unit (excitation, Omega, a, c, branch, F_m); F_m is the load of the unperturbed system."""
 
-    damping: Callable[[float, float], float]
-    term: Callable[[str, float, float, float, HomoclinicBranch], float]
+    damping: Callable[[float, float, float, HomoclinicBranch], float]
+    term: Callable[[str, float, float, float, HomoclinicBranch, float], float]
 
 
 METHODS: dict[Method, CoefficientMethod] = {
@@ -254,6 +289,7 @@ def melnikov_coefficients(
     branch: HomoclinicBranch,
     method: Method = "closed_form",
     include_inactive: bool = False,
+    fm: float = 0.0,
 ) -> BranchCoefficients:
     """Coefficients of M(tau0) (Eq. 19) of ``params`` on one branch for the cubic law (a, c).
 
@@ -263,9 +299,10 @@ def melnikov_coefficients(
         branch: ``plus`` (x_h > 0) or ``minus``.
         method: a key of ``METHODS``: ``closed_form`` or ``quadrature``.
         include_inactive: keep zero-amplitude first harmonics as terms (for threshold search).
+        fm: the mean force in the unperturbed system (``loop_load``; 0: a perturbation).
     """
     how = METHODS[method]
-    per_unit_damping = how.damping(a, c)
+    per_unit_damping = how.damping(a, c, fm, branch)
     terms = []
     for name, exc in params.excitations():
         harmonics = list(enumerate(exc.harmonics, start=1)) or [(1, None)]
@@ -274,7 +311,7 @@ def melnikov_coefficients(
             if amplitude == 0.0 and not (include_inactive and r == 1):
                 continue
             omega = r * exc.frequency
-            unit = how.term(name, omega, a, c, branch)
+            unit = how.term(name, omega, a, c, branch, fm)
             phase = 0.0 if h is None else h.phase
             terms.append(
                 Term.model_construct(

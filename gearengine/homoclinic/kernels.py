@@ -13,7 +13,10 @@ Omega_e scan and the threshold root finding run without Python objects in their 
   (a port of scipy's ``brentq``, Brent 1973, *Algorithms for Minimization without Derivatives*,
   ch. 4).
 
-Excitation kinds are coded as integers: ``STIFFNESS``, ``TRANSMISSION_ERROR``, ``TORQUE``.
+Every kernel takes the Melnikov function in the packed form of ``homoclinic.terms``: ``terms``
+of shape (5, n) (rows ``FUNDAMENTAL``, ``HARMONIC``, ``KIND_ROW``, ``AMPLITUDE``, ``PHASE``) and
+``system`` of shape (``SYSTEM_SIZE``,) (``MU``, ``A``, ``C``, ``FM``, ``GCD``, ``LCM``).
+Excitation kinds are coded as numbers: ``STIFFNESS``, ``TRANSMISSION_ERROR``, ``TORQUE``.
 """
 
 from __future__ import annotations
@@ -23,8 +26,17 @@ import math
 import numba
 import numpy as np
 
+from gearengine.homoclinic.loops import loop_integrals
+
 STIFFNESS, TRANSMISSION_ERROR, TORQUE = 0, 1, 2
 KIND = {"stiffness": STIFFNESS, "transmission_error": TRANSMISSION_ERROR, "torque": TORQUE}
+
+FUNDAMENTAL, HARMONIC, KIND_ROW, AMPLITUDE, PHASE = range(5)
+"""Rows of ``terms``: fundamental Omega, harmonic number r, kind, amplitude, phase [rad]."""
+MU, A, C, FM, GCD, LCM, SYSTEM_SIZE = *range(6), 6
+"""Entries of ``system``: damping mu, cubic a and c, the mean force F_m carried by the
+unperturbed system (0 when it is treated as a perturbation, as in the paper), and the
+commensurability (gcd, lcm) of the frequencies (gcd = 0: incommensurate)."""
 
 GRID_PER_CYCLE = 16
 MAX_GRID = 1 << 16
@@ -52,18 +64,33 @@ def _csch(z: float) -> float:
 
 
 @jit
-def damping_unit(a: float, c: float) -> float:
-    """dA/dmu = -(8/3) a^(3/2) / c (Eq. 19, first term)."""
+def damping_unit(system, s: float) -> float:
+    """dA/dmu = -2 integral y_h^2 dt on branch s: -(8/3) a^(3/2) / c (Eq. 19, first term) of
+    the system's cubic (a, c), both branches; -2 T_2(0) of ``loops.loop_integrals`` on the
+    loaded loop s (F_m != 0: the loops differ)."""
+    a, c, fm = system[A], system[C], system[FM]
+    if fm != 0.0:
+        return -2.0 * loop_integrals(0.0, a, c, fm, s)[1]
     return -8.0 / 3.0 * a**1.5 / c
 
 
 @jit
-def unit_coefficient(kind: int, omega: float, a: float, c: float, s: float) -> float:
-    """B per unit amplitude at frequency omega = r Omega on branch s = +-1 (corrected Eq. 19).
+def unit_coefficient(kind: int, omega: float, system, s: float) -> float:
+    """B per unit amplitude at frequency omega = r Omega on branch s = +-1 (corrected Eq. 19)
+    for the system's cubic (a, c).
 
     stiffness: pi Omega^2 (2a - Omega^2) / (3c) csch(sigma); torque: s sqrt(2/c) pi Omega
     sech(sigma); transmission error: Omega^2 times torque; sigma = pi Omega / (2 sqrt a).
+    With the mean load F_m in the unperturbed system (F_m != 0), from the loaded loop's
+    integrals (``loops.loop_integrals``): torque Omega I_1, transmission error Omega^3 I_1,
+    stiffness Omega T_2 - 2 F_m Omega I_1 (Eq. 18 with a x - c x^3 = x'' - F_m on the loop).
     """
+    a, c, fm = system[A], system[C], system[FM]
+    if fm != 0.0:
+        i1, t2 = loop_integrals(omega, a, c, fm, s)
+        if kind == STIFFNESS:
+            return omega * t2 - 2.0 * fm * omega * i1
+        return omega * i1 if kind == TORQUE else omega**3 * i1
     if kind == STIFFNESS:
         w2 = omega**2
         return (
@@ -188,17 +215,18 @@ def trig_extrema(offset: float, amps, freqs, phases, period: float, taus, table,
 
 
 @jit
-def scan_strength(om, value, base, r, kind, amp, phase, mu, a, c, gcd, lcm) -> float:
+def scan_strength(om: float, value: float, terms, system) -> float:
     """Sign-change strength max_s min(max M_s, -min M_s) at Omega_e = om, every frequency
     scaled by om / value (``thresholds.sign_change_strength`` along a running-speed scan).
 
-    Terms are the active harmonics: fundamental ``base``, harmonic number ``r``, excitation
-    ``kind``, amplitude ``amp`` and ``phase``. The common frequency is Omega_0 = top * gcd / lcm,
-    as ``model.frequencies.common_frequency`` computes it (gcd = 0: incommensurate). Returns
-    FALLBACK (NaN) when a coefficient underflows to 0 and the active set (and so its period) is
-    no longer the given one.
+    ``terms`` and ``system`` are the packed form of ``homoclinic.terms``. The common frequency
+    is Omega_0 = top * gcd / lcm, as ``model.frequencies.commensurability`` gives it (gcd = 0:
+    incommensurate). Returns FALLBACK (NaN) when a coefficient underflows to 0 and the active
+    set (and so its period) is no longer the given one.
     """
-    n = base.size
+    n = terms.shape[1]
+    base, r, phase = terms[FUNDAMENTAL], terms[HARMONIC], terms[PHASE]
+    gcd, lcm = system[GCD], system[LCM]
     factor = om / value
     freqs = np.empty(n)
     for i in range(n):
@@ -210,13 +238,14 @@ def scan_strength(om, value, base, r, kind, amp, phase, mu, a, c, gcd, lcm) -> f
     else:
         taus, table = np.zeros(2), np.zeros((2, n))
     values = np.empty(taus.size)
-    damping = damping_unit(a, c) * mu
     best = -np.inf
     amps = np.empty(n)
     for s in (1.0, -1.0):
+        damping = damping_unit(system, s) * system[MU]
         nact = 0
         for i in range(n):
-            amps[i] = unit_coefficient(kind[i], freqs[i], a, c, s) * amp[i]
+            kind = int(terms[KIND_ROW, i])
+            amps[i] = unit_coefficient(kind, freqs[i], system, s) * terms[AMPLITUDE, i]
             nact += amps[i] != 0.0
         if 2 <= nact < n:
             return FALLBACK
@@ -226,11 +255,12 @@ def scan_strength(om, value, base, r, kind, amp, phase, mu, a, c, gcd, lcm) -> f
 
 
 @jit
-def _brentq(args, xa: float, xb: float, xtol: float) -> float:
+def _brentq(value: float, terms, system, xa: float, xb: float, xtol: float) -> float:
     """Root of ``scan_strength`` in [xa, xb]: scipy's brentq (Zeros/brentq.c), step for step."""
     xpre, xcur = xa, xb
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
-    fpre, fcur = scan_strength(xpre, *args), scan_strength(xcur, *args)
+    fpre = scan_strength(xpre, value, terms, system)
+    fcur = scan_strength(xcur, value, terms, system)
     if fpre == 0.0:
         return xpre
     if fcur == 0.0:
@@ -261,30 +291,29 @@ def _brentq(args, xa: float, xb: float, xtol: float) -> float:
             spre, scur = sbis, sbis
         xpre, fpre = xcur, fcur
         xcur += scur if abs(scur) > delta else (delta if sbis > 0 else -delta)
-        fcur = scan_strength(xcur, *args)
+        fcur = scan_strength(xcur, value, terms, system)
         if math.isnan(fcur):
             return np.nan
     return np.nan
 
 
 @jit
-def scan_roots(omegas, xtol, value, base, r, kind, amp, phase, mu, a, c, gcd, lcm):
+def scan_roots(omegas, xtol: float, value: float, terms, system):
     """Critical Omega_e of a running-speed scan and the no-chaos flag of each piece between them.
 
     Returns (critical, no_chaos, ok): ``no_chaos[j]`` says the strength is <= 0 in the middle of
     piece j of [start, *critical, stop]; ``ok`` is False when the scan met a FALLBACK point.
     """
-    args = (value, base, r, kind, amp, phase, mu, a, c, gcd, lcm)
     m = omegas.size
     vals = np.empty(m)
     for k in range(m):
-        vals[k] = scan_strength(omegas[k], *args)
+        vals[k] = scan_strength(omegas[k], value, terms, system)
     critical = [0.0 for _ in range(0)]
     if np.isnan(vals).any():
         return np.empty(0), np.zeros(0, dtype=np.bool_), False
     for k in range(m - 1):
         if (vals[k] > 0.0) != (vals[k + 1] > 0.0):
-            root = _brentq(args, omegas[k], omegas[k + 1], xtol)
+            root = _brentq(value, terms, system, omegas[k], omegas[k + 1], xtol)
             if math.isnan(root):
                 return np.empty(0), np.zeros(0, dtype=np.bool_), False
             critical.append(root)
@@ -294,7 +323,7 @@ def scan_roots(omegas, xtol, value, base, r, kind, amp, phase, mu, a, c, gcd, lc
         edges[j + 1] = critical[j]
     no_chaos = np.zeros(edges.size - 1, dtype=np.bool_)
     for j in range(edges.size - 1):
-        mid = scan_strength(0.5 * (edges[j] + edges[j + 1]), *args)
+        mid = scan_strength(0.5 * (edges[j] + edges[j + 1]), value, terms, system)
         if math.isnan(mid):
             return np.empty(0), np.zeros(0, dtype=np.bool_), False
         no_chaos[j] = mid <= 0.0

@@ -7,7 +7,12 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from gearengine.homoclinic.coefficients import BranchCoefficients, HomoclinicBranch, Method
+from gearengine.homoclinic.coefficients import (
+    BranchCoefficients,
+    HomoclinicBranch,
+    MeanLoad,
+    Method,
+)
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import MIN_FREQUENCY, WholeNumber, request_config
 from gearengine.model.reduction import ParamsOrDesign
@@ -58,11 +63,22 @@ class ParameterThreshold(_Result):
     critical_values: list[float] = Field(
         description="Values where the overall verdict (either branch changes sign) flips."
     )
-    nearest: float | None = Field(description="The critical value nearest to the design.")
+    nearest: float | None = Field(
+        description="The critical value nearest to the design (for an amplitude, of its sign)."
+    )
     margin: float | None = Field(
-        description="value - nearest: signed distance to the nearest critical value."
+        description="|value - nearest|, positive on the safe side (neither branch changes sign "
+        "at the design's value), negative inside the chaos-possible region. For an amplitude the "
+        "nearest critical value of the design's own sign is taken (a negative amplitude is a "
+        "phase shift by pi)."
     )
     relative_margin: float | None = Field(description="margin / |nearest| (null if nearest = 0).")
+    margin_in_force_scale: float | None = Field(
+        None,
+        description="The margin as the largest force it makes along the loops, over the force "
+        "scale F_crit of the unperturbed system (as perturbation_sizes): how far first-order "
+        "theory carries the threshold (null for Omega_e).",
+    )
     no_chaos: list[Bounds] = Field(
         description="Intervals of the parameter where neither branch changes sign."
     )
@@ -78,7 +94,10 @@ class ParameterThreshold(_Result):
 class MelnikovResult(_Result):
     """The Melnikov verdict of a design (the /v1/melnikov contract)."""
 
-    applicable: bool = Field(description="False when the unperturbed system has no saddle loop.")
+    applicable: bool = Field(
+        description="False when the unperturbed system has no saddle loop (with the mean load "
+        "in it: |F_m| >= F_crit)."
+    )
     chaos_possible: bool | None = Field(
         description="Either branch changes sign: transverse homoclinic orbits, chaos possible. "
         "null when not applicable."
@@ -100,6 +119,27 @@ class MelnikovResult(_Result):
     )
     method: Method = Field(description="closed_form (corrected Eq. 19) or quadrature (Eq. 18).")
     notes: list[str] = Field(description="Caveats and explanations, in plain words.")
+    mean_load: MeanLoad = Field(
+        "unperturbed",
+        description="unperturbed: F_m in the unperturbed system x'' = a x - c x^3 + F_m (its "
+        "saddle and asymmetric loops); perturbation: the paper's first-order treatment, where "
+        "F_m drops out of M.",
+    )
+    critical_mean_force: float | None = Field(
+        None,
+        description="F_crit = (2a/3) sqrt(a/(3c)): the largest |F_m| for which the unperturbed "
+        "system has a saddle (null without a cubic with a, c > 0).",
+    )
+    saddle: float | None = Field(
+        None, description="x_s, the saddle of the unperturbed system (0 without mean load)."
+    )
+    perturbation_sizes: dict[str, float] | None = Field(
+        None,
+        description="Each perturbation's largest force along the loops over the force scale "
+        "F_crit (the cubic's peak restoring force): damping, stiffness, torque, "
+        "transmission_error, and mean_force when it is treated as a perturbation. First-order "
+        "theory assumes them small; a note says when they are not.",
+    )
 
 
 class ThresholdCurve(_Result):
@@ -133,6 +173,12 @@ class MelnikovRequest(ParamsOrDesign):
         "closed_form",
         description="closed_form: corrected Eq. (19); quadrature: Eq. (18) integrated numerically.",
     )
+    mean_load: MeanLoad = Field(
+        "unperturbed",
+        description="unperturbed (default): the mean force F_m belongs to the unperturbed system "
+        "(saddle and loops under load; not applicable for |F_m| >= F_crit); perturbation: the "
+        "paper's treatment (section 3.1), F_m small and absent from M.",
+    )
 
 
 class ThresholdsRequest(ParamsOrDesign):
@@ -162,6 +208,10 @@ class ThresholdsRequest(ParamsOrDesign):
         description="Last frequency (dimensionless, 1e-6 to 1000); below start the "
         "frequencies run downwards.",
         examples=[2.5],
+    )
+    mean_load: MeanLoad = Field(
+        "unperturbed",
+        description="Where the mean force goes, as in POST /v1/melnikov.",
     )
     num: WholeNumber = Field(
         100,

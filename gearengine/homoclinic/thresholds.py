@@ -10,17 +10,18 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Iterable
-from fractions import Fraction
+from collections.abc import Sequence
 
 import numpy as np
 
-from gearengine.homoclinic import kernels
 from gearengine.homoclinic.coefficients import (
     BRANCH_SIGN,
     BranchCoefficients,
     HomoclinicBranch,
+    MeanLoad,
     Method,
+    critical_mean_force,
+    loop_load,
     melnikov_coefficients,
     saddle_loop,
 )
@@ -31,9 +32,9 @@ from gearengine.homoclinic.schemas import (
     ThresholdCurve,
     ThresholdsRequest,
 )
+from gearengine.homoclinic.terms import packed_terms
 from gearengine.model.aliases import get_alias, with_alias, with_aliases
 from gearengine.model.backlash import melnikov_cubic
-from gearengine.model.frequencies import MAX_DENOMINATOR, RATIO_TOLERANCE
 from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash
 
 CONTROL_PARAMETERS = ("F_e1", "mu", "k_p1", "F_p1")
@@ -52,40 +53,32 @@ Coefficients = dict[HomoclinicBranch, BranchCoefficients]
 
 
 def sign_change_strength(
-    params: GearParams, a: float, c: float, method: Method = "closed_form"
+    params: GearParams,
+    a: float,
+    c: float,
+    method: Method = "closed_form",
+    mean_load: MeanLoad = "unperturbed",
 ) -> float:
     """max over branches of min(max M, -min M): > 0 iff some branch changes sign.
 
     Continuous in the parameters (for a fixed set of commensurate frequencies), so its roots
-    are the critical values of any parameter. ``method`` names the coefficients (``METHODS``).
+    are the critical values of any parameter. ``method`` names the coefficients (``METHODS``),
+    ``mean_load`` where F_m goes (``coefficients.MeanLoad``; the loops must exist,
+    ``saddle_loop``).
     The closed form runs compiled (``kernels.scan_strength`` at the design's own speed, on the
-    arrays of ``scan_terms``); quadrature, and the rare design on which a coefficient underflows
+    packed form of ``terms``); quadrature, and the rare design on which a coefficient underflows
     to 0, take the same algorithm on the pydantic documents.
     """
+    fm = loop_load(params, mean_load)
     if method == "closed_form":
-        strength = _compiled_strength(params, a, c)
+        strength = packed_terms(params, a, c, fm).strength()
         if not math.isnan(strength):
             return strength
     strengths = []
     for br in BRANCH_SIGN:
-        ext = extrema(melnikov_coefficients(params, a, c, br, method).trig_sum())
+        ext = extrema(melnikov_coefficients(params, a, c, br, method, fm=fm).trig_sum())
         strengths.append(min(ext.maximum.value, -ext.minimum.value))
     return max(strengths)
-
-
-def _compiled_strength(params: GearParams, a: float, c: float) -> float:
-    """``sign_change_strength`` (closed form) by ``kernels.scan_strength`` with Omega_e at its
-    own value (factor 1, so the frequencies are exactly r Omega); NaN to fall back."""
-    base, r, kind, amp, phase = scan_terms(params)
-    gcd, lcm = _commensurability(tuple((r * base).tolist()))
-    mu = float(params.damping)
-    return float(kernels.scan_strength(1.0, 1.0, base, r, kind, amp, phase, mu, a, c, gcd, lcm))
-
-
-@functools.lru_cache(maxsize=4096)
-def _commensurability(frequencies: tuple[float, ...]) -> tuple[float, float]:
-    """``commensurability``, remembered (sweeps and scans ask for the same ratios again)."""
-    return commensurability(list(frequencies))
 
 
 @functools.lru_cache(maxsize=1024)
@@ -96,21 +89,28 @@ def _cubic(backlash: CubicBacklash | PiecewiseBacklash) -> tuple[float, float]:
     return a, c
 
 
-def strength_at(params: GearParams, values: dict[str, float] | None = None) -> float:
+def strength_at(
+    params: GearParams,
+    values: dict[str, float] | None = None,
+    mean_load: MeanLoad = "unperturbed",
+) -> float:
     """``sign_change_strength`` of ``params`` with aliases set to ``values``; NaN without a
-    saddle loop (the criterion does not apply there)."""
+    saddle loop (the criterion does not apply there: no saddle, or |F_m| >= F_crit with the
+    mean load in the unperturbed system)."""
     design = with_aliases(params, values) if values else params
     a, c = _cubic(design.backlash)
-    return sign_change_strength(design, a, c) if saddle_loop(a, c) else math.nan
+    if not saddle_loop(a, c, loop_load(design, mean_load)):
+        return math.nan
+    return sign_change_strength(design, a, c, mean_load=mean_load)
 
 
-def chaos_possible(params: GearParams) -> bool | None:
+def chaos_possible(params: GearParams, mean_load: MeanLoad = "unperturbed") -> bool | None:
     """The Melnikov verdict (``melnikov(params).chaos_possible``) without the thresholds.
 
-    Some branch changes sign iff ``sign_change_strength > 0``; None when the cubic law has no
-    saddle loop.
+    Some branch changes sign iff ``sign_change_strength > 0``; None when the criterion does not
+    apply (no saddle loop).
     """
-    strength = strength_at(params)
+    strength = strength_at(params, mean_load=mean_load)
     return None if math.isnan(strength) else strength > 0.0
 
 
@@ -185,15 +185,37 @@ def _ends(intervals: list[Interval], domain: Interval) -> list[float]:
     return sorted({e for i in intervals for e in (i.lo, i.hi) if e is not None and e not in bounds})
 
 
+AMPLITUDES = frozenset(_TERM_OF)
+"""Control parameters that are amplitudes: a negative amplitude is the same harmonic shifted by
+pi, so a design's amplitude reaches a critical value by growing or shrinking, not through 0."""
+
+
+def signed_margin(
+    parameter: str, value: float, critical: Sequence[float], no_chaos: Sequence[Sequence]
+) -> tuple[float | None, float | None, float | None]:
+    """(nearest, margin, relative_margin) of a design's value: the nearest critical value (for an
+    amplitude, the nearest of its own sign when there is one), the distance |value - nearest|
+    signed positive on the safe side (the value lies in a ``no_chaos`` interval [lo, hi], None
+    an open end) and negative inside the chaos-possible region, and margin / |nearest| (None if
+    nearest is 0). All None without a critical value."""
+    if not critical:
+        return None, None, None
+    pool = list(critical)
+    if parameter in AMPLITUDES and value != 0.0:
+        pool = [v for v in critical if (v > 0.0) == (value > 0.0)] or pool
+    nearest = min(pool, key=lambda v: abs(value - v))
+    safe = any((lo is None or value >= lo) and (hi is None or value <= hi) for lo, hi in no_chaos)
+    margin = abs(value - nearest) if safe else -abs(value - nearest)
+    return nearest, margin, margin / abs(nearest) if nearest != 0.0 else None
+
+
 def _threshold(
-    value: float | None, critical: list[float], no_chaos: list, **extra: object
+    parameter: str, value: float | None, critical: list[float], no_chaos: list, **extra: object
 ) -> ParameterThreshold:
-    """The threshold document: critical values and the design's margin to the nearest one."""
+    """The threshold document: critical values and the design's margin (``signed_margin``)."""
     nearest = margin = rel = None
-    if value is not None and critical:
-        nearest = min(critical, key=lambda v: abs(value - v))
-        margin = value - nearest
-        rel = margin / abs(nearest) if nearest != 0.0 else None
+    if value is not None:
+        nearest, margin, rel = signed_margin(parameter, value, critical, no_chaos)
     return ParameterThreshold(
         value=value,
         critical_values=critical,
@@ -205,11 +227,14 @@ def _threshold(
     )
 
 
-def unit_coefficients(params: GearParams, a: float, c: float, method: Method) -> Coefficients:
+def unit_coefficients(
+    params: GearParams, a: float, c: float, method: Method, mean_load: MeanLoad = "unperturbed"
+) -> Coefficients:
     """Coefficients of both branches with the inactive first harmonics (for thresholds): built
     once per branch, then split per control parameter by ``_family``."""
+    fm = loop_load(params, mean_load)
     return {
-        br: melnikov_coefficients(params, a, c, br, method, include_inactive=True)
+        br: melnikov_coefficients(params, a, c, br, method, include_inactive=True, fm=fm)
         for br in BRANCH_SIGN
     }
 
@@ -221,15 +246,16 @@ def parameter_threshold(
     c: float,
     method: Method = "closed_form",
     coefs: Coefficients | None = None,
+    mean_load: MeanLoad = "unperturbed",
 ) -> ParameterThreshold:
     """Critical values of one control parameter (others fixed) and the design's margin.
 
     ``coefs`` are the branches' ``unit_coefficients`` if already known (else computed with
-    ``method``).
+    ``method`` and ``mean_load``).
     """
     value = get_alias(params, parameter)
     domain = DOMAIN.get(parameter, Interval(None, None))
-    coefs = unit_coefficients(params, a, c, method) if coefs is None else coefs
+    coefs = unit_coefficients(params, a, c, method, mean_load) if coefs is None else coefs
     branches: dict[HomoclinicBranch, BranchThreshold] = {}
     sets: dict[HomoclinicBranch, list[Interval]] = {}
     for br in BRANCH_SIGN:
@@ -237,7 +263,7 @@ def parameter_threshold(
         if family is None:
             exc = _TERM_OF[parameter]
             return _threshold(
-                value, [], [], note=f"{exc} is not given: no frequency for {parameter}"
+                parameter, value, [], [], note=f"{exc} is not given: no frequency for {parameter}"
             )
         sets[br] = _intersect(no_sign_change(*family), [domain])
         branches[br] = BranchThreshold(
@@ -246,6 +272,7 @@ def parameter_threshold(
         )
     overall = _intersect(sets["plus"], sets["minus"])
     return _threshold(
+        parameter,
         value,
         _ends(overall, domain),
         [(i.lo, i.hi) for i in overall],
@@ -259,6 +286,7 @@ def frequency_threshold(
     c: float,
     scan: tuple = OMEGA_SCAN,
     method: Method = "closed_form",
+    mean_load: MeanLoad = "unperturbed",
 ) -> ParameterThreshold:
     """Critical Omega_e in a scan: where the verdict flips, located by brentq.
 
@@ -273,11 +301,18 @@ def frequency_threshold(
     value = get_alias(params, "Omega_e")
     if value is None:
         return _threshold(
-            None, [], [], scan=scan, note="transmission_error is not given: no Omega_e to scan"
+            "Omega_e",
+            None,
+            [],
+            [],
+            scan=scan,
+            note="transmission_error is not given: no Omega_e to scan",
         )
-    found = _scan_compiled(params, a, c, scan, value) if method == "closed_form" else None
-    critical, no_chaos = found or _scan_python(params, a, c, scan, value, method)
+    fm = loop_load(params, mean_load)
+    found = _scan_compiled(params, a, c, fm, scan, value) if method == "closed_form" else None
+    critical, no_chaos = found or _scan_python(params, a, c, scan, value, method, mean_load)
     return _threshold(
+        "Omega_e",
         value,
         critical,
         no_chaos,
@@ -286,49 +321,6 @@ def frequency_threshold(
         "alongside (ratios fixed, as a change of running speed); flips between scan points "
         "closer than the grid step may be missed",
     )
-
-
-def scan_terms(params: GearParams) -> tuple[np.ndarray, ...]:
-    """The active harmonics as arrays (fundamental, r, kind, amplitude, phase), in the order of
-    ``melnikov_coefficients``: the per-unit coefficients are functions of r Omega alone."""
-    return terms_table(
-        (name, exc.frequency, [(h.amplitude, h.phase) for h in exc.harmonics])
-        for name, exc in params.excitations()
-    )
-
-
-def terms_table(
-    excitations: Iterable[tuple[str, float, list[tuple[float, float]]]],
-) -> tuple[np.ndarray, ...]:
-    """``scan_terms`` of excitations given as (name, fundamental, [(amplitude, phase), ...]) in
-    the order of ``model.params.EXCITATIONS``; harmonics are numbered r = 1, 2, ... as listed
-    and those with a zero amplitude are left out."""
-    rows = [
-        (float(frequency), r, kernels.KIND[name], float(amplitude), float(phase))
-        for name, frequency, harmonics in excitations
-        for r, (amplitude, phase) in enumerate(harmonics, start=1)
-        if amplitude != 0.0
-    ]
-    table = np.array(rows, dtype=float).reshape(len(rows), 5).T
-    return table[0], table[1], table[2].astype(np.int64), table[3], table[4]
-
-
-def commensurability(frequencies: list[float]) -> tuple[float, float]:
-    """(gcd, lcm) with Omega_0 = top * gcd / lcm (``model.frequencies.common_frequency``, whose
-    steps these are); (0, 1) when incommensurate or empty. Scaling every frequency by one factor
-    keeps the ratios, so one answer serves a whole running-speed scan."""
-    freqs = sorted({f for f in frequencies if f > 0.0})
-    if not freqs:
-        return 0.0, 1.0
-    top = freqs[-1]
-    ratios = []
-    for f in freqs:
-        q = Fraction(f / top).limit_denominator(MAX_DENOMINATOR)
-        if abs(float(q) - f / top) > RATIO_TOLERANCE * (f / top):
-            return 0.0, 1.0
-        ratios.append(q)
-    lcm = math.lcm(*(q.denominator for q in ratios))
-    return float(math.gcd(*(q.numerator * (lcm // q.denominator) for q in ratios))), float(lcm)
 
 
 @functools.lru_cache(maxsize=256)
@@ -341,15 +333,12 @@ def scan_grid(start: float, stop: float, num: int) -> np.ndarray:
 
 
 def _scan_compiled(
-    params: GearParams, a: float, c: float, scan: tuple, value: float
+    params: GearParams, a: float, c: float, fm: float, scan: tuple, value: float
 ) -> tuple[list[float], list[tuple[float, float]]] | None:
     """Critical Omega_e and no-chaos pieces by ``kernels.scan_roots``; None to fall back."""
     start, stop, num = scan
-    base, r, kind, amp, phase = scan_terms(params)
-    gcd, lcm = commensurability((r * base).tolist())
     omegas = scan_grid(start, stop, num)
-    args = (value, base, r, kind, amp, phase, float(params.damping), a, c, gcd, lcm)
-    critical, flags, ok = kernels.scan_roots(omegas, 1e-12, *args)
+    critical, flags, ok = packed_terms(params, a, c, fm).scan_roots(omegas, value)
     if not ok:
         return None
     edges = [float(start), *critical.tolist(), float(stop)]
@@ -357,7 +346,13 @@ def _scan_compiled(
 
 
 def _scan_python(
-    params: GearParams, a: float, c: float, scan: tuple, value: float, method: Method
+    params: GearParams,
+    a: float,
+    c: float,
+    scan: tuple,
+    value: float,
+    method: Method,
+    mean_load: MeanLoad,
 ) -> tuple[list[float], list[tuple[float, float]]]:
     """The running-speed scan on the documents: ``sign_change_strength`` with ``method``."""
     start, stop, num = scan
@@ -368,7 +363,7 @@ def _scan_python(
             name: exc.model_copy(update={"frequency": exc.frequency * factor})
             for name, exc in params.excitations()
         }
-        return sign_change_strength(params.model_copy(update=moved), a, c, method)
+        return sign_change_strength(params.model_copy(update=moved), a, c, method, mean_load)
 
     from scipy import optimize
 
@@ -395,6 +390,7 @@ def threshold_curve(
     start: float = 0.05,
     stop: float = 2.5,
     num: int = 100,
+    mean_load: MeanLoad = "unperturbed",
 ) -> ThresholdCurve:
     """Critical values of ``parameter`` for ``num`` values of a frequency in [start, stop].
 
@@ -406,17 +402,27 @@ def threshold_curve(
         parameter: F_e1, mu, k_p1 or F_p1.
         frequency_parameter: Omega_e, Omega_k or Omega_p (the excitation must be given).
         start, stop, num: the frequency grid (dimensionless).
+        mean_load: where F_m goes (``coefficients.MeanLoad``).
     """
     a, c, notes = melnikov_cubic(params.backlash)
     if not saddle_loop(a, c):
         raise ValueError(
             f"params.backlash: the Melnikov criterion needs a > 0 and c > 0 (got a = {a}, c = {c})"
         )
+    fm = loop_load(params, mean_load)
+    if not saddle_loop(a, c, fm):
+        raise ValueError(
+            f"params.mean_force: F_m = {fm:g} is at or above F_crit = "
+            f"{critical_mean_force(a, c):.6g}: no saddle, the Melnikov criterion does not apply "
+            "(mean_load: perturbation gives the paper's first-order treatment)"
+        )
     if get_alias(params, frequency_parameter) is None:
         raise ValueError(f"frequency_parameter: {frequency_parameter}: its excitation is not given")
     omegas = [float(w) for w in np.linspace(start, stop, num)]
     rows = [
-        parameter_threshold(with_alias(params, frequency_parameter, w), parameter, a, c)
+        parameter_threshold(
+            with_alias(params, frequency_parameter, w), parameter, a, c, mean_load=mean_load
+        )
         for w in omegas
     ]
     if any(r.note for r in rows):
@@ -441,4 +447,5 @@ def curve_of(request: ThresholdsRequest) -> ThresholdCurve:
         request.start,
         request.stop,
         request.num,
+        request.mean_load,
     )

@@ -9,9 +9,24 @@ from __future__ import annotations
 
 import math
 
-from gearengine.homoclinic.coefficients import BRANCH_SIGN, Method, active_only, saddle_loop
+from gearengine.homoclinic.coefficients import (
+    BRANCH_SIGN,
+    MeanLoad,
+    Method,
+    active_only,
+    critical_mean_force,
+    loop_load,
+    saddle_loop,
+)
 from gearengine.homoclinic.extrema import Extrema, extrema
-from gearengine.homoclinic.schemas import BranchVerdict, MelnikovResult
+from gearengine.homoclinic.loops import saddle
+from gearengine.homoclinic.perturbations import (
+    caveat,
+    force_per_unit,
+    loop_extremes,
+    perturbation_sizes,
+)
+from gearengine.homoclinic.schemas import BranchVerdict, MelnikovResult, ParameterThreshold
 from gearengine.homoclinic.thresholds import (
     CONTROL_PARAMETERS,
     OMEGA_SCAN,
@@ -37,7 +52,9 @@ def branch_verdict(ext: Extrema) -> BranchVerdict:
     )
 
 
-def not_applicable(a: float, c: float, method: Method, notes: list[str]) -> MelnikovResult:
+def not_applicable(
+    a: float, c: float, method: Method, notes: list[str], mean_load: MeanLoad = "unperturbed"
+) -> MelnikovResult:
     """A result without numbers: the criterion does not apply, and the notes say why."""
     return MelnikovResult(
         applicable=False,
@@ -50,15 +67,18 @@ def not_applicable(a: float, c: float, method: Method, notes: list[str]) -> Meln
         forcing_period=None,
         method=method,
         notes=notes,
+        mean_load=mean_load,
+        critical_mean_force=critical_mean_force(a, c) if a > 0.0 and c > 0.0 else None,
     )
 
 
 def applicability(
-    params: GearParams, method: Method = "closed_form"
+    params: GearParams, method: Method = "closed_form", mean_load: MeanLoad = "unperturbed"
 ) -> tuple[float, float, list[str], Coefficients | None]:
     """(a, c, notes, units) of a design: the cubic law, its notes, and the per-unit coefficients
     of both branches (``unit_coefficients``); units is None when the criterion does not apply
-    (no saddle loop, or M overflows), and the last note says why."""
+    (no saddle loop, |F_m| >= F_crit with the mean load in the unperturbed system, or M
+    overflows), and the last note says why."""
     a, c, notes = melnikov_cubic(params.backlash)
     if not saddle_loop(a, c):
         notes.append(
@@ -67,8 +87,19 @@ def applicability(
             "Melnikov criterion"
         )
         return a, c, notes, None
+    fm, f_crit = loop_load(params, mean_load), critical_mean_force(a, c)
+    if not saddle_loop(a, c, fm):
+        notes.append(
+            f"not applicable: the mean load F~_m = {fm:.4g} is at or above F_crit = "
+            f"(2a/3) sqrt(a/(3c)) = {f_crit:.4g}, the largest force the backlash nonlinearity "
+            "can balance with a saddle: the teeth sit in one potential well of x'' = a x - "
+            "c x^3 + F_m, there is no saddle and no homoclinic orbit, so the homoclinic "
+            "mechanism of chaos does not exist at this load; the numerical verdict still "
+            "applies"
+        )
+        return a, c, notes, None
     # every per-unit coefficient the thresholds will use, inactive first harmonics included
-    units = unit_coefficients(params, a, c, method)
+    units = unit_coefficients(params, a, c, method, mean_load)
     scale = [units["plus"].damping_per_unit, *(t.per_unit for t in units["plus"].terms)]
     if not all(math.isfinite(v) and abs(v) < 1e150 for v in scale):
         notes.append(
@@ -79,8 +110,25 @@ def applicability(
     return a, c, notes, units
 
 
+def _in_force_scale(
+    params: GearParams,
+    parameter: str,
+    t: ParameterThreshold,
+    extremes: tuple[float, float],
+    f_crit: float,
+) -> ParameterThreshold:
+    """``t`` with its margin measured in the force scale F_crit (``perturbations``)."""
+    unit = force_per_unit(params, parameter, extremes)
+    if t.margin is None or unit is None:
+        return t
+    return t.model_copy(update={"margin_in_force_scale": t.margin * unit / f_crit})
+
+
 def melnikov(
-    params: GearParams, method: Method = "closed_form", omega_scan: tuple = OMEGA_SCAN
+    params: GearParams,
+    method: Method = "closed_form",
+    omega_scan: tuple = OMEGA_SCAN,
+    mean_load: MeanLoad = "unperturbed",
 ) -> MelnikovResult:
     """The Melnikov verdict of ``params`` with thresholds of every control parameter.
 
@@ -89,10 +137,13 @@ def melnikov(
         method: ``closed_form`` or ``quadrature`` for the coefficients of M, used everywhere:
             the branch extrema, the thresholds and the Omega_e scan.
         omega_scan: (start, stop, num) of the Omega_e scan for critical frequencies.
+        mean_load: ``unperturbed`` (F_m in the unperturbed system, its saddle and loops) or
+            ``perturbation`` (the paper's first-order treatment, F_m absent from M).
     """
-    a, c, notes, units = applicability(params, method)
+    a, c, notes, units = applicability(params, method, mean_load)
     if units is None:
-        return not_applicable(a, c, method, notes)
+        return not_applicable(a, c, method, notes, mean_load)
+    fm, f_crit = loop_load(params, mean_load), critical_mean_force(a, c)
     coefs = {br: active_only(units[br], params) for br in BRANCH_SIGN}
     branches = {br: branch_verdict(extrema(coefs[br].trig_sum())) for br in BRANCH_SIGN}
     period = forcing_period(params.active_frequencies())
@@ -101,17 +152,39 @@ def melnikov(
             "the active frequencies are incommensurate (no ratio p/q with q <= 64): min and max "
             "of M are the infimum and supremum A -/+ sum |B_i|, approached but not attained"
         )
-    if params.mean_force != 0.0:
-        notes.append("the mean force F_m does not enter M: the integral of y_h over the orbit is 0")
+    if params.mean_force != 0.0 and mean_load == "perturbation":
+        notes.append(
+            "mean_load perturbation: the mean force F_m is taken as small (the paper's "
+            "F~_m = eps f_m) and does not enter M, the integral of y_h over the orbit being 0"
+            + (
+                ""
+                if saddle_loop(a, c, params.mean_force)
+                else f"; at F~_m = {params.mean_force:.4g} >= F_crit = {f_crit:.4g} the loaded "
+                "system has no saddle at all, so this first-order answer is outside its domain"
+            )
+        )
+    elif fm != 0.0:
+        notes.append(
+            f"the mean force F~_m = {fm:.4g} is in the unperturbed system (F_crit = "
+            f"{f_crit:.4g}): the saddle sits at x_s = {saddle(a, c, fm):.6g} and the two "
+            "homoclinic loops differ, so each has its own M and thresholds"
+        )
+    extremes = loop_extremes(a, c, fm)
+    sizes = perturbation_sizes(params, extremes, fm, f_crit)
+    stretched = caveat(sizes, f_crit)
+    if stretched:
+        notes.append(stretched)
     if method != "closed_form":
         notes.append(
             f"method {method}: the verdict, the thresholds and the Omega_e scan all use "
             f"{method} coefficients"
         )
     thresholds = {
-        p: parameter_threshold(params, p, a, c, method, units) for p in CONTROL_PARAMETERS
-    }
-    thresholds["Omega_e"] = frequency_threshold(params, a, c, omega_scan, method)
+        p: _in_force_scale(params, p, parameter_threshold(params, p, a, c, method, units),
+                           extremes, f_crit)
+        for p in CONTROL_PARAMETERS
+    }  # fmt: skip
+    thresholds["Omega_e"] = frequency_threshold(params, a, c, omega_scan, method, mean_load)
     return MelnikovResult(
         applicable=True,
         chaos_possible=any(b.sign_change for b in branches.values()),
@@ -123,4 +196,8 @@ def melnikov(
         forcing_period=period,
         method=method,
         notes=notes,
+        mean_load=mean_load,
+        critical_mean_force=f_crit,
+        saddle=float(saddle(a, c, fm)),
+        perturbation_sizes=sizes,
     )

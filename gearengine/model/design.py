@@ -32,6 +32,7 @@ from gearengine.model.params import (
     given,
     request_config,
 )
+from gearengine.model.tolerances import Tolerances
 from gearengine.model.units import (
     Angle,
     Bore,
@@ -214,6 +215,11 @@ class Design(_Strict):
         None, description="Driver speeds scanned for Melnikov windows (default 10 rpm to 3x "
         "speed).",
     )  # fmt: skip
+    tolerances: Tolerances | None = Field(
+        None,
+        description="Manufacturing tolerances (distributions of fields by path, ISO 1328 "
+        "accuracy, backlash band): read by robustness jobs; the analyses use the nominal design.",
+    )
 
     @model_validator(mode="after")
     def _consistent(self) -> Design:
@@ -223,4 +229,26 @@ class Design(_Strict):
             raise ValueError("mesh.stiffness 'iso6336' needs module and face_width on both gears")
         if self.speed_range is not None and not self.speed_range[0] < self.speed_range[1]:
             raise ValueError("speed_range: the first speed must be below the second")
+        tol = self.tolerances
+        if tol is not None and tol.accuracy is not None:
+            if self.driver.geometry() is None or self.driven.geometry() is None:
+                raise ValueError(
+                    "tolerances.accuracy: an ISO 1328 class needs the geometry form (module and "
+                    "face_width) on both gears"
+                )
+            if self.transmission_error is not None and self.transmission_error.order is not None:
+                raise ValueError(
+                    "tolerances.accuracy: the ISO 1328 class sets the transmission error at the "
+                    "mesh frequency; remove transmission_error.order"
+                )
+            if ACCURACY_FIELD in tol.fields():
+                raise ValueError(f"tolerances.accuracy: already sets {ACCURACY_FIELD}")
+        if tol is not None and tol.backlash is not None and BACKLASH_FIELD in tol.fields():
+            raise ValueError(f"tolerances.backlash: already sets {BACKLASH_FIELD}")
         return self
+
+
+ACCURACY_FIELD = "transmission_error.harmonics.0.amplitude"
+"""The field an ISO 1328 accuracy class sets (``model.standards.iso1328.mesh_error_bound``)."""
+BACKLASH_FIELD = "mesh.half_backlash"
+"""The field a backlash band sets (``model.standards.backlash``)."""

@@ -34,6 +34,7 @@ from gearengine.model.conversion import (
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash, given
+from gearengine.model.standards import backlash, iso1328
 from gearengine.model.units import RPM
 
 RATIO_TOLERANCE = 0.01
@@ -50,7 +51,9 @@ class Derived(BaseModel):
 
     model_config = ConfigDict(frozen=True)
 
-    value: float | list[dict[str, float]] = Field(description="The value (SI units).")
+    value: float | list[dict[str, float]] = Field(
+        description="The value in its unit (SI, except the ISO 1328 tolerances: um)."
+    )
     unit: str = Field(description="Its unit.")
     source: str = Field(description="The formula or standard it comes from.")
 
@@ -185,6 +188,60 @@ def _paper_cubic() -> CubicBacklash:
     return CubicBacklash(a=fit.a, c=fit.c)
 
 
+def tolerance_derived(design: Design) -> dict[str, Derived]:
+    """With ``tolerances.accuracy``: each gear's ISO 1328-1:2013 flank tolerances [µm]
+    (``f_pT_driver``, ``F_alpha_driven``, ...) and the bound of the mesh-frequency transmission
+    error they allow (``transmission_error_bound``, ``iso1328.mesh_error_bound``); with
+    ``tolerances.backlash``: the half-backlash band (``half_backlash_min``/``_max``)."""
+    tol, out = design.tolerances, {}
+    if tol is None:
+        return out
+    if tol.accuracy is not None:
+        grade = tol.accuracy.tolerance_class
+        profile = {}
+        for role, gear in (("driver", design.driver), ("driven", design.driven)):
+            assert gear.module is not None and gear.face_width is not None
+            values = iso1328.tolerances(grade, gear.teeth, gear.module * 1e3, gear.face_width * 1e3)
+            profile[role] = values.F_alpha
+            for name, formula in iso1328.FORMULAS.items():
+                out[f"{name}_{role}"] = Derived(
+                    value=getattr(values, name),
+                    unit="um",
+                    source=f"{iso1328.STANDARD} class {grade}, 5.3 Eq. {formula}, rounded (5.2.3)",
+                )
+        out["transmission_error_bound"] = Derived(
+            value=iso1328.mesh_error_bound(profile["driver"], profile["driven"]) * 1e-6,
+            unit="m",
+            source="mesh-harmonic TE amplitude bound sqrt(F_alpha_driver^2 + F_alpha_driven^2)/2 "
+            "(profile deviations drive the mesh harmonic; amplitude drawn uniformly below it)",
+        )
+    if tol.backlash is not None:
+        band = half_backlash_band(design, tol.backlash.min, tol.backlash.max)
+        for end, value in zip(("min", "max"), band, strict=True):
+            out[f"half_backlash_{end}"] = Derived(
+                value=value,
+                unit="m",
+                source="b = j_t cos(alpha_wt) / 2 of the circumferential band (ISO/TR 10064-2)",
+            )
+    return out
+
+
+def operating_pressure_angle(design: Design) -> float:
+    """alpha_wt [rad] of the pair: from the profile shifts with the geometry form, else the
+    driver's pressure angle."""
+    a, b = design.driver, design.driven
+    if a.profile_shift == 0.0 and b.profile_shift == 0.0:
+        return a.pressure_angle
+    return geometry.operating_pressure_angle(
+        a.teeth, b.teeth, a.profile_shift, b.profile_shift, a.pressure_angle
+    )
+
+
+def half_backlash_band(design: Design, j_min: float, j_max: float) -> tuple[float, float]:
+    """(b_min, b_max) [m] of a circumferential backlash band [m] of this pair."""
+    return backlash.half_backlash_band(j_min, j_max, operating_pressure_angle(design))
+
+
 def convert_design(design: Design) -> DesignConversion:
     """The dimensionless parameters of ``design`` (Eq. 7-9) with the scales and derivations."""
     data, derived, notes = physical_data(design)
@@ -208,6 +265,7 @@ def convert_design(design: Design) -> DesignConversion:
             "the numerical verdict uses the exact piecewise backlash law; the Melnikov "
             "criterion needs a smooth law and uses its cubic fit -x/6 + x^3/6 (the paper's)"
         )
+    derived |= tolerance_derived(design)
     force_scale = data.half_backlash * data.mesh_stiffness
     return DesignConversion(
         params=conv.params,

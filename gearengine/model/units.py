@@ -70,6 +70,15 @@ QUANTITIES: dict[str, QuantityKind] = {
     "inertia": QuantityKind("inertia", "kg*m^2", 1e-9, 1e4, ("kg*cm^2", "kg*mm^2"), "2e-3 kg*m^2"),
     "damping": QuantityKind("damping", "N*s/m", 0.0, 1e7, (), "1100 N*s/m"),
     "angle": QuantityKind("angle", "rad", math.radians(10), math.radians(35), ("deg",), "20 deg"),
+    "speed_rate": QuantityKind(
+        "rate of change of shaft speed",
+        "rad/s^2",
+        2 * math.pi / 60,
+        1e6 * 2 * math.pi / 60,
+        ("rpm/s",),
+        "1000 rpm/s",
+    ),
+    "duration": QuantityKind("duration", "s", 1e-3, 3600.0, ("ms", "min"), "5 s"),
 }
 """Kinds of quantity by key; ``low``/``high`` bound plausible magnitudes in SI units."""
 
@@ -216,6 +225,9 @@ StiffnessVariation = quantity_type("stiffness_variation", allow_zero=True)
 Inertia = quantity_type("inertia")
 Damping = quantity_type("damping", allow_zero=True)
 Angle = quantity_type("angle")
+SpeedRate = quantity_type("speed_rate")
+Duration = quantity_type("duration")
+Time = quantity_type("duration", allow_zero=True)
 
 RPM = 2.0 * math.pi / 60.0
 """One revolution per minute in rad/s."""

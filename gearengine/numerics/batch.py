@@ -1,9 +1,10 @@
 """Verdicts of many parameter points at once: the sweeps' path to the kernels.
 
-Cubic-law points with commensurate forcing are grouped by steps per T0 and advanced in lock-step
-by the SIMD kernel ``kernels.run_batch`` (parallel over chunks of lanes), and their verdicts are
-taken array-wise (``numerics.lanes``); other points run one by one in the single kernels
-(``numerics.runs``). Numbers equal those of ``simulate``.
+Points with commensurate forcing are grouped by backlash law and steps per T0 and advanced in
+lock-step by the SIMD kernels ``kernels.run_batch`` (cubic law) and ``kernels.run_kink_batch``
+(piecewise law, split at the kinks lane by lane), parallel over chunks of lanes, and their
+verdicts are taken array-wise (``numerics.lanes``); other points (incommensurate forcing) run
+one by one in the single kernels (``numerics.runs``). Numbers equal those of ``simulate``.
 """
 
 from __future__ import annotations
@@ -76,10 +77,14 @@ def run_lanes(
     """The verdict of every lane: the one door of ensembles into the kernels.
 
     Every run of a request (point x start x sample) is a lane ``(i, (x0, v0))``: parameter
-    point ``points[i]`` from the initial state (x0, v0). Lanes of cubic-law points with
-    commensurate forcing are grouped by steps per T0 and advanced together in the lock-step SIMD
-    kernel (``kernels.run_batch``); the others run one by one in the single kernels
-    (``runs.integrate``). Numbers equal those of ``simulate`` for the same point and start.
+    point ``points[i]`` from the initial state (x0, v0). Lanes of points with commensurate
+    forcing are grouped by backlash law and steps per T0 and advanced together in the lock-step
+    SIMD kernels (``kernels.run_batch``, cubic; ``kernels.run_kink_batch``, piecewise); the
+    others run one by one in the single kernels (``runs.integrate``). With
+    ``settings.adaptive`` a lane may stop early (``kernels.adaptive``: settled periodic orbits,
+    and chaotic or quasi-periodic ones once their LLE's stderr is within the settings'
+    tolerances); otherwise, and in the single kernels, the numbers equal those of ``simulate``
+    for the same point and start.
 
     Args:
         points: the parameter points, shape (P,).
@@ -95,47 +100,79 @@ def run_lanes(
     return _run_lanes(points, step_plans(points, settings.steps_per_period), lanes, settings)
 
 
+LOCKSTEP_LAWS = ("cubic", "piecewise")
+"""Backlash laws whose lanes with commensurate forcing run in a lock-step kernel."""
+
+
 def _run_lanes(
     points: Sequence[GearParams],
     plans: list[StepPlan],
     lanes: Sequence[Lane],
     settings: SimulationSettings,
 ) -> list[BatchPoint]:
-    n_trans, n_rec = settings.transient_periods, settings.record_periods
     results: list[BatchPoint | None] = [None] * len(lanes)
-    groups: dict[int, list[int]] = {}
+    groups: dict[tuple[str, int], list[int]] = {}
     for k, (i, s) in enumerate(lanes):
         plan = plans[i]
-        if points[i].backlash.model == "cubic" and plan.omega0 is not None:
-            groups.setdefault(plan.steps, []).append(k)
+        name = points[i].backlash.model
+        if name in LOCKSTEP_LAWS and plan.omega0 is not None:
+            groups.setdefault((name, plan.steps), []).append(k)
         else:
             results[k] = run_verdict(integrate(points[i], settings, s), s, plan, k)
-    for N, ks in groups.items():
-        members = list(dict.fromkeys(lanes[k][0] for k in ks))
-        tables = {
-            i: kernels.forcing_table(plans[i].period, N, *packed_forcing(points[i]))
-            for i in members
-        }
-        laws = {i: law(points[i]) for i in members}
-        owner = [lanes[k][0] for k in ks]
-        Kt = np.array([tables[i][0] for i in owner])
-        Ft = np.array([tables[i][1] for i in owner])
-        per = np.array([plans[i].period for i in owner])
-        a = np.array([laws[i].a for i in owner])
-        c = np.array([laws[i].c for i in owner])
-        mu = np.array([points[i].damping for i in owner])
-        x0 = np.array([lanes[k][1][0] for k in ks])
-        v0 = np.array([lanes[k][1][1] for k in ks])
+    for (name, N), ks in groups.items():
+        owner = np.array([lanes[k][0] for k in ks], dtype=np.int64)
+        members, inverse = np.unique(owner, return_inverse=True)
+        packed = [packed_forcing(points[i]) for i in members.tolist()]
+        tables = [kernels.forcing_table(plans[i].period, N, *f)
+                  for i, f in zip(members.tolist(), packed, strict=True)]  # fmt: skip
+        per = np.array([plans[i].period for i in members.tolist()])[inverse]
+        mu = np.array([points[i].damping for i in members.tolist()])[inverse]
+        starts = np.array([lanes[k][1] for k in ks], dtype=np.float64).reshape(-1, 2)
+        x0, v0 = starts[:, 0].copy(), starts[:, 1].copy()
+        tabled = (
+            np.array([kt for kt, _ in tables]),
+            np.array([ft for _, ft in tables]),
+            inverse.astype(np.int64),
+        )  # one table per point, shared by its lanes
         streams = max(1, min(numba.get_num_threads(), -(-len(ks) // kernels.LANES)))
-        out = kernels.run_batch(
-            a, c, mu, x0, v0, Kt, Ft, per, N, n_trans, n_rec, DIVERGENCE_BOUND,
-            settings.adaptive, streams,
-        )  # fmt: skip
+        shared = (per, N, settings.transient_periods, settings.record_periods, DIVERGENCE_BOUND,
+                  settings.adaptive, streams, *lle_tolerances(settings))  # fmt: skip
+        laws = [law(points[i]) for i in members.tolist()]
+        if name == "cubic":
+            a = np.array([lw.a for lw in laws])[inverse]
+            c = np.array([lw.c for lw in laws])[inverse]
+            out = kernels.run_batch(a, c, mu, x0, v0, *tabled, *shared)
+        else:
+            alpha = np.array([lw.alpha for lw in laws])[inverse]
+            kc, nk = padded_terms([f[0] for f in packed])
+            fc, nf = padded_terms([f[2] for f in packed])
+            fm = np.array([f[1] for f in packed])
+            out = kernels.run_kink_batch(
+                alpha, mu, x0, v0, *tabled, kc, nk, fm, fc, nf, *shared
+            )  # fmt: skip
         verdicts = lane_verdicts(out, per)
         strobes = last_strobes(out, list(range(len(ks))))
         for j, k in enumerate(ks):
             results[k] = lane_point(out, j, k, verdicts[j], strobes[j])
     return results  # type: ignore[return-value]
+
+
+def lle_tolerances(settings: SimulationSettings) -> tuple[float, float]:
+    """(relative, absolute) tolerance of the adaptive LLE rule (``kernels.adaptive``); (0, 0),
+    the rule off, with ``adaptive`` false."""
+    if not settings.adaptive:
+        return 0.0, 0.0
+    return settings.lle_stderr_rel, settings.lle_stderr_abs
+
+
+def padded_terms(terms: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Forcing coefficients of shape (3, n_i) of M points as one array (M, 3, max n_i), zero
+    padded, and the counts n_i, shape (M,)."""
+    count = np.array([t.shape[1] for t in terms], dtype=np.int64)
+    padded = np.zeros((len(terms), 3, max(1, int(count.max(initial=0)))))
+    for m, t in enumerate(terms):
+        padded[m, :, : t.shape[1]] = t
+    return padded, count
 
 
 def simulate_batch(

@@ -84,7 +84,7 @@ def _kink(lw: Law, mu: float, start: tuple[float, float], forcing: tuple, plan: 
           n_trans: int, n_rec: int, stride: int) -> tuple:  # fmt: skip
     return kernels.run_kink(
         lw.alpha, mu, start[0], start[1], *forcing, plan.period, plan.steps, n_trans, n_rec,
-        stride, DIVERGENCE_BOUND,
+        stride, DIVERGENCE_BOUND, plan.omega0 is not None,
     )  # fmt: skip
 
 
@@ -98,7 +98,7 @@ INTEGRATORS: dict[str, tuple[Kernel, str]] = {
 def method_of(params: GearParams, plan: StepPlan) -> str:
     """How ``integrate`` runs this design, in words (the ``method`` of the result)."""
     name = params.backlash.model
-    table = name == "cubic" and plan.omega0 is not None
+    table = plan.omega0 is not None
     return INTEGRATORS[name][1] + (", forcing table" if table else ", forcing at abs. time")
 
 

@@ -101,12 +101,33 @@ class SimulationSettings(BaseModel):
     )
     adaptive: bool = Field(
         True,
-        description="Sweeps and batches: let a point stop early once its strobes repeat with a "
-        "period <= 12 over the last 120 intervals and its LLE has converged below zero "
-        "(numerics.kernels.adaptive); false runs every point transient_periods + "
-        "record_periods. Applies to cubic-law points with commensurate forcing (the lock-step "
-        "kernel); piecewise-law and incommensurate points, and simulate(), run the full length.",
+        description="Sweeps and batches: let a run stop early (numerics.kernels.adaptive) once "
+        "its strobes repeat with a period <= 12 over the last 120 intervals and its LLE has "
+        "converged below zero, or, chaotic and quasi-periodic runs, once at least 100 intervals "
+        "are recorded, the LLE's standard error over the 10 blocks of the record so far is "
+        "below max(lle_stderr_abs, lle_stderr_rel |lle|) and the verdict is clear by 3 of them "
+        "at three checks 10 intervals apart; "
+        "false runs every point transient_periods + record_periods. Applies to the lanes of the "
+        "lock-step kernels: commensurate forcing, both backlash laws; incommensurate points and "
+        "simulate() run the full length.",
         examples=[True],
+    )
+    lle_stderr_rel: float = Field(
+        0.1,
+        ge=0.0,
+        le=1.0 / 3.0,
+        description="adaptive: tolerance on the LLE's standard error relative to |lle| at which "
+        "a chaotic or quasi-periodic run stops (0: the relative test off).",
+        examples=[0.1],
+    )
+    lle_stderr_abs: float = Field(
+        1e-3,
+        ge=0.0,
+        le=0.1,
+        description="adaptive: absolute tolerance on the LLE's standard error (per unit "
+        "dimensionless time tau) at which a chaotic or quasi-periodic run stops (0: off; both "
+        "0: such runs run the full length).",
+        examples=[1e-3],
     )
     lyapunov_nolds: bool = Field(
         False,

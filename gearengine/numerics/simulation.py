@@ -167,6 +167,7 @@ def warm_up() -> None:
     }
     torque = {"frequency": math.sqrt(2.0), "harmonics": [{"amplitude": 0.01}]}
     cubic = GearParams.model_validate(base)
+    piecewise = GearParams.model_validate({**base, "backlash": {"model": "piecewise"}})
     for extra in ({}, {"torque": torque}, {"backlash": {"model": "piecewise"}}):
         simulate(GearParams.model_validate({**base, **extra}), tiny)
-    simulate_batch([cubic, cubic], tiny)
+    simulate_batch([cubic, cubic, piecewise, piecewise], tiny)  # both lock-step kernels

@@ -65,14 +65,15 @@ def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
     i0 = {v: i for i, v in enumerate(s0)}
     i1 = {v: i for i, v in enumerate(s1)}
     cls = np.full((len(g1), len(g0)), np.nan)
-    mel = np.zeros((len(g1), len(g0)))
+    mel = np.full((len(g1), len(g0)), np.nan)  # NaN: the criterion does not apply there
     marks: dict[str, list[tuple[float, float]]] = {"single_sided": [], "double_sided": []}
     for p in points:
         if p.branch == "down":
             continue
         i, j = i0[p.values[ax0.parameter]], i1[p.values[ax1.parameter]]
         cls[j, i] = response_class(p)
-        mel[j, i] = 1.0 if p.melnikov_chaos_possible else 0.0
+        if p.melnikov_chaos_possible is not None:
+            mel[j, i] = 1.0 if p.melnikov_chaos_possible else 0.0
         if p.impact_regime in marks:
             marks[p.impact_regime].append((g0[i], g1[j]))
     fig = Figure(figsize=(10.0, 6.4), layout="constrained")
@@ -85,9 +86,16 @@ def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
             xs, ys = zip(*marks[regime], strict=True)
             ax.scatter(xs, ys, marker=style[0], c=style[1], s=style[2], linewidths=0.8,
                        edgecolors="k" if style[0] == "o" else None, zorder=3)  # fmt: skip
-    if len(g0) > 1 and len(g1) > 1 and 0.0 < mel.mean() < 1.0:
-        ax.contourf(g0, g1, mel, levels=[0.5, 1.5], colors="none", hatches=["//"])
-        ax.contour(g0, g1, mel, levels=[0.5], colors="black", linewidths=1.6)
+    applies = np.isfinite(mel)
+    if len(g0) > 1 and len(g1) > 1:
+        judged = np.ma.masked_invalid(mel)  # the region and its boundary only where it applies
+        if np.nanmax(mel, initial=0.0) > 0.5:
+            ax.contourf(g0, g1, judged, levels=[0.5, 1.5], colors="none", hatches=["//"])
+        if np.nanmin(mel, initial=1.0) < 0.5 < np.nanmax(mel, initial=0.0):
+            ax.contour(g0, g1, judged, levels=[0.5], colors="black", linewidths=1.6)
+        if applies.any() and not applies.all():  # a map wholly outside says so in the legend
+            ax.contourf(g0, g1, (~applies).astype(float), levels=[0.5, 1.5], colors="none",
+                        hatches=["."])  # fmt: skip
     ax.set_xlabel(axis_label(ax0.parameter))
     ax.set_ylabel(axis_label(ax1.parameter))
     s = request.settings
@@ -108,6 +116,14 @@ def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
         Patch(facecolor="none", edgecolor="k", hatch="//",
               label="Melnikov criterion: chaos possible\n(black line: its boundary)"),
     ]  # fmt: skip
+    if not applies.any():
+        handles[-1] = Patch(facecolor="none", edgecolor="none", label=(
+            "Melnikov criterion: does not apply anywhere\non this map (mean load above the "
+            "critical\ntorque: no saddle, no homoclinic orbit)"))  # fmt: skip
+    elif not applies.all():
+        words = "Melnikov criterion does not apply\n(mean load above the critical torque:\n"
+        handles.append(Patch(facecolor="none", edgecolor="k", hatch=".",
+                             label=words + "no saddle, no homoclinic orbit)"))  # fmt: skip
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
               title="response", title_fontsize=9, frameon=False)  # fmt: skip
     return fig

@@ -18,10 +18,10 @@ from matplotlib.colors import TwoSlopeNorm
 from matplotlib.figure import Figure
 
 from gearengine.homoclinic.boundary import chaos_intervals_from, flips, strength_at
+from gearengine.homoclinic.grid import strength_grid
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
 from gearengine.plots.envelope import axis_label, envelope_map
-from gearengine.plots.strength_grid import strength_grid
 from gearengine.plots.style import LLE_LABEL, SYMBOLS, ImageFormat, figure_bytes
 from gearengine.sweeps.axes import display_unit, is_dimensionless, is_integer_field
 from gearengine.sweeps.export import agreement_table
@@ -180,7 +180,8 @@ def chaos_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
     fig.colorbar(mesh, ax=ax, label=LLE_LABEL + "; grey: diverged", shrink=0.9)
     g0 = np.linspace(v0.min(), v0.max(), BOUNDARY_GRID)
     g1 = np.linspace(v1.min(), v1.max(), BOUNDARY_GRID)
-    strength = strength_grid(request, g0, g1)
+    assert request.params is not None
+    strength = strength_grid(request.params, (ax0.parameter, ax1.parameter), g0, g1, request.point)
     if np.nanmin(strength) < 0.0 < np.nanmax(strength):
         ax.contourf(g0, g1, strength, levels=[0.0, np.inf], colors="none", hatches=["//"])
         ax.contour(g0, g1, strength, levels=[0.0], colors="black", linewidths=1.6)

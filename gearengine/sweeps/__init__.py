@@ -14,6 +14,7 @@ from gearengine.sweeps.export import (
     chunk_points,
     csv_rows,
     result_json,
+    text_blocks,
     to_csv,
 )
 from gearengine.sweeps.plan import DEFAULT_CHUNK_POINTS, SweepPlan, sweep_work
@@ -46,6 +47,7 @@ __all__ = [
     "result_json",
     "run_local",
     "sweep_work",
+    "text_blocks",
     "to_csv",
     "validated",
 ]

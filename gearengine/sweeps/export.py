@@ -134,6 +134,26 @@ def csv_rows(
         yield ",".join(_row(p, names, shown, fields)) + "\n"
 
 
+STREAM_BLOCK = 1 << 16
+"""Characters per piece of a streamed document (``text_blocks``)."""
+
+
+def text_blocks(parts: Iterable[str], size: int = STREAM_BLOCK) -> Iterator[str]:
+    """``parts`` joined into pieces of about ``size`` characters (the last one shorter). A
+    streamed response hands each piece of a synchronous iterator to a thread of its pool: one
+    row per hand-over (~0.1 ms each) held a million-row CSV at 0.5 MB/s."""
+    block: list[str] = []
+    count = 0
+    for part in parts:
+        block.append(part)
+        count += len(part)
+        if count >= size:
+            yield "".join(block)
+            block, count = [], 0
+    if block:
+        yield "".join(block)
+
+
 def _physical_columns(
     names: list[str], outputs: Sequence[str] | None
 ) -> list[tuple[str, str, bool]]:

@@ -96,6 +96,11 @@ class EnvelopeReport(BaseModel):
     rules: Rules
     points: int = Field(description="Grid points checked.")
     failing_points: int
+    melnikov_not_judged: int = Field(
+        0,
+        description="Grid points where the Melnikov criterion does not apply (above the critical "
+        "torque, or no saddle): --fail-on melnikov never fails them.",
+    )
     failures: list[FailingWindow]
     windows: list[SpeedWindows] = Field(description="All response windows, failing or not.")
     sweep: SweepResult = Field(description="The sweep result (the API's document).")
@@ -130,6 +135,9 @@ def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
         rules=rules,
         points=sum(len(r) for r in rows.values()),
         failing_points=failing,
+        melnikov_not_judged=sum(
+            1 for r in rows.values() for p in r if p.melnikov_chaos_possible is None
+        ),
         failures=failures,
         windows=result.windows or [],
         sweep=result,

@@ -137,6 +137,11 @@ class SpeedWindows(BaseModel):
     melnikov: list[list[float]] = Field(
         description="Runs of grid speeds where the Melnikov criterion allows chaos."
     )
+    melnikov_not_applicable: list[list[float]] = Field(
+        default_factory=list,
+        description="Runs of grid speeds where the Melnikov criterion does not apply (the mean "
+        "load is above the critical torque: no saddle, no homoclinic orbit).",
+    )
 
 
 class SweepResult(BaseModel):

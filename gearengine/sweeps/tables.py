@@ -81,6 +81,8 @@ def summary(result: SweepResult) -> str:
     counts = Counter(response_label(p) for p in result.points if p.classification is not None)
     responses = ", ".join(f"{label} {n}" for label, n in counts.most_common()) or "no verdicts"
     melnikov = sum(bool(p.melnikov_chaos_possible) for p in result.points)
+    unjudged = sum(p.melnikov_chaos_possible is None for p in result.points)
+    na = f", not applicable at {unjudged}" if unjudged else ""  # above the critical torque
     partial = " (partial)" if result.partial else ""
     return (f"sweep of {axes}: {len(result.points)} points{partial}: {responses}; "
-            f"Melnikov: chaos possible at {melnikov} points")  # fmt: skip
+            f"Melnikov: chaos possible at {melnikov} points{na}")  # fmt: skip

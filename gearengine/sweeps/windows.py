@@ -54,7 +54,11 @@ def speed_windows(request: SweepRequest, points: Sequence[SweepPoint]) -> list[S
         row.sort(key=lambda p: p.values[SPEED])
         speeds = [rounded(p.values[SPEED] * factor) for p in row]
         impacts = [p.impact_regime if p.impact_regime != "no_impact" else None for p in row]
-        melnikov = ["chaos" if p.melnikov_chaos_possible else None for p in row]
+        melnikov = [
+            "n/a" if p.melnikov_chaos_possible is None else
+            "chaos" if p.melnikov_chaos_possible else None
+            for p in row
+        ]  # fmt: skip
         shown: dict[str, PhysicalValue] = {}
         if other is not None and level is not None:
             shown[other] = _level(row[0], other, level)
@@ -64,6 +68,7 @@ def speed_windows(request: SweepRequest, points: Sequence[SweepPoint]) -> list[S
                 response=runs(speeds, [response_label(p) for p in row]),
                 impacts=runs(speeds, impacts),
                 melnikov=runs(speeds, melnikov).get("chaos", []),
+                melnikov_not_applicable=runs(speeds, melnikov).get("n/a", []),
             )
         )
     return out

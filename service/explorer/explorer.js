@@ -278,11 +278,16 @@ function facts(result) {
       ? n.floquet.stability_margin.toFixed(3)
         + (n.floquet.nearest_bifurcation ? ` (nearest: ${n.floquet.nearest_bifurcation.replace("_", "-")})` : "")
       : "—" + (n.floquet_note ? ` (${n.floquet_note})` : "")],
-    ["Melnikov", result.melnikov.chaos_possible ? "chaos possible" : "chaos ruled out"]];
+    ["Melnikov", result.melnikov.chaos_possible === null ? "not applicable at this load (no saddle)"
+      : result.melnikov.chaos_possible ? "chaos possible" : "chaos ruled out"]];
   if (eng) {
     const w = eng.speed_windows_rpm || [];
     const scan = eng.speed_range_rpm ? ` (scanned ${rpm(eng.speed_range_rpm[0])}–${rpm(eng.speed_range_rpm[1])} rpm)` : "";
-    rows.push(["Melnikov speed windows", (w.length ? w.map(([a, b]) => `${rpm(a)}–${rpm(b)} rpm`).join(", ") : "none") + scan]);
+    rows.push(["Melnikov speed windows", (w.length ? w.map(([a, b]) => `${rpm(a)}–${rpm(b)} rpm`).join(", ") : "none")
+      + (eng.speed_windows_note ? ` (${eng.speed_windows_note})` : scan)]);
+    if (eng.critical_torque_nm !== null && eng.critical_torque_nm !== undefined) {
+      rows.push(["Critical torque", `${fmt(eng.critical_torque_nm, 3)} N·m (the Melnikov criterion applies below it)`]);
+    }
   }
   if (resp) {
     rows.push(["Dynamic transmission error", `${fmt(resp.dte_peak_to_peak_um, 3)} µm peak to peak`],
@@ -529,7 +534,8 @@ async function drawEnvelope(id, result) {
       x: sel.map((p) => p.rpm), y: sel.map((p) => p.nm),
       customdata: sel.map((p) => [
         p.classification.replace("_", "-"), p.period ? p.period + "T" : "none", fmt(p.lle), fmt(p.lle_stderr, 2),
-        CONTACT[p.impact_regime] || "no verdict on contact", p.melnikov_chaos_possible ? "possible" : "ruled out",
+        CONTACT[p.impact_regime] || "no verdict on contact",
+        p.melnikov_chaos_possible === null ? "not applicable" : p.melnikov_chaos_possible ? "possible" : "ruled out",
         physicalText(p, "dynamic_factor", 3, ""), physicalText(p, "dte", 3, " µm"),
       ]),
       hovertemplate: "speed %{x:,.0f} rpm<br>torque %{y:,.1f} N·m"
@@ -585,7 +591,8 @@ function showWindows(windows) {
     const level = Object.entries(w.level)
       .map(([k, v]) => `${k} ${fmt(v.value)} ${v.unit.replace("*", "·")}`).join(", ") || "all";
     const cells = [[level], runs(w.response), runs(w.impacts).concat(w.impacts && Object.keys(w.impacts).length ? [] : ["none"]),
-      w.melnikov.length ? w.melnikov.map(span) : ["none"]];
+      (w.melnikov.length ? w.melnikov.map(span) : ["none"])
+        .concat((w.melnikov_not_applicable || []).map((s) => `not applicable: ${span(s)}`))];
     return el("tr", {}, ...cells.map((lines) => el("td", {}, ...lines.flatMap((t, i) => (i ? [el("br"), t] : [t])))));
   };
   box.replaceChildren(el("h3", { text: "Speed windows" }), el("table", {},

@@ -1,1 +1,2 @@
-"""The durable sweep queue: SQLite store, dispatcher (process pool or Dask), worker command."""
+"""The durable job queue of every kind of ``gearengine.jobs.KINDS``: SQLite store, dispatcher
+(process pool or Dask), worker command."""

@@ -1,8 +1,9 @@
 """Where chunks run: a local process pool or a Dask distributed cluster.
 
 Both hand back futures with ``done()``, ``result()`` and ``add_done_callback``; the dispatcher
-treats them alike. Workers only compute (``gearengine.sweeps.compute_chunk_json``); they never
-touch the store, so a worker that dies or hangs cannot corrupt it.
+treats them alike. Workers only compute (``gearengine.jobs.compute_chunk_json`` with the
+claim's kind, whatever the kind); they never touch the store, so a worker that dies or hangs
+cannot corrupt it.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Protocol
 
-from gearengine.sweeps import compute_chunk_json
+from gearengine.jobs import compute_chunk_json
 from service.jobs.store import Claim
 from service.lifetime import exit_with_parent
 
@@ -90,7 +91,7 @@ class LocalPool:
 
     def submit(self, claim: Claim) -> Future[str]:
         return self._pool.submit(
-            compute_chunk_json, claim.request_json, claim.index, claim.chunk_points
+            compute_chunk_json, claim.kind, claim.request_json, claim.index, claim.chunk_points
         )
 
     def recover(self, error: BaseException) -> None:
@@ -128,10 +129,11 @@ class DaskCluster:
     def submit(self, claim: Claim) -> Any:
         return self.client.submit(
             compute_chunk_json,
+            claim.kind,
             claim.request_json,
             claim.index,
             claim.chunk_points,
-            key=f"sweep-{claim.job_id}-{claim.index}-{claim.attempt}",
+            key=f"{claim.kind}-{claim.job_id}-{claim.index}-{claim.attempt}",
             pure=False,
         )
 

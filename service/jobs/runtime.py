@@ -1,4 +1,5 @@
-"""The sweep queue of one process: the store and, when there are workers, a dispatcher."""
+"""The job queue of one process (jobs of every kind): the store and, when there are workers, a
+dispatcher."""
 
 from __future__ import annotations
 

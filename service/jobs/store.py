@@ -1,6 +1,8 @@
 """The durable job store: one SQLite file (WAL) holding jobs and the results of finished chunks.
 
-Tables: ``jobs`` (one row per sweep), ``chunks`` (one row per chunk: status pending | leased |
+Tables: ``jobs`` (one row per job, of any kind of ``gearengine.jobs.KINDS``: its ``kind``
+column names it; a store written before kinds existed gains the column, every old job a sweep),
+``chunks`` (one row per chunk: status pending | leased |
 done | failed | cancelled, lease owner and expiry, attempts, result JSON) and ``commits`` (an
 append-only log of chunk commits, for audits and the fault tests). A chunk's result JSON is
 stored zlib-compressed (a BLOB in ``result_json``; ``pack``/``unpack``), read back one chunk at
@@ -50,6 +52,7 @@ def unpack(stored: bytes | str) -> str:
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS jobs (
     id TEXT PRIMARY KEY,
+    kind TEXT NOT NULL DEFAULT 'sweep',
     owner TEXT,
     status TEXT NOT NULL,
     request_json TEXT NOT NULL,
@@ -104,6 +107,13 @@ END;
 """
 
 
+KIND_COLUMN = """
+ALTER TABLE jobs ADD COLUMN kind TEXT NOT NULL DEFAULT 'sweep';
+"""
+"""Migration of a store from before job kinds: every job in it is a sweep."""
+KIND_INDEX = "CREATE INDEX IF NOT EXISTS jobs_kind ON jobs(kind, owner, created_at);"
+
+
 class QueueFullError(Exception):
     """The number of unfinished jobs reached the cap."""
 
@@ -117,6 +127,8 @@ class Claim:
     request_json: str
     chunk_points: int
     attempt: int
+    kind: str
+    """The job's kind (``gearengine.jobs.KINDS``): what computes the chunk."""
 
     @property
     def key(self) -> tuple[str, int]:
@@ -130,7 +142,12 @@ class JobStore:
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._local = threading.local()
-        self._db().executescript(SCHEMA)
+        db = self._db()
+        db.executescript(SCHEMA)
+        columns = {r["name"] for r in db.execute("PRAGMA table_info(jobs)")}
+        if "kind" not in columns:
+            db.executescript(KIND_COLUMN)
+        db.executescript(KIND_INDEX)
 
     @classmethod
     def in_dir(cls, data_dir: Path) -> JobStore:
@@ -185,9 +202,10 @@ class JobStore:
 
     def submit(
         self, owner: str | None, request_json: str, chunk_counts: list[int], chunk_points: int,
-        max_unfinished: int,
+        max_unfinished: int, kind: str = "sweep",
     ) -> Job:  # fmt: skip
-        """Store a job and its chunks; raises ``QueueFullError`` at ``max_unfinished`` jobs."""
+        """Store a job of ``kind`` and its chunks; raises ``QueueFullError`` at
+        ``max_unfinished`` jobs (of every kind)."""
         job_id, now = uuid.uuid4().hex, time.time()
         with self._tx() as db:
             (n,) = db.execute(
@@ -196,9 +214,9 @@ class JobStore:
             if n >= max_unfinished:
                 raise QueueFullError(f"{n} unfinished jobs, the limit is {max_unfinished}")
             db.execute(
-                "INSERT INTO jobs (id, owner, status, request_json, chunk_points, total_chunks, "
-                "total_points, created_at) VALUES (?, ?, 'queued', ?, ?, ?, ?, ?)",
-                (job_id, owner, request_json, chunk_points, len(chunk_counts),
+                "INSERT INTO jobs (id, kind, owner, status, request_json, chunk_points, "
+                "total_chunks, total_points, created_at) VALUES (?, ?, ?, 'queued', ?, ?, ?, ?, ?)",
+                (job_id, kind, owner, request_json, chunk_points, len(chunk_counts),
                  sum(chunk_counts), now),
             )  # fmt: skip
             db.executemany(
@@ -209,13 +227,11 @@ class JobStore:
         assert job is not None
         return job
 
-    def get(self, job_id: str, owner: str | None) -> Job | None:
-        """The job if it exists and belongs to ``owner`` (None: auth off)."""
-        row = (
-            self._db()
-            .execute(f"{_JOB_SELECT} WHERE j.id = ? AND j.owner IS ?", (job_id, owner))
-            .fetchone()
-        )
+    def get(self, job_id: str, owner: str | None, kind: str | None = None) -> Job | None:
+        """The job if it exists, belongs to ``owner`` (None: auth off) and, when ``kind`` is
+        given, is of that kind."""
+        where, args = _of("j.id = ? AND j.owner IS ?", [job_id, owner], kind)
+        row = self._db().execute(f"{_JOB_SELECT} WHERE {where}", args).fetchone()
         return None if row is None else _job(row)
 
     def request_json(self, job_id: str) -> str:
@@ -226,10 +242,12 @@ class JobStore:
         return text
 
     def list(
-        self, owner: str | None, status: JobStatus | None, limit: int, offset: int
-    ) -> tuple[list[Job], int]:
-        """A page of ``owner``'s jobs, newest first, and the number matching."""
-        where, args = "j.owner IS ?", [owner]
+        self, owner: str | None, status: JobStatus | None, limit: int, offset: int,
+        kind: str | None = None,
+    ) -> tuple[list[Job], int]:  # fmt: skip
+        """A page of ``owner``'s jobs (of ``kind`` when given), newest first, and the number
+        matching."""
+        where, args = _of("j.owner IS ?", [owner], kind)
         if status is not None:
             where += " AND j.status = ?"
             args.append(status)
@@ -241,13 +259,14 @@ class JobStore:
         ).fetchall()
         return [_job(r) for r in rows], total
 
-    def cancel(self, job_id: str, owner: str | None) -> Job | None:
+    def cancel(self, job_id: str, owner: str | None, kind: str | None = None) -> Job | None:
         """Cancel an unfinished job: no new chunk starts. Finished jobs are left as they are."""
+        where, args = _of("id = ? AND owner IS ?", [job_id, owner], kind, column="kind")
         with self._tx() as db:
             hit = db.execute(
                 "UPDATE jobs SET status = 'cancelled', finished_at = ? "
-                "WHERE id = ? AND owner IS ? AND status IN ('queued', 'running')",
-                (time.time(), job_id, owner),
+                f"WHERE {where} AND status IN ('queued', 'running')",
+                [time.time(), *args],
             ).rowcount
             if hit:
                 db.execute(
@@ -255,7 +274,7 @@ class JobStore:
                     "WHERE job_id = ? AND status IN ('pending', 'leased')",
                     (job_id,),
                 )
-        return self.get(job_id, owner)
+        return self.get(job_id, owner, kind)
 
     def chunk_results(self, job_id: str) -> Iterator[str]:
         """JSON arrays of the committed chunks, in chunk order, one query each (so the
@@ -286,7 +305,7 @@ class JobStore:
         with self._tx() as db:
             rows = db.execute(
                 "SELECT c.job_id, c.idx, c.attempts, c.status, c.error, j.request_json, "
-                "j.chunk_points FROM chunks c JOIN jobs j ON j.id = c.job_id "
+                "j.chunk_points, j.kind FROM chunks c JOIN jobs j ON j.id = c.job_id "
                 "WHERE j.status IN ('queued', 'running') AND (c.status = 'pending' "
                 "OR (c.status = 'leased' AND c.lease_expires < ?)) "
                 "ORDER BY j.created_at, j.id, c.idx LIMIT ?",
@@ -313,7 +332,7 @@ class JobStore:
                 )
                 claims.append(
                     Claim(r["job_id"], r["idx"], r["request_json"], r["chunk_points"],
-                          r["attempts"] + 1)
+                          r["attempts"] + 1, r["kind"])
                 )  # fmt: skip
         return claims
 
@@ -434,6 +453,13 @@ _JOB_SELECT = (
     "SELECT j.*, (SELECT COALESCE(SUM(n_points), 0) FROM chunks c "
     "WHERE c.job_id = j.id AND c.status = 'done') AS done_points FROM jobs j"
 )
+
+
+def _of(
+    where: str, args: list[object], kind: str | None, column: str = "j.kind"
+) -> tuple[str, list[object]]:
+    """``where`` narrowed to jobs of ``kind`` (None: every kind)."""
+    return (where, args) if kind is None else (f"{where} AND {column} = ?", [*args, kind])
 
 
 def _job(row: sqlite3.Row) -> Job:

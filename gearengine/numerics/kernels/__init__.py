@@ -19,6 +19,9 @@ The three run kernels share one output layout (see ``run_rk4``); ``monodromy`` i
 * ``run_batch``: cubic law only; many parameter points ("lanes") in lock-step, struct of arrays,
   inner loops over ``LANES`` lanes so LLVM vectorises, ``prange`` over chunks of lanes. Same
   arithmetic as ``run_rk4`` with a forcing table.
+* ``run_kink_batch`` (``kinklanes``): the piecewise law in lock-step lanes, each step split at
+  the kinks lane by lane; the numbers of ``run_kink`` with its forcing table. Both lock-step
+  kernels end their intervals with ``intervals.end_interval`` (record, adaptive stopping).
 
 Benettin et al. (Meccanica 15, 1980): the tangent vector starts at (1, 1)/sqrt(2) and is
 renormalised at the end of every interval T0; the log of its norm is recorded over the n_rec
@@ -29,15 +32,16 @@ Forcing coefficients are packed as kc, fc of shape (3, n_terms): rows amplitude,
 (see ``gearengine.numerics.forcing``); K(t) = 1 + sum kc0 cos(kc1 t + kc2),
 F(t) = fm + sum fc0 cos(fc1 t + fc2).
 
-The kernels call each other across these files and freeze constants of ``numerics.periodicity``
-and ``numerics.lyapunov``; ``gearengine.jitcache`` drops their numba cache when any of those
-sources changes (numba itself watches only the defining file).
+The kernels call each other across these files and freeze constants of ``numerics.periodicity``,
+``numerics.lyapunov`` and ``numerics.classify``; ``gearengine.jitcache`` drops their numba cache
+when any of those sources changes (numba itself watches only the defining file).
 """
 
 from pathlib import Path
 
 from gearengine.jitcache import drop_stale
 from gearengine.numerics.kernels.kink import run_kink
+from gearengine.numerics.kernels.kinklanes import run_kink_batch
 from gearengine.numerics.kernels.lockstep import LANES, run_batch
 from gearengine.numerics.kernels.monodromy import monodromy
 from gearengine.numerics.kernels.smooth import (
@@ -59,12 +63,16 @@ __all__ = [
     "region_force",
     "run_batch",
     "run_kink",
+    "run_kink_batch",
     "run_rk4",
 ]
 
 _HERE = Path(__file__).parent
 drop_stale(  # before any kernel runs: numba loads a cached kernel on its first call
-    "adaptive,kink,lockstep,monodromy,smooth",
-    [*_HERE.glob("*.py"), _HERE.parent / "periodicity.py", _HERE.parent / "lyapunov.py"],
+    "adaptive,intervals,kink,kinklanes,lockstep,monodromy,phase,ramp,smooth",
+    [
+        *_HERE.glob("*.py"),
+        *(_HERE.parent / f"{m}.py" for m in ("periodicity", "lyapunov", "classify")),
+    ],
     _HERE / "__pycache__",
 )

@@ -36,13 +36,29 @@ the earliest after ``min(n_trans, ADAPT_SETTLE) + ADAPT_WINDOW`` intervals:
 
 The record of a stopped run is then its last ``ADAPT_WINDOW`` intervals (strobes, logs and the
 extremes of x and of the mesh force over their steps); chaotic, quasi-periodic, long-period
-(> ``ADAPT_MAX_PERIOD``) and undecided runs never satisfy the rule and run to the end with the
-fixed-length record, bit for bit. Runs with ``n_rec < ADAPT_WINDOW`` never stop early.
+(> ``ADAPT_MAX_PERIOD``) and undecided runs never satisfy the rule. Runs with
+``n_rec < ADAPT_WINDOW`` never stop early by it.
 
-Only the lock-step kernel ``run_batch`` applies the rule (the cubic map path); ``run_rk4`` and
-``run_kink`` always run the full length. ``run_batch`` compiles the helpers and constants
-here into its own code; an edit here drops its numba cache (``gearengine.jitcache``), so it is
-compiled again on its next call.
+**The LLE rule** (chaotic and quasi-periodic runs, ``lle_known``): in the record, whenever the
+number k of recorded intervals is a multiple of ``BLOCKS`` and at least ``ADAPT_LLE_MIN_RECORD``,
+the Benettin estimate over those k intervals, lle = sum l_i / (k T0), and its standard error
+over ``BLOCKS`` equal blocks (as ``numerics.lyapunov.benettin``) are taken; the run stops when
+
+    stderr <= max(lle_stderr_abs, lle_stderr_rel |lle|)        (the tolerances of the settings)
+
+and the verdict they give cannot change within three standard errors: lle - 3 stderr >
+``LLE_FLOOR`` (chaotic) or lle + 3 stderr < ``LLE_FLOOR`` (not chaotic), both also at k - 10 and
+k - 20 (``ADAPT_LLE_CONFIRM``), and the k strobes have
+no period <= ``MAX_PERIOD`` (``periodicity.detect_period``; a longer record, holding these
+pairs, would have none either). The record of such a run is its first k intervals, so its LLE
+is the fixed-length run's estimate truncated to k intervals: it differs from the fixed-length
+LLE by about its stated stderr (or less). Runs that never satisfy it run to the end with the
+fixed-length record, bit for bit.
+
+Only the lock-step kernels ``run_batch`` and ``run_kink_batch`` apply the rules (through
+``kernels.intervals``); ``run_rk4`` and ``run_kink`` always run the full length. The kernels
+compile the helpers and constants here into their own code; an edit here drops their numba
+cache (``gearengine.jitcache``), so they are compiled again on their next call.
 """
 
 from __future__ import annotations
@@ -52,9 +68,10 @@ import math
 import numpy as np
 from numba import njit
 
+from gearengine.numerics.classify import LLE_FLOOR
 from gearengine.numerics.kernels.smooth import JIT_OPTIONS
 from gearengine.numerics.lyapunov import BLOCKS
-from gearengine.numerics.periodicity import REL_TOL, SIZE_FLOOR
+from gearengine.numerics.periodicity import MAX_PERIOD, REL_TOL, SIZE_FLOOR, _smallest_period
 
 ADAPT_WINDOW = 120
 """Intervals T0 of the record of an early-stopped run (a multiple of ``BLOCKS``)."""
@@ -79,6 +96,13 @@ ADAPT_LLE_REL = 0.1
 """Standard error relative to |lle| that counts as converged (10 %): the per-interval logs of
 an orbit whose multipliers are complex (a focus) oscillate, so their block estimates scatter by
 a few per cent of lle even when the orbit has settled."""
+ADAPT_LLE_MIN_RECORD = 100
+"""Recorded intervals before the LLE rule applies (blocks of at least 10 intervals, several
+correlation times of the chaotic responses of Eq. 9)."""
+ADAPT_LLE_CONFIRM = 3
+"""Consecutive checks (every ``BLOCKS`` intervals) at which the LLE tests must hold: a single
+check stops too often where the 10-block stderr happens to be low (it has 9 degrees of
+freedom), and then the stated stderr covers the fixed-length LLE less often than it should."""
 
 
 @njit(**JIT_OPTIONS)
@@ -165,3 +189,48 @@ def settled(
     stderr = math.sqrt(var / (BLOCKS - 1) / BLOCKS)
     converged = stderr <= max(ADAPT_LLE_STDERR, ADAPT_LLE_REL * abs(lle))
     return converged and lle + 3.0 * stderr < -ADAPT_MIN_CONTRACTION
+
+
+@njit(**JIT_OPTIONS)
+def _lle_clear(
+    logs: np.ndarray, k: int, T: float, rel: float, abs_tol: float
+) -> bool:  # pragma: no cover - compiled
+    """The LLE tests of the rule on the first k logs (k a multiple of ``BLOCKS``)."""
+    total = 0.0
+    for i in range(k):
+        total += logs[i]
+    lle = total / (k * T)
+    size = k // BLOCKS
+    var = 0.0
+    for b in range(BLOCKS):
+        s = 0.0
+        for i in range(b * size, (b + 1) * size):
+            s += logs[i]
+        var += (s / (size * T) - lle) ** 2
+    stderr = math.sqrt(var / (BLOCKS - 1) / BLOCKS)
+    if not stderr <= max(abs_tol, rel * abs(lle)):
+        return False
+    return lle - 3.0 * stderr > LLE_FLOOR or lle + 3.0 * stderr < LLE_FLOOR
+
+
+@njit(**JIT_OPTIONS)
+def lle_known(
+    xs: np.ndarray,
+    vs: np.ndarray,
+    logs: np.ndarray,
+    k: int,
+    xmin: float,
+    xmax: float,
+    T: float,
+    rel: float,
+    abs_tol: float,
+) -> bool:  # pragma: no cover - compiled
+    """The LLE rule (module doc) on the first k entries of one record (strobes xs, vs, logs;
+    x extremes xmin, xmax over its steps; T: the interval T0)."""
+    if k < ADAPT_LLE_MIN_RECORD or k % BLOCKS != 0:
+        return False
+    for c in range(ADAPT_LLE_CONFIRM):  # the record of k, k - 10, ... intervals
+        if not _lle_clear(logs, k - BLOCKS * c, T, rel, abs_tol):
+            return False
+    tol = REL_TOL * max(xmax - xmin, SIZE_FLOOR)
+    return _smallest_period(xs[:k], vs[:k], tol, min(MAX_PERIOD, k - 1)) == 0

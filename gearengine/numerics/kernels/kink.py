@@ -8,10 +8,11 @@ import math
 import numpy as np
 from numba import njit
 
+from gearengine.numerics.kernels.phase import excitation_at
 from gearengine.numerics.kernels.smooth import (
     JIT_OPTIONS,
     SQRT1_2,
-    forcing_at,
+    forcing_table,
     region,
     region_force,
     stiffness_at,
@@ -36,24 +37,24 @@ def _rhs_region(
 
 
 @njit(**JIT_OPTIONS)
-def _rk4_region(
+def rk4_region_kf(
     reg: int,
     alpha: float,
     twomu: float,
-    kc: np.ndarray,
-    fm: float,
-    fc: np.ndarray,
-    t: float,
+    K0: float,
+    F0: float,
+    K1: float,
+    F1: float,
+    K2: float,
+    F2: float,
     dt: float,
     x: float,
     v: float,
     dx: float,
     dv: float,
 ) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
-    """One RK4 step of length dt from time t in region ``reg``, forcing at absolute time."""
-    K0, F0 = forcing_at(t, kc, fm, fc)
-    K1, F1 = forcing_at(t + 0.5 * dt, kc, fm, fc)
-    K2, F2 = forcing_at(t + dt, kc, fm, fc)
+    """One RK4 step of length dt in region ``reg`` with the forcing (K, F) at its start (0),
+    middle (1) and end (2) given: the arithmetic ``kernels.kinklanes`` repeats lane by lane."""
     a1, b1, c1, d1 = _rhs_region(reg, alpha, twomu, K0, F0, x, v, dx, dv)
     h2 = 0.5 * dt
     a2, b2, c2, d2 = _rhs_region(
@@ -75,12 +76,35 @@ def _rk4_region(
 
 
 @njit(**JIT_OPTIONS)
+def _rk4_region(
+    reg: int,
+    alpha: float,
+    twomu: float,
+    kc: np.ndarray,
+    fm: float | np.ndarray,
+    fc: np.ndarray,
+    t: float,
+    dt: float,
+    x: float,
+    v: float,
+    dx: float,
+    dv: float,
+) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
+    """One RK4 step of length dt from time t in region ``reg``, forcing evaluated at t:
+    stationary (float ``fm``) or on a speed ramp (``fm`` a ramp record, ``kernels.phase``)."""
+    K0, F0 = excitation_at(t, kc, fm, fc)
+    K1, F1 = excitation_at(t + 0.5 * dt, kc, fm, fc)
+    K2, F2 = excitation_at(t + dt, kc, fm, fc)
+    return rk4_region_kf(reg, alpha, twomu, K0, F0, K1, F1, K2, F2, dt, x, v, dx, dv)
+
+
+@njit(**JIT_OPTIONS)
 def kink_step(
     reg: int,
     alpha: float,
     twomu: float,
     kc: np.ndarray,
-    fm: float,
+    fm: float | np.ndarray,
     fc: np.ndarray,
     t: float,
     h: float,
@@ -93,12 +117,40 @@ def kink_step(
 
     Returns the new (x, v, dx, dv) and region; public because ``kernels.monodromy`` steps the
     two columns of the monodromy matrix with it."""
+    x1, v1, dx1, dv1 = _rk4_region(reg, alpha, twomu, kc, fm, fc, t, h, x, v, dx, dv)
+    return kink_split(reg, alpha, twomu, kc, fm, fc, t, h, x, v, dx, dv, x1, v1, dx1, dv1)
+
+
+@njit(**JIT_OPTIONS)
+def kink_split(
+    reg: int,
+    alpha: float,
+    twomu: float,
+    kc: np.ndarray,
+    fm: float | np.ndarray,
+    fc: np.ndarray,
+    t: float,
+    h: float,
+    x: float,
+    v: float,
+    dx: float,
+    dv: float,
+    x1: float,
+    v1: float,
+    dx1: float,
+    dv1: float,
+) -> tuple[float, float, float, float, int]:  # pragma: no cover - compiled
+    """``kink_step`` given its first attempt (x1, v1, dx1, dv1), the whole step h from t in
+    region ``reg`` (from ``_rk4_region``, or ``rk4_region_kf`` with a forcing table): the step
+    is accepted if no sample of its Hermite interpolant leaves the region, else split at the
+    crossing, the substeps evaluating the forcing at their times."""
     rem = h
     tc = t
-    for _ in range(16):
+    for it in range(16):
         if not rem > 0.0:
             return x, v, dx, dv, reg
-        x1, v1, dx1, dv1 = _rk4_region(reg, alpha, twomu, kc, fm, fc, tc, rem, x, v, dx, dv)
+        if it > 0:
+            x1, v1, dx1, dv1 = _rk4_region(reg, alpha, twomu, kc, fm, fc, tc, rem, x, v, dx, dv)
         # cubic Hermite interpolant of x over the substep, sampled at 8 points
         kfound = 0
         b = 0.0
@@ -182,13 +234,23 @@ def run_kink(
     n_rec: int,
     stride: int,
     bound: float,
+    use_table: bool = False,
 ):  # pragma: no cover - compiled
     """Kink-splitting RK4 of Eq. (9) with the piecewise law of Eq. (8); outputs as ``run_rk4``.
 
-    The mesh force needs K at the step end: one ``stiffness_at`` per recorded step (the
-    stiffness harmonics only), beside the ~12 forcing evaluations of a kink-splitting step."""
+    With ``use_table`` (T-periodic forcing) the whole steps take K and F from the table of one
+    period (``forcing_table``), as ``run_rk4`` does, and the substeps of a split step evaluate
+    them at the time within the period (t - n T); otherwise everything is evaluated at absolute
+    time. The mesh force needs K at the step end: the table's, or one ``stiffness_at`` per
+    recorded step (the stiffness harmonics only). ``kernels.kinklanes`` runs the same steps in
+    lock-step lanes, bit for bit."""
     h = T / N
     twomu = 2.0 * mu
+    if use_table:
+        Kt, Ft = forcing_table(T, N, kc, fm, fc)
+    else:
+        Kt = np.empty(0)
+        Ft = np.empty(0)
     xs = np.zeros(n_rec)
     vs = np.zeros(n_rec)
     logs = np.zeros(n_rec)
@@ -206,13 +268,24 @@ def run_kink(
     for n in range(n_trans + n_rec):
         rec = n >= n_trans
         for j in range(N):
-            x, v, dx, dv, reg = kink_step(
-                reg, alpha, twomu, kc, fm, fc, n * T + j * h, h, x, v, dx, dv
-            )
+            if use_table:
+                K0, F0, K1, F1 = Kt[2 * j], Ft[2 * j], Kt[2 * j + 1], Ft[2 * j + 1]
+                K2, F2 = Kt[2 * j + 2], Ft[2 * j + 2]
+                x1, v1, dx1, dv1 = rk4_region_kf(
+                    reg, alpha, twomu, K0, F0, K1, F1, K2, F2, h, x, v, dx, dv
+                )
+                x, v, dx, dv, reg = kink_split(
+                    reg, alpha, twomu, kc, fm, fc, j * h, h, x, v, dx, dv, x1, v1, dx1, dv1
+                )
+            else:
+                x, v, dx, dv, reg = kink_step(
+                    reg, alpha, twomu, kc, fm, fc, n * T + j * h, h, x, v, dx, dv
+                )
+                K2 = stiffness_at(n * T + (j + 1) * h, kc) if rec else 1.0
             xmin = min(xmin, x)
             xmax = max(xmax, x)
             if rec:  # mesh force K(t) f_h(x) + 2 mu x' at the step end
-                force = stiffness_at(n * T + (j + 1) * h, kc) * region_force(reg, alpha, x)[0]
+                force = K2 * region_force(reg, alpha, x)[0]
                 force += twomu * v
                 fmin = min(fmin, force)
                 fmax = max(fmax, force)

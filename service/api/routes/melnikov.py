@@ -55,7 +55,8 @@ async def post_melnikov_batch(body: MelnikovBatchRequest) -> Response:
     """
 
     def compute() -> bytes:
-        result = MelnikovBatchResult.model_construct(results=melnikov_batch(body.designs))
+        results = melnikov_batch(body.designs, body.mean_load)
+        result = MelnikovBatchResult.model_construct(results=results)
         return result.model_dump_json().encode()
 
     return Response(await run_in_threadpool(compute), media_type=JSON)

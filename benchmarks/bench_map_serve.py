@@ -1,0 +1,112 @@
+"""The chaos maps of examples/chaos-map.json through a warm ``gearengine serve``, beside the CLI
+and ``gear_ref --simd --batch`` on one thread.
+
+Run:  .venv/bin/python benchmarks/bench_map_serve.py [--sizes 100 200]
+A real ``gearengine serve`` with its defaults (point and step limits raised to admit the maps)
+is started once and warmed with a 4 x 4 map; each map (default settings, 500 + 500 periods x
+200 RK4 steps, adaptive stopping) is then submitted (POST /v1/sweeps) and polled every 10 ms
+until it succeeded, and its JSON result fetched: submit to result in hand, best of 2. The CLI
+row is ``gearengine sweep`` end to end (a new process, ``bench_map.sweep_seconds``), and
+gear_ref.c (gcc -O3 -march=native) runs one ``--simd --batch We`` call per F_e1 line on the
+same points (``bench_map.gear_ref_seconds``). Targets (issue 20): the warm service at <= 0.2x
+gear_ref. Prints the load average; writes its section of benchmarks/README.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import httpx
+from bench_big_map import free_port  # benchmarks/bench_big_map.py
+from bench_map import GEAR_REF, gear_ref_seconds, map_doc, sweep_seconds
+from common import wait_ready  # benchmarks/common.py
+from report import write_section  # benchmarks/report.py (the script's own folder)
+
+from gearengine.numerics.simulation import warm_up
+
+ROOT = Path(__file__).resolve().parents[1]
+REPEATS = 2
+
+
+def served_seconds(c: httpx.Client, doc: dict) -> float:
+    """Wall seconds from POST to the JSON result in hand (polling every 10 ms)."""
+    t = time.perf_counter()
+    r = c.post("/v1/sweeps", json=doc)
+    assert r.status_code in (200, 201, 202), r.text
+    job = r.json()["id"]
+    while (s := c.get(f"/v1/sweeps/{job}").json())["status"] in ("queued", "running"):
+        time.sleep(0.01)
+    assert s["status"] == "succeeded", s
+    assert c.get(f"/v1/sweeps/{job}/result").status_code == 200
+    return time.perf_counter() - t
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--sizes", type=int, nargs="+", default=[100, 200])
+    sizes = parser.parse_args().sizes
+    warm_up()  # numba's caches filled before the server loads them
+    rows = []
+    with tempfile.TemporaryDirectory() as d:
+        tmp = Path(d)
+        exe = tmp / "gear_ref"
+        gcc = shutil.which("gcc") or sys.exit("gcc is needed to build gear_ref")
+        subprocess.run([gcc, "-O3", "-march=native", "-o", exe, GEAR_REF, "-lm"], check=True)
+        served = {}
+        port = free_port()
+        env = {**os.environ, "GEARCHAOS_MAX_SWEEP_POINTS": str(max(sizes) ** 2),
+               "GEARCHAOS_MAX_SWEEP_STEPS": str(10**12)}  # fmt: skip
+        cmd = [sys.executable, "-m", "gearengine.cli", "serve", "--port", str(port),
+               "--data-dir", str(tmp / "data")]  # fmt: skip
+        with open(tmp / "server.log", "w") as log:
+            proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=log, stderr=subprocess.STDOUT)
+            try:
+                with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=600) as c:
+                    wait_ready(c)
+                    served_seconds(c, map_doc(4, True))  # workers warm
+                    for num in sizes:
+                        served[num] = min(
+                            served_seconds(c, map_doc(num, True)) for _ in range(REPEATS)
+                        )
+            finally:
+                proc.terminate()
+                proc.wait(timeout=60)
+        sweep_seconds(tmp, 4, True)  # the CLI's numba caches warm
+        for num in sizes:
+            cli = sweep_seconds(tmp, num, True)[0]
+            ref = gear_ref_seconds(exe, num)
+            rows.append((num, served[num], cli, ref))
+    load = os.getloadavg()[0]
+    table = [
+        "| map | warm `gearengine serve`, submit to result, s | `gearengine sweep` (CLI, new "
+        "process), s | gear_ref --simd --batch, 1 thread, s | serve / gear_ref | CLI / gear_ref |",
+        "| --- | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    table += [
+        f"| {n} x {n} | {s:.2f} | {c:.2f} | {r:.2f} | **{s / r:.2f}x** | {c / r:.2f}x |"
+        for n, s, c, r in rows
+    ]
+    section = (
+        "## Chaos maps through a warm server\n\n"
+        "Reproduce: `.venv/bin/python benchmarks/bench_map_serve.py` (rewrites this section).\n\n"
+        "examples/chaos-map.json at default settings (500 + 500 periods x 200 RK4 steps, "
+        "adaptive stopping: periodic and, issue 20, chaotic points) through a real "
+        "`gearengine serve` started once and warmed (2 worker processes), submit to JSON result "
+        "in hand, best of 2; the CLI end to end; gear_ref --simd --batch single-threaded on the "
+        "same points. Target (issue 20): serve <= 0.2x gear_ref.\n\n"
+        + "\n".join(table)
+        + f"\n\nLoad average (1 min) at the end of the run: {load:.1f} on 2 cores.\n"
+    )
+    print(section)
+    write_section("maps-serve", section)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,108 @@
+"""``gearengine runup FILE --from 500 --to 6000 --rate 1000``: a run-up in this process.
+
+FILE holds ``{"design": {...}}`` (and any other field of ``POST /v1/runups``; the options
+override them). Bare numbers of ``--from``/``--to`` are rpm, of ``--rate`` rpm/s, of
+``--duration`` seconds, of ``--to-torque`` N m. Prints a table per branch (bins, contact, FTLE,
+the quasi-static DTE beside it) and the jumps with their lag behind the quasi-static loop;
+``--json OUT`` writes the API's document, ``--plot OUT.png|OUT.svg`` the figure.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from pathlib import Path
+
+from gearengine.cli.documents import EXIT_OK, InvalidInputError, read_document, validated_input
+from gearengine.cli.sweep import progress_bar
+from gearengine.jsonio import dumps
+from gearengine.runup.compute import run_local
+from gearengine.runup.request import RunupRequest, validated
+from gearengine.runup.results import RunupBranch, RunupResult
+
+OPTIONS = {  # option -> (request field, unit of a bare number)
+    "from_speed": ("from_speed", "rpm"),
+    "to_speed": ("to_speed", "rpm"),
+    "rate": ("rate", "rpm/s"),
+    "duration": ("duration", "s"),
+    "to_torque": ("to_torque", "N*m"),
+}
+
+
+def with_unit(text: str, unit: str) -> str:
+    """ "500" -> "500 rpm"; "52 rad/s" stays as it is."""
+    return text if any(c.isalpha() for c in text) else f"{text} {unit}"
+
+
+def runup_request(args: argparse.Namespace) -> RunupRequest:
+    """The request of FILE with the options applied."""
+    doc = read_document(args.file)
+    if not isinstance(doc, dict) or "design" not in doc:
+        raise InvalidInputError([f'{args.file}: a run-up needs {{"design": {{...}}}}'])
+    body = dict(doc)
+    for option, (field, unit) in OPTIONS.items():
+        value = getattr(args, option, None)
+        if value is not None:
+            body[field] = with_unit(value, unit)
+    if args.direction is not None:
+        body["direction"] = args.direction
+    if args.bin is not None:
+        body["bin_rpm"] = args.bin
+    if args.ensemble is not None:
+        body["ensemble"] = {**body.get("ensemble", {}), "size": args.ensemble}
+    return validated_input(validated, body, args.file)
+
+
+def _number(value: float | None, fmt: str) -> str:
+    return "-" if value is None else format(value, fmt)
+
+
+def branch_table(name: str, branch: RunupBranch, result: RunupResult) -> list[str]:
+    """One line per bin: speed, DTE (and the quasi-static one), factor, contact, FTLE."""
+    quasi = {round(p.speed_rpm, 6): p for p in getattr(result.quasi_static, name).points}
+    lines = [
+        f"run-{name}:",
+        "  speed [rpm]    time [s]   DTE [µm]  QS DTE  dyn.f.  contact       sep   back  "
+        "impacts  FTLE/tau",
+    ]
+    for b in branch.bins:
+        lo, hi = b.speed_rpm
+        q = quasi.get(round(0.5 * (lo + hi), 6))
+        impacts = "-" if b.back_flank_impacts is None else str(b.back_flank_impacts)
+        lines.append(
+            f"  {lo:6.0f}-{hi:<6.0f} {b.time_s[0]:6.2f}-{b.time_s[1]:<5.2f} "
+            f"{_number(b.dte_peak_to_peak_um, '8.2f')} "
+            f"{_number(None if q is None else q.dte_peak_to_peak_um, '7.2f')} "
+            f"{_number(b.dynamic_factor, '6.2f')}  {b.contact or '-':12s} "
+            f"{_number(b.separation_fraction, '5.2f')} {_number(b.back_flank_fraction, '5.2f')} "
+            f"{impacts:>7s}  {_number(b.lle, '+8.4f')}{' chaotic' if b.chaotic else ''}"
+        )
+    for j in branch.jumps:
+        lag = ""
+        if j.lag_rpm is not None:
+            lag = f"; quasi-static at {j.quasi_static_speed_rpm:.0f} rpm, lag {j.lag_rpm:+.0f} rpm"
+        lines.append(f"  jump at {j.speed_rpm:.0f} rpm: {j.from_um:.1f} -> {j.to_um:.1f} µm{lag}")
+    return lines
+
+
+def cmd_runup(args: argparse.Namespace) -> int:
+    """Run the run-up, print the tables, write --json and --plot."""
+    request = runup_request(args)
+    result = run_local(request, progress_bar(time.monotonic()), workers=os.cpu_count() or 1)
+    for name in ("up", "down"):
+        branch = getattr(result, name)
+        if branch is not None:
+            print("\n".join(branch_table(name, branch, result)))
+    for name in ("up", "down"):
+        for j in getattr(result.quasi_static, name).jumps:
+            print(f"quasi-static {name}: jump at {j.speed_rpm:.0f} rpm, "
+                  f"{j.from_um:.1f} -> {j.to_um:.1f} µm")  # fmt: skip
+    if args.json:
+        Path(args.json).write_text(dumps(result))
+    if args.plot:
+        from gearengine.plots.runup import runup_figure
+
+        fmt = "svg" if args.plot.endswith(".svg") else "png"
+        Path(args.plot).write_bytes(runup_figure(result, fmt))  # type: ignore[arg-type]
+    return EXIT_OK

@@ -1,0 +1,137 @@
+"""ISO 1328-1:2013 flank tolerances of a cylindrical gear for a flank tolerance class A.
+
+Clause 5.3 gives each tolerance of class A as its class-5 value times the class step
+sqrt(2)^(A - 5) (5.2.2: one class is a factor sqrt(2)); d is the reference diameter [mm], m_n
+the normal module [mm], b the face width [mm], results in µm:
+
+(5)  f_pT  = (0.001 d + 0.4 m_n + 5) sqrt(2)^(A-5)                  single pitch
+(6)  F_pT  = (0.002 d + 0.55 sqrt(d) + 0.7 m_n + 12) sqrt(2)^(A-5)  total cumulative pitch
+(7)  f_HaT = (0.4 m_n + 0.001 d + 4) sqrt(2)^(A-5)                  profile slope
+(8)  f_faT = (0.55 m_n + 5) sqrt(2)^(A-5)                           profile form
+(9)  F_aT  = sqrt(f_HaT^2 + f_faT^2)                                total profile
+(10) f_HbT = (0.05 sqrt(d) + 0.35 sqrt(b) + 4) sqrt(2)^(A-5)        helix slope
+(11) f_fbT = (0.07 sqrt(d) + 0.45 sqrt(b) + 4) sqrt(2)^(A-5)        helix form
+(12) F_bT  = sqrt(f_HbT^2 + f_fbT^2)                                total helix
+
+Rounding (5.2.3): the unrounded values enter (9) and (12); each tolerance is then rounded, above
+10 µm to the nearest integer, from 5 µm to 10 µm to the nearest 0.5 µm, below 5 µm to the
+nearest 0.1 µm. Range of validity (clause 1): 1 <= A <= 11, 5 <= z <= 1000, 5 mm <= d <= 15 000
+mm, 0.5 mm <= m_n <= 70 mm, 4 mm <= b <= 1200 mm, helix angle <= 45 deg (spur gears here: 0).
+Outside it the standard says nothing, so ``tolerances`` refuses (ValueError naming the input).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+STANDARD = "ISO 1328-1:2013"
+
+RANGES: dict[str, tuple[float, float]] = {
+    "class": (1, 11),
+    "teeth": (5, 1000),
+    "reference_diameter": (5.0, 15_000.0),
+    "module": (0.5, 70.0),
+    "face_width": (4.0, 1200.0),
+}
+"""Range of validity of clause 1 (lengths in mm)."""
+
+
+def class_step(tolerance_class: int) -> float:
+    """sqrt(2)^(A - 5): the factor from class 5 to class A (5.2.2)."""
+    return math.sqrt(2.0) ** (tolerance_class - 5)
+
+
+def rounded(value_um: float) -> float:
+    """A tolerance rounded as 5.2.3 says: > 10 µm to 1 µm, 5-10 µm to 0.5 µm, < 5 µm to 0.1 µm
+    (halves up)."""
+    step = 1.0 if value_um > 10.0 else 0.5 if value_um >= 5.0 else 0.1
+    return round(math.floor(value_um / step + 0.5 + 1e-9) * step, 1)
+
+
+@dataclass(frozen=True)
+class FlankTolerances:
+    """The eight flank tolerances of one gear [µm], rounded (5.2.3), and the unrounded ones."""
+
+    f_pT: float
+    F_pT: float
+    f_Halpha: float
+    f_falpha: float
+    F_alpha: float
+    f_Hbeta: float
+    f_fbeta: float
+    F_beta: float
+    unrounded: dict[str, float]
+
+
+FORMULAS: dict[str, str] = {
+    "f_pT": "(5) f_pT = (0.001 d + 0.4 m_n + 5) sqrt(2)^(A-5)",
+    "F_pT": "(6) F_pT = (0.002 d + 0.55 sqrt(d) + 0.7 m_n + 12) sqrt(2)^(A-5)",
+    "f_Halpha": "(7) f_HaT = (0.4 m_n + 0.001 d + 4) sqrt(2)^(A-5)",
+    "f_falpha": "(8) f_faT = (0.55 m_n + 5) sqrt(2)^(A-5)",
+    "F_alpha": "(9) F_aT = sqrt(f_HaT^2 + f_faT^2)",
+    "f_Hbeta": "(10) f_HbT = (0.05 sqrt(d) + 0.35 sqrt(b) + 4) sqrt(2)^(A-5)",
+    "f_fbeta": "(11) f_fbT = (0.07 sqrt(d) + 0.45 sqrt(b) + 4) sqrt(2)^(A-5)",
+    "F_beta": "(12) F_bT = sqrt(f_HbT^2 + f_fbT^2)",
+}
+"""Each tolerance's formula (ISO 1328-1:2013, 5.3), for the ``source`` of derived values."""
+
+
+def check_range(name: str, value: float) -> None:
+    """Refuse ``value`` outside clause 1's range for ``name`` (ValueError naming it)."""
+    lo, hi = RANGES[name]
+    if not lo <= value <= hi:
+        raise ValueError(
+            f"{name}: {value:g} is outside the range of {STANDARD} ({lo:g} to {hi:g}"
+            f"{' mm' if name not in ('class', 'teeth') else ''}); the standard does not apply"
+        )
+
+
+def tolerances(tolerance_class: int, teeth: int, module_mm: float, face_width_mm: float):
+    """The flank tolerances of a spur gear of class ``tolerance_class`` (1..11).
+
+    Args:
+        tolerance_class: flank tolerance class A, 1 (finest) to 11.
+        teeth: number of teeth z.
+        module_mm: normal module m_n [mm]; the reference diameter is d = m_n z [mm].
+        face_width_mm: face width b [mm].
+
+    Returns:
+        ``FlankTolerances`` [µm], Eq. (5)-(12) of ISO 1328-1:2013, 5.3, rounded by 5.2.3.
+
+    Raises:
+        ValueError: an input outside the range of validity (clause 1), naming it.
+    """
+    d = module_mm * teeth
+    for name, value in (("class", tolerance_class), ("teeth", teeth), ("module", module_mm),
+                        ("face_width", face_width_mm), ("reference_diameter", d)):  # fmt: skip
+        check_range(name, value)
+    s, m, b = class_step(tolerance_class), module_mm, face_width_mm
+    raw = {
+        "f_pT": (0.001 * d + 0.4 * m + 5.0) * s,
+        "F_pT": (0.002 * d + 0.55 * math.sqrt(d) + 0.7 * m + 12.0) * s,
+        "f_Halpha": (0.4 * m + 0.001 * d + 4.0) * s,
+        "f_falpha": (0.55 * m + 5.0) * s,
+        "f_Hbeta": (0.05 * math.sqrt(d) + 0.35 * math.sqrt(b) + 4.0) * s,
+        "f_fbeta": (0.07 * math.sqrt(d) + 0.45 * math.sqrt(b) + 4.0) * s,
+    }
+    raw["F_alpha"] = math.hypot(raw["f_Halpha"], raw["f_falpha"])
+    raw["F_beta"] = math.hypot(raw["f_Hbeta"], raw["f_fbeta"])
+    return FlankTolerances(**{k: rounded(v) for k, v in raw.items()}, unrounded=raw)
+
+
+def mesh_error_bound(profile_driver_um: float, profile_driven_um: float) -> float:
+    """Largest amplitude [µm] of the mesh-frequency transmission-error harmonic of a pair whose
+    gears have total profile tolerances F_aT,1 and F_aT,2 [µm] (the TE model).
+
+    Assumed (and only this): (a) the mesh-frequency harmonic of the static transmission error is
+    driven by the profile deviations, which repeat on every tooth; pitch deviations vary from
+    tooth to tooth and feed shaft-order sidebands, not modelled (Welbourn 1979, "Fundamental
+    knowledge of gear noise: a survey", IMechE C117/79; Smith 2003, "Gear Noise and Vibration",
+    2nd ed., ch. 2-3); (b) one gear's transmission error over a mesh cycle spans at most its total
+    profile deviation F_a, so its mesh harmonic has an amplitude of at most F_a / 2 (rigid teeth,
+    single contact); (c) the two gears' profile errors have unrelated phases and add as a
+    root-sum-square, e_max = sqrt(F_aT,1^2 + F_aT,2^2) / 2. Within that bound a gear that passes
+    inspection is anywhere: the amplitude is drawn uniformly on [0, e_max].
+    """
+    return math.hypot(profile_driver_um, profile_driven_um) / 2.0

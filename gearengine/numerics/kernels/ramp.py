@@ -1,0 +1,95 @@
+"""Kink-splitting RK4 of Eq. (9) along one linear segment of a speed profile (run-ups).
+
+The same step as the stationary piecewise kernel (``kink.kink_step``, split at every switching
+time |x| = 1) with the forcing of ``kernels.phase`` (excitations at the integrated driver
+angle); the tangent equation rides along for the finite-time Lyapunov exponent (Benettin et
+al., Meccanica 15, 1980: renormalised at the end of every block, the log of its norm kept).
+
+The segment is cut into ``n_blocks`` blocks of ``steps`` RK4 steps of length h; per block the
+kernel keeps what the reading of a run-up needs (``BLOCK_COLUMNS``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from gearengine.numerics.kernels.kink import kink_step
+from gearengine.numerics.kernels.phase import ramp_forcing_at
+from gearengine.numerics.kernels.smooth import JIT_OPTIONS, region, region_force
+
+BLOCK_COLUMNS = (
+    "x_min", "x_max", "force_min", "force_max", "steps_separated", "steps_back_flank",
+    "back_flank_impacts", "drive_flank_impacts", "log_growth",
+)  # fmt: skip
+"""Columns of ``run_ramp``'s block table: extremes of x and of the dimensionless mesh force
+K f_h(x) + 2 mu x' at step ends; steps ending inside the clearance (|x| <= 1) and on the back
+flank (x < -1); entries into the back flank and re-engagements of the drive flank (0 -> x > 1)
+at step ends; log of the tangent norm over the block."""
+
+
+@njit(**JIT_OPTIONS)
+def run_ramp(
+    alpha: float,
+    mu: float,
+    state: np.ndarray,
+    kc: np.ndarray,
+    ramp: np.ndarray,
+    fc: np.ndarray,
+    h: float,
+    n_blocks: int,
+    steps: int,
+    bound: float,
+):  # pragma: no cover - compiled
+    """Integrate one segment from ``state`` = [x, v, dx, dv] (updated in place to the end).
+
+    Args:
+        alpha: slope of f_h inside the clearance (Eq. 8); mu: damping ratio.
+        kc, ramp, fc: the segment's forcing (``kernels.phase``), tau from the segment start.
+        h: RK4 step (time units tau); n_blocks x steps steps in all.
+        bound: divergence bound on |x| and |v| (checked at block ends).
+
+    Returns:
+        table of shape (n_blocks, len(BLOCK_COLUMNS)), rows past a divergence NaN;
+        blocks completed.
+    """
+    twomu = 2.0 * mu
+    out = np.full((n_blocks, 9), np.nan)
+    x, v, dx, dv = state[0], state[1], state[2], state[3]
+    reg = region(x)
+    for n in range(n_blocks):
+        xmin, xmax, fmin, fmax = np.inf, -np.inf, np.inf, -np.inf
+        sep, back, back_in, drive_in = 0, 0, 0, 0
+        t0 = n * steps * h
+        for j in range(steps):
+            prev = reg
+            x, v, dx, dv, reg = kink_step(reg, alpha, twomu, kc, ramp, fc, t0 + j * h, h, x, v,
+                                          dx, dv)  # fmt: skip
+            K = ramp_forcing_at(t0 + (j + 1) * h, kc, ramp, fc)[0]
+            force = K * region_force(reg, alpha, x)[0] + twomu * v
+            xmin = min(xmin, x)
+            xmax = max(xmax, x)
+            fmin = min(fmin, force)
+            fmax = max(fmax, force)
+            if reg == 0:
+                sep += 1
+            elif reg < 0:
+                back += 1
+                if prev >= 0:
+                    back_in += 1
+            elif prev == 0:
+                drive_in += 1
+        nrm = math.sqrt(dx * dx + dv * dv)
+        dx /= nrm
+        dv /= nrm
+        if not (abs(x) < bound and abs(v) < bound):
+            state[0], state[1], state[2], state[3] = x, v, dx, dv
+            return out, n
+        row = out[n]
+        row[0], row[1], row[2], row[3] = xmin, xmax, fmin, fmax
+        row[4], row[5], row[6], row[7] = sep, back, back_in, drive_in
+        row[8] = math.log(nrm)
+    state[0], state[1], state[2], state[3] = x, v, dx, dv
+    return out, n_blocks

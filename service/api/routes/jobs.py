@@ -1,0 +1,294 @@
+"""The routes every kind of durable job has: submit, list, status, result, cancel.
+
+``JobRoutes(kind, prefix, ...).router()`` gives, for a kind of ``gearengine.jobs.KINDS``:
+``POST /v1/<prefix>`` (202, ``Location``, ``Retry-After``), ``GET /v1/<prefix>`` (the caller's
+jobs of that kind, newest first), ``GET /v1/<prefix>/{id}``, ``GET /v1/<prefix>/{id}/result``
+(409 until succeeded; ``?partial=true`` for the finished chunks) and ``DELETE
+/v1/<prefix>/{id}`` (cancel). Jobs belong to the API key that submitted them (``require_key``'s
+key id; None with auth off): another key, or another kind's route, gets 404 and does not list
+them. A kind with a result of its own (sweeps: CSV, windows) sets ``result=False`` and adds its
+routes to the router returned.
+
+No ``from __future__ import annotations`` here: the endpoints are closures whose annotations
+(the kind's request model) FastAPI reads at run time.
+"""
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Annotated, Any
+
+from fastapi import APIRouter, Query, Request, Response
+from pydantic import BaseModel
+from starlette.concurrency import run_in_threadpool
+
+from gearengine import jobs as job_kinds
+from service.api.deps import AppSettings, Jobs, Owner
+from service.api.responses import JSON, PROBLEMS, RETRY_AFTER_HEADER, header
+from service.core.config import Settings
+from service.errors import ProblemError
+from service.jobs.models import UNFINISHED, Job, JobPage, JobStatus
+from service.jobs.runtime import SweepJobs
+from service.jobs.store import QueueFullError
+
+RETRY_AFTER = {"queued": "5", "running": "2"}
+"""Seconds a client should wait before polling an unfinished job again."""
+QUEUE_FULL_RETRY = "30"
+PARTIAL_HEADER = "X-Partial-Result"
+"""Set to true on a result with chunks missing (?partial=true on a job that did not succeed)."""
+
+NOT_FOUND = {404: {"description": "No such job for this API key."}}
+RETRY = {"Retry-After": RETRY_AFTER_HEADER}
+CONFLICT = {
+    409: {
+        "description": "The job has not succeeded (yet); ?partial=true gives its finished "
+        "chunks. Retry-After while it is queued or running.",
+        "headers": RETRY,
+    }
+}
+
+
+def poll_headers(job: Job) -> dict[str, str]:
+    """``Retry-After`` while the job is queued or running."""
+    return {"Retry-After": RETRY_AFTER[job.status]} if job.status in UNFINISHED else {}
+
+
+def no_check(body: BaseModel, request: Request, settings: Settings) -> None:
+    """A kind whose request model and work budget say everything."""
+
+
+@dataclass(frozen=True)
+class JobRoutes:
+    """The routes of one kind of job.
+
+    Attributes:
+        kind: its name in ``gearengine.jobs.KINDS``.
+        prefix: the routes' prefix, ``/v1/<prefix>``.
+        noun, plural: how messages, summaries and operation ids name one job and several.
+        submit_summary, submit_doc: the POST route's summary and description.
+        result_model, result_summary, result_doc: the result route's model and texts.
+        check: ``(body, request, settings)``: refusals beyond the model (422 problems), before
+            the work budget (the kind's ``work`` against max_sweep_steps) is checked.
+        chunk_size: ``settings -> units of work per chunk`` (default: the kind's).
+        budget_path: the field a refusal over the work budget names.
+    """
+
+    kind: str
+    prefix: str
+    noun: str
+    plural: str
+    submit_summary: str
+    submit_doc: str
+    result_model: type[BaseModel] | None = None
+    result_summary: str = ""
+    result_doc: str = ""
+    check: Callable[[Any, Request, Settings], None] = no_check
+    chunk_size: Callable[[Settings], int] | None = None
+    budget_path: str = "axes"
+
+    def job_or_404(self, jobs: SweepJobs, job_id: str, owner: str | None) -> Job:
+        """The caller's job of this kind, else 404."""
+        job = jobs.store.get(job_id, owner, self.kind)
+        if job is None:
+            raise ProblemError(404, "not-found", "Not found", f"no {self.noun} job {job_id}")
+        return job
+
+    def succeeded(self, jobs: SweepJobs, job_id: str, owner: str | None) -> Job:
+        """The caller's succeeded job, else 404 or 409 (with Retry-After while unfinished)."""
+        job = self.job_or_404(jobs, job_id, owner)
+        if job.status != "succeeded":
+            raise ProblemError(
+                409,
+                "not-finished" if job.status in UNFINISHED else "no-result",
+                "No result",
+                f"{self.noun} {job_id} is {job.status}: the full result exists only once it has "
+                "succeeded; ?partial=true gives the points of its finished chunks",
+                headers=poll_headers(job),
+            )
+        return job
+
+    def submit(
+        self, body: BaseModel, request: Request, response: Response, owner: str | None,
+        settings: Settings, jobs: SweepJobs,
+    ) -> Job:  # fmt: skip
+        """Check, plan and store a job; 429 when the queue is full."""
+        self.check(body, request, settings)
+        request.app.state.limits.check_job(self.kind, body, self.noun, self.budget_path)
+        kind = job_kinds.kind(self.kind)
+        size = kind.chunk_points if self.chunk_size is None else self.chunk_size(settings)
+        try:
+            job = jobs.store.submit(
+                owner, body.model_dump_json(), kind.chunk_counts(body, size), size,
+                settings.max_queued_jobs, kind=self.kind,
+            )  # fmt: skip
+        except QueueFullError as exc:
+            raise ProblemError(
+                429,
+                "queue-full",
+                "Too many requests",
+                f"{exc} (max_queued_jobs); retry later",
+                headers={"Retry-After": QUEUE_FULL_RETRY},
+            ) from None
+        jobs.wake()
+        response.headers["Location"] = f"/v1/{self.prefix}/{job.id}"
+        response.headers.update(poll_headers(job))
+        return job
+
+    def router(self, result: bool = True) -> APIRouter:
+        """The kind's routes (with its generic result route unless ``result`` is False)."""
+        routes = self
+        router = APIRouter(prefix=f"/v1/{self.prefix}")
+        model = job_kinds.kind(self.kind).request
+
+        def post(
+            body: model,  # type: ignore[valid-type]
+            request: Request,
+            response: Response,
+            owner: Owner,
+            settings: AppSettings,
+            jobs: Jobs,
+        ) -> Job:
+            return routes.submit(body, request, response, owner, settings, jobs)
+
+        def listing(
+            owner: Owner,
+            jobs: Jobs,
+            status: Annotated[
+                JobStatus | None, Query(description="Only jobs in this status.")
+            ] = None,
+            limit: Annotated[int, Query(ge=1, le=100, description="Jobs per page.")] = 20,
+            offset: Annotated[
+                int, Query(ge=0, le=2**31, description="Jobs to skip (newest first).")
+            ] = 0,
+        ) -> JobPage:
+            items, total = jobs.store.list(owner, status, limit, offset, routes.kind)
+            more = offset + len(items) < total
+            return JobPage(
+                items=items, total=total, next_offset=offset + len(items) if more else None
+            )
+
+        def status(job_id: str, response: Response, owner: Owner, jobs: Jobs) -> Job:
+            job = routes.job_or_404(jobs, job_id, owner)
+            response.headers.update(poll_headers(job))
+            return job
+
+        def cancel(job_id: str, owner: Owner, jobs: Jobs) -> Job:
+            routes.job_or_404(jobs, job_id, owner)
+            job = jobs.store.cancel(job_id, owner, routes.kind)
+            assert job is not None
+            if job.status not in ("cancelled", *UNFINISHED):
+                raise ProblemError(
+                    409, "finished", "Already finished", f"{routes.noun} {job_id} {job.status}"
+                )
+            jobs.wake()
+            return job
+
+        router.add_api_route(
+            "",
+            post,
+            methods=["POST"],
+            name=f"post_{self.noun}",
+            status_code=202,
+            response_model=Job,
+            responses={
+                **PROBLEMS,
+                202: {
+                    "description": "Stored and queued.",
+                    "headers": {
+                        "Location": header("URL of the job: poll it."),
+                        "Retry-After": RETRY_AFTER_HEADER,
+                    },
+                },
+                429: {
+                    "description": "Too many unfinished jobs; see Retry-After.",
+                    "headers": RETRY,
+                },
+            },
+            summary=self.submit_summary,
+            description=self.submit_doc,
+        )
+        router.add_api_route(
+            "",
+            listing,
+            methods=["GET"],
+            name=f"list_{self.plural}",
+            response_model=JobPage,
+            responses=PROBLEMS,
+            summary=f"The caller's {self.noun} jobs",
+            description="Newest first, paginated with ``limit`` and ``offset``.",
+        )
+        router.add_api_route(
+            "/{job_id}",
+            status,
+            methods=["GET"],
+            name=f"get_{self.noun}",
+            response_model=Job,
+            responses={**PROBLEMS, **NOT_FOUND, 200: {"description": "The job.", "headers": RETRY}},
+            summary=f"Status and progress of a {self.noun} job",
+            description="``Retry-After`` is set while the job is queued or running.",
+        )
+        router.add_api_route(
+            "/{job_id}",
+            cancel,
+            methods=["DELETE"],
+            name=f"cancel_{self.noun}",
+            response_model=Job,
+            responses={**PROBLEMS, **NOT_FOUND, 409: {"description": "The job already finished."}},
+            summary=f"Cancel a {self.noun} job",
+            description="No new chunk of the job starts; running chunks are dropped. Cancelling "
+            "a cancelled job\nis a no-op; a succeeded or failed job cannot be cancelled (409).",
+        )
+        if result:
+            self._result_route(router)
+        return router
+
+    def _result_route(self, router: APIRouter) -> None:
+        routes = self
+        kind = job_kinds.kind(self.kind)
+
+        async def result(
+            job_id: str,
+            owner: Owner,
+            jobs: Jobs,
+            partial: Annotated[
+                bool,
+                Query(
+                    description="Also answer for a job that did not succeed (cancelled, failed, "
+                    "or still running): the result of its finished chunks, with "
+                    f"{PARTIAL_HEADER}: true."
+                ),
+            ] = False,
+        ) -> Response:
+            check = routes.job_or_404 if partial else routes.succeeded
+            job = await run_in_threadpool(check, jobs, job_id, owner)
+            missing = job.status != "succeeded"
+
+            def assemble() -> bytes:
+                request = kind.request.model_validate_json(jobs.store.request_json(job_id))
+                document = kind.assemble(request, list(jobs.store.chunk_results(job_id)))
+                return document.model_dump_json().encode()
+
+            body = await run_in_threadpool(assemble)
+            headers = {PARTIAL_HEADER: "true", **poll_headers(job)} if missing else {}
+            return Response(body, media_type=JSON, headers=headers)
+
+        router.add_api_route(
+            "/{job_id}/result",
+            result,
+            methods=["GET"],
+            name="get_result",
+            response_model=self.result_model,
+            responses={
+                **PROBLEMS,
+                **NOT_FOUND,
+                **CONFLICT,
+                200: {
+                    "description": f"The {self.noun}'s result.",
+                    "headers": {
+                        PARTIAL_HEADER: header("true when chunks are missing (?partial=true)."),
+                        "Retry-After": RETRY_AFTER_HEADER,
+                    },
+                },
+            },
+            summary=self.result_summary or f"Result of a succeeded {self.noun} job",
+            description=self.result_doc,
+        )

@@ -1,0 +1,107 @@
+"""Piecewise lanes (``kernels.run_kink_batch``) against the scalar kink kernel, and the adaptive
+LLE rule (``kernels.adaptive.lle_known``) of both lock-step kernels against fixed length."""
+
+from __future__ import annotations
+
+import pytest
+
+from gearengine.model.params import GearParams
+from gearengine.numerics.batch import run_lanes
+from gearengine.numerics.runs import integrate
+from gearengine.numerics.settings import SimulationSettings
+from gearengine.numerics.simulation import simulate
+from tests._gear_cases import paper
+
+STARTS = [(0.01, 0.01), (1.5, 0.0), (-1.2, 0.3)]
+"""Inside the clearance, in contact on the drive side, on the back side."""
+
+
+def piecewise_points() -> list[GearParams]:
+    """No impact (small TE), single-sided and double-sided impacts, periodic and chaotic, with
+    alpha 0 and 0.3, and a design with stiffness, torque and TE harmonics (several forcing
+    terms, K(t) != 1)."""
+    points = [
+        paper(0.02, model="piecewise"),
+        paper(0.1, model="piecewise", alpha=0.3),
+        paper(0.2, model="piecewise"),
+        paper(0.3, mu=0.05, model="piecewise"),
+        paper(0.6, mu=0.1, model="piecewise"),
+        paper(1.0, model="piecewise", alpha=0.3),
+    ]
+    several = {
+        "damping": 0.06,
+        "mean_force": 0.05,
+        "backlash": {"model": "piecewise", "alpha": 0.1},
+        "stiffness": {"frequency": 1.0, "harmonics": [{"amplitude": 0.1}, {"amplitude": 0.03}]},
+        "torque": {"frequency": 0.5, "harmonics": [{"amplitude": 0.02}]},
+        "transmission_error": {
+            "frequency": 1.0,
+            "harmonics": [{"amplitude": 0.1}, {"amplitude": 0.02, "phase": 0.4}],
+        },
+    }
+    return [*points, GearParams.model_validate(several)]
+
+
+def test_piecewise_lanes_equal_the_scalar_kink_kernel_bit_for_bit() -> None:
+    points = piecewise_points()
+    lanes = [(i, s) for i in range(len(points)) for s in STARTS]
+    settings = SimulationSettings(transient_periods=60, record_periods=60, adaptive=False)
+    out = run_lanes(points, lanes, settings)
+    regimes, classes = set(), set()
+    for (i, start), o in zip(lanes, out, strict=True):
+        run = integrate(points[i], settings, start)  # run_kink with its forcing table
+        assert o.final_state == [run.final[0], run.final[1]]
+        assert o.x_peak_to_peak == run.xmax - run.xmin
+        assert (o.force_min, o.force_max) == (run.fmin, run.fmax)
+        assert o.poincare[-1] == [run.xs[-1], run.vs[-1]]
+        assert o.periods_run == run.done == 120
+        regimes.add(o.impact_regime)
+        classes.add(o.classification)
+    assert regimes == {"no_impact", "single_sided", "double_sided"}
+    assert {"periodic", "chaotic"} <= classes
+
+
+def test_piecewise_lanes_give_simulates_verdicts() -> None:
+    points = piecewise_points()
+    settings = SimulationSettings(
+        transient_periods=60,
+        record_periods=60,
+        adaptive=False,
+        initial_states=[list(s) for s in STARTS],
+    )
+    lanes = [(i, s) for i in range(len(points)) for s in STARTS]
+    out = run_lanes(points, lanes, settings)
+    for i, p in enumerate(points):
+        single = simulate(p, settings)
+        assert single.method.endswith("forcing table")
+        for k, summary in enumerate(single.starts):
+            o = out[i * len(STARTS) + k]
+            assert (o.classification, o.period) == (summary.classification, summary.period)
+            assert (o.lle, o.lle_stderr) == (summary.lle, summary.lle_stderr)
+
+
+@pytest.mark.parametrize(
+    "point",
+    [paper(0.25), paper(0.2, model="piecewise"), paper(0.6, mu=0.1, model="piecewise")],
+    ids=["cubic", "piecewise-single-sided", "piecewise-double-sided"],
+)
+def test_chaotic_lane_stops_once_its_lle_is_known(point: GearParams) -> None:
+    fixed_settings = SimulationSettings(adaptive=False)
+    adaptive_settings = SimulationSettings()
+    (fixed,) = run_lanes([point], [(0, (0.01, 0.01))], fixed_settings)
+    (early,) = run_lanes([point], [(0, (0.01, 0.01))], adaptive_settings)
+    assert fixed.classification == early.classification == "chaotic"
+    assert fixed.periods_run == 1000
+    assert 600 <= early.periods_run < 1000 and (early.periods_run - 500) % 10 == 0
+    tol = max(adaptive_settings.lle_stderr_abs, adaptive_settings.lle_stderr_rel * early.lle)
+    assert early.lle_stderr <= tol
+    assert abs(early.lle - fixed.lle) <= 3.0 * early.lle_stderr
+    assert early.lle - 3.0 * early.lle_stderr > 0.0
+
+
+def test_lle_rule_off_runs_the_full_length_bit_for_bit() -> None:
+    point = paper(0.2, model="piecewise")
+    off = SimulationSettings(lle_stderr_rel=0.0, lle_stderr_abs=0.0)
+    (a,) = run_lanes([point], [(0, (0.01, 0.01))], off)
+    (f,) = run_lanes([point], [(0, (0.01, 0.01))], SimulationSettings(adaptive=False))
+    assert a == f and a.periods_run == 1000

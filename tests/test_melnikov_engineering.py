@@ -1,0 +1,94 @@
+"""The Melnikov answer in gear units: the critical torque and the edge of applicability for
+designs (issue 25), one sign convention for margins (issue 26 item 3), speed windows scanned
+until they close (issue 26 item 4)."""
+
+from __future__ import annotations
+
+import copy
+
+import pytest
+
+from gearengine.analysis import answer_melnikov
+from gearengine.homoclinic.batch import melnikov_batch
+from gearengine.homoclinic.schemas import MelnikovRequest
+from gearengine.homoclinic.verdict import melnikov
+from gearengine.model.design import EXAMPLE_DESIGN
+from gearengine.model.params import GearParams
+from tests.conftest import PAPER_PARAMS
+from tests.test_design import LIGHT, design
+
+
+def answer(d: dict, **extra: object):
+    return answer_melnikov(MelnikovRequest.model_validate({"design": d, **extra}))
+
+
+def test_the_readme_design_at_40_nm_is_outside_the_criterion() -> None:
+    """40 N m deflects the mesh 13.3 µm: F~_m = 0.267 > F_crit = 0.0642; no windows, and the
+    summary says why in gear words and names the critical torque."""
+    got = answer(EXAMPLE_DESIGN)
+    assert got.applicable is False and got.chaos_possible is None
+    eng = got.engineering
+    assert eng.critical_torque_nm == pytest.approx(40.0 * got.critical_mean_force / (0.8 / 3))
+    assert eng.speed_windows_rpm == []
+    assert eng.speed_windows_note.startswith("not applicable above T_crit")
+    assert "13.3 µm statically" in eng.summary and "numerical verdict still applies" in eng.summary
+
+
+@pytest.mark.parametrize("factor", [1 - 1e-6, 1 + 1e-6])
+def test_applicability_switches_at_the_critical_torque(factor: float) -> None:
+    t_crit = answer(LIGHT).engineering.critical_torque_nm
+    assert t_crit == pytest.approx(9.623, abs=1e-3)
+    got = answer(design(torque=f"{factor * t_crit!r} N*m"))
+    assert got.applicable is (factor < 1)
+    assert (got.engineering.speed_windows_note or "").startswith("not applicable") is (factor > 1)
+
+
+def test_margins_are_positive_on_the_safe_side() -> None:
+    """Issue 26 item 3: F_e1 below its threshold and mu above its threshold are both safe and
+    both positive, in the thresholds, the batch and the engineering block."""
+    safe = GearParams.model_validate({**PAPER_PARAMS, "transmission_error": {
+        "frequency": 0.5, "harmonics": [{"amplitude": 0.1}]}})  # fmt: skip
+    result = melnikov(safe)
+    assert result.chaos_possible is False
+    assert result.thresholds["F_e1"].margin > 0 and result.thresholds["mu"].margin > 0
+    batch = melnikov_batch([safe])[0]["margins"]
+    assert batch["F_e1"]["margin"] > 0 and batch["mu"]["margin"] > 0
+    unsafe = GearParams.model_validate(PAPER_PARAMS)  # F_e1 = 0.2 beyond both loops' thresholds
+    assert melnikov(unsafe).chaos_possible is True
+    assert melnikov(unsafe).thresholds["F_e1"].margin < 0
+    assert melnikov_batch([unsafe])[0]["margins"]["F_e1"]["margin"] < 0
+    eng = answer(LIGHT).engineering.critical
+    assert all(c.margin_to_chaos > 0 for c in eng.values())
+
+
+def test_an_amplitudes_nearest_critical_value_has_its_sign() -> None:
+    """A negative amplitude is a phase shift by pi: the nearest critical stiffness variation of
+    the light design is +88 MN/m (growing the 10 MN/m variation), not -30 MN/m through 0."""
+    crit = answer(LIGHT).engineering.critical
+    for name in ("stiffness_variation_amplitude", "torque_fluctuation_amplitude"):
+        c = crit[name]
+        assert c.nearest > 0 and c.margin_to_chaos == pytest.approx(c.nearest - c.value), name
+
+
+def test_speed_windows_do_not_end_at_the_scan() -> None:
+    """Issue 26 item 4: the same pair at 1,500 and at 3,000 rpm has the same window (2,735-4,723
+    rpm), not one cut at 3 x the design speed."""
+    at_1500 = answer(LIGHT).engineering
+    fast = copy.deepcopy(LIGHT)
+    fast["speed"] = "3000 rpm"
+    at_3000 = answer(fast).engineering
+    assert len(at_1500.speed_windows_rpm) == len(at_3000.speed_windows_rpm) == 1
+    assert at_1500.speed_windows_rpm[0] == pytest.approx(at_3000.speed_windows_rpm[0], rel=1e-6)
+    assert at_1500.speed_windows_rpm[0][1] < at_1500.speed_range_rpm[1]
+    assert at_1500.speed_windows_note is None
+
+
+def test_an_open_ended_window_says_so() -> None:
+    """Without damping every sinusoid of M changes sign: chaos is possible up to the scan's
+    physical bound (10 x the design speed), and the note says the window is open-ended."""
+    undamped = copy.deepcopy(LIGHT)
+    undamped["mesh"]["damping_ratio"] = 0.0
+    eng = answer(undamped).engineering
+    assert eng.speed_range_rpm[1] == pytest.approx(15_000.0)
+    assert eng.speed_windows_rpm[-1][1] == pytest.approx(15_000.0)
+    assert "open-ended" in eng.speed_windows_note

@@ -1,0 +1,281 @@
+"""Run-ups (gearengine.runup): the kernel on the integrated driver angle against an independent
+DOP853 integration of Eq. (7) in SI units with events at the backlash edges, the quasi-static
+jump speeds at a slow rate, the lag at a fast one, refusals before any compute, and the job
+through a real server equal to the CLI's document."""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import httpx
+import numpy as np
+import pytest
+from pydantic import ValidationError
+from scipy.integrate import solve_ivp
+
+from gearengine.cli.main import main
+from gearengine.jsonio import dumps, error_lines
+from gearengine.model.units import RPM
+from gearengine.numerics.forcing import packed_forcing
+from gearengine.numerics.kernels.phase import ramp_forcing_at
+from gearengine.numerics.kernels.smooth import forcing_at
+from gearengine.runup import run_local
+from gearengine.runup.compute import compute_chunk
+from gearengine.runup.gate import runup_failures
+from gearengine.runup.profile import ramp_forcing
+from gearengine.runup.request import RunupRequest, validated
+from gearengine.sweeps.gate import Rules
+from tests.conftest import ROOT, Server
+
+CI_DESIGN = json.loads((ROOT / "examples" / "ci" / "design.json").read_text())["design"]
+
+
+def _request(**fields: object) -> dict:
+    return {"design": CI_DESIGN, **fields}
+
+
+def test_ramp_forcing_without_acceleration_is_the_stationary_forcing() -> None:
+    """beta = 0: the phase record reproduces Eq. (9)'s forcing at absolute time exactly."""
+    r = validated(_request(from_speed="1500 rpm", to_speed="2000 rpm", rate="1000 rpm/s"))
+    conv = r.conversion
+    assert conv is not None and r.params is not None
+    wn = 1.0 / conv.time_scale_s
+    f = ramp_forcing(r.params, 1500 * RPM, wn)
+    kc, fm, fc = packed_forcing(r.params)
+    record = np.array([fm, 0.0, 1500 * RPM / wn, 0.0, 0.0])
+    for t in (0.0, 1.3, 47.9, 1234.5):
+        assert ramp_forcing_at(t, f.kc, record, f.fc) == pytest.approx(
+            forcing_at(t, kc, fm, fc), rel=1e-12, abs=1e-14
+        )
+
+
+def _dop853_eq7(request: RunupRequest, t_end: float, samples_per_mesh: int = 200):
+    """Eq. (7) in SI units for examples/ci/design.json, written from the paper, not from the
+    engine: m x'' + c x' + k(t)
+    f_h(x) = F_m(t) - m e''(t) + m r_a / I_a T_p(t), every excitation at the driver angle
+    phi(t) = w0 t + a t^2 / 2 of the linear ramp, f_h of Eq. (6) with alpha = 0, DOP853
+    (rtol 1e-10) restarted at every event x = +-b. Returns a dense sampler x(t) and the event
+    times with the region entered."""
+    ra, rb, ia, ib = 0.03, 0.05, 2e-3, 8e-3
+    za, km, k1, b = 18, 1e8, 1e7, 50e-6
+    e1, tp, torque, zeta = 5e-6, 4.0, 40.0, 0.05
+    m = ia * ib / (ib * ra**2 + ia * rb**2)
+    c = 2.0 * zeta * math.sqrt(km * m)
+    knots = request.knots()
+
+    def speed(t: float) -> tuple[float, float, float]:  # (phi, w, dw/dt) of the profile
+        phi = 0.0
+        for (t0, w0), (t1, w1) in itertools.pairwise(knots):
+            a = (w1 - w0) / (t1 - t0)
+            if t <= t1 or t1 == knots[-1][0]:
+                s = t - t0
+                return phi + w0 * s + 0.5 * a * s * s, w0 + a * s, a
+            phi += 0.5 * (w0 + w1) * (t1 - t0)
+        raise AssertionError
+
+    def rhs(t: float, y: np.ndarray, region: int) -> list[float]:
+        phi, w, a = speed(t)
+        k = km + k1 * math.cos(za * phi)
+        fh = y[0] - b if region > 0 else (y[0] + b if region < 0 else 0.0)
+        ee = -e1 * ((za * w) ** 2 * math.cos(za * phi) + za * a * math.sin(za * phi))  # e''
+        fm = torque / ra + ib * (a * ra / rb) / rb
+        force = fm - m * ee + m * ra / ia * tp * math.cos(phi)
+        return [y[1], (force - c * y[1] - k * fh) / m]
+
+    def edge(level: float, direction: int) -> Callable[..., float]:
+        def event(t: float, y: np.ndarray, region: int) -> float:
+            return y[0] - level
+
+        event.terminal = True
+        event.direction = direction
+        return event
+
+    leaving = {  # the edges a region is left through, with their crossing direction
+        1: [edge(b, -1)],
+        0: [edge(b, 1), edge(-b, -1)],
+        -1: [edge(-b, 1)],
+    }
+    y = np.array([b + torque / ra / km, 0.0])  # static contact, as the run-up starts
+    t, region = 0.0, 1
+    pieces, events = [], []
+    while t < t_end:
+        sol = solve_ivp(rhs, (t, t_end), y, method="DOP853", rtol=1e-10, atol=1e-16,
+                        args=(region,), events=leaving[region], dense_output=True)  # fmt: skip
+        pieces.append((t, sol.t[-1], sol.sol))
+        y, t = sol.y[:, -1].copy(), sol.t[-1]
+        if sol.status == 1:
+            y[0] = b if y[0] > 0 else -b
+            region = (1 if y[1] > 0 else 0) if y[0] > 0 else (-1 if y[1] < 0 else 0)
+            events.append((t, region))
+    mesh = za * knots[-1][1] / (2.0 * math.pi)
+
+    def sample(t0: float, t1: float) -> np.ndarray:
+        ts = np.linspace(t0, t1, max(2, int((t1 - t0) * mesh * samples_per_mesh)))
+        out = np.empty_like(ts)
+        for lo, hi, f in pieces:
+            inside = (ts >= lo) & (ts <= hi)
+            if inside.any():
+                out[inside] = f(ts[inside])[0]
+        return out
+
+    return sample, events
+
+
+def test_runup_follows_an_independent_integration_of_eq7() -> None:
+    """DTE envelope and contact status of every bin of a fast up-and-down ramp through the
+    separating branch (4300-4500 rpm at 4000 rpm/s) against DOP853 of the SI model."""
+    r = validated(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s",
+                           direction="up_down", settle_periods=0,
+                           ensemble={"size": 1}))  # fmt: skip
+    result = run_local(r)
+    sample, events = _dop853_eq7(r, r.duration_s())
+    bins = [*result.up.bins, *result.down.bins]  # type: ignore[union-attr]
+    assert len(bins) == 8
+    for k, bn in enumerate(bins):
+        t0, t1 = bn.time_s
+        x = sample(t0, t1)
+        dte = (x.max() - x.min()) * 1e6
+        assert bn.dte_peak_to_peak_um == pytest.approx(dte, rel=2e-3), (k, bn.speed_rpm)
+        # time in the clearance from the exact event times
+        marks = [(t0, _region_at(events, t0))] + [(t, g) for t, g in events if t0 < t < t1]
+        sep = sum(min(t1, nxt) - t for (t, g), nxt in
+                  zip(marks, [m[0] for m in marks[1:]] + [t1], strict=True) if g == 0)  # fmt: skip
+        assert bn.separation_fraction == pytest.approx(sep / (t1 - t0), abs=0.01), k
+        assert (bn.contact == "no_contact") == (sep > 0)
+        assert bn.back_flank_fraction == 0.0 and not any(g < 0 for _, g in events)
+    assert min(b.separation_fraction for b in bins) > 0.2  # the separating branch
+
+
+def _region_at(events: list[tuple[float, int]], t: float) -> int:
+    before = [g for s, g in events if s <= t]
+    return before[-1] if before else 1
+
+
+def test_slow_runup_reproduces_the_quasi_static_jumps() -> None:
+    """examples/ci/design.json at 40 N m: at 100 rpm/s the jump up and the jump down agree
+    with the continuation sweep (the hysteresis loop) within its grid step."""
+    r = validated(_request(from_speed="3700 rpm", to_speed="4400 rpm", rate="100 rpm/s",
+                           direction="up_down", ensemble={"size": 1}))  # fmt: skip
+    result = run_local(r, workers=2)
+    step = result.quasi_static.grid_step_rpm
+    for name, sense in (("up", 1), ("down", -1)):
+        branch = getattr(result, name)
+        (jump,) = [j for j in branch.jumps if (j.to_um - j.from_um) * sense > 0]
+        (quasi,) = getattr(result.quasi_static, name).jumps
+        assert jump.quasi_static_speed_rpm == quasi.speed_rpm
+        assert abs(jump.lag_rpm) <= step, (name, jump)
+    up, down = result.up.jumps[0], result.down.jumps[0]  # type: ignore[union-attr]
+    assert 3850 <= down.speed_rpm < up.speed_rpm <= 4250  # the loop: up above down
+
+
+def test_a_fast_ramp_lags_the_quasi_static_jump() -> None:
+    """At 20 000 rpm/s the response needs time to move to the new branch: the run-down's
+    jump comes later (lower speed) than the quasi-static one, by more than at 1000 rpm/s."""
+    lags = {}
+    for rate in ("1000 rpm/s", "20000 rpm/s"):
+        r = validated(_request(from_speed="3500 rpm", to_speed="4500 rpm", rate=rate,
+                               direction="up_down", ensemble={"size": 1}))  # fmt: skip
+        result = run_local(r, workers=2)
+        (jump,) = [j for j in result.down.jumps if j.to_um < j.from_um]  # type: ignore[union-attr]
+        lags[rate] = jump.lag_rpm
+    assert lags["20000 rpm/s"] > lags["1000 rpm/s"] >= 0
+
+
+@pytest.mark.parametrize(
+    ("fields", "path", "words"),
+    [
+        ({"rate": 0}, "rate", "positive"),
+        ({"rate": "-500 rpm/s"}, "rate", "positive"),
+        ({"rate": "1000 rpm"}, "rate", "dimension"),
+        ({"to_speed": "300000 rpm"}, "to_speed", "plausible range"),
+        ({"from_speed": "0.01 rpm"}, "from_speed", "plausible range"),
+        ({"to_speed": "400 rpm"}, "to_speed", "above from_speed"),
+        ({"rate": None, "duration": "3000 s"}, "duration", "budget"),
+        ({"direction": "sideways"}, "direction", "up"),
+    ],
+)
+def test_bad_ramps_are_refused_naming_the_field(fields: dict, path: str, words: str) -> None:
+    ramp = _request(from_speed="500 rpm", to_speed="6000 rpm", rate="1000 rpm/s")
+    body = {k: v for k, v in {**ramp, **fields}.items() if v is not None}
+    with pytest.raises(ValidationError) as exc:
+        validated(body)
+    lines = error_lines(exc.value)
+    assert any(line.startswith(f"{path}:") and words in line for line in lines), lines
+
+
+def test_a_chunk_is_the_same_bytes_twice() -> None:
+    r = validated(_request(from_speed="4000 rpm", to_speed="4100 rpm", rate="5000 rpm/s",
+                           ensemble={"size": 2}))  # fmt: skip
+    assert compute_chunk(r, 1) == compute_chunk(r, 1)
+    assert compute_chunk(r, 0) != compute_chunk(r, 1)  # the perturbed start differs
+
+
+def test_the_service_job_is_the_cli_document(tmp_path: Path) -> None:
+    """POST /v1/runups on a real server (workers, SQLite): 202 + Location, then the result is
+    byte for byte what ``gearengine runup --json`` writes; a bad ramp is a 422 naming the field
+    before anything is stored."""
+    body = _request(from_speed="4000 rpm", to_speed="4300 rpm", rate="6000 rpm/s",
+                    direction="up_down", ensemble={"size": 2}, settle_periods=20)  # fmt: skip
+    design_file = tmp_path / "runup.json"
+    design_file.write_text(json.dumps(body))
+    out = tmp_path / "out.json"
+    assert main(["runup", str(design_file), "--json", str(out), "--plot",
+                 str(tmp_path / "runup.png")]) == 0  # fmt: skip
+    assert (tmp_path / "runup.png").read_bytes()[:4] == b"\x89PNG"
+    server = Server(tmp_path / "data")
+    try:
+        with httpx.Client(base_url=server.url, timeout=60) as http:
+            bad = http.post("/v1/runups", json={**body, "rate": "0 rpm/s"})
+            assert bad.status_code == 422
+            assert "rate" in json.dumps(bad.json()["errors"])
+            assert http.get("/v1/runups").json()["total"] == 0
+            posted = http.post("/v1/runups", json=body)
+            assert posted.status_code == 202
+            location = posted.headers["location"]
+            deadline = time.monotonic() + 300
+            while http.get(location).json()["status"] in ("queued", "running"):
+                assert time.monotonic() < deadline
+                time.sleep(0.5)
+            result = http.get(f"{location}/result")
+            assert result.status_code == 200
+            assert result.content == out.read_bytes()
+    finally:
+        server.stop()
+    assert dumps(run_local(validated(body))) == out.read_text()
+
+
+def test_the_gate_runs_up_and_down_and_names_the_speeds(tmp_path: Path) -> None:
+    """check --runup: the run-down holds the separating branch below the run-up's jump, so a
+    dynamic-factor limit fails it from a lower speed (the hysteresis), naming both branches."""
+    report = tmp_path / "report.json"
+    code = main(["check", str(ROOT / "examples" / "ci" / "design.json"), "--speed", "3700:4400",
+                 "--speed-points", "8", "--runup", "1000", "--max-dynamic-factor", "2.5",
+                 "--json", str(report)])  # fmt: skip
+    assert code == 1
+    failures = json.loads(report.read_text())["failures"]
+    spans = {f["rule"]: f["speeds_rpm"] for f in failures if f["rule"].startswith("run-")}
+    up, down = spans["run-up: dynamic factor > 2.5"], spans["run-down: dynamic factor > 2.5"]
+    assert down[0] < up[0] <= 4200 and up[1] == down[1] == 4400
+
+
+def test_chaos_fails_the_gate_only_when_it_lasts(tmp_path: Path) -> None:
+    """A run of chaotic bins fails after CHAOS_SECONDS, not before (the rule over time)."""
+    r = validated(_request(from_speed="4000 rpm", to_speed="4400 rpm", rate="4000 rpm/s",
+                           ensemble={"size": 2}))  # fmt: skip
+    result = run_local(r)
+    bins = result.up.bins  # type: ignore[union-attr]
+    rules = Rules()
+    assert runup_failures(result, rules, {}) == []  # periodic throughout
+    for n, fails in ((1, False), (len(bins), True)):  # 0.0125 s of chaos, then 0.1 s
+        marked = [b.model_copy(update={"chaotic": True}) if k < n else b
+                  for k, b in enumerate(bins)]  # fmt: skip
+        chaotic = result.model_copy(update={"up": result.up.model_copy(update={"bins": marked})})
+        found = runup_failures(chaotic, rules, {})
+        assert bool(found) == fails
+        if fails:
+            assert found[0].speeds_rpm == [4000.0, 4400.0] and "chaotic" in found[0].rule
