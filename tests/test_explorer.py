@@ -393,10 +393,10 @@ def test_a_design_page_speaks_gear_units_and_enlarges_figures(page: Page) -> Non
     lle = page.text("#verdict-facts").split("Largest Lyapunov exponent")[1].splitlines()[1]
     assert " per s (" in lle and "per unit τ)" in lle
     page.figures_done()  # the threshold figure's gear units: tests/test_threshold_units.py
-    page.field("threshold-figure", by="id").click()
+    page.field("analysis-figure", by="id").click()
     page.wait(lambda d: d.execute_script("return document.getElementById('enlarged').open"))
     width = page.driver.execute_script("return document.getElementById('enlarged-img').width")
-    thumb = page.driver.execute_script("return document.getElementById('threshold-figure').width")
+    thumb = page.driver.execute_script("return document.getElementById('analysis-figure').width")
     assert width > thumb
     page.show("#verdict")
     page.screenshot("explorer-enlarged.png", height=1000)
