@@ -6,10 +6,10 @@ from typing import Literal
 
 from fastapi import APIRouter, Depends, Request, Response
 
+from gearengine import plots  # its figures load matplotlib on first use, not at start-up
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.jsonio import dumps
 from gearengine.numerics import work
-from gearengine.plots import MEDIA_TYPES, analysis_figure
 from service.api.deps import cached_compute, require_key
 from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
 
@@ -61,5 +61,5 @@ async def post_analysis_plot(
         request,
         f"analyses/plot.{fmt}",
         body.model_dump_json(),
-        lambda: (analysis_figure(_analysis(request, body), fmt), MEDIA_TYPES[fmt]),
+        lambda: (plots.analysis_figure(_analysis(request, body), fmt), plots.MEDIA_TYPES[fmt]),
     )

@@ -6,13 +6,13 @@ from typing import Literal
 
 from fastapi import APIRouter, Depends, Request, Response
 
+from gearengine import plots  # its figures load matplotlib on first use, not at start-up
 from gearengine.engineering import threshold_units
 from gearengine.homoclinic import ThresholdCurve
 from gearengine.homoclinic.schemas import ThresholdsRequest
 from gearengine.homoclinic.thresholds import curve_of
 from gearengine.jsonio import dumps
 from gearengine.model.aliases import get_alias
-from gearengine.plots import MEDIA_TYPES, threshold_figure
 from service.api.deps import cached_compute, require_key
 from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
 
@@ -46,7 +46,7 @@ def figure(body: ThresholdsRequest, fmt: Literal["png", "svg"]) -> bytes:
     """The curves' figure; a design's in gear units (its parameter's unit over the speed)."""
     conv, name, freq = body.conversion, body.parameter, body.frequency_parameter
     units = None if conv is None else threshold_units(conv, name, freq)
-    return threshold_figure(curve_of(body), fmt, _design_frequency(body), units)
+    return plots.threshold_figure(curve_of(body), fmt, _design_frequency(body), units)
 
 
 @router.post(
@@ -68,5 +68,5 @@ async def post_threshold_plot(
         request,
         f"thresholds/plot.{fmt}",
         body.model_dump_json(),
-        lambda: (figure(body, fmt), MEDIA_TYPES[fmt]),
+        lambda: (figure(body, fmt), plots.MEDIA_TYPES[fmt]),
     )
