@@ -30,9 +30,9 @@ from pathlib import Path
 from common import best_of  # benchmarks/common.py
 from report import write_section  # benchmarks/report.py (the script's own folder)
 
-from gearengine.cli.envelope import ENVELOPE_SETTINGS
 from gearengine.model.design import EXAMPLE_DESIGN
 from gearengine.sweeps import run_local, validated
+from gearengine.sweeps.gate import ENVELOPE_SETTINGS
 
 ROOT = Path(__file__).resolve().parents[1]
 GEAR_REF = Path("/work/shared/reference/gear_ref.c")

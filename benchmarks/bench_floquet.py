@@ -27,7 +27,7 @@ from report import write_section  # benchmarks/report.py (the script's own folde
 
 from gearengine.model.aliases import with_alias
 from gearengine.model.params import GearParams
-from gearengine.numerics.bifurcations import Response, locate_bifurcations
+from gearengine.numerics.bifurcations import PointResponse, locate_bifurcations
 from gearengine.numerics.floquet import floquet
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate, warm_up
@@ -49,14 +49,14 @@ def best_of(fn: Callable[[], object], repeats: int = REPEATS) -> float:
     return common.best_of(fn, repeats)
 
 
-def line_responses(grid: np.ndarray) -> list[Response]:
+def line_responses(grid: np.ndarray) -> list[PointResponse]:
     """The line computed as a continuation sweep does: each point from the last final state."""
     out, start = [], SETTINGS.initial_state
     for value in grid:
         run = SETTINGS.model_copy(update={"initial_state": list(start)})
         r = simulate(with_alias(DESIGN, "F_e1", float(value)), run)
         final = r.worst_case.final_state
-        out.append(Response(r.classification, r.period, r.poincare[-1], tuple(final)))
+        out.append(PointResponse(r.classification, r.period, r.poincare[-1], tuple(final)))
         start = final
     return out
 

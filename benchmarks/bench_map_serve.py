@@ -24,9 +24,8 @@ import time
 from pathlib import Path
 
 import httpx
-from bench_big_map import free_port  # benchmarks/bench_big_map.py
 from bench_map import GEAR_REF, gear_ref_seconds, map_doc, sweep_seconds
-from common import wait_ready  # benchmarks/common.py
+from common import served  # benchmarks/common.py
 from report import write_section  # benchmarks/report.py (the script's own folder)
 
 from gearengine.numerics.simulation import warm_up
@@ -59,30 +58,17 @@ def main() -> None:
         exe = tmp / "gear_ref"
         gcc = shutil.which("gcc") or sys.exit("gcc is needed to build gear_ref")
         subprocess.run([gcc, "-O3", "-march=native", "-o", exe, GEAR_REF, "-lm"], check=True)
-        served = {}
-        port = free_port()
-        env = {**os.environ, "GEARCHAOS_MAX_SWEEP_POINTS": str(max(sizes) ** 2),
+        env = {"GEARCHAOS_MAX_SWEEP_POINTS": str(max(sizes) ** 2),
                "GEARCHAOS_MAX_SWEEP_STEPS": str(10**12)}  # fmt: skip
-        cmd = [sys.executable, "-m", "gearengine.cli", "serve", "--port", str(port),
-               "--data-dir", str(tmp / "data")]  # fmt: skip
-        with open(tmp / "server.log", "w") as log:
-            proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=log, stderr=subprocess.STDOUT)
-            try:
-                with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=600) as c:
-                    wait_ready(c)
-                    served_seconds(c, map_doc(4, True))  # workers warm
-                    for num in sizes:
-                        served[num] = min(
-                            served_seconds(c, map_doc(num, True)) for _ in range(REPEATS)
-                        )
-            finally:
-                proc.terminate()
-                proc.wait(timeout=60)
+        with served(tmp / "data", env) as c:
+            served_seconds(c, map_doc(4, True))  # workers warm
+            warm = {n: min(served_seconds(c, map_doc(n, True)) for _ in range(REPEATS))
+                    for n in sizes}  # fmt: skip
         sweep_seconds(tmp, 4, True)  # the CLI's numba caches warm
         for num in sizes:
             cli = sweep_seconds(tmp, num, True)[0]
             ref = gear_ref_seconds(exe, num)
-            rows.append((num, served[num], cli, ref))
+            rows.append((num, warm[num], cli, ref))
     load = os.getloadavg()[0]
     table = [
         "| map | warm `gearengine serve`, submit to result, s | `gearengine sweep` (CLI, new "

@@ -3,7 +3,10 @@ for a real server."""
 
 from __future__ import annotations
 
+import os
+import socket
 import subprocess
+import sys
 import tempfile
 import time
 from collections.abc import Callable, Iterator
@@ -48,3 +51,30 @@ def extracted(commit: str) -> Iterator[Path]:
         )
         subprocess.run(["tar", "-x", "-C", tmp], input=archive.stdout, check=True)
         yield Path(tmp)
+
+
+@contextmanager
+def served(data_dir: Path, env: dict[str, str]) -> Iterator[httpx.Client]:
+    """A real ``gearengine serve`` of the working tree on a free loopback port with ``env`` added
+    to this process's environment and its job store in ``data_dir``, ready (``wait_ready``);
+    yields a client of it and stops it afterwards (killed if it does not stop within 60 s)."""
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    cmd = [sys.executable, "-m", "gearengine.cli", "serve", "--port", str(port),
+           "--data-dir", str(data_dir)]  # fmt: skip
+    with open(data_dir.parent / "server.log", "w") as log:
+        proc = subprocess.Popen(
+            cmd, cwd=ROOT, env={**os.environ, **env}, stdout=log, stderr=subprocess.STDOUT
+        )
+        try:
+            with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=600) as client:
+                wait_ready(client)
+                yield client
+        finally:
+            proc.terminate()
+            try:
+                proc.wait(timeout=60)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()

@@ -9,10 +9,11 @@ The public facade, short verbs on a design (as ChaosTools.jl):
     >>> analyze(Design.model_validate(doc["design"])).summary()   # one line; repr is short too
     >>> run_sweep(SweepRequest.model_validate(sweep)).to_pandas()  # pip install 'gearchaos[pandas]'
 
-Rooms (subpackages) follow the data flow: ``model`` -> ``homoclinic`` (the Melnikov analysis
-of the homoclinic orbits) -> ``numerics`` ->
-``analysis`` -> ``sweeps`` -> ``plots`` -> ``cli``; ``docs/architecture.md`` draws it. The
-engine imports no web code.
+Rooms (subpackages) follow the data flow, a diamond rather than a chain: ``model`` feeds both
+``homoclinic`` (the Melnikov analysis of the homoclinic orbits) and ``numerics``, which know
+nothing of each other; ``ensembles.attractors`` runs many starts of one design, ``analysis``
+and ``engineering`` join them, then ``sweeps`` -> ``plots`` -> ``cli``;
+``docs/architecture.md`` draws it. The engine imports no web code.
 """
 
 from __future__ import annotations
@@ -23,6 +24,8 @@ from gearengine.lazyload import lazy_names
 
 if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDEs
     from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
+    from gearengine.ensembles.attractors import of_design as attractors
+    from gearengine.ensembles.remedies import RemediesRequest, RemediesResult, remedies
     from gearengine.homoclinic import MelnikovResult, chaos_possible, melnikov, threshold_curve
     from gearengine.model.design import Design
     from gearengine.model.examples import PAPER_SECTION_41
@@ -47,16 +50,20 @@ __all__ = [
     "Design",
     "GearParams",
     "MelnikovResult",
+    "RemediesRequest",
+    "RemediesResult",
     "RunupRequest",
     "RunupResult",
     "SimulationSettings",
     "SweepRequest",
     "SweepResult",
     "analyze",
+    "attractors",
     "chaos_possible",
     "lyapunov",
     "melnikov",
     "poincare",
+    "remedies",
     "run_runup",
     "run_sweep",
     "simulate",
@@ -72,16 +79,20 @@ _HOMES: dict[str, tuple[str, str]] = {
     "Design": ("gearengine.model.design", "Design"),
     "GearParams": ("gearengine.model.params", "GearParams"),
     "MelnikovResult": ("gearengine.homoclinic", "MelnikovResult"),
+    "RemediesRequest": ("gearengine.ensembles.remedies", "RemediesRequest"),
+    "RemediesResult": ("gearengine.ensembles.remedies", "RemediesResult"),
     "RunupRequest": ("gearengine.runup", "RunupRequest"),
     "RunupResult": ("gearengine.runup", "RunupResult"),
     "SimulationSettings": ("gearengine.numerics", "SimulationSettings"),
     "SweepRequest": ("gearengine.sweeps", "SweepRequest"),
     "SweepResult": ("gearengine.sweeps", "SweepResult"),
     "analyze": ("gearengine.analysis", "analyze"),
+    "attractors": ("gearengine.ensembles.attractors", "of_design"),
     "chaos_possible": ("gearengine.homoclinic", "chaos_possible"),
     "lyapunov": ("gearengine.numerics", "lyapunov"),
     "melnikov": ("gearengine.homoclinic", "melnikov"),
     "poincare": ("gearengine.numerics", "poincare"),
+    "remedies": ("gearengine.ensembles.remedies", "remedies"),
     "run_runup": ("gearengine.runup", "run_local"),
     "run_sweep": ("gearengine.sweeps", "run_local"),
     "simulate": ("gearengine.numerics", "simulate"),

@@ -4,7 +4,9 @@ The Melnikov criterion is first order in the perturbation and only *necessary* f
 (a transverse homoclinic tangle may give transient chaos and a periodic attractor). The two
 verdicts are consistent unless the numerics find chaos where Melnikov rules it out.
 
-This module joins the melnikov and numerics rooms; it imports nothing else of the engine.
+This module joins the homoclinic (Melnikov) and numerics rooms on a request of the model room,
+and adds the engineering block (``engineering``: answers in gear units) for a design.
+With ``settings.basins`` it adds the attractors of ``ensembles.attractors``.
 """
 
 from __future__ import annotations
@@ -14,14 +16,16 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.engineering import IMPACT_WORDS, Engineering, engineering
+from gearengine.ensembles.attractors import attractors, coexistence, headline
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
 from gearengine.homoclinic.verdict import melnikov
 from gearengine.model.design import EXAMPLE_DESIGN, Design
+from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
 from gearengine.numerics.results import NumericsResult
-from gearengine.numerics.settings import SimulationSettings
+from gearengine.numerics.settings import RequestSettings, SimulationSettings
 from gearengine.numerics.simulation import simulate
 
 Agreement = Literal["both_chaotic", "both_regular", "melnikov_only", "numerics_only", "undecided"]
@@ -32,7 +36,7 @@ class AnalysisRequest(ParamsOrDesign):
 
     model_config = request_config({"params": PAPER_SECTION_41, "settings": {}})
 
-    settings: SimulationSettings = Field(
+    settings: RequestSettings = Field(
         default_factory=SimulationSettings,
         description="Integration settings (defaults: 500 + 500 periods, 200 steps, x0 = "
         "(0.01, 0.01)).",
@@ -51,8 +55,16 @@ class Verdict(BaseModel):
         "not applicable or the state diverged."
     )
     consistent: bool = Field(description="False only for numerics_only.")
-    chaotic: bool = Field(description="The numerics classify the worst start as chaotic.")
+    chaotic: bool = Field(
+        description="The numerics classify the worst start as chaotic (with settings.basins: "
+        "the worst attractor whose basin fraction is above basins.min_fraction)."
+    )
     summary: str = Field(description="One readable line.")
+    decided_by: str | None = Field(
+        None,
+        description="With settings.basins: the attractor (or divergence) that decided the "
+        "verdict and its basin fraction; null without.",
+    )
 
 
 class AnalysisResult(BaseModel):
@@ -115,16 +127,22 @@ class MelnikovAnswer(MelnikovResult):
     )
 
 
-def verdict(mel: MelnikovResult, num: NumericsResult) -> Verdict:
-    """Compare the Melnikov verdict with the numerical classification."""
-    chaotic = num.classification == "chaotic"
-    period = f" ({num.period}T)" if num.period else ""
-    numerics = f"numerics: {num.classification}{period}"
-    if num.classification == "diverged" or mel.chaos_possible is None:
+def verdict(mel: MelnikovResult, num: NumericsResult, min_fraction: float = 0.0) -> Verdict:
+    """Compare the Melnikov verdict with the numerical classification: that of the worst
+    start, or with basins of the worst attractor above ``min_fraction`` (``ensembles``)."""
+    classification, period_n, decided_by, basins = num.classification, num.period, None, ""
+    if num.attractors is not None and num.basins is not None:
+        head = headline(num.attractors, num.basins, min_fraction)
+        basins = f" ({coexistence(num.attractors, num.basins)})"
+        if head is not None:
+            classification, period_n, decided_by = head.classification, head.period, head.decided_by
+    chaotic = classification == "chaotic"
+    period = f" ({period_n}T)" if period_n else ""
+    numerics = f"numerics: {classification}{period}{basins}"
+    if classification == "diverged" or mel.chaos_possible is None:
         why = "Melnikov not applicable" if mel.chaos_possible is None else "the state diverged"
-        return Verdict(
-            agreement="undecided", consistent=True, chaotic=chaotic, summary=f"{numerics}; {why}"
-        )
+        return Verdict(agreement="undecided", consistent=True, chaotic=chaotic,
+                       summary=f"{numerics}; {why}", decided_by=decided_by)  # fmt: skip
     if mel.chaos_possible and chaotic:
         agreement, text = "both_chaotic", "transverse homoclinic tangle and chaotic response"
     elif mel.chaos_possible:
@@ -141,6 +159,7 @@ def verdict(mel: MelnikovResult, num: NumericsResult) -> Verdict:
         consistent=agreement != "numerics_only",
         chaotic=chaotic,
         summary=f"{numerics}; Melnikov: chaos {possible} — {text}",
+        decided_by=decided_by,
     )
 
 
@@ -160,10 +179,15 @@ def analyze(
         raise TypeError("analyze: an AnalysisRequest carries its settings; give one or the other")
     mel = melnikov(request.params)
     num = simulate(request.params, request.settings)
-    result = AnalysisResult(
-        melnikov=mel, numerics=num, settings=request.settings, verdict=verdict(mel, num)
-    )
     conv = request.conversion
+    basins = request.settings.basins
+    if basins is not None:
+        scales = None if conv is None else conv.scales
+        found, counts = attractors(request.params, request.settings, scales)
+        num = num.model_copy(update={"attractors": found, "basins": counts})
+    min_fraction = 0.0 if basins is None else basins.min_fraction
+    result = AnalysisResult(melnikov=mel, numerics=num, settings=request.settings,
+                            verdict=verdict(mel, num, min_fraction))  # fmt: skip
     if conv is None:
         return result
     eng = engineering(conv, request.speed_rpm_range(), mel, num)
@@ -202,7 +226,7 @@ def convert(request: DesignRequest) -> DesignReport:
     """The conversion of a design with its engineering block (Melnikov windows, thresholds)."""
     conv = request.conversion
     if conv is None:
-        raise ValueError("design: give a design (physical units) to convert")
+        raise InputError("design", "give a design (physical units) to convert")
     mel = melnikov(conv.params)
     return DesignReport(
         conversion=conv, engineering=engineering(conv, request.speed_rpm_range(), mel)

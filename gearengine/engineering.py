@@ -20,6 +20,9 @@ gives what a gearbox engineer asks:
   the fractions of time with the teeth apart (|x| <= 1) and on the back flank (x < -1), the
   response period and the dominant response frequency;
 * ``summary``: plain sentences for a design review.
+
+Every dimensionless number crosses to gear units through ``model.units.to_physical`` (the
+``OUTPUTS`` table) with the design's ``Scales``.
 """
 
 from __future__ import annotations
@@ -35,10 +38,16 @@ from gearengine.homoclinic.coefficients import MeanLoad
 from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
 from gearengine.homoclinic.thresholds import strength_at
 from gearengine.model.aliases import get_alias, with_speed_factor
-from gearengine.model.backlash import LAWS
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import Derived, DesignConversion
-from gearengine.numerics.forcing import forcing_coefficients
+from gearengine.model.units import (
+    OUTPUTS,
+    Scales,
+    display_label,
+    in_si,
+    response_values,
+    to_physical,
+)
 from gearengine.numerics.results import NumericsResult
 
 WINDOW_SCAN = 240
@@ -161,20 +170,20 @@ IMPACT_WORDS = {
     "double_sided": "impacts on both flanks (back-flank contact)",
 }
 
-SCALES = {
-    "F_e1": ("transmission_error_amplitude", "um"),
-    "F_p1": ("torque_fluctuation_amplitude", "N*m"),
-    "mu": ("damping_ratio", "1"),
-    "k_p1": ("stiffness_variation_amplitude", "N/m"),
+CONTROLS = {
+    "F_e1": "transmission_error_amplitude",
+    "F_p1": "torque_fluctuation_amplitude",
+    "mu": "damping_ratio",
+    "k_p1": "stiffness_variation_amplitude",
 }
-"""Control parameter -> (engineering name, unit)."""
+"""Control parameter -> its output quantity (``model.units.OUTPUTS``), the engineering name."""
 
 
 @dataclass(frozen=True)
 class ThresholdUnits:
     """A threshold figure's axes in gear units: every excitation frequency scales with the
     driver speed, so a frequency Omega is the speed ``rpm_per_frequency * Omega``; each control
-    parameter is linear in its physical value (``_to_physical``)."""
+    parameter is linear in its physical value (``model.units.to_physical``)."""
 
     rpm_per_frequency: float
     parameter_label: str
@@ -189,29 +198,19 @@ def threshold_units(
     omega = get_alias(conv.params, frequency_parameter)
     if not omega:
         return None
-    name, unit = SCALES[parameter]
-    label = name.replace("_", " ") + ("" if unit == "1" else f" [{unit.replace('um', 'µm')}]")
-    return ThresholdUnits(conv.speed_rpm / omega, label, _to_physical(parameter, 1.0, conv))
+    output = CONTROLS[parameter]
+    label = display_label(output).replace("_", " ").replace("[um]", "[µm]")
+    return ThresholdUnits(conv.speed_rpm / omega, label, to_physical(output, 1.0, conv.scales))
 
 
-def _to_physical(name: str, value: float, conv: DesignConversion) -> float:
-    """A dimensionless control parameter in its physical unit (Eq. 8 inverted)."""
-    if name == "F_e1":
-        return value * conv.half_backlash_m * 1e6  # e_1 = F~_e1 b, in µm
-    if name == "F_p1":
-        return value / conv.torque_gain  # T_p1 = F~_p1 / (m r_a / (I_a b k_m))
-    if name == "k_p1":
-        return 2.0 * value * conv.mesh_stiffness_n_per_m  # k_1 = 2 k_m k~_p1
-    return value  # mu~ = zeta
-
-
-def critical(name: str, t: ParameterThreshold, conv: DesignConversion) -> Critical:
+def critical(name: str, t: ParameterThreshold, scales: Scales) -> Critical:
     """One threshold in physical units with its signed margin to chaos (the threshold's
-    margin, positive on the safe side, in this unit: every map of ``_to_physical`` is linear)."""
-    unit = SCALES[name][1]
-    crit = [_to_physical(name, v, conv) for v in t.critical_values]
-    value = None if t.value is None else _to_physical(name, t.value, conv)
-    nearest = None if t.nearest is None else _to_physical(name, t.nearest, conv)
+    margin, positive on the safe side, in this unit: every map of ``to_physical`` is linear)."""
+    output = CONTROLS[name]
+    unit = OUTPUTS[output].unit
+    crit = [to_physical(output, v, scales) for v in t.critical_values]
+    value = None if t.value is None else to_physical(output, t.value, scales)
+    nearest = None if t.nearest is None else to_physical(output, t.nearest, scales)
     margin = rel = None
     if value is not None and nearest is not None and t.margin is not None:
         margin = math.copysign(abs(value - nearest), t.margin)
@@ -226,7 +225,7 @@ def critical_torque(conv: DesignConversion, mel: MelnikovResult) -> float | None
     if mel.critical_mean_force is None:
         return None
     r_a = float(conv.derived["base_radius_driver"].value)  # type: ignore[arg-type]
-    return mel.critical_mean_force * conv.half_backlash_m * conv.mesh_stiffness_n_per_m * r_a
+    return to_physical("mesh_force", mel.critical_mean_force, conv.scales) * r_a
 
 
 def over_critical(conv: DesignConversion, mel: MelnikovResult) -> bool:
@@ -241,7 +240,7 @@ def over_critical(conv: DesignConversion, mel: MelnikovResult) -> bool:
 
 def load_words(conv: DesignConversion, f_crit: float, t_crit: float) -> str:
     """Why the criterion does not apply at this torque (F~_m >= F_crit), in gear words."""
-    fm, b_um = conv.params.mean_force, conv.half_backlash_m * 1e6
+    fm, b_um = conv.params.mean_force, to_physical("displacement", 1.0, conv.scales)
     torque = t_crit * abs(fm) / f_crit  # the static force is proportional to the torque
     return (
         f"under {torque:,.3g} N*m the mesh deflects {abs(fm) * b_um:.3g} µm statically (half "
@@ -252,42 +251,36 @@ def load_words(conv: DesignConversion, f_crit: float, t_crit: float) -> str:
     )
 
 
-def mesh_force(params: GearParams, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Dimensionless mesh force K(tau) f_h(x) + 2 mu~ x' at the samples (Eq. 9's left side)."""
-    co = forcing_coefficients(params)
-    stiffness = 1.0 + np.cos(np.multiply.outer(t, co.k_omega) + co.k_phase) @ co.k_amp
-    f_h = LAWS[params.backlash.model].f_h(params.backlash, x)
-    return stiffness * f_h + 2.0 * params.damping * v
-
-
 def response(params: GearParams, num: NumericsResult, conv: DesignConversion) -> Response:
-    """The response of an analysis in physical units (from its recorded time history)."""
-    static = conv.static_force_n
+    """The response of an analysis in physical units: DTE, mesh forces and dynamic factor from
+    the kernel's extremes over every step of the record (``model.units.response_values``, as a
+    sweep point's), the contact fractions from the recorded time history."""
+    scales = conv.scales
     hist = num.time_history
-    contact = force_max = force_min = factor = None
+    contact = None
+    forces = [None if f is None else to_physical("mesh_force", f, scales)
+              for f in (num.force_max, num.force_min)]  # fmt: skip
+    values = response_values(num.x_peak_to_peak, num.force_max, scales)
     if hist is not None and hist.x:
-        t, x, v = (np.asarray(a) for a in (hist.t, hist.x, hist.v))
-        force = mesh_force(params, t, x, v) * conv.half_backlash_m * conv.mesh_stiffness_n_per_m
-        force_max, force_min = float(force.max()), float(force.min())
-        factor = force_max / static if static > 0.0 else None
+        x = np.asarray(hist.x)
         contact = Contact(
             regime=num.impact_regime,
             separation_fraction=float(np.mean(np.abs(x) <= 1.0)),
             back_flank_fraction=float(np.mean(x < -1.0)),
         )
-    omega_n = 1.0 / conv.time_scale_s
-    period_s = None if num.period is None else num.period * num.sampling_interval / omega_n
-    peak = num.spectrum_peaks[0].frequency * omega_n / (2 * math.pi) if num.spectrum_peaks else None
+    period = None if num.period is None else num.period * num.sampling_interval
+    period_s = None if period is None else in_si("time", period, scales)
+    peaks = num.spectrum_peaks
+    peak = to_physical("frequency", peaks[0].frequency, scales) if peaks else None
     shaft_hz = conv.speed_rpm / 60.0
-    dte = num.x_peak_to_peak
     return Response(
-        dte_peak_to_peak_um=None if dte is None else dte * conv.half_backlash_m * 1e6,
-        dynamic_mesh_force_max_n=force_max,
-        dynamic_mesh_force_min_n=force_min,
-        static_force_n=static,
-        dynamic_factor=factor,
+        dte_peak_to_peak_um=values["dte"],
+        dynamic_mesh_force_max_n=forces[0],
+        dynamic_mesh_force_min_n=forces[1],
+        static_force_n=scales.static_force,
+        dynamic_factor=values["dynamic_factor"],
         contact=contact,
-        period_ms=None if period_s is None else 1e3 * period_s,
+        period_ms=None if period is None else to_physical("time", period, scales),
         period_mesh_periods=None if period_s is None else period_s * conv.mesh_frequency_hz,
         dominant_frequency_hz=peak,
         dominant_shaft_order=None if peak is None else peak / shaft_hz,
@@ -374,16 +367,16 @@ def engineering(
         elif windows and windows[-1][1] >= top:
             note = f"the window from {windows[-1][0]:,.0f} rpm reaches the end of the scan"
     crit = {
-        SCALES[name][0]: critical(name, t, conv)
+        CONTROLS[name]: critical(name, t, conv.scales)
         for name, t in mel.thresholds.items()
-        if name in SCALES and t.value is not None and (t.critical_values or t.note is None)
+        if name in CONTROLS and t.value is not None and (t.critical_values or t.note is None)
     }
     resp = None if num is None else response(params, num, conv)
     return Engineering(
         natural_frequency_hz=conv.natural_frequency_hz,
         time_scale_s=conv.time_scale_s,
         mesh_frequency_hz=conv.mesh_frequency_hz,
-        half_backlash_um=conv.half_backlash_m * 1e6,
+        half_backlash_um=to_physical("displacement", 1.0, conv.scales),
         speed_rpm=conv.speed_rpm,
         speed_range_rpm=[lo, hi],
         speed_windows_rpm=windows,

@@ -38,7 +38,11 @@ def drop_stale(group: str, sources: Iterable[Path], cache_dir: Path) -> bool:
     """Delete the numba cache files of ``group`` (a module name such as ``lockstep``, files
     ``GROUP.*.nbi`` and ``GROUP.*.nbc``; several names joined by ``,``) in ``cache_dir`` unless
     the digest of ``sources`` is the one recorded at the last call. True if files were dropped.
-    A directory that cannot be read or written is left alone (False)."""
+    A directory that cannot be read or written is left alone (False), and so is every directory
+    while ``NUMBA_CACHE_DIR`` moves numba's cache elsewhere: nothing of the cache is there, and
+    importing the engine must not write stamp files into the source tree."""
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return False
     digest = sources_digest(sources)
     stamp = cache_dir / (group.replace(",", "+") + STAMP_SUFFIX)
     try:

@@ -48,6 +48,7 @@ class JobKind:
 
 KINDS: dict[str, str] = {
     "sweep": "gearengine.sweeps.compute:SWEEP_JOB",
+    "remedies": "gearengine.ensembles.remedies:REMEDIES_JOB",
     "runup": "gearengine.runup.compute:RUNUP_JOB",
     "robustness": "gearengine.ensembles.robustness:ROBUSTNESS_JOB",
 }

@@ -12,6 +12,8 @@ from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
+from gearengine.model.errors import InputError
+
 
 def dumps(result: BaseModel) -> str:
     """Compact, deterministic JSON of a result model (field order as declared)."""
@@ -29,9 +31,23 @@ def field_path(loc: tuple[Any, ...]) -> str:
     return out or "(body)"
 
 
+def located(error: Mapping[str, Any], loc: tuple[Any, ...] | None = None) -> tuple[tuple, str]:
+    """(location, message) of a pydantic error: an ``InputError`` raised in a model's validator
+    adds its field path to the model's location (``loc``, default the error's) and gives its
+    own message, read from the object, not from the text."""
+    loc = tuple(error["loc"]) if loc is None else loc
+    cause = (error.get("ctx") or {}).get("error")
+    if isinstance(cause, InputError):
+        parts = (int(p) if p.isdigit() else p for p in cause.path.split(".") if p)
+        return (*loc, *parts), cause.message
+    return loc, message(error)
+
+
 def error_lines(exc: ValidationError) -> list[str]:
     """One line per problem: 'path: message'."""
-    return [f"{field_path(e['loc'])}: {message(e)}" for e in exc.errors(include_url=False)]
+    return [
+        f"{field_path(loc)}: {text}" for loc, text in map(located, exc.errors(include_url=False))
+    ]
 
 
 def message(error: Mapping[str, Any]) -> str:

@@ -16,7 +16,7 @@ from fastapi.responses import JSONResponse
 from pydantic import BaseModel, Field, ValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from gearengine.jsonio import field_path, message
+from gearengine.jsonio import field_path, located
 
 PROBLEM_JSON = "application/problem+json"
 TYPE_BASE = "https://gearchaos.dev/problems/"
@@ -77,8 +77,9 @@ def field_errors(errors: list[dict[str, Any]], strip_body: bool = True) -> list[
             continue
         if strip_body and loc[:1] == ("body",):
             loc = loc[1:]
+        loc, text = located(e, loc)
         pointer = "/" + "/".join(str(p).replace("~", "~0").replace("/", "~1") for p in loc)
-        out.append(FieldError(path=field_path(loc), pointer=pointer, message=message(e)))
+        out.append(FieldError(path=field_path(loc), pointer=pointer, message=text))
     return out
 
 

@@ -43,12 +43,14 @@ class Limits:
         if body.num > cap:
             raise over_limit("num", f"at most {cap} frequencies per curve (max_curve_points)")
 
-    def check_budget(self, steps: int, sweep_hint: bool = True) -> None:
+    def check_budget(self, steps: int, sweep_hint: bool = True, field: str = "settings") -> None:
+        """Refuse work over the synchronous budget, naming ``field`` (``settings.basins.starts``
+        when basin starts are asked for: they multiply the cost)."""
         cap = self.settings.max_sync_steps
         if steps > cap:
             hint = "; submit it as a sweep job: POST /v1/sweeps" if sweep_hint else ""
             raise over_limit(
-                "settings",
+                field,
                 f"this analysis needs {steps} RK4 steps, over the synchronous compute budget of "
                 f"{cap} steps (max_sync_steps){hint}",
                 kind="over-budget",

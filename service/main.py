@@ -20,6 +20,7 @@ from service.api.routes import (
     explorer,
     health,
     melnikov,
+    remedies,
     robustness,
     runups,
     sweeps,
@@ -97,6 +98,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(thresholds.router, tags=["melnikov"])
     app.include_router(analyses.router, tags=["analyses"])
     app.include_router(sweeps.router, tags=["sweeps"])
+    app.include_router(remedies.router, tags=["remedies"])
     app.include_router(runups.router, tags=["runups"])
     app.include_router(robustness.router, tags=["robustness"])
     app.include_router(explorer.router)

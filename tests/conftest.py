@@ -19,6 +19,7 @@ from fastapi import FastAPI
 from fastapi.testclient import TestClient
 from hypothesis import settings
 
+from gearengine.model.examples import PAPER_SECTION_41
 from service.core.config import Settings
 from service.main import create_app
 
@@ -30,12 +31,8 @@ ROOT = Path(__file__).resolve().parents[1]
 settings.register_profile("repeatable", derandomize=True, database=None)
 settings.register_profile("explore", derandomize=False)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repeatable"))
-PAPER_PARAMS = {
-    "damping": 0.07,
-    "mean_force": 0.01,
-    "backlash": {"model": "cubic", "a": 0.1667, "c": 0.1667},
-    "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 0.2, "phase": 0.0}]},
-}
+PAPER_PARAMS = PAPER_SECTION_41
+"""The paper's section 4.1 design (``model.examples``), the parameters most tests start from."""
 
 
 @pytest.fixture

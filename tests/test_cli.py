@@ -85,3 +85,16 @@ def test_a_closed_pipe_ends_quietly() -> None:
     # `true` reads nothing and exits at once, long before the CLI has computed: every write fails
     out = pipe("gearengine melnikov examples/paper-4.1.json --json | true")
     assert out.stderr == "" and out.stdout.strip() == "status=141"
+
+
+def test_convert_prints_readable_text_and_refuses_params() -> None:
+    """No Python list or JSON in the text output; a params file is refused (exit 2), not a
+    traceback."""
+    out = run("convert", str(EXAMPLE.with_name("design-geometry.json")))
+    assert out.returncode == 0, out.stderr
+    assert "[{" not in out.stdout and "{'" not in out.stdout and '{"' not in out.stdout
+    assert "stiffness_harmonics        r=1 1.34463e+08 N/m @ -1.859 rad; r=2" in out.stdout
+    assert "  mu~ (damping)              0.04" in out.stdout
+    refused = run("convert", str(EXAMPLE))
+    assert refused.returncode == 2 and "Traceback" not in refused.stderr
+    assert "design: give a design" in refused.stderr

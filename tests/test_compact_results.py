@@ -7,7 +7,6 @@ import csv
 import io
 import json
 import sqlite3
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -20,6 +19,7 @@ from gearengine.sweeps import compute_chunk_json, csv_rows, run_local, validated
 from service.core.config import Settings
 from service.jobs.store import DB_FILE, pack, unpack
 from service.main import create_app
+from tests._polling import poll
 from tests.conftest import PAPER_PARAMS, started
 
 SHORT = {"transient_periods": 50, "record_periods": 50, "steps_per_period": 64}
@@ -72,10 +72,7 @@ def test_service_stores_compressed_chunks_and_streams_compact_results(working) -
     c, data = working
     doc = body(outputs=["classification", "period", "lle"])
     job_id = c.post("/v1/sweeps", json=doc).json()["id"]
-    deadline = time.monotonic() + 120
-    while c.get(f"/v1/sweeps/{job_id}").json()["status"] in ("queued", "running"):
-        assert time.monotonic() < deadline
-        time.sleep(0.05)
+    poll(lambda: c.get(f"/v1/sweeps/{job_id}").json())
     result = c.get(f"/v1/sweeps/{job_id}/result").json()
     assert len(result["points"]) == 10 and result["windows"] is None
     assert all(sorted(p) == ["branch", "classification", "lle", "period", "values"]

@@ -397,3 +397,12 @@ def test_every_field_documents_units_and_example() -> None:
         assert field.examples, name
     for name, field in Conversion.model_fields.items():
         assert field.description, name
+
+
+def test_the_physical_conversion_gives_its_units() -> None:
+    """natural_frequency and mesh_frequency are rad/s (named in ``units``), also given in Hz."""
+    conv = to_dimensionless(gear())
+    assert conv.units["natural_frequency"] == conv.units["mesh_frequency"] == "rad/s"
+    assert conv.natural_frequency_hz == pytest.approx(conv.natural_frequency / (2 * math.pi))
+    assert conv.mesh_frequency_hz == pytest.approx(conv.mesh_frequency / (2 * math.pi))
+    assert set(conv.units) == set(conv.model_dump()) - {"params", "notes", "units"}

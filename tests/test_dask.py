@@ -7,7 +7,6 @@ import json
 import signal
 import subprocess
 import sys
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -18,6 +17,7 @@ from gearengine.sweeps import SweepPlan, run_local, validated
 from service.jobs.backends import DaskCluster
 from service.jobs.dispatcher import Dispatcher
 from service.jobs.store import JobStore
+from tests._polling import UNFINISHED, poll
 from tests.conftest import PAPER_PARAMS
 
 DOC = {
@@ -50,13 +50,7 @@ def submit(store: JobStore, chunk_points: int = 4) -> str:
 
 
 def wait_done(store: JobStore, job_id: str, timeout: float = 60.0) -> str:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        status = store.get(job_id, None).status
-        if status not in ("queued", "running"):
-            return status
-        time.sleep(0.05)
-    raise TimeoutError(job_id)
+    return poll(lambda: store.get(job_id, None).status, lambda s: s not in UNFINISHED, timeout)
 
 
 def stored_result(store: JobStore, job_id: str) -> list[str]:

@@ -14,13 +14,16 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from gearengine.analysis import AnalysisRequest, analyze, answer_melnikov, convert
-from gearengine.engineering import mesh_force, response, speed_windows
+from gearengine.engineering import response, speed_windows
 from gearengine.homoclinic import melnikov
 from gearengine.homoclinic.schemas import MelnikovRequest
 from gearengine.model.aliases import with_speed_factor
+from gearengine.model.backlash import LAWS
 from gearengine.model.conversion import to_dimensionless
 from gearengine.model.design import EXAMPLE_DESIGN, Design
+from gearengine.model.params import GearParams
 from gearengine.model.reduction import convert_design, physical_data
+from gearengine.numerics.forcing import forcing_coefficients
 from gearengine.numerics.results import NumericsResult
 from tests.test_conversion import dimensionless_response, physical_response
 
@@ -99,6 +102,25 @@ def test_rounded_braking_torque_raises_no_note() -> None:
     )
     noted = convert_design(Design.model_validate(design(braking_torque="80 N*m")))
     assert any("balancing" in n for n in noted.notes)
+
+
+@pytest.mark.parametrize(
+    ("typed", "understood"),
+    [("40 Nm", "40 N*m"), ("0.04 kNm", "0.04 kN*m"), ("40000 Nmm", "40000 N*mm"),
+     ("40 N.m", None), ("40 N m", None)],
+)  # fmt: skip
+def test_torque_spellings_engineers_type(
+    client: TestClient, typed: str, understood: str | None
+) -> None:
+    """pint alone reads "Nm" as a number-metre (N: Avogadro's number) and refuses it as a
+    torque; the design reads it as newton metres and says so in its notes."""
+    d = Design.model_validate(design(torque=typed))
+    assert d.torque == pytest.approx(40.0)
+    said = [n for n in convert_design(d).notes if "read as" in n]
+    assert said == ([] if understood is None else [f"torque {typed!r} read as {understood!r}"])
+    r = client.post("/v1/melnikov", json={"design": design(torque=typed)})
+    assert r.status_code == 200, r.text
+    assert r.json()["engineering"]["notes"][: len(said)] == said
 
 
 def test_params_xor_design(client: TestClient) -> None:
@@ -206,12 +228,22 @@ def test_margin_to_chaos_sign_follows_the_verdict() -> None:
     assert unsafe.engineering.critical["transmission_error_amplitude"].margin_to_chaos < 0
 
 
-def _synthetic(x: np.ndarray, t: np.ndarray, v: np.ndarray) -> NumericsResult:
+def mesh_force(params: GearParams, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Dimensionless mesh force K(tau) f_h(x) + 2 mu~ x' at the samples (Eq. 9's left side)."""
+    co = forcing_coefficients(params)
+    stiffness = 1.0 + np.cos(np.multiply.outer(t, co.k_omega) + co.k_phase) @ co.k_amp
+    return stiffness * LAWS[params.backlash.model].f_h(params.backlash, x) + 2 * params.damping * v
+
+
+def _synthetic(params: GearParams, x: np.ndarray, t: np.ndarray, v: np.ndarray) -> NumericsResult:
+    """A numerical result whose record is the path (t, x, v), its extremes those of the path."""
     base = analyze(AnalysisRequest.model_validate({"design": EXAMPLE_DESIGN})).numerics
     hist = {"t": t.tolist(), "x": x.tolist(), "v": v.tolist()}
+    force = mesh_force(params, t, x, v)
     return base.model_copy(
         update={"time_history": base.time_history.model_copy(update=hist),
-                "x_peak_to_peak": float(x.max() - x.min())}
+                "x_peak_to_peak": float(x.max() - x.min()),
+                "force_max": float(force.max()), "force_min": float(force.min())}
     )  # fmt: skip
 
 
@@ -230,7 +262,7 @@ def test_engineering_numbers_of_a_hand_computed_response() -> None:
     conv = convert_design(Design.model_validate(d))
     t = np.linspace(0.0, 2 * math.pi, 200_001)
     x, v = 1.5 * np.cos(t), -1.5 * np.sin(t)
-    resp = response(conv.params, _synthetic(x, t, v), conv)
+    resp = response(conv.params, _synthetic(conv.params, x, t, v), conv)
     assert resp.dte_peak_to_peak_um == pytest.approx(150.0)
     assert resp.contact.separation_fraction == pytest.approx(
         2 / math.pi * math.asin(2 / 3), abs=1e-4
@@ -247,7 +279,7 @@ def test_single_sided_hand_computed_fractions() -> None:
     below -1 (min -0.5), so no back-flank contact: single-sided impacts."""
     conv = convert_design(Design.model_validate(design()))
     t = np.linspace(0.0, 2 * math.pi, 200_001)
-    resp = response(conv.params, _synthetic(0.5 + np.cos(t), t, -np.sin(t)), conv)
+    resp = response(conv.params, _synthetic(conv.params, 0.5 + np.cos(t), t, -np.sin(t)), conv)
     assert resp.contact.separation_fraction == pytest.approx(2 / 3, abs=1e-4)
     assert resp.contact.back_flank_fraction == 0.0
 
@@ -270,15 +302,6 @@ def test_simulated_contact_regimes(backlash: str, torque: str, error: str, regim
     assert (contact.separation_fraction > 0) == (regime != "no_impact")
     assert (contact.back_flank_fraction > 0) == (regime == "double_sided")
     assert 0.0 <= contact.back_flank_fraction <= 1.0 - contact.separation_fraction
-
-
-def test_mesh_force_is_the_left_side_of_eq9() -> None:
-    """K(tau) f_h(x) + 2 mu~ x' with K = 1 + 2 k~_p1 cos(Omega_k tau)."""
-    conv = convert_design(Design.model_validate(design()))
-    p = conv.params
-    t, x, v = np.array([0.3]), np.array([1.2]), np.array([0.4])
-    k = 1 + 2 * p.stiffness.harmonics[0].amplitude * math.cos(p.stiffness.frequency * 0.3)
-    assert mesh_force(p, t, x, v)[0] == pytest.approx(k * 0.2 + 2 * p.damping * 0.4)
 
 
 def test_every_endpoint_answers_a_design(client: TestClient) -> None:
@@ -309,3 +332,24 @@ def test_speed_windows_of_a_scan_without_flips() -> None:
             {"design": LIGHT}
         )
     ).engineering.speed_windows_rpm
+
+
+def test_an_analysis_and_a_one_point_sweep_give_the_same_response() -> None:
+    """One definition of the DTE and the dynamic factor (``model.units.response_values``, from
+    the kernel's per-step extremes): /v1/analyses and a one-point speed sweep at the design's
+    speed give the same numbers (before: dynamic factor 1.093296 against 1.093390)."""
+    from gearengine.sweeps import run_local, validated
+
+    light = {"transient_periods": 60, "record_periods": 60}
+    analysis = analyze(AnalysisRequest.model_validate({"design": EXAMPLE_DESIGN,
+                                                       "settings": light}))  # fmt: skip
+    axes = [{"parameter": "speed", "start": "1500 rpm", "stop": "1500 rpm", "num": 1}]
+    (point,) = run_local(
+        validated({"design": EXAMPLE_DESIGN, "settings": light, "axes": axes})
+    ).points
+    resp = analysis.engineering.response
+    assert point.values["speed"] == Design.model_validate(EXAMPLE_DESIGN).speed
+    assert point.physical["dte"].value == resp.dte_peak_to_peak_um
+    assert point.physical["dynamic_factor"].value == resp.dynamic_factor
+    assert point.force_max == analysis.numerics.force_max
+    assert point.x_peak_to_peak == analysis.numerics.x_peak_to_peak

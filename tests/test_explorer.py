@@ -251,7 +251,9 @@ def test_analyse_shows_the_verdict(page: Page) -> None:
     states = page.driver.execute_script(
         "return [...document.querySelectorAll('figure img')].map(i => i.dataset.state)"
     )
-    assert states == ["shown", "shown"]
+    # no threshold curves above the critical torque, and the note says why
+    assert states == ["shown", "failed"]
+    assert "above the critical torque 9.62 N·m" in page.text("#threshold-note")
     page.show("#verdict")
     page.screenshot("explorer-verdict.png", height=1150)
     page.assert_same_origin()
@@ -435,4 +437,21 @@ def test_the_map_shows_impacts_and_the_dynamic_factor(page: Page) -> None:
     assert "no-impact" not in hover and "impacts no" not in hover
     page.show("#envelope")
     page.screenshot("explorer-envelope-impacts.png", height=1000)
+
+
+def test_basins_show_the_attractors_and_their_picture(page: Page) -> None:
+    page.open()
+    page.type("settings.basins.starts", "16")
+    page.field("analyse", by="id").click()  # 500 + 500 periods from 16 starts: over the budget
+    page.wait(lambda d: "settings.basins.starts" in page.text("#refused"))
+    page.type("settings.transient_periods", "30")
+    page.type("settings.record_periods", "30")
+    page.field("analyse", by="id").click()
+    table = page.wait(lambda d: page.text("#attractors-table"))
+    assert "95 % interval" in table and "periodic" in table
+    assert "16 starts" in page.text("#basins-count")
+    page.figures_done()
+    page.wait(lambda d: page.field("basins-figure", by="id").get_attribute("data-state") == "shown")
+    page.show("#basins")
+    page.screenshot("explorer-basins.png", height=1400)
     page.assert_same_origin()

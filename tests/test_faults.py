@@ -18,6 +18,7 @@ import pytest
 
 from gearengine.sweeps import run_local, validated
 from service.jobs.store import JobStore
+from tests._polling import finished, poll
 from tests.conftest import PAPER_PARAMS, Server
 
 CHUNK_POINTS = 2
@@ -53,18 +54,8 @@ def kill9(processes: list[psutil.Process]) -> None:
             os.kill(p.pid, signal.SIGKILL)
 
 
-def poll(url: str, until: Any, timeout: float = 120.0) -> dict[str, Any]:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        job = httpx.get(url, timeout=10).json()
-        if until(job):
-            return job
-        time.sleep(0.05)
-    raise TimeoutError(f"{url}: {job}")
-
-
-def finished(job: dict[str, Any]) -> bool:
-    return job["status"] not in ("queued", "running")
+def poll_url(url: str, until: Any, timeout: float = 120.0) -> dict[str, Any]:
+    return poll(lambda: httpx.get(url, timeout=10).json(), until, timeout)
 
 
 @pytest.fixture
@@ -110,7 +101,7 @@ def crash_and_resume(
     srv = Server(data_dir, ENV)
     try:
         job = httpx.post(f"{srv.url}{route}", json=body, timeout=30).json()
-        seen = poll(f"{srv.url}{route}/{job['id']}", lambda j: j["progress"]["done"] >= done)
+        seen = poll_url(f"{srv.url}{route}/{job['id']}", lambda j: j["progress"]["done"] >= done)
         assert seen["status"] == "running"
         children = pool_workers(srv)
         os.kill(srv.proc.pid, signal.SIGKILL)
@@ -122,7 +113,7 @@ def crash_and_resume(
     again = Server(data_dir, ENV)
     try:
         url = f"{again.url}{route}/{job['id']}"
-        assert poll(url, finished, timeout)["status"] == "succeeded"
+        assert poll_url(url, finished, timeout)["status"] == "succeeded"
         assert httpx.get(url + "/result", timeout=30).json() == reference
     finally:
         again.stop()
@@ -144,10 +135,10 @@ def test_kill9_a_worker_process_retries_its_chunk(
     srv = Server(data_dir, ENV)
     try:
         job, url = submit(srv)
-        poll(url, mid_chunk(data_dir, job["id"], 2 * CHUNK_POINTS))
+        poll_url(url, mid_chunk(data_dir, job["id"], 2 * CHUNK_POINTS))
         (worker,) = pool_workers(srv)
         kill9([worker])
-        assert poll(url, finished)["status"] == "succeeded"
+        assert poll_url(url, finished)["status"] == "succeeded"
         assert httpx.get(url + "/result", timeout=30).json() == reference
         assert worker.pid not in [p.pid for p in pool_workers(srv)]  # a fresh pool
     finally:
@@ -160,7 +151,7 @@ def test_cancel_mid_run_stops_the_sweep(data_dir: Path) -> None:
     srv = Server(data_dir, ENV)
     try:
         job, url = submit(srv)
-        poll(url, lambda j: j["progress"]["done"] >= CHUNK_POINTS)
+        poll_url(url, lambda j: j["progress"]["done"] >= CHUNK_POINTS)
         r = httpx.delete(url, timeout=10)
         assert r.status_code == 200 and r.json()["status"] == "cancelled"
         store = JobStore.in_dir(data_dir)
@@ -171,7 +162,7 @@ def test_cancel_mid_run_stops_the_sweep(data_dir: Path) -> None:
         assert after["progress"]["done"] < after["progress"]["total"]
         small = {**SWEEP, "settings": {"transient_periods": 10, "record_periods": 10}}
         nxt = httpx.post(srv.url + "/v1/sweeps", json=small, timeout=10).json()
-        assert poll(f"{srv.url}/v1/sweeps/{nxt['id']}", finished)["status"] == "succeeded"
+        assert poll_url(f"{srv.url}/v1/sweeps/{nxt['id']}", finished)["status"] == "succeeded"
     finally:
         srv.stop()
 
@@ -185,7 +176,7 @@ def test_restart_after_kill9_reclaims_the_dead_servers_leases_at_once(
     srv = Server(data_dir, env)
     try:
         job, url = submit(srv)
-        poll(url, mid_chunk(data_dir, job["id"], 2 * CHUNK_POINTS))
+        poll_url(url, mid_chunk(data_dir, job["id"], 2 * CHUNK_POINTS))
         children = pool_workers(srv)
         os.kill(srv.proc.pid, signal.SIGKILL)
         srv.proc.wait()
@@ -203,7 +194,7 @@ def test_restart_after_kill9_reclaims_the_dead_servers_leases_at_once(
     again = Server(data_dir, env)
     try:
         url = f"{again.url}/v1/sweeps/{job['id']}"
-        assert poll(url, finished)["status"] == "succeeded"
+        assert poll_url(url, finished)["status"] == "succeeded"
         assert httpx.get(url + "/result", timeout=30).json() == reference
         assert "reclaimed" in again.output()
     finally:

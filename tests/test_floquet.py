@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import json
 import math
-import time
 from collections.abc import Callable
 
 import numpy as np
@@ -34,6 +33,7 @@ from gearengine.sweeps import run_local, validated
 from service.core.config import Settings
 from service.main import create_app
 from tests._gear_cases import paper
+from tests._polling import poll
 from tests.conftest import PAPER_PARAMS, started
 
 MU, FM, WE, A, C = 0.07, 0.01, 0.5, 0.1667, 0.1667
@@ -421,10 +421,7 @@ def working(tmp_path_factory: pytest.TempPathFactory):
 def test_continuation_sweep_over_the_queue_carries_the_bifurcations(working) -> None:
     doc = _line_sweep(15)
     job_id = working.post("/v1/sweeps", json=doc).json()["id"]
-    deadline = time.monotonic() + 120.0
-    while working.get(f"/v1/sweeps/{job_id}").json()["status"] in ("queued", "running"):
-        assert time.monotonic() < deadline
-        time.sleep(0.05)
+    poll(lambda: working.get(f"/v1/sweeps/{job_id}").json())
     body = working.get(f"/v1/sweeps/{job_id}/result").json()
     local = run_local(validated(doc)).model_dump(mode="json")
     assert body == local

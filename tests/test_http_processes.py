@@ -7,12 +7,12 @@ from __future__ import annotations
 import os
 import signal
 import socket
-import time
 from pathlib import Path
 
 import httpx
 import psutil
 
+from tests._polling import UNFINISHED, poll
 from tests.conftest import PAPER_PARAMS, Server
 
 
@@ -57,14 +57,11 @@ def test_three_processes_answer_on_one_port_and_stop_together(tmp_path: Path) ->
             httpx.post(srv.url + "/v1/sweeps", json=sweep, timeout=60).json()["id"]
             for _ in range(4)
         ]
-        deadline = time.monotonic() + 120
-        while time.monotonic() < deadline:  # submitted to any process, run by the one dispatcher
-            states = {
-                httpx.get(f"{srv.url}/v1/sweeps/{j}", timeout=10).json()["status"] for j in jobs
-            }
-            if states == {"succeeded"}:
-                break
-            time.sleep(0.3)
+        states = poll(  # submitted to any process, run by the one dispatcher
+            lambda: {httpx.get(f"{srv.url}/v1/sweeps/{j}", timeout=10).json()["status"]
+                     for j in jobs},
+            lambda s: not s & set(UNFINISHED), interval=0.3,
+        )  # fmt: skip
         assert states == {"succeeded"}
     finally:
         srv.stop()

@@ -2,8 +2,15 @@
 
 from __future__ import annotations
 
+import os
+import shutil
+import subprocess
+import sys
 from pathlib import Path
 
+import pytest
+
+import gearengine
 import gearengine.homoclinic
 import gearengine.numerics.kernels as kernels
 from gearengine.jitcache import STAMP_SUFFIX, drop_stale, sources_digest
@@ -66,3 +73,31 @@ def test_the_kernels_caches_are_stamped_with_their_current_sources() -> None:
     for stem, sources in groups.items():
         stamp = stem.with_name(stem.name + STAMP_SUFFIX)
         assert stamp.read_text() == sources_digest(sources), stamp
+
+
+def test_a_cache_moved_elsewhere_leaves_the_source_tree_alone(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With NUMBA_CACHE_DIR set (the Docker image), importing the engine wrote a stamp into the
+    sources' __pycache__ all the same; now nothing is written or dropped there."""
+    source = tmp_path / "k.py"
+    source.write_text("x = 1\n")
+    cache = tmp_path / "__pycache__"
+    cache.mkdir()
+    (cache / "k.f-1.py311.nbi").write_bytes(b"machine code")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "elsewhere"))
+    assert not drop_stale("k", [source], cache)
+    assert sorted(p.name for p in cache.iterdir()) == ["k.f-1.py311.nbi"]
+
+
+def test_importing_the_engine_with_a_moved_cache_writes_no_stamp(tmp_path: Path) -> None:
+    """A fresh process importing the kernels from a copy of the sources under NUMBA_CACHE_DIR."""
+    copy = tmp_path / "src"
+    shutil.copytree(Path(gearengine.__file__).parent, copy / "gearengine",
+                    ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
+    env = {**os.environ, "PYTHONPATH": str(copy), "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    code = "import gearengine.numerics.kernels, gearengine.homoclinic as h; print(h.__file__)"
+    run = subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, check=True,
+                         timeout=300, capture_output=True, text=True)  # fmt: skip
+    assert run.stdout.startswith(str(copy))
+    assert not list(copy.rglob(f"*{STAMP_SUFFIX}"))

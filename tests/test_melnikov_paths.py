@@ -11,13 +11,10 @@ from gearengine.homoclinic import coefficients as mk
 from gearengine.homoclinic import thresholds as th
 from gearengine.homoclinic.verdict import melnikov
 from gearengine.model.params import GearParams
+from tests.conftest import PAPER_PARAMS
 
-PAPER = GearParams.model_validate(
-    {
-        "damping": 0.07,
-        "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 0.2}]},
-    }
-)
+PAPER = GearParams.model_validate({**PAPER_PARAMS, "mean_force": 0.0})
+"""The paper's design without mean force."""
 
 
 def test_quadrature_thresholds_use_quadrature_coefficients(monkeypatch: pytest.MonkeyPatch) -> None:

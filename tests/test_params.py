@@ -10,15 +10,14 @@ from pydantic import ValidationError
 from gearengine.model.aliases import ALIASES, get_alias, with_alias, with_aliases
 from gearengine.model.frequencies import common_frequency, forcing_period
 from gearengine.model.params import GearParams
+from tests.conftest import PAPER_PARAMS
 
 PAPER = {
-    "damping": 0.07,
-    "mean_force": 0.01,
-    "backlash": {"model": "cubic", "a": 0.1667, "c": 0.1667},
+    **PAPER_PARAMS,
     "stiffness": {"frequency": 1.0, "harmonics": [{"amplitude": 0.0, "phase": 0.0}]},
-    "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 0.2, "phase": 0.0}]},
     "torque": {"frequency": 0.1, "harmonics": [{"amplitude": 0.0, "phase": 0.0}]},
 }
+"""The paper's design with its zero stiffness and torque excitations written out."""
 
 
 def test_public_json_contract_round_trips() -> None:

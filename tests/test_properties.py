@@ -73,12 +73,16 @@ def test_melnikov_output_is_finite_and_coherent(p: GearParams) -> None:
     for b in r.branches.values():
         assert b.min <= b.max
         assert b.sign_change == (b.min < 0.0 < b.max)
-    for t in r.thresholds.values():
-        if t.nearest is not None:
-            # positive on the safe side; an amplitude's nearest critical value is one of its own
-            # sign (engineering convention of issue 26.3), not always the closest one
+    for name, t in r.thresholds.items():
+        if t.nearest is not None:  # |value - nearest|, positive on the safe side
             assert abs(t.margin) == abs(t.value - t.nearest)
-            assert t.nearest in t.critical_values
+            safe = any((lo is None or t.value >= lo) and (hi is None or t.value <= hi)
+                       for lo, hi in t.no_chaos)  # fmt: skip
+            assert t.margin == 0.0 or (t.margin > 0.0) == safe
+            own = [v for v in t.critical_values if (v > 0.0) == (t.value > 0.0)]
+            amplitude = name in ("F_e1", "k_p1", "F_p1") and t.value != 0.0 and own
+            pool = own if amplitude else t.critical_values  # an amplitude keeps its sign
+            assert min(abs(t.value - v) for v in pool) == abs(t.margin)
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])

@@ -4,8 +4,9 @@ Sobol indices, bad tolerance input, and the job over HTTP with a real worker pro
 from __future__ import annotations
 
 import copy
-import time
+import json
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -21,8 +22,10 @@ from gearengine.ensembles.tolerances import (
     sample_design,
     sample_values,
 )
+from gearengine.jobs import compute_chunk_json
 from service.core.config import Settings
 from service.main import create_app
+from tests._polling import poll
 from tests.conftest import PAPER_PARAMS
 
 SHORT = {"transient_periods": 100, "record_periods": 100}
@@ -150,6 +153,11 @@ def test_bad_tolerance_input_is_a_422_naming_the_field(
     assert any(field in e["path"] for e in r.json()["errors"]), r.json()
 
 
+def test_samples_must_be_a_power_of_two(client: TestClient) -> None:
+    r = client.post("/v1/robustness", json=doc(samples=100))
+    assert r.status_code == 422 and r.json()["errors"][0]["path"] == "samples"
+
+
 def test_an_accuracy_class_without_geometry_is_a_422(client: TestClient) -> None:
     d = doc()
     for gear, r_b, j in (("driver", "27 mm", "2e-4 kg*m^2"), ("driven", "78.7 mm", "1e-2 kg*m^2")):
@@ -178,13 +186,7 @@ def working(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestClient]:
 
 
 def wait(c: TestClient, url: str, timeout: float = 120.0) -> dict[str, Any]:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        job = c.get(url).json()
-        if job["status"] not in ("queued", "running"):
-            return job
-        time.sleep(0.1)
-    raise TimeoutError(url)
+    return poll(lambda: c.get(url).json(), timeout=timeout, interval=0.1)
 
 
 def test_a_robustness_job_over_http_equals_run_local(
@@ -211,3 +213,28 @@ def test_a_robustness_job_over_http_equals_run_local(
     assert working.get(f"/v1/sweeps/{job['id']}").status_code == 404
     assert [j["id"] for j in working.get("/v1/robustness").json()["items"]] == [job["id"]]
     assert working.delete(url).status_code == 409
+
+
+def test_a_cancelled_study_gives_a_partial_result_of_its_finished_chunks(tmp_path: Path) -> None:
+    """Four chunks of 16 samples; only chunk 2 is committed before the cancel: ?partial=true
+    counts those 16 samples (the numbers of rows 32..47), the plain result is a 409."""
+    app = create_app(Settings(data_dir=tmp_path, workers=0))
+    with TestClient(app) as c:
+        job = c.post("/v1/robustness", json=doc(samples=64)).json()
+        url, store = f"/v1/robustness/{job['id']}", app.state.sweep_jobs.store
+        assert c.get(url + "/result").status_code == 409
+        claims = store.claim("test-worker", 60.0, 3, 4)
+        assert [(cl.index, cl.kind) for cl in claims] == [(i, "robustness") for i in range(4)]
+        done = compute_chunk_json("robustness", claims[2].request_json, 2, claims[2].chunk_points)
+        assert store.commit("test-worker", job["id"], 2, done)
+        assert c.delete(url).json()["status"] == "cancelled"
+        assert c.get(url + "/result").status_code == 409
+        r = c.get(url + "/result", params={"partial": True})
+        assert r.status_code == 200 and r.headers["x-partial-result"] == "true"
+        result = r.json()
+        assert result["partial"] is True and result["points"][0]["samples"] == 16
+        runs = json.loads(done)["runs"][0]  # [class, contact, melnikov, dte, dynamic factor]
+        p = result["points"][0]["probabilities"]
+        assert p["impacts"]["count"] == sum(r[1] in (1, 2) for r in runs)
+        assert p["chaotic"]["count"] == sum(r[0] == 2 for r in runs)
+        assert p["impacts"]["samples"] == 16

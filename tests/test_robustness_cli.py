@@ -9,9 +9,9 @@ from xml.etree import ElementTree
 
 import pytest
 
-from gearengine.cli.envelope import ENVELOPE_SETTINGS
 from gearengine.cli.main import main
 from gearengine.ensembles.robustness import RobustnessRequest, run_local
+from gearengine.sweeps.gate import ENVELOPE_SETTINGS
 from tests.test_robustness import DESIGN
 
 

@@ -8,7 +8,6 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -28,8 +27,10 @@ from gearengine.runup import run_local
 from gearengine.runup.compute import compute_chunk
 from gearengine.runup.gate import runup_failures
 from gearengine.runup.profile import ramp_forcing
+from gearengine.runup.reading import jumps
 from gearengine.runup.request import RunupRequest, validated
 from gearengine.sweeps.gate import Rules
+from tests._polling import poll
 from tests.conftest import ROOT, Server
 
 CI_DESIGN = json.loads((ROOT / "examples" / "ci" / "design.json").read_text())["design"]
@@ -237,13 +238,12 @@ def test_the_service_job_is_the_cli_document(tmp_path: Path) -> None:
             posted = http.post("/v1/runups", json=body)
             assert posted.status_code == 202
             location = posted.headers["location"]
-            deadline = time.monotonic() + 300
-            while http.get(location).json()["status"] in ("queued", "running"):
-                assert time.monotonic() < deadline
-                time.sleep(0.5)
+            poll(lambda: http.get(location).json(), timeout=300, interval=0.5)
             result = http.get(f"{location}/result")
             assert result.status_code == 200
             assert result.content == out.read_bytes()
+            plot = http.get(f"{location}/plot", params={"format": "png"})
+            assert plot.status_code == 200 and plot.content[:4] == b"\x89PNG"
     finally:
         server.stop()
     assert dumps(run_local(validated(body))) == out.read_text()
@@ -279,3 +279,13 @@ def test_chaos_fails_the_gate_only_when_it_lasts(tmp_path: Path) -> None:
         assert bool(found) == fails
         if fails:
             assert found[0].speeds_rpm == [4000.0, 4400.0] and "chaotic" in found[0].rule
+
+
+def test_a_jump_caught_half_way_by_a_bin_is_one_jump() -> None:
+    """Steps in one sense at neighbouring edges join into one jump at the largest step; a step
+    back the other way is a jump of its own."""
+    found = jumps([100.0, 150.0, 200.0, 250.0], [10.0, 20.0, 50.0, 50.0, 12.0], b_um=50.0)
+    assert [(j.speed_rpm, j.from_um, j.to_um) for j in found] == [
+        (150.0, 10.0, 50.0),
+        (250.0, 50.0, 12.0),
+    ]

@@ -16,7 +16,6 @@ from service.jobs.runtime import SweepJobs
 from service.main import create_app
 from service.warmup import KernelWarmUp
 from tests.conftest import Server, free_port, started
-from tests.test_imports import loaded_after
 
 
 def serve(*args: str, env: dict[str, str] | None = None) -> subprocess.CompletedProcess[str]:
@@ -111,9 +110,3 @@ def test_no_dispatcher_starts_once_the_service_stops(tmp_path: Path) -> None:
     warming._thread.join()
     assert jobs.dispatcher is None and not warming.done.is_set()
     jobs.close()
-
-
-def test_the_service_starts_without_matplotlib() -> None:
-    """Each HTTP process imports the service before it says ready; matplotlib (about 1 s of
-    that on a loaded machine) waits for the first figure."""
-    assert "matplotlib" not in loaded_after("import service.main")

@@ -253,18 +253,21 @@ def test_sweep_work_costs_every_frequency_combination() -> None:
 
 
 def test_csv_of_a_design_sweep_has_its_values_in_gear_units() -> None:
-    """A design's sweep: the axes also in rpm and N*m, the DTE in µm and the dynamic factor,
-    equal to each point's ``physical``; a sweep of params has no such columns."""
+    """A design's sweep: the axes titled with their SI units and, where the display unit
+    differs, also in it (rpm), the DTE in µm and the dynamic factor, equal to each point's
+    ``physical``; axis cells as plain decimals; a sweep of params has no such columns."""
     doc = json.loads((Path(__file__).parents[1] / "examples" / "envelope-map.json").read_text())
     doc["settings"] = SHORT
     doc["axes"][0]["num"], doc["axes"][1]["num"] = 3, 2
     req = validated(doc)
     result = run_local(req)
     rows = list(csv.DictReader(io.StringIO("".join(to_csv(result, design=True)))))
-    assert list(rows[0])[:6] == [
-        "speed", "torque", "speed [rpm]", "torque [N*m]", "dte [um]", "dynamic_factor"
+    assert list(rows[0])[:5] == [
+        "speed [rad/s]", "torque [N*m]", "speed [rpm]", "dte [um]", "dynamic_factor"
     ]  # fmt: skip
-    assert [float(r["speed [rpm]"]) for r in rows[:3]] == [500.0, 3250.0, 6000.0]
+    assert [r["speed [rpm]"] for r in rows[:3]] == ["500", "3250", "6000"]
+    assert all("e" not in r["speed [rad/s]"] and not r["torque [N*m]"].endswith(".0")
+               for r in rows)  # fmt: skip
     for row, point in zip(rows, result.points, strict=True):
         assert point.physical is not None
         for key, title in (("torque", "torque [N*m]"), ("dte", "dte [um]")):

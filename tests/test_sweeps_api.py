@@ -6,7 +6,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -17,6 +16,7 @@ from fastapi.testclient import TestClient
 from gearengine.sweeps import compute_chunk_json, run_local, to_csv, validated
 from service.core.config import Settings
 from service.main import create_app
+from tests._polling import poll
 from tests.conftest import PAPER_PARAMS, started
 
 SHORT = {"transient_periods": 50, "record_periods": 50, "steps_per_period": 64}
@@ -153,13 +153,7 @@ def working(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestClient]:
 
 
 def wait(c: TestClient, job_id: str, timeout: float = 60.0) -> dict[str, Any]:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        job = c.get(f"/v1/sweeps/{job_id}").json()
-        if job["status"] not in ("queued", "running"):
-            return job
-        time.sleep(0.05)
-    raise TimeoutError(job_id)
+    return poll(lambda: c.get(f"/v1/sweeps/{job_id}").json(), timeout=timeout)
 
 
 def test_a_sweep_runs_to_the_same_result_as_run_local(working: TestClient) -> None:

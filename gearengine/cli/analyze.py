@@ -15,8 +15,9 @@ from gearengine.cli.documents import EXIT_FAIL, EXIT_OK, InvalidInputError, read
 from gearengine.cli.envelope import cmd_envelope, physical_limits, rules_of
 from gearengine.cli.melnikov import fmt_value, render_engineering, render_melnikov
 from gearengine.jsonio import dumps
+from gearengine.model.units import OUTPUTS, RESPONSES
 from gearengine.sweeps.gate import Rules, point_failures
-from gearengine.sweeps.results import RESPONSE_UNITS, PhysicalValue, SweepPoint
+from gearengine.sweeps.results import PhysicalValue, SweepPoint
 
 
 def cmd_analyze(args: argparse.Namespace) -> int:
@@ -73,12 +74,10 @@ def gate_point(r: AnalysisResult) -> SweepPoint:
     ``sweeps.gate.point_failures``."""
     worst = r.numerics.worst_case
     resp = None if r.engineering is None else r.engineering.response
+    values = (None, None) if resp is None else (resp.dte_peak_to_peak_um, resp.dynamic_factor)
     physical = {
-        key: PhysicalValue(value=value, unit=RESPONSE_UNITS[key])
-        for key, value in (
-            ("dte", None if resp is None else resp.dte_peak_to_peak_um),
-            ("dynamic_factor", None if resp is None else resp.dynamic_factor),
-        )
+        key: PhysicalValue(value=value, unit=OUTPUTS[key].unit)
+        for key, value in zip(RESPONSES, values, strict=True)
         if value is not None
     }
     return SweepPoint(values={}, branch=None, classification=worst.classification,
@@ -107,11 +106,12 @@ def cmd_check(args: argparse.Namespace) -> int:
         return cmd_probability_gate(args)
     if args.speed or args.torque:
         return cmd_envelope(args)
-    if args.json or args.junit or args.server:
+    if args.starts is not None or args.min_basin is not None or args.json or args.junit or \
+            args.server:  # fmt: skip
         raise InvalidInputError(
             [
-                "--json, --junit and --server check an envelope: give --speed LOW:HIGH (rpm) "
-                "and/or --torque LOW:HIGH (N m)"
+                "--starts, --min-basin, --json, --junit and --server check an envelope: give "
+                "--speed LOW:HIGH (rpm) and/or --torque LOW:HIGH (N m)"
             ]
         )
     request = read_request(args.file, AnalysisRequest)

@@ -4,6 +4,9 @@ envelope.
 Sweeps the design over a grid of driver speeds (rpm unless a unit is given) and mean torques
 (N m unless a unit is given), checks every point against the rules (``sweeps.gate``), prints
 the failing windows, and exits 1 when any point fails, 0 when none does, 2 on invalid input.
+Each point runs ``--starts N`` initial states (default ``GATE_STARTS``, a grid over the
+default basin box) and every attractor found whose basin fraction is above ``--min-basin``
+(default: any) is checked; ``--starts 1`` checks the settings' own start only.
 ``--json FILE`` writes the report (with the API's sweep result in it), ``--junit FILE`` a
 JUnit XML report, ``--server URL`` runs the sweep on a running service (its queue, its
 workers) instead of in this process, with the same report.
@@ -13,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 import time
@@ -31,11 +35,13 @@ from gearengine.cli.documents import (
 from gearengine.cli.sweep import progress
 from gearengine.jsonio import dumps
 from gearengine.numerics.settings import SimulationSettings
-from gearengine.sweeps.compute import run_local
 from gearengine.sweeps.gate import (
     EnvelopeReport,
     Rules,
+    check_envelope,
+    envelope_axis,
     envelope_report,
+    envelope_sweep,
     junit_xml,
     level_text,
     window_text,
@@ -43,19 +49,19 @@ from gearengine.sweeps.gate import (
 from gearengine.sweeps.request import SweepRequest, validated
 from gearengine.sweeps.results import SpeedWindows, SweepResult
 
-ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
-"""Light integration settings of an envelope check; a design file's ``settings`` are merged
-over them (adding ``random_initial_states`` keeps the 60 + 60 periods)."""
 POLL_SECONDS = 1.0
+GATE_STARTS = 16
+"""Basin starts per operating point of the gate unless ``--starts`` or the file's
+``settings.basins`` say otherwise: a 4 x 4 grid over the default box (benchmarks/README.md has
+its cost); ``--starts 1`` checks the settings' own start alone, as before basins."""
 
 
 def axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
-    """A sweep axis from "A:B" (bare numbers in ``unit``) or "52rad/s:628rad/s"."""
-    ends = text.split(":")
-    if len(ends) != 2 or not all(e.strip() for e in ends):
-        raise InvalidInputError([f"--{name}: give a range as LOW:HIGH, e.g. --{name} 500:6000"])
-    lo, hi = (e.strip() if any(c.isalpha() for c in e) else f"{e.strip()} {unit}" for e in ends)
-    return {"parameter": name, "start": lo, "stop": hi, "num": num}
+    """``sweeps.gate.envelope_axis``, its error naming the option."""
+    try:
+        return envelope_axis(name, text, unit, num)
+    except ValueError as exc:
+        raise InvalidInputError([f"--{name}: {exc}"]) from None
 
 
 def envelope_request(args: argparse.Namespace) -> SweepRequest:
@@ -74,9 +80,28 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
     settings = doc.get("settings", {})
     if not isinstance(settings, dict):
         raise InvalidInputError([f"{args.file}: settings must be an object"])
-    sweep = {"design": design, "settings": {**ENVELOPE_SETTINGS, **settings}, "axes": axes,
-             "label": f"envelope check of {Path(args.file).name}"}  # fmt: skip
+    sweep = envelope_sweep(
+        design,
+        gate_settings(settings, args.starts),
+        axes,
+        f"envelope check of {Path(args.file).name}",
+    )
     return validated_input(validated, sweep, args.file)
+
+
+def gate_settings(settings: dict, starts: int | None) -> dict:
+    """The gate's settings with its basin starts: ``starts`` (a grid when it is a square, else
+    random draws), else the file's basins, else ``GATE_STARTS``; ``starts`` 1 leaves basins
+    out."""
+    if starts is None:
+        starts = None if settings.get("basins") is not None else GATE_STARTS
+    if starts is None:
+        return settings
+    if starts == 1:
+        return {k: v for k, v in settings.items() if k != "basins"}
+    basins = dict(settings.get("basins") or {})
+    basins.update(starts=starts, grid=math.isqrt(max(starts, 0)) ** 2 == starts)
+    return {**settings, "basins": basins}
 
 
 def _here(design: dict, name: str) -> str:
@@ -120,7 +145,8 @@ def rules_of(args: argparse.Namespace) -> Rules:
     """--fail-on classes (default chaotic; limits add to them, never replace them)."""
     return Rules(fail_on=args.fail_on or ["chaotic"], max_lle=args.max_lle,
                  max_dte_um=args.max_dte,
-                 max_dynamic_factor=args.max_dynamic_factor)  # fmt: skip
+                 max_dynamic_factor=args.max_dynamic_factor,
+                 min_basin=getattr(args, "min_basin", None))  # fmt: skip
 
 
 def physical_limits(rules: Rules) -> list[str]:
@@ -138,6 +164,8 @@ def rules_text(rules: Rules) -> str:
         parts.append(f"--max-dte {rules.max_dte_um:g} µm")
     if rules.max_dynamic_factor is not None:
         parts.append(f"--max-dynamic-factor {rules.max_dynamic_factor:g}")
+    if rules.min_basin is not None:
+        parts.append(f"--min-basin {rules.min_basin:g}")
     return ", ".join(parts)
 
 
@@ -207,11 +235,9 @@ def cmd_envelope(args: argparse.Namespace) -> int:
     tick = progress(time.monotonic(), "envelope")
     if args.server:
         key = os.environ.get("GEARCHAOS_API_KEY")
-        result = run_on_server(args.server, request, key, tick)
+        report = envelope_report(run_on_server(args.server, request, key, tick), rules)
     else:
-        chunk = max(1, request.n_points() // (4 * (os.cpu_count() or 1)))
-        result = run_local(request, tick, chunk_points=chunk, workers=os.cpu_count() or 1)
-    report = envelope_report(result, rules)
+        report = check_envelope(request, rules, tick, workers=os.cpu_count() or 1)
     if getattr(args, "runup", None) is not None:  # run-ups through the range (runup.gate)
         from gearengine.runup.gate import gate_envelope
 

@@ -5,9 +5,11 @@
     gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov|impacts|separation]
         [--max-lle V] [--max-dte E] [--max-dynamic-factor F]
         [--min-stability-margin X]
+    gearengine remedies FILE --speed A:B [--torque A:B] [check's rules] [--lever PATH=LO:HI]
     gearengine sweep FILE [--out DIR|-] [--format json|csv]
     gearengine runup FILE --from 500 --to 6000 --rate 1000 [--direction up|down|up_down]
         [--bin 50] [--json OUT] [--plot OUT.png]
+    gearengine basins FILE [--starts N] [--json] [--plot FILE]
     gearengine convert FILE [--json]
 
 FILE holds ``{"params": {...}}`` or ``{"design": {...}}`` (physical units), and ``"settings"``
@@ -55,6 +57,23 @@ def lazy(module: str, name: str) -> Command:
     return run
 
 
+def lever_range(text: str) -> dict[str, object]:
+    """``mesh.half_backlash=5um:200um`` as a lever range (bare numbers are SI units)."""
+    path, _, bounds = text.partition("=")
+    ends = [e.strip() for e in bounds.split(":")]
+    if not path.strip() or len(ends) != 2 or not all(ends):
+        raise argparse.ArgumentTypeError(f"{text!r}: give PATH=LOW:HIGH, e.g. "
+                                         "mesh.half_backlash=5um:200um")  # fmt: skip
+    return {"lever": path.strip(), "bounds": [_number_or_text(e) for e in ends]}
+
+
+def _number_or_text(text: str) -> float | str:
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
 def micrometres(text: str) -> float:
     """A length option in µm: a bare number is µm, "0.02 mm" is read with its unit."""
     try:
@@ -65,6 +84,28 @@ def micrometres(text: str) -> float:
         return parse_quantity(text, QUANTITIES["error"]) * 1e6
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -> None:
+    """The gate's rules and envelope options, shared by ``check`` and ``remedies``."""
+    p.add_argument(
+        "--fail-on",
+        action="append",
+        choices=["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"],
+        help="repeatable",
+    )
+    p.add_argument("--speed", metavar="LOW:HIGH", required=speed_required,
+                   help="driver speeds: rpm, or with units")  # fmt: skip
+    p.add_argument("--torque", metavar="LOW:HIGH", help="mean driver torques: N m, or with units")
+    p.add_argument("--speed-points", type=int, default=23, metavar="N", help="default 23")
+    p.add_argument("--torque-points", type=int, default=5, metavar="N", help="default 5")
+    p.add_argument("--max-dte", type=micrometres, default=None, metavar="E",
+                   help="fail where the dynamic transmission error (peak to peak) exceeds E "
+                   "(µm, or with a unit: 20um, 0.02mm)")  # fmt: skip
+    p.add_argument("--max-dynamic-factor", type=float, default=None, metavar="F",
+                   help="fail where the largest dynamic mesh force exceeds F times the static "
+                   "force")  # fmt: skip
+    p.add_argument("--max-lle", type=float, default=None, help="fail when the LLE exceeds V")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -107,27 +148,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "file", help='JSON file holding {"params" or "design": {...}, "settings": {...}}, or -'
     )
-    p.add_argument(
-        "--fail-on",
-        action="append",
-        choices=["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"],
-        help="repeatable",
-    )
-    p.add_argument("--speed", metavar="LOW:HIGH", help="driver speeds: rpm, or with units")
-    p.add_argument("--torque", metavar="LOW:HIGH", help="mean driver torques: N m, or with units")
-    p.add_argument("--speed-points", type=int, default=23, metavar="N", help="default 23")
-    p.add_argument("--torque-points", type=int, default=5, metavar="N", help="default 5")
-    p.add_argument("--max-dte", type=micrometres, default=None, metavar="E",
-                   help="fail where the dynamic transmission error (peak to peak) exceeds E "
-                   "(µm, or with a unit: 20um, 0.02mm)")  # fmt: skip
-    p.add_argument("--max-dynamic-factor", type=float, default=None, metavar="F",
-                   help="fail where the largest dynamic mesh force exceeds F times the static "
-                   "force")  # fmt: skip
+    envelope_options(p)
+    p.add_argument("--starts", type=int, default=None, metavar="N",
+                   help="envelope checks: basin starts per operating point (default 16; 1: "
+                   "the settings' own start only)")  # fmt: skip
+    p.add_argument("--min-basin", type=float, default=None, metavar="F",
+                   help="envelope checks: check only attractors whose basin fraction is above "
+                   "F (default: every attractor found)")  # fmt: skip
     p.add_argument("--json", metavar="FILE", help="write the envelope report (JSON)")
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
     p.add_argument("--server", metavar="URL", help="run the envelope on a running service "
                    "(API key from GEARCHAOS_API_KEY)")  # fmt: skip
-    p.add_argument("--max-lle", type=float, default=None, help="fail when the LLE exceeds V")
     p.add_argument("--runup", type=float, default=None, metavar="RATE",
                    help="envelope checks: also run up and down through --speed at RATE rpm/s "
                    "at each torque level (same rules; chaos fails after 0.05 s)")  # fmt: skip
@@ -145,6 +176,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--samples", type=int, default=64, help="with --max-probability (default 64)")
     p.add_argument("--seed", type=int, default=0, help="with --max-probability (default 0)")
     p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
+
+    p = sub.add_parser("basins", help="coexisting attractors of a design and their basins")
+    p.add_argument("file", help='JSON file holding {"params" or "design": {...}, "settings": '
+                   '{"basins": {...}}}, or -')  # fmt: skip
+    p.add_argument("--starts", type=int, default=None, metavar="N",
+                   help="number of starts (a square on a grid: 16, 64, 256)")  # fmt: skip
+    p.add_argument("--json", action="store_true", help="print the API's JSON response")
+    p.add_argument("--plot", metavar="FILE", help="write the basin picture (.png or .svg)")
+    p.set_defaults(func=lazy("gearengine.cli.basins", "cmd_basins"))
+
+    p = sub.add_parser(
+        "remedies",
+        help="what to change in a failing design, by how much (exit 1: nothing found)",
+        description="For each lever (damping, transmission error, half backlash down and up, "
+        "stiffness variation, torque fluctuation) the smallest change that makes the envelope "
+        "pass under the gate's rules, numerically (verified by a run) and by the Melnikov "
+        "criterion.",
+    )
+    p.add_argument("file", help='JSON file holding {"design": {...}, "settings": {...}}, or -')
+    envelope_options(p, speed_required=True)
+    p.add_argument("--lever", action="append", type=lever_range, metavar="PATH=LOW:HIGH",
+                   help="search this design field instead of the default levers, e.g. "
+                   "mesh.half_backlash=5um:200um (repeatable)")  # fmt: skip
+    p.add_argument("--json", metavar="FILE", help="write the result (as POST /v1/remedies)")
+    p.set_defaults(func=lazy("gearengine.cli.remedies", "cmd_remedies"))
 
     p = sub.add_parser("robustness", help="probabilities over a design's tolerances, here")
     p.add_argument("file", help='JSON file holding {"design": {..., "tolerances": {...}}}, or -')

@@ -21,7 +21,7 @@ from gearengine.cli.documents import (
     read_document,
     validated_input,
 )
-from gearengine.cli.envelope import ENVELOPE_SETTINGS, axis
+from gearengine.cli.envelope import axis
 from gearengine.cli.sweep import progress
 from gearengine.ensembles.robustness import (
     RobustnessRequest,
@@ -29,7 +29,8 @@ from gearengine.ensembles.robustness import (
     checked,
     run_local,
 )
-from gearengine.sweeps.axes import display_unit
+from gearengine.model.units import display_unit
+from gearengine.sweeps.gate import ENVELOPE_SETTINGS
 
 GATED = ("chaotic", "quasi_periodic", "diverged", "impacts", "back_flank",
          "dynamic_factor_above_limit", "melnikov_chaos_possible")  # fmt: skip

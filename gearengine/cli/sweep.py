@@ -57,11 +57,11 @@ def read_sweep(path: str) -> SweepRequest:
     return validated_input(validated, read_document(path), path)
 
 
-def progress(start: float, label: str) -> Callable[[int, int], None]:
+def progress(start: float, label: str, unit: str = "points") -> Callable[[int, int], None]:
     """Progress on standard error: a bar on a terminal, plain lines (every 10 %) when stderr is
-    a file or a CI log, which a carriage return would litter."""
+    a file or a CI log, which a carriage return would litter; counted in ``unit``."""
     if sys.stderr.isatty():
-        return progress_bar(start)
+        return progress_bar(start, unit)
     shown = [-1]
 
     def line(done: int, total: int) -> None:
@@ -69,12 +69,12 @@ def progress(start: float, label: str) -> Callable[[int, int], None]:
         if tenth > shown[0]:
             shown[0] = tenth
             elapsed = time.monotonic() - start
-            print(f"{label}: {done}/{total} points, {elapsed:.1f} s", file=sys.stderr)
+            print(f"{label}: {done}/{total} {unit}, {elapsed:.1f} s", file=sys.stderr)
 
     return line
 
 
-def progress_bar(start: float) -> Callable[[int, int], None]:
+def progress_bar(start: float, unit: str = "points") -> Callable[[int, int], None]:
     """A callback drawing ``[#####     ] done/total points, seconds`` on a terminal's stderr."""
 
     def draw(done: int, total: int) -> None:
@@ -82,7 +82,7 @@ def progress_bar(start: float) -> Callable[[int, int], None]:
         elapsed = time.monotonic() - start
         bar = "#" * filled + " " * (BAR - filled)
         end = "\n" if done >= total else ""
-        print(f"\r[{bar}] {done}/{total} points, {elapsed:.1f} s", end=end, file=sys.stderr)
+        print(f"\r[{bar}] {done}/{total} {unit}, {elapsed:.1f} s", end=end, file=sys.stderr)
 
     return draw
 

@@ -42,9 +42,10 @@ from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.model.design import Design
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
+from gearengine.model.units import in_display_unit
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.settings import SimulationSettings, work
-from gearengine.sweeps.axes import axis_problem, design_with, in_display_unit, is_dimensionless
+from gearengine.sweeps.axes import axis_problem, design_with, is_dimensionless
 from gearengine.sweeps.request import SweepAxis
 
 CLASSES = ("periodic", "quasi_periodic", "chaotic", "diverged")
@@ -248,8 +249,8 @@ ASSUMPTIONS = [
 
 
 def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[int],
-                  complete: bool, names: list[str]) -> dict[str, Any]:  # fmt: skip
-    d = len(names)
+                  complete: bool, variables_: list[Variable]) -> dict[str, Any]:  # fmt: skip
+    names, d = [v.path for v in variables_], len(variables_)
     counted = set(sensitivity.base_rows(request.n_rows(), d)) if request.sensitivity else None
     base = [r for row, r in zip(rows, runs, strict=True) if counted is None or row in counted]
     n = len(base)
@@ -279,7 +280,8 @@ def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[
         table = {k: sensitivity.indices(names, np.array(y, float), request.seed)
                  for k, y in ys.items()}  # fmt: skip
         out["sensitivity"] = table
-        out["ranking"] = [sensitivity.ranked(k, t, {}) for k, t in table.items()]
+        labels = {v.path: v.name for v in variables_}
+        out["ranking"] = [sensitivity.ranked(k, t, labels) for k, t in table.items()]
     return out
 
 
@@ -287,7 +289,6 @@ def assemble(request: RobustnessRequest, chunks: list[str]) -> RobustnessResult:
     """The result from the chunks present (any subset, any order: a partial result counts the
     samples it has; Sobol indices need every chunk)."""
     variables_ = request.variables()
-    names = [v.path for v in variables_]
     points = request.points() or [{}]
     decoded = sorted((json.loads(c) for c in chunks), key=lambda c: c["first_row"])
     complete = sum(len(c["runs"][0]) for c in decoded) == request.n_rows()
@@ -295,7 +296,7 @@ def assemble(request: RobustnessRequest, chunks: list[str]) -> RobustnessResult:
     for i, values in enumerate(points):
         runs = [r for c in decoded for r in c["runs"][i]]
         rows = [c["first_row"] + j for c in decoded for j in range(len(c["runs"][i]))]
-        answer = _point_answer(request, runs, rows, complete, names)
+        answer = _point_answer(request, runs, rows, complete, variables_)
         shown = {k: in_display_unit(k, v) for k, v in values.items()}
         answers.append(RobustnessPoint.model_validate({"values": values, "shown": shown, **answer}))
     return RobustnessResult(

@@ -47,12 +47,19 @@ def base_rows(n_rows: int, dimension: int) -> list[int]:
     return list(range(0, n_rows, dimension + 2))
 
 
+MIN_EVENTS = 10
+"""Least number of samples with, and without, a yes/no outcome for its indices: with fewer, the
+estimators share out the variance of a handful of samples (indices of 0 or 2, meaningless)."""
+
+
 def indices(names: list[str], y: np.ndarray, seed: int) -> dict[str, dict[str, float]] | None:
     """Sobol first-order and total indices of output ``y`` (one value per Saltelli row) for the
-    fields ``names``, with their 95 % bootstrap half-widths; None when ``y`` does not vary (or
-    has undefined values): no variance to share out."""
+    fields ``names``, with their 95 % bootstrap half-widths; None when ``y`` does not vary, has
+    undefined values, or is a yes/no outcome seen (or missed) fewer than ``MIN_EVENTS`` times."""
     y = np.asarray(y, dtype=float)
     if not np.all(np.isfinite(y)) or float(np.var(y)) == 0.0:
+        return None
+    if np.all((y == 0.0) | (y == 1.0)) and min(y.sum(), (1.0 - y).sum()) < MIN_EVENTS:
         return None
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore")
@@ -77,11 +84,18 @@ def indices(names: list[str], y: np.ndarray, seed: int) -> dict[str, dict[str, f
 def ranked(output: str, table: dict[str, dict[str, float]] | None, labels: dict[str, str]) -> str:
     """The indices of one output in plain words, largest total index first."""
     if table is None:
-        return f"{output}: does not vary over the samples (no variance to explain)"
+        return (
+            f"{output}: too few samples differ (fewer than {MIN_EVENTS} either way, or none) "
+            "to share out its variance"
+        )
     order = sorted(table, key=lambda k: -(table[k]["total"] or 0.0))
+
+    def pct(x: float | None) -> str:
+        return f"{100 * min(max(x or 0.0, 0.0), 1.0):.0f} %"
+
     parts = [
-        f"{labels.get(k, k)} explains {100 * max(table[k]['first'] or 0.0, 0.0):.0f} % "
-        f"(with interactions {100 * max(table[k]['total'] or 0.0, 0.0):.0f} %)"
+        f"{labels.get(k, k)} explains {pct(table[k]['first'])} (with its interactions "
+        f"{pct(table[k]['total'])} +- {pct(table[k]['total_conf'])})"
         for k in order
     ]
     return f"variance of {output}: " + "; ".join(parts)

@@ -53,20 +53,26 @@ class Variable:
     path: str
     words: str
     ppf: Callable[[np.ndarray], np.ndarray]
+    label: str = ""
+    """How sentences name it ("profile accuracy (ISO 1328 class 7)"); default: the path."""
+
+    @property
+    def name(self) -> str:
+        return self.label or self.path
 
 
 class ToleranceError(ValueError):
     """Bad tolerance input: ``field`` is the path inside ``design.tolerances``."""
 
     def __init__(self, field: str, message: str) -> None:
-        super().__init__(f"design.tolerances.{field}: {message}")
+        super().__init__(f"design.tolerances{'.' if field else ''}{field}: {message}")
         self.field, self.message = field, message
 
     def details(self) -> InitErrorDetails:
         """As a pydantic error detail (loc design.tolerances.<field>)."""
         return {
             "type": PydanticCustomError("tolerance", self.message),
-            "loc": ("design", "tolerances", self.field),
+            "loc": ("design", "tolerances", self.field) if self.field else ("design", "tolerances"),
             "input": self.field,
         }
 
@@ -151,14 +157,16 @@ def variables(design: Design) -> list[Variable]:
         e_max = iso1328.mesh_error_bound(*profile) * 1e-6
         out.append(Variable(ACCURACY_FIELD, f"ISO 1328 class {grade}: mesh-frequency TE "
                             f"uniform on [0, {e_max * 1e6:.3g} um]",
-                            stats.uniform(0.0, e_max).ppf))  # fmt: skip
+                            stats.uniform(0.0, e_max).ppf,
+                            f"profile accuracy (ISO 1328 class {grade})"))  # fmt: skip
     if tol.backlash is not None:
         lo, hi = half_backlash_band(design, tol.backlash.min, tol.backlash.max)
         band = f"{tol.backlash.min * 1e6:.4g}-{tol.backlash.max * 1e6:.4g} um"
         words = (
             f"backlash band {band}: half backlash uniform on [{lo * 1e6:.4g}, {hi * 1e6:.4g}] um"
         )
-        out.append(Variable(BACKLASH_FIELD, words, stats.uniform(lo, hi - lo).ppf))
+        label = f"backlash (band {band})"
+        out.append(Variable(BACKLASH_FIELD, words, stats.uniform(lo, hi - lo).ppf, label))
     for path, dist in tol.fields().items():
         out.append(_variable(base, path, dist))
     if not out:

@@ -100,4 +100,4 @@ def with_speed_factor(params: GearParams, factor: float) -> GearParams:
     data = params.model_dump()
     for name, _ in params.excitations():
         data[name]["frequency"] *= factor
-    return GearParams.model_validate(data)
+    return GearParams.model_validate(data).with_shaft_orders(params.shaft_orders)

@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 from typing import Annotated
 
-from pydantic import BaseModel, Field
+from pydantic import Field
 
 from gearengine.model.params import (
     MAX_HARMONICS,
@@ -40,26 +40,17 @@ from gearengine.model.params import (
     GearParams,
     Harmonic,
     PiecewiseBacklash,
-    request_config,
+    StrictModel,
 )
+from gearengine.model.units import RADIUS_RATIO_TOLERANCE, TORQUE_BALANCE_TOLERANCE
 
 Positive = Annotated[float, Field(ge=1.0e-12, le=1.0e12, allow_inf_nan=False)]
 """A physical quantity that must be positive, in [1e-12, 1e12] SI units (no subnormals)."""
 SIValue = Annotated[float, Field(ge=-1.0e12, le=1.0e12, allow_inf_nan=False)]
 """A signed physical quantity in SI units, |value| <= 1e12."""
 
-BALANCE_TOLERANCE = 1e-9
-"""Relative mismatch of T_ma / r_a and T_mb / r_b above which the notes flag unbalanced torques."""
 
-RATIO_TOLERANCE = 0.01
-"""Relative mismatch of r_a / r_b and n_a / n_b above which the notes flag inconsistent data."""
-
-
-class _Strict(BaseModel):
-    model_config = request_config()
-
-
-class _Phase(_Strict):
+class _Phase(StrictModel):
     phase: SIValue = Field(
         0.0, description="Phase angle phi_r of this harmonic [rad].", examples=[0.0]
     )
@@ -85,7 +76,7 @@ class TransmissionErrorHarmonic(_Phase):
     )
 
 
-class PhysicalGearData(_Strict):
+class PhysicalGearData(StrictModel):
     """A spur gear pair in SI units, the model of Eq. (1)-(6); gear a drives gear b."""
 
     inertia_a: Positive = Field(
@@ -181,7 +172,18 @@ class PhysicalGearData(_Strict):
     )
 
 
-class Conversion(_Strict):
+CONVERSION_UNITS = {
+    "equivalent_mass": "kg",
+    "natural_frequency": "rad/s",
+    "time_scale": "s",
+    "mesh_frequency": "rad/s",
+    "natural_frequency_hz": "Hz",
+    "mesh_frequency_hz": "Hz",
+}
+"""Units of the numbers of a ``Conversion`` (/v1/conversions/physical)."""
+
+
+class Conversion(StrictModel):
     """Result of ``to_dimensionless``: the parameters of Eq. (8) and the scales used."""
 
     params: GearParams = Field(description="Dimensionless parameters of Eq. (8)-(9).")
@@ -196,12 +198,30 @@ class Conversion(_Strict):
     notes: list[str] = Field(
         default_factory=list, description="Derived values and warnings about the input."
     )
+    natural_frequency_hz: float = Field(description="f_n = w_n / (2 pi) [Hz].")
+    mesh_frequency_hz: float = Field(description="Mesh frequency w_k / (2 pi) [Hz].")
+    units: dict[str, str] = Field(
+        default_factory=lambda: dict(CONVERSION_UNITS),
+        description="The unit of each number above.",
+        examples=[{"natural_frequency": "rad/s", "mesh_frequency": "rad/s"}],
+    )
+
+
+def pair_mass(ia: float, ib: float, ra: float, rb: float) -> float:
+    """Equivalent mass m = I_a I_b / (I_b r_a^2 + I_a r_b^2) [kg] of inertias I [kg m^2] on
+    base radii r [m] (Eq. 7)."""
+    return ia * ib / (ib * ra**2 + ia * rb**2)
 
 
 def equivalent_mass(data: PhysicalGearData) -> float:
-    """m = I_a I_b / (I_b r_a^2 + I_a r_b^2) [kg] (Eq. 7)."""
-    ia, ib, ra, rb = data.inertia_a, data.inertia_b, data.base_radius_a, data.base_radius_b
-    return ia * ib / (ib * ra**2 + ia * rb**2)
+    """m = I_a I_b / (I_b r_a^2 + I_a r_b^2) [kg] of the record (Eq. 7, ``pair_mass``)."""
+    return pair_mass(data.inertia_a, data.inertia_b, data.base_radius_a, data.base_radius_b)
+
+
+def torque_gain(data: PhysicalGearData) -> float:
+    """F~_p per N m of driver-torque fluctuation, m r_a / (I_a b k_m) [1/(N m)] (Eq. 7-8)."""
+    force_scale = data.half_backlash * data.mesh_stiffness
+    return equivalent_mass(data) * data.base_radius_a / data.inertia_a / force_scale
 
 
 def mean_force(data: PhysicalGearData) -> float:
@@ -237,7 +257,7 @@ def to_dimensionless(data: PhysicalGearData) -> Conversion:
             harmonics=[Harmonic(amplitude=amp, phase=phase) for amp, phase in harmonics],
         )
 
-    torque_gain = m * data.base_radius_a / data.inertia_a / force_scale
+    gain = torque_gain(data)
     params = GearParams(
         damping=data.mesh_damping / (2.0 * m * omega_n),
         mean_force=f_m / force_scale,
@@ -251,16 +271,20 @@ def to_dimensionless(data: PhysicalGearData) -> Conversion:
         ),
         torque=excitation(
             data.torque_order * data.shaft_speed_a,
-            [(h.amplitude * torque_gain, h.phase) for h in data.torque_harmonics],
+            [(h.amplitude * gain, h.phase) for h in data.torque_harmonics],
         ),
     )
+    orders = {"stiffness": data.teeth_a, "transmission_error": te_order,
+              "torque": data.torque_order}  # fmt: skip
     return Conversion(
-        params=params,
+        params=params.with_shaft_orders(orders),
         equivalent_mass=m,
         natural_frequency=omega_n,
         time_scale=1.0 / omega_n,
         mesh_frequency=omega_k,
         notes=_notes(data, f_m),
+        natural_frequency_hz=omega_n / (2.0 * math.pi),
+        mesh_frequency_hz=omega_k / (2.0 * math.pi),
     )
 
 
@@ -271,14 +295,14 @@ def _notes(data: PhysicalGearData, f_m: float) -> list[str]:
         "printed Eq. 7 omits r_a in the first term; corrected here)"
     ]
     imbalance = data.torque_a_mean / ra - data.torque_b_mean / rb
-    if abs(imbalance) > BALANCE_TOLERANCE * max(abs(data.torque_a_mean / ra), abs(f_m)):
+    if abs(imbalance) > TORQUE_BALANCE_TOLERANCE * max(abs(data.torque_a_mean / ra), abs(f_m)):
         notes.append(
             f"mean torques are unbalanced: T_ma / r_a - T_mb / r_b = {imbalance:.6g} N, so the "
             "pair speeds up or slows down (Eq. 1 assumes constant speeds); Eq. 7 for x~ still "
             "holds"
         )
     ratio, teeth_ratio = ra / rb, data.teeth_a / data.teeth_b
-    if abs(ratio - teeth_ratio) > RATIO_TOLERANCE * teeth_ratio:
+    if abs(ratio - teeth_ratio) > RADIUS_RATIO_TOLERANCE * teeth_ratio:
         notes.append(
             f"base-radius ratio r_a / r_b = {ratio:.6g} differs from the teeth ratio "
             f"n_a / n_b = {teeth_ratio:.6g}"

@@ -20,14 +20,18 @@ import math
 from typing import Annotated, Any, Literal
 
 from pydantic import (
-    BaseModel,
+    ConfigDict,
     Field,
+    ModelWrapValidatorHandler,
+    PrivateAttr,
     model_validator,
 )
 
+from gearengine.model.errors import InputError
 from gearengine.model.params import (
     MAX_HARMONICS,
     Phase,
+    StrictModel,
     WholeNumber,
     given,
     request_config,
@@ -45,23 +49,22 @@ from gearengine.model.units import (
     Speed,
     StiffnessVariation,
     Torque,
+    readings,
 )
 
 
-class _Strict(BaseModel):
-    model_config = request_config()
-
-
-class Gear(_Strict):
+class Gear(StrictModel):
     """One gear: base radius and inertia directly, or its geometry (module, face width, ...)."""
 
-    model_config = request_config()
-    model_config["json_schema_extra"] = {  # what _enough checks, in the schema
-        "allOf": [
-            {"anyOf": [given(name), {"allOf": [given("module"), given("face_width")]}]}
-            for name in ("base_radius", "inertia")
-        ]
-    }
+    model_config = ConfigDict(
+        **request_config(),
+        json_schema_extra={  # what _enough checks, in the schema
+            "allOf": [
+                {"anyOf": [given(name), {"allOf": [given("module"), given("face_width")]}]}
+                for name in ("base_radius", "inertia")
+            ]
+        },
+    )
 
     teeth: WholeNumber = Field(ge=5, le=1000, description="Number of teeth z.", examples=[18])
     base_radius: Length | None = Field(None, description="Base-circle radius r_b.")
@@ -101,32 +104,33 @@ class Gear(_Strict):
         }
 
 
-class StiffnessVariationHarmonic(_Strict):
+class StiffnessVariationHarmonic(StrictModel):
     """Harmonic r of the mesh stiffness at r x the mesh frequency (Eq. 4)."""
 
     amplitude: StiffnessVariation = Field(description="k_r.", examples=["1e7 N/m"])
     phase: Phase = Field(0.0, description="Phase, rad.")
 
 
-class ErrorHarmonic(_Strict):
+class ErrorHarmonic(StrictModel):
     """Harmonic r of the static transmission error (Eq. 5)."""
 
     amplitude: ErrorAmplitude = Field(description="e_r.", examples=["5 um"])
     phase: Phase = Field(0.0, description="Phase, rad.")
 
 
-class TorqueFluctuationHarmonic(_Strict):
+class TorqueFluctuationHarmonic(StrictModel):
     """Harmonic r of the driver-torque fluctuation (Eq. 3)."""
 
     amplitude: Torque = Field(description="T_pr.", examples=["4 N*m"])
     phase: Phase = Field(0.0, description="Phase, rad.")
 
 
-class Mesh(_Strict):
+class Mesh(StrictModel):
     """The tooth mesh: stiffness, damping and half backlash."""
 
-    model_config = request_config()
-    model_config["json_schema_extra"] = {"oneOf": [given("damping_ratio"), given("damping")]}
+    model_config = ConfigDict(
+        **request_config(), json_schema_extra={"oneOf": [given("damping_ratio"), given("damping")]}
+    )
 
     stiffness: MeshStiffness = Field(
         description="Mean mesh stiffness k_m, or 'iso6336' to derive it from both gears' "
@@ -152,7 +156,7 @@ class Mesh(_Strict):
         return self
 
 
-class TransmissionError(_Strict):
+class TransmissionError(StrictModel):
     """Static transmission error e(t) = sum e_r cos(r w_e t + phi_r)."""
 
     order: float | None = Field(
@@ -163,7 +167,7 @@ class TransmissionError(_Strict):
     harmonics: list[ErrorHarmonic] = Field(max_length=MAX_HARMONICS)
 
 
-class TorqueFluctuation(_Strict):
+class TorqueFluctuation(StrictModel):
     """Driver-torque fluctuation sum T_r cos(r w_p t + phi_r)."""
 
     order: float = Field(
@@ -191,7 +195,7 @@ EXAMPLE_DESIGN = {
 """The README's design (direct form)."""
 
 
-class Design(_Strict):
+class Design(StrictModel):
     """A spur-gear pair in physical units; the driver (gear a) drives the driven gear (b)."""
 
     model_config = request_config(EXAMPLE_DESIGN)
@@ -221,6 +225,23 @@ class Design(_Strict):
         "accuracy, backlash band): read by robustness jobs; the analyses use the nominal design.",
     )
 
+    _readings: list[str] = PrivateAttr(default_factory=list)
+
+    @model_validator(mode="wrap")
+    @classmethod
+    def _with_readings(cls, data: Any, handler: ModelWrapValidatorHandler[Design]) -> Design:
+        """Validate, keeping what was understood from engineers' unit spellings ("40 Nm")."""
+        with readings() as found:
+            design = handler(data)
+        design._readings = found
+        return design
+
+    @property
+    def readings(self) -> list[str]:
+        """How unit spellings pint reads otherwise were understood ("torque '40 Nm' read as
+        '40 N*m'"), for the notes."""
+        return list(self._readings)
+
     @model_validator(mode="after")
     def _consistent(self) -> Design:
         if self.mesh.stiffness == "iso6336" and (
@@ -228,23 +249,25 @@ class Design(_Strict):
         ):
             raise ValueError("mesh.stiffness 'iso6336' needs module and face_width on both gears")
         if self.speed_range is not None and not self.speed_range[0] < self.speed_range[1]:
-            raise ValueError("speed_range: the first speed must be below the second")
+            raise InputError("speed_range", "the first speed must be below the second")
         tol = self.tolerances
         if tol is not None and tol.accuracy is not None:
             if self.driver.geometry() is None or self.driven.geometry() is None:
-                raise ValueError(
-                    "tolerances.accuracy: an ISO 1328 class needs the geometry form (module and "
-                    "face_width) on both gears"
+                raise InputError(
+                    "tolerances.accuracy",
+                    "an ISO 1328 class needs the geometry form (module and face_width) on both "
+                    "gears",
                 )
             if self.transmission_error is not None and self.transmission_error.order is not None:
-                raise ValueError(
-                    "tolerances.accuracy: the ISO 1328 class sets the transmission error at the "
-                    "mesh frequency; remove transmission_error.order"
+                raise InputError(
+                    "tolerances.accuracy",
+                    "the ISO 1328 class sets the transmission error at the mesh frequency; remove "
+                    "transmission_error.order",
                 )
             if ACCURACY_FIELD in tol.fields():
-                raise ValueError(f"tolerances.accuracy: already sets {ACCURACY_FIELD}")
+                raise InputError("tolerances.accuracy", f"already sets {ACCURACY_FIELD}")
         if tol is not None and tol.backlash is not None and BACKLASH_FIELD in tol.fields():
-            raise ValueError(f"tolerances.backlash: already sets {BACKLASH_FIELD}")
+            raise InputError("tolerances.backlash", f"already sets {BACKLASH_FIELD}")
         return self
 
 

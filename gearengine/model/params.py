@@ -15,7 +15,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr
 
 MAX_HARMONICS = 32
 """Largest number of harmonics r = 1..R accepted per excitation."""
@@ -57,11 +57,13 @@ def given(name: str) -> dict[str, Any]:
     return {"required": [name], "properties": {name: {"not": {"type": "null"}}}}
 
 
-class _Strict(BaseModel):
+class StrictModel(BaseModel):
+    """Base of every request model of the engine (``request_config``)."""
+
     model_config = request_config()
 
 
-class Harmonic(_Strict):
+class Harmonic(StrictModel):
     """One harmonic r of an excitation: amplitude times cos(r Omega tau + phase)."""
 
     amplitude: Magnitude = Field(
@@ -76,7 +78,7 @@ class Harmonic(_Strict):
     )
 
 
-class Excitation(_Strict):
+class Excitation(StrictModel):
     """A periodic excitation: fundamental frequency Omega and harmonics r = 1..R."""
 
     frequency: Annotated[float, Field(ge=MIN_FREQUENCY, le=1.0e3, allow_inf_nan=False)] = Field(
@@ -100,7 +102,7 @@ class Excitation(_Strict):
                 yield r, h
 
 
-class CubicBacklash(_Strict):
+class CubicBacklash(StrictModel):
     """Cubic approximation of the backlash law, f_h(x) = -a x + c x^3 (Eq. 9)."""
 
     model_config = request_config()
@@ -119,7 +121,7 @@ class CubicBacklash(_Strict):
     )
 
 
-class PiecewiseBacklash(_Strict):
+class PiecewiseBacklash(StrictModel):
     """Exact backlash law of Eq. (8): slope alpha inside the clearance |x| <= 1, 1 outside."""
 
     model_config = request_config()
@@ -141,7 +143,7 @@ EXCITATIONS = ("stiffness", "transmission_error", "torque")
 """Names of the three excitations, in the order used by the kernels."""
 
 
-class GearParams(_Strict):
+class GearParams(StrictModel):
     """Dimensionless parameters of Eq. (9); an omitted excitation has zero amplitude."""
 
     damping: Annotated[float, Field(ge=0.0, le=1.0e3, allow_inf_nan=False)] = Field(
@@ -188,6 +190,26 @@ class GearParams(_Strict):
             },
         }
     )
+
+    _shaft_orders: dict[str, float] | None = PrivateAttr(None)
+
+    @property
+    def shaft_orders(self) -> dict[str, float] | None:
+        """For the parameters of a design: each excitation's fundamental as a multiple of the
+        driver speed (stiffness: the teeth z; transmission error and torque: their orders),
+        from which ``model.frequencies`` takes the Poincare period exactly; None for
+        parameters given dimensionless. Not part of the JSON: it travels with the object."""
+        return None if self._shaft_orders is None else dict(self._shaft_orders)
+
+    def with_shaft_orders(self, orders: dict[str, float] | None) -> GearParams:
+        """A copy recording ``orders`` (see ``shaft_orders``)."""
+        copy = self.model_copy()
+        copy._shaft_orders = None if orders is None else dict(orders)
+        return copy
+
+    def same_parameters(self, other: GearParams) -> bool:
+        """Equal parameters of Eq. (9) (``==`` also compares ``shaft_orders``)."""
+        return self.model_dump() == other.model_dump()
 
     def excitations(self) -> Iterator[tuple[str, Excitation]]:
         """Yield (name, excitation) for each excitation that is given."""

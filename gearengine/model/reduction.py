@@ -23,25 +23,28 @@ from pydantic.json_schema import JsonSchemaValue
 from pydantic_core import CoreSchema
 
 from gearengine.model import geometry
-from gearengine.model.backlash import collocation_fit
+from gearengine.model.backlash import paper_cubic
 from gearengine.model.conversion import (
     PhysicalGearData,
     StiffnessHarmonic,
     TorqueHarmonic,
     TransmissionErrorHarmonic,
+    pair_mass,
     to_dimensionless,
+    torque_gain,
 )
 from gearengine.model.design import EXAMPLE_DESIGN, Design
+from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash, given
 from gearengine.model.standards import backlash, iso1328
-from gearengine.model.units import RPM
+from gearengine.model.units import (
+    RADIUS_RATIO_TOLERANCE,
+    RPM,
+    TORQUE_BALANCE_TOLERANCE,
+    Scales,
+)
 
-RATIO_TOLERANCE = 0.01
-"""Largest relative mismatch of base-radius ratio and teeth ratio accepted."""
-BALANCE_TOLERANCE = 1e-3
-"""Relative mismatch of a given braking torque with the balancing one that raises a note
-(rounding such as 66.667 for 200/3 N m stays below it)."""
 ISO_HARMONICS = 5
 """Harmonics of the mesh-stiffness wave kept when the variation comes from the contact ratio."""
 
@@ -75,6 +78,20 @@ class DesignConversion(BaseModel):
     static_force_n: float = Field(description="Mean mesh force F^_m [N] (Eq. 7).")
     torque_gain: float = Field(description="F~_p per N m of driver torque fluctuation [1/(N m)].")
     notes: list[str] = Field(description="Assumptions and remarks, in plain words.")
+
+    @property
+    def scales(self) -> Scales:
+        """What maps this design's dimensionless answers back to gear data (``model.units``:
+        ``to_physical``, ``OUTPUTS``)."""
+        return Scales(
+            half_backlash=self.half_backlash_m,
+            mesh_stiffness=self.mesh_stiffness_n_per_m,
+            natural_frequency=1.0 / self.time_scale_s,
+            static_force=self.static_force_n,
+            mesh_frequency=2.0 * math.pi * self.mesh_frequency_hz,
+            speed=self.speed_rpm * RPM,
+            torque_gain=self.torque_gain,
+        )
 
 
 def _gear_values(design: Design, derived: dict[str, Derived]) -> dict[str, float]:
@@ -141,27 +158,29 @@ def physical_data(design: Design) -> tuple[PhysicalGearData, dict[str, Derived],
     gears = _gear_values(design, derived)
     ra, rb = gears["base_radius_driver"], gears["base_radius_driven"]
     teeth = design.driver.teeth / design.driven.teeth
-    if abs(ra / rb - teeth) > RATIO_TOLERANCE * teeth:
-        raise ValueError(
-            f"design.driven.base_radius: base radii ratio r_a / r_b = {ra / rb:.4f} differs "
-            f"from the teeth ratio {design.driver.teeth}/{design.driven.teeth} = {teeth:.4f} "
-            "by more than 1 %"
+    if abs(ra / rb - teeth) > RADIUS_RATIO_TOLERANCE * teeth:
+        raise InputError(
+            "design.driven.base_radius",
+            f"base radii ratio r_a / r_b = {ra / rb:.4f} differs from the teeth ratio "
+            f"{design.driver.teeth}/{design.driven.teeth} = {teeth:.4f} by more than "
+            f"{RADIUS_RATIO_TOLERANCE:.0%}",
         )
     k_m, harmonics = _stiffness(design, derived)
     if sum(abs(a) for a, _ in harmonics) >= k_m:
-        raise ValueError(
-            "design.mesh.stiffness_harmonics: the amplitudes add up to the mean mesh stiffness "
-            f"{k_m:.6g} N/m or more, so the stiffness would become negative"
+        raise InputError(
+            "design.mesh.stiffness_harmonics",
+            f"the amplitudes add up to the mean mesh stiffness {k_m:.6g} N/m or more, so the "
+            "stiffness would become negative",
         )
     balancing = design.torque * rb / ra
     braking = balancing if design.braking_torque is None else design.braking_torque
-    notes = []
-    if abs(braking - balancing) > BALANCE_TOLERANCE * max(abs(balancing), 1e-12):
+    notes = design.readings
+    if abs(braking - balancing) > TORQUE_BALANCE_TOLERANCE * max(abs(balancing), 1e-12):
         notes.append(f"braking torque {braking:.6g} N m differs from the balancing "
                      f"{balancing:.6g} N m: the pair would speed up or slow down")  # fmt: skip
     mesh, te, tf = design.mesh, design.transmission_error, design.torque_fluctuation
     ia, ib = gears["inertia_driver"], gears["inertia_driven"]
-    m = ia * ib / (ib * ra**2 + ia * rb**2)  # equivalent mass (Eq. 7)
+    m = pair_mass(ia, ib, ra, rb)
     zeta = mesh.damping_ratio
     damping = mesh.damping if zeta is None else 2.0 * zeta * math.sqrt(k_m * m)  # mu~ = zeta
     data = PhysicalGearData(
@@ -184,7 +203,8 @@ def physical_data(design: Design) -> tuple[PhysicalGearData, dict[str, Derived],
 
 
 def _paper_cubic() -> CubicBacklash:
-    fit = collocation_fit(0.0)
+    """The paper's cubic law (``backlash.paper_cubic``) as a backlash of Eq. (9)."""
+    fit = paper_cubic()
     return CubicBacklash(a=fit.a, c=fit.c)
 
 
@@ -270,15 +290,15 @@ def convert_design(design: Design) -> DesignConversion:
     return DesignConversion(
         params=conv.params,
         derived=derived,
-        natural_frequency_hz=conv.natural_frequency / (2.0 * math.pi),
+        natural_frequency_hz=conv.natural_frequency_hz,
         time_scale_s=conv.time_scale,
-        mesh_frequency_hz=conv.mesh_frequency / (2.0 * math.pi),
+        mesh_frequency_hz=conv.mesh_frequency_hz,
         speed_rpm=design.speed / RPM,
         equivalent_mass_kg=m,
         half_backlash_m=data.half_backlash,
         mesh_stiffness_n_per_m=data.mesh_stiffness,
         static_force_n=conv.params.mean_force * force_scale,
-        torque_gain=m * data.base_radius_a / data.inertia_a / force_scale,
+        torque_gain=torque_gain(data),
         notes=notes,
     )
 
@@ -318,7 +338,7 @@ class ParamsOrDesign(BaseModel):
             return self
         conversion = convert_design(self.design)
         # a stored request (a sweep job) carries both: params must be the design's conversion
-        if self.params is not None and self.params != conversion.params:
+        if self.params is not None and not self.params.same_parameters(conversion.params):
             raise ValueError("give params or design, not both")
         object.__setattr__(self, "params", conversion.params)
         self._conversion = conversion

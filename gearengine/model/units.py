@@ -14,7 +14,10 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass, field, replace
 from functools import cache
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -45,6 +48,9 @@ class QuantityKind:
     high: float
     slips: tuple[str, ...]
     example: str
+    spellings: dict[str, str] = field(default_factory=dict)
+    """Units as engineers type them that pint reads otherwise (``Nm``: pint's N is Avogadro's
+    number), and the unit meant; the whole unit text must match."""
 
     @property
     def dimensionality(self) -> Any:
@@ -55,6 +61,42 @@ class QuantityKind:
         return f"{si:.6g} {self.unit}"
 
 
+TORQUE_SPELLINGS = {"Nm": "N*m", "kNm": "kN*m", "MNm": "MN*m", "Nmm": "N*mm"}
+"""Torque units as typed on drawings and in spreadsheets, read as newton metres (pint reads
+``Nm`` as a number-metre, ``N`` being Avogadro's number there; ``N.m`` and ``N m`` it reads
+right)."""
+
+_READINGS: ContextVar[list[str] | None] = ContextVar("readings", default=None)
+
+
+@contextmanager
+def readings() -> Iterator[list[str]]:
+    """Collect, while validating inside this block, what ``parse_quantity`` understood from a
+    spelling of ``QuantityKind.spellings`` (one sentence each, for the notes of a design)."""
+    found: list[str] = []
+    token = _READINGS.set(found)
+    try:
+        yield found
+    finally:
+        _READINGS.reset(token)
+
+
+_NUMBER_AND_UNIT = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)\s*")
+
+
+def _respelled(text: str, kind: QuantityKind) -> str:
+    """``text`` with an engineer's spelling of the unit (``40 Nm``) written as pint reads it
+    (``40 N*m``), noted in the current ``readings``; other text unchanged."""
+    match = _NUMBER_AND_UNIT.fullmatch(text)
+    if match is None or match.group(2) not in kind.spellings:
+        return text
+    meant = f"{match.group(1)} {kind.spellings[match.group(2)]}"
+    found = _READINGS.get()
+    if found is not None:
+        found.append(f"{kind.name} {text.strip()!r} read as {meant!r}")
+    return meant
+
+
 QUANTITIES: dict[str, QuantityKind] = {
     "length": QuantityKind("length", "m", 1e-9, 10.0, ("um", "mm"), "30 mm"),
     "half_backlash": QuantityKind("half backlash", "m", 1e-7, 5e-3, ("um", "mm"), "50 um"),
@@ -62,7 +104,7 @@ QUANTITIES: dict[str, QuantityKind] = {
     "speed": QuantityKind(
         "shaft speed", "rad/s", 2 * math.pi / 60, 2e5 * 2 * math.pi / 60, ("rpm",), "1500 rpm"
     ),
-    "torque": QuantityKind("torque", "N*m", 0.0, 1e6, (), "40 N*m"),
+    "torque": QuantityKind("torque", "N*m", 0.0, 1e6, (), "40 N*m", TORQUE_SPELLINGS),
     "stiffness": QuantityKind("mesh stiffness", "N/m", 1e6, 1e11, ("N/um", "N/mm"), "1e8 N/m"),
     "stiffness_variation": QuantityKind(
         "stiffness variation", "N/m", 0.0, 1e11, ("N/um", "N/mm"), "1e7 N/m"
@@ -70,6 +112,8 @@ QUANTITIES: dict[str, QuantityKind] = {
     "inertia": QuantityKind("inertia", "kg*m^2", 1e-9, 1e4, ("kg*cm^2", "kg*mm^2"), "2e-3 kg*m^2"),
     "damping": QuantityKind("damping", "N*s/m", 0.0, 1e7, (), "1100 N*s/m"),
     "angle": QuantityKind("angle", "rad", math.radians(10), math.radians(35), ("deg",), "20 deg"),
+    "displacement": QuantityKind("displacement", "m", 0.0, 1e-2, ("um", "mm"), "-30 um"),
+    "velocity": QuantityKind("velocity", "m/s", 0.0, 100.0, ("mm/s",), "200 mm/s"),
     "speed_rate": QuantityKind(
         "rate of change of shaft speed",
         "rad/s^2",
@@ -97,6 +141,7 @@ def parse_quantity(value: object, kind: QuantityKind, allow_zero: bool = False) 
         raise ValueError(f"give a number in {kind.unit} or a string with a unit, e.g. "
                          f"{kind.example!r}")  # fmt: skip
     if isinstance(value, str):
+        value = _respelled(value, kind)
         try:
             quantity = ureg.Quantity(value.strip())
         except Exception as exc:
@@ -225,9 +270,235 @@ StiffnessVariation = quantity_type("stiffness_variation", allow_zero=True)
 Inertia = quantity_type("inertia")
 Damping = quantity_type("damping", allow_zero=True)
 Angle = quantity_type("angle")
-SpeedRate = quantity_type("speed_rate")
 Duration = quantity_type("duration")
 Time = quantity_type("duration", allow_zero=True)
 
 RPM = 2.0 * math.pi / 60.0
 """One revolution per minute in rad/s."""
+
+# Tolerances of the units boundary: one meaning per name.
+RADIUS_RATIO_TOLERANCE = 0.01
+"""Relative mismatch of the base-radius ratio r_a / r_b and the teeth ratio n_a / n_b beyond
+which the data are inconsistent: a design is refused, the SI record of
+/v1/conversions/physical (no teeth check of its own) gets a note."""
+TORQUE_BALANCE_TOLERANCE = 1e-3
+"""Relative mismatch of the braking torque with the balancing one, T_mb = T_ma r_b / r_a, beyond
+which a note says the pair would speed up or slow down (rounding such as 66.667 for 200/3 N m
+stays below it)."""
+
+
+def shown(value: float) -> float:
+    """A value in display units rounded to 12 significant digits (6000 rpm, not
+    6000.000000000001): how every physical number of a sweep point, of its CSV row and of an
+    analysis's response is given."""
+    return float(f"{value:.12g}")
+
+
+@dataclass(frozen=True)
+class Scales:
+    """What maps a dimensionless answer of Eq. (9) back to gear data (Eq. 8: x = x~ / b,
+    tau = omega_n t, forces in units of b k_m)."""
+
+    half_backlash: float
+    """b [m]: x = 1 is one half backlash."""
+    mesh_stiffness: float
+    """k_m [N/m]: a dimensionless force times b k_m is in N."""
+    natural_frequency: float
+    """omega_n = sqrt(k_m / m) [rad/s]: t = tau / omega_n."""
+    static_force: float
+    """Mean mesh force F^_m = F~_m b k_m [N] (Eq. 7)."""
+    mesh_frequency: float
+    """omega_k = n_a omega_a [rad/s]."""
+    speed: float
+    """Driver speed omega_a [rad/s]."""
+    torque_gain: float
+    """F~_p per N m of driver-torque fluctuation, m r_a / (I_a b k_m) [1/(N m)]."""
+
+    def at(self, mean_force: float) -> Scales:
+        """These scales for a point whose dimensionless mean force F~_m was set (an ``F_m``
+        axis): the static force is F~_m b k_m."""
+        return replace(self, static_force=mean_force * (self.half_backlash * self.mesh_stiffness))
+
+
+@dataclass(frozen=True)
+class OutputKind:
+    """A dimensionless result as a physical quantity: ``to_si(value, scales)`` inverts Eq. (8)
+    for it, ``display`` is the factor from its SI unit to the unit it is shown in."""
+
+    label: str
+    si_unit: str
+    unit: str
+    to_si: Callable[[float, Scales], float]
+    display: float = 1.0
+
+
+OUTPUTS: dict[str, OutputKind] = {
+    "dte": OutputKind(
+        "dynamic transmission error (peak to peak)", "m", "um", lambda x, s: x * s.half_backlash,
+        1e6,
+    ),
+    "dynamic_factor": OutputKind(
+        "dynamic factor (largest mesh force / static force)", "1", "1",
+        lambda f, s: f * s.half_backlash * s.mesh_stiffness / s.static_force,
+    ),
+    "mesh_force": OutputKind(
+        "dynamic mesh force", "N", "N", lambda f, s: f * s.half_backlash * s.mesh_stiffness
+    ),
+    "transmission_error_amplitude": OutputKind(
+        "transmission-error amplitude e_1 = F~_e1 b", "m", "um",
+        lambda v, s: v * s.half_backlash, 1e6,
+    ),
+    "torque_fluctuation_amplitude": OutputKind(
+        "torque-fluctuation amplitude T_p1 = F~_p1 / (m r_a / (I_a b k_m))", "N*m", "N*m",
+        lambda v, s: v / s.torque_gain,
+    ),
+    "stiffness_variation_amplitude": OutputKind(
+        "stiffness-variation amplitude k_1 = 2 k_m k~_p1", "N/m", "N/m",
+        lambda v, s: 2.0 * v * s.mesh_stiffness,
+    ),
+    "damping_ratio": OutputKind("damping ratio zeta = mu~", "1", "1", lambda v, s: v),
+    "displacement": OutputKind(
+        "displacement x~ = x b", "m", "um", lambda x, s: x * s.half_backlash, 1e6
+    ),
+    "time": OutputKind("time t = tau / omega_n", "s", "ms", lambda t, s: t / s.natural_frequency,
+                       1e3),
+    "frequency": OutputKind(
+        "frequency f = Omega omega_n / (2 pi)", "Hz", "Hz",
+        lambda w, s: w * s.natural_frequency / (2 * math.pi),
+    ),
+}  # fmt: skip
+"""Output quantities by name: the physical meaning of a dimensionless result (beside the inputs'
+``QUANTITIES``); the engineering block, sweep points, CSV columns, gate rules and plots read it."""
+
+RESPONSES = ("dte", "dynamic_factor")
+"""The response quantities of a design's simulated point (a sweep point's ``physical`` entries
+beside its axes, the CSV's response columns, the gate's limits)."""
+
+
+def in_si(name: str, value: float, scales: Scales) -> float:
+    """The dimensionless ``value`` of output ``name`` in its SI unit (``OUTPUTS``)."""
+    return OUTPUTS[name].to_si(value, scales)
+
+
+def to_physical(name: str, value: float, scales: Scales) -> float:
+    """The dimensionless ``value`` of output ``name`` in its display unit (``OUTPUTS``): the one
+    crossing from a dimensionless result to a physical value."""
+    kind = OUTPUTS[name]
+    si = in_si(name, value, scales)
+    return si if kind.display == 1.0 else si * kind.display
+
+
+def response_values(
+    x_peak_to_peak: float | None, force_max: float | None, scales: Scales
+) -> dict[str, float | None]:
+    """DTE [µm peak to peak] and dynamic factor of a simulated response, ``shown``: the one
+    definition used by an analysis's engineering block and by every sweep point.
+
+    ``x_peak_to_peak`` (units of b) and ``force_max`` (units of b k_m) come from the kernel's
+    per-step extremes over the record; the dynamic factor is None without a positive static
+    force."""
+    dte = None if x_peak_to_peak is None else shown(to_physical("dte", x_peak_to_peak, scales))
+    factor = None
+    if force_max is not None and scales.static_force > 0.0:
+        factor = shown(to_physical("dynamic_factor", force_max, scales))
+    return {"dte": dte, "dynamic_factor": factor}
+
+
+def display_label(name: str) -> str:
+    """An output's name with its display unit, as a CSV column title or a plot's axis label
+    ("dte [um]"; a dimensionless one bare)."""
+    unit = OUTPUTS[name].unit
+    return name if unit == "1" else f"{name} [{unit}]"
+
+
+@dataclass(frozen=True)
+class FieldUnit:
+    """How a design field (a sweep axis) is shown: its SI unit, its display unit and the factor
+    from the one to the other."""
+
+    si: str
+    display: str
+    factor: float = 1.0
+
+
+DISPLAY_UNITS: dict[str, FieldUnit] = {
+    "speed": FieldUnit("rad/s", "rpm", 1.0 / RPM),
+    "torque": FieldUnit("N*m", "N*m"),
+    "braking_torque": FieldUnit("N*m", "N*m"),
+    "half_backlash": FieldUnit("m", "um", 1e6),
+    "transmission_error": FieldUnit("m", "um", 1e6),
+    "torque_fluctuation": FieldUnit("N*m", "N*m"),
+    "stiffness_harmonics": FieldUnit("N/m", "N/m"),
+    "stiffness": FieldUnit("N/m", "N/m"),
+    "damping_ratio": FieldUnit("1", "1"),
+    "damping": FieldUnit("N*s/m", "N*s/m"),
+    "inertia": FieldUnit("kg*m^2", "kg*m^2"),
+    "base_radius": FieldUnit("m", "mm", 1e3),
+    "module": FieldUnit("m", "mm", 1e3),
+    "face_width": FieldUnit("m", "mm", 1e3),
+    "bore": FieldUnit("m", "mm", 1e3),
+    "pressure_angle": FieldUnit("rad", "deg", 180.0 / math.pi),
+    "order": FieldUnit("1", "1"),
+    "profile_shift": FieldUnit("1", "1"),
+    "phase": FieldUnit("rad", "rad"),
+}
+"""Units of a design's fields by the most specific name in their path
+(``transmission_error.harmonics.0.amplitude`` is shown in µm)."""
+
+FIELD_NAMES = {
+    "speed": "driver speed",
+    "torque": "mean driver torque",
+    "braking_torque": "braking torque",
+    "half_backlash": "half backlash",
+    "damping_ratio": "damping ratio",
+    "damping": "mesh damping",
+    "stiffness": "mean mesh stiffness",
+    "stiffness_harmonics": "mesh-stiffness variation",
+    "transmission_error": "transmission error",
+    "torque_fluctuation": "torque fluctuation",
+    "base_radius": "base radius",
+    "face_width": "face width",
+    "pressure_angle": "pressure angle",
+    "profile_shift": "profile shift",
+}
+"""Readable names of the parts of a field path (others are shown as they are)."""
+
+
+def field_unit(path: str) -> FieldUnit:
+    """The units of a design field path (``DISPLAY_UNITS``; SI shown as it is when unknown)."""
+    for part in (path, *reversed(path.split("."))):
+        if part in DISPLAY_UNITS:
+            return DISPLAY_UNITS[part]
+    return FieldUnit("SI", "SI")
+
+
+def display_unit(path: str) -> tuple[str, float]:
+    """(display unit, factor from SI) of a design field path."""
+    unit = field_unit(path)
+    return unit.display, unit.factor
+
+
+def in_display_unit(path: str, si: float) -> float:
+    """A design field's SI value in its display unit, ``shown``: the number of a sweep point's
+    ``physical`` entry and of its CSV column."""
+    return shown(si * field_unit(path).factor)
+
+
+def pretty_unit(unit: str) -> str:
+    """A unit as printed on a figure: µm for um, a middle dot for a product."""
+    return unit.replace("um", "µm").replace("*", "·").replace("^2", "²")
+
+
+def field_label(path: str) -> str:
+    """A readable axis label of a design field path: "driver speed [rpm]",
+    "transmission error, harmonic 1 amplitude [µm]", "driver module [mm]"."""
+    parts = [p for p in path.split(".") if p != "mesh"]
+    words = []
+    for k, part in enumerate(parts):
+        if part.isdigit():
+            words[-1] += f", harmonic {int(part) + 1}"
+        elif part != "harmonics" or k == 0:
+            words.append(FIELD_NAMES.get(part, part.replace("_", " ")))
+    unit = field_unit(path).display
+    text = " ".join(words)
+    return text if unit == "1" else f"{text} [{pretty_unit(unit)}]"

@@ -59,10 +59,10 @@ def step_plans(points: Sequence[GearParams], steps_per_period: int) -> list[Step
     known: dict[tuple, StepPlan] = {}
     plans = []
     for p in points:
-        key = tuple(
+        key = (*(
             (name, exc.frequency, tuple(r for r, _ in exc.active()))
             for name, exc in p.excitations()
-        )
+        ), str(p.shaft_orders))  # fmt: skip
         if key not in known:
             known[key] = step_plan(p, steps_per_period)
         plans.append(known[key])

@@ -44,7 +44,7 @@ COLLAPSE_TOL = 1e-8
 """|P^d(X) - X| < COLLAPSE_TOL max(1, |X|) for a divisor d < n: X lies on a shorter orbit."""
 
 
-class Response(NamedTuple):
+class PointResponse(NamedTuple):
     """A simulated response at one grid value (e.g. a continuation sweep's point)."""
 
     classification: str
@@ -56,7 +56,7 @@ class Response(NamedTuple):
 
 
 class _Attractor(NamedTuple):
-    """Response at one grid point: its stable refined orbit (or None), period, end state."""
+    """The response at one grid point: its stable refined orbit (or None), period, end state."""
 
     orbit: FloquetResult | None
     period: int | None
@@ -134,20 +134,22 @@ def _follow(flow: Flow, orbit: FloquetResult) -> FloquetResult:
 
 
 def _simulated(params: GearParams, settings: SimulationSettings, start: Sequence[float]):
-    """``simulate`` from the single state ``start``, as a ``Response``."""
+    """``simulate`` from the single state ``start``, as a ``PointResponse``."""
     run = settings.model_copy(
         update={"initial_state": list(start), "initial_states": None, "random_initial_states": None}
     )
     r = simulate(params, run)
     final = r.worst_case.final_state
     strobe = r.poincare[-1] if r.poincare else None
-    return Response(r.classification, r.period, strobe, None if final is None else tuple(final))
+    return PointResponse(
+        r.classification, r.period, strobe, None if final is None else tuple(final)
+    )
 
 
 def _settle(
     params: GearParams,
     settings: SimulationSettings,
-    response: Response,
+    response: PointResponse,
     doubled: FloquetResult | None = None,
 ) -> _Attractor:
     """Newton-refine a simulated response; keep the orbit if it is stable.
@@ -264,7 +266,7 @@ def locate_bifurcations(
     values: Sequence[float],
     settings: SimulationSettings | None = None,
     xtol: float = 1e-10,
-    responses: Sequence[Response] | None = None,
+    responses: Sequence[PointResponse] | None = None,
     path: Path | None = None,
 ) -> list[dict[str, Any]]:
     """Bifurcation points of the periodic responses along a sweep of one parameter.

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from gearengine.model.backlash import LAWS
-from gearengine.model.frequencies import common_frequency
+from gearengine.model.frequencies import incommensurate_reason, poincare_frequency
 from gearengine.model.params import CubicBacklash, GearParams
 
 
@@ -132,11 +132,12 @@ def step_plan(params: GearParams, steps_per_period: int) -> StepPlan:
     if fast is None:
         note = "no active excitation: constant forcing, sampling interval T0 = 2 pi (Omega_0 = 1)"
         return StepPlan(1.0, 2.0 * math.pi, steps_per_period, 1.0, (note,))
-    omega0 = common_frequency(params.active_frequencies())
+    omega0 = poincare_frequency(params)
     if omega0 is None:
         note = (
             f"active frequencies {sorted(set(params.active_frequencies()))} are incommensurate "
-            "(no common Omega_0): the forcing is quasi-periodic and has no Poincare period; "
+            f"(no common Omega_0: {incommensurate_reason(params)}): the forcing is "
+            "quasi-periodic and has no Poincare period; "
             f"strobes are taken every 2 pi / {fast:g} (fastest excitation) and the forcing is "
             "evaluated at absolute time"
         )

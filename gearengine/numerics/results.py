@@ -80,6 +80,60 @@ class FloquetResult(_Result):
     notes: list[str] = Field(description="Remarks on the result.")
 
 
+class Attractor(_Result):
+    """One attractor found from the basin starts (``ensembles.attractors``, docs/basins.md)."""
+
+    label: str = Field(
+        description="How the gate and the summary name it: 'periodic 1T, no impacts', "
+        "'chaotic, double-sided impacts'.",
+        examples=["chaotic, double-sided impacts"],
+    )
+    classification: str = Field(description="periodic | chaotic | quasi_periodic.")
+    period: int | None = Field(description="Period in units of T0, null if not periodic.")
+    lle: float | None = Field(description="Mean LLE of the starts that reached it, per unit tau.")
+    lle_stderr: float | None = Field(description="Standard error of that mean.")
+    impact_regime: str | None = Field(
+        description="no_impact | single_sided | double_sided (the worst seen on the attractor)."
+    )
+    x_peak_to_peak: float | None = Field(description="Largest max x - min x seen (units of b).")
+    dte_um: float | None = Field(
+        None, description="With a design: dynamic transmission error peak to peak [µm]."
+    )
+    dynamic_factor: float | None = Field(
+        None, description="With a design: largest mesh force / static force."
+    )
+    fraction: float = Field(description="count / basins.starts: the basin fraction.")
+    interval: list[float] = Field(
+        description="95 % Wilson score interval [low, high] of the fraction "
+        "(scipy.stats.binomtest(count, starts).proportion_ci)."
+    )
+    count: int = Field(description="Starts that reached it.")
+    start: list[float] = Field(description="One start [x0, v0] that reached it (dimensionless).")
+    strobes: list[list[float]] = Field(
+        description="Its stroboscopic orbit [[x, v], ...]: the n points of a period-n orbit, "
+        "else the representative start's last strobes (<= 64)."
+    )
+
+
+class BasinCounts(_Result):
+    """How the basin starts ended (``settings.basins``)."""
+
+    starts: int = Field(description="Initial states run.")
+    diverged: int = Field(description="Starts whose state left the divergence bound.")
+    unsettled: int = Field(
+        description="Starts with neither a period <= 64 nor a positive LLE under commensurate "
+        "forcing: an unfinished transient or a longer period (more transient_periods decide)."
+    )
+    labels: list[int] = Field(
+        description="Per start, in the order of settings.basins: the index of its attractor "
+        "in attractors, -1 diverged, -2 unsettled."
+    )
+    grid: list[int] | None = Field(
+        description="[nx, nv] of a grid of starts (x fastest); null for random draws."
+    )
+    box: list[list[float]] = Field(description="The box of the starts, dimensionless.")
+
+
 class NumericsResult(_Result):
     """Numerical verdict. Detailed fields describe the worst-case start (``worst_case``)."""
 
@@ -94,6 +148,14 @@ class NumericsResult(_Result):
     impact_regime: str | None = Field(description="no_impact | single_sided | double_sided.")
     x_rms: float | None = Field(description="sqrt(mean x^2) over the record.")
     x_peak_to_peak: float | None = Field(description="max x - min x over the record.")
+    force_max: float | None = Field(
+        None,
+        description="Largest dimensionless mesh force K(t) f_h(x) + 2 mu x' over the record's "
+        "steps (the kernel's extremes, as a sweep point's); null if diverged.",
+    )
+    force_min: float | None = Field(
+        None, description="Smallest dimensionless mesh force over the record; null if diverged."
+    )
     spectrum_peaks: list[SpectrumPeak] = Field(description="Largest peaks of the spectrum of x.")
     poincare: list[list[float]] = Field(description="Last strobes [[x, v], ...] (<= 256).")
     time_history: TimeHistory | None = Field(description="Last 20 intervals, <= 2000 samples.")
@@ -110,6 +172,15 @@ class NumericsResult(_Result):
         "Newton shooting did not converge (floquet_note says which).",
     )
     floquet_note: str | None = Field(None, description="Why floquet is null; else null.")
+    attractors: list[Attractor] | None = Field(
+        None,
+        description="With settings.basins: every distinct attractor found, worst first; "
+        "null without.",
+    )
+    basins: BasinCounts | None = Field(
+        None, description="With settings.basins: the starts, and those that diverged or did "
+        "not settle.",
+    )  # fmt: skip
 
 
 class BatchPoint(_Result):

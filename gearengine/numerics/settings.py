@@ -6,12 +6,22 @@ refuse absurd requests before any compute.
 
 from __future__ import annotations
 
+import math
 from typing import Annotated
 
 import numpy as np
-from pydantic import BaseModel, Field, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    Field,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
+from gearengine.model.errors import InputError
 from gearengine.model.params import Finite, GearParams, WholeNumber, request_config
+from gearengine.model.units import QUANTITIES, parse_quantity
 from gearengine.numerics.forcing import step_plan
 
 MAX_PERIODS = 100_000
@@ -22,9 +32,22 @@ MAX_STARTS = 64
 """Upper cap of the number of initial states."""
 MAX_TOTAL_STEPS = 1_000_000_000
 """Cap on RK4 steps of one request: (transient + record) x steps per T0 x starts."""
+MAX_BASIN_STARTS = 4096
+"""Upper cap of ``basins.starts`` (a 64 x 64 grid)."""
+DEFAULT_BASIN_BOX = [[-3.0, 3.0], [-3.0, 3.0]]
+"""Default box of basin starts, dimensionless (see ``BasinSettings``)."""
 
 State = Annotated[list[Finite], Field(min_length=2, max_length=2)]
 """A state [x, v] of Eq. (9): x in units of b, v = dx/dtau."""
+MAX_BOX = 1000.0
+"""Largest |end| of a dimensionless basin box (a thousand half backlashes)."""
+BoxEnd = Annotated[
+    Annotated[float, Field(ge=-MAX_BOX, le=MAX_BOX, allow_inf_nan=False)]
+    | Annotated[str, Field(max_length=40)],
+    Field(union_mode="left_to_right", examples=[-3.0, "-30 um", "-400 mm/s"]),
+]
+"""One end of a basin box range: a dimensionless number, or with a design a string with a
+unit (µm, mm ... for x; mm/s, m/s ... for v)."""
 
 
 class RandomStarts(BaseModel):
@@ -47,8 +70,110 @@ class RandomStarts(BaseModel):
     def _ordered(self) -> RandomStarts:
         for name, (lo, hi) in zip(("x", "v"), self.box, strict=True):
             if lo > hi:
-                raise ValueError(f"box: {name} range [{lo}, {hi}] is reversed")
+                raise InputError("box", f"{name} range [{lo}, {hi}] is reversed")
         return self
+
+
+class BasinSettings(BaseModel):
+    """Many starts of one design, to find every attractor and the fraction of starts reaching
+    each (``ensembles.attractors``).
+
+    The default box, x in [-3, 3] half backlashes and v = dx/dtau in [-3, 3], covers the states
+    a running gear pair can be thrown into: from 2 b onto the back flank, through the whole
+    clearance (|x| <= 1), to 2 b of extra tooth deflection on the drive flank, and relative
+    velocities at the mesh up to 3 b omega_n, the speed at which a free pair crosses the
+    clearance in 2/3 of a time unit 1/omega_n (a shock or a load step of a few static
+    forces gives that). With a design the ends may be given in µm and mm/s.
+    """
+
+    model_config = request_config()
+
+    starts: int = Field(
+        16,
+        ge=1,
+        le=MAX_BASIN_STARTS,
+        description=f"Number of initial states (1..{MAX_BASIN_STARTS}); with grid, a square "
+        "(16, 64, 256, ...).",
+        examples=[256],
+    )
+    box: Annotated[list[Annotated[list[BoxEnd], Field(min_length=2, max_length=2)]],
+                   Field(min_length=2, max_length=2)] = Field(
+        default_factory=lambda: [list(r) for r in DEFAULT_BASIN_BOX],
+        description="[[xmin, xmax], [vmin, vmax]]: dimensionless (x in half backlashes b, "
+        "v = dx/dtau), or with a design strings with units, e.g. [['-30 um', '30 um'], "
+        "['-400 mm/s', '400 mm/s']]. Default [[-3, 3], [-3, 3]].",
+        examples=[[[-3.0, 3.0], [-3.0, 3.0]]],
+    )  # fmt: skip
+    grid: bool = Field(
+        True,
+        description="true: the cell centres of a sqrt(starts) x sqrt(starts) grid over the box "
+        "(x fastest); false: uniform random draws from seed.",
+        examples=[True],
+    )
+    seed: int = Field(0, ge=0, description="Seed of numpy.random.default_rng (grid: false).")
+    min_fraction: float = Field(
+        0.0,
+        ge=0.0,
+        lt=1.0,
+        description="The headline verdict is that of the worst attractor whose basin fraction "
+        "is above this (0: any attractor found).",
+        examples=[0.0],
+    )
+
+    @field_validator("box")
+    @classmethod
+    def _box(cls, box: list[list[float | str]]) -> list[list[float | str]]:
+        for name, kind, (lo, hi) in zip("xv", ("displacement", "velocity"), box, strict=True):
+            if isinstance(lo, str) != isinstance(hi, str):
+                raise ValueError(f"give both ends of the {name} range with units or neither")
+            ends = [box_end(e, kind) for e in (lo, hi)]
+            if not ends[0] < ends[1]:
+                raise ValueError(f"the {name} range [{lo}, {hi}] is empty or reversed")
+        return box
+
+    @model_validator(mode="after")
+    def _square(self) -> BasinSettings:
+        if self.grid and math.isqrt(self.starts) ** 2 != self.starts:
+            raise ValueError(f"starts: {self.starts} is not a square; a grid needs 16, 64, 256...")
+        return self
+
+    def physical(self) -> bool:
+        """True when the box is given in units (it needs a design's scales)."""
+        return any(isinstance(e, str) for r in self.box for e in r)
+
+    def dimensionless_box(self, x_scale: float = 1.0, v_scale: float = 1.0) -> list[list[float]]:
+        """[[xmin, xmax], [vmin, vmax]] in units of b and b omega_n.
+
+        Args:
+            x_scale: metres per unit x (the half backlash b), for ends given in units.
+            v_scale: m/s per unit v (b omega_n), for ends given in units.
+        """
+        return [
+            [box_end(e, kind) / (scale if isinstance(e, str) else 1.0) for e in r]
+            for r, kind, scale in zip(self.box, ("displacement", "velocity"),
+                                      (x_scale, v_scale), strict=True)
+        ]  # fmt: skip
+
+    def states(self, x_scale: float = 1.0, v_scale: float = 1.0) -> list[tuple[float, float]]:
+        """The initial states (x0, v0), dimensionless, in order (x fastest on a grid); the
+        scales as in ``dimensionless_box``."""
+        (x0, x1), (v0, v1) = self.dimensionless_box(x_scale, v_scale)
+        if self.grid:
+            n = math.isqrt(self.starts)
+            xs = x0 + (x1 - x0) * (np.arange(n) + 0.5) / n
+            vs = v0 + (v1 - v0) * (np.arange(n) + 0.5) / n
+            return [(float(x), float(v)) for v in vs for x in xs]
+        rng = np.random.default_rng(self.seed)
+        xr = rng.uniform(x0, x1, self.starts)
+        vr = rng.uniform(v0, v1, self.starts)
+        return [(float(x), float(v)) for x, v in zip(xr, vr, strict=True)]
+
+
+def box_end(end: float | str, kind: str) -> float:
+    """A box end: the number itself, or a string with a unit in SI (m or m/s)."""
+    if isinstance(end, str):
+        return parse_quantity(end, QUANTITIES[kind], allow_zero=True)
+    return end
 
 
 class SimulationSettings(BaseModel):
@@ -112,6 +237,12 @@ class SimulationSettings(BaseModel):
         "simulate() run the full length.",
         examples=[True],
     )
+    basins: BasinSettings | None = Field(
+        None,
+        description="Also run basins.starts initial states from a box and report every "
+        "attractor found with its basin fraction (numerics.attractors, numerics.basins); the "
+        "headline verdict becomes the worst attractor's. Null: the starts above only.",
+    )
     lle_stderr_rel: float = Field(
         0.1,
         ge=0.0,
@@ -140,10 +271,11 @@ class SimulationSettings(BaseModel):
         if self.initial_states is not None and self.random_initial_states is not None:
             raise ValueError("give initial_states or random_initial_states, not both")
         work = (self.transient_periods + self.record_periods) * self.steps_per_period
-        work *= len(self.starts())
+        work *= self.lanes()
         if work > MAX_TOTAL_STEPS:
             raise ValueError(
-                f"(transient_periods + record_periods) x steps_per_period x starts = {work} RK4 "
+                f"(transient_periods + record_periods) x steps_per_period x (starts + "
+                f"basins.starts) = {work} RK4 "
                 f"steps exceeds {MAX_TOTAL_STEPS}"
             )
         return self
@@ -160,10 +292,32 @@ class SimulationSettings(BaseModel):
             return [(float(x), float(v)) for x, v in zip(xs, vs, strict=True)]
         return [(self.initial_state[0], self.initial_state[1])]
 
+    def for_request(self, has_design: bool) -> SimulationSettings:
+        """``self``, or ValueError when a basin box in units comes without a design."""
+        if self.basins is not None and self.basins.physical() and not has_design:
+            raise ValueError("basins.box: a box in units (µm, mm/s) needs a design; with "
+                             "params give it dimensionless")  # fmt: skip
+        return self
+
+    def lanes(self) -> int:
+        """Runs of one point: its starts and its basin starts."""
+        return len(self.starts()) + (0 if self.basins is None else self.basins.starts)
+
+
+def _for_request(settings: SimulationSettings, info: ValidationInfo) -> SimulationSettings:
+    # a request's fields are validated in order: design (if any) comes before settings
+    return settings.for_request(info.data.get("design") is not None)
+
+
+RequestSettings = Annotated[SimulationSettings, AfterValidator(_for_request)]
+"""The settings of a request that carries params or a design (``ParamsOrDesign``): a basin box
+in units is refused without a design, naming ``settings``."""
+
 
 def run_steps(settings: SimulationSettings, steps: int) -> int:
-    """RK4 steps of a run: (transient + record) periods x ``steps`` per T0 x starts."""
-    return (settings.transient_periods + settings.record_periods) * steps * len(settings.starts())
+    """RK4 steps of a run: (transient + record) periods x ``steps`` per T0 x (starts + basin
+    starts)."""
+    return (settings.transient_periods + settings.record_periods) * steps * settings.lanes()
 
 
 def work(params: GearParams, settings: SimulationSettings) -> int:
@@ -172,11 +326,11 @@ def work(params: GearParams, settings: SimulationSettings) -> int:
 
 
 def check_work(settings: SimulationSettings, steps: int) -> None:
-    """Refuse (ValueError naming ``steps_per_period``) a run over ``MAX_TOTAL_STEPS``."""
+    """Refuse (``InputError`` naming ``steps_per_period``) a run over ``MAX_TOTAL_STEPS``."""
     total = run_steps(settings, steps)
     if total > MAX_TOTAL_STEPS:
-        raise ValueError(
-            f"steps_per_period: the excitation frequencies need {steps} RK4 steps per T0, "
-            f"{total} steps in all, over the cap {MAX_TOTAL_STEPS}; lower steps_per_period or "
-            "the periods"
+        raise InputError(
+            "steps_per_period",
+            f"the excitation frequencies need {steps} RK4 steps per T0, {total} steps in all, "
+            f"over the cap {MAX_TOTAL_STEPS}; lower steps_per_period or the periods",
         )

@@ -140,6 +140,8 @@ def _detailed(
         impact_regime=impact_regime(worst.xmin, worst.xmax),
         x_rms=finite_or_none(rms(worst.hx)),
         x_peak_to_peak=finite_or_none(worst.xmax - worst.xmin),
+        force_max=finite_or_none(worst.fmax),
+        force_min=finite_or_none(worst.fmin),
         spectrum_peaks=[SpectrumPeak(**p) for p in peaks],
         poincare=poincare_points(worst.xs, worst.vs),
         time_history=TimeHistory(**time_history(t0, dt, worst.hx, worst.hv, plan.period)),

@@ -1,6 +1,7 @@
 """The plots room: figures engineers read, as PNG or SVG bytes.
 
-``analysis`` draws one design (the four-panel response, the threshold curves), ``sweep`` a
+``analysis`` draws one design (the four-panel response, the threshold curves), ``basins`` its
+basin picture (starts coloured by attractor), ``sweep`` a
 sweep (bifurcation diagram, chaos map); both go through ``style`` (one symbol table, one render
 path). Rendering only: imports the result documents of the other rooms, computes nothing but
 the Melnikov boundary it draws (from ``homoclinic.thresholds``).
@@ -17,15 +18,27 @@ from gearengine.lazyload import lazy_names
 
 if TYPE_CHECKING:
     from gearengine.plots.analysis import analysis_figure, threshold_figure
+    from gearengine.plots.basins import basins_figure
+    from gearengine.plots.runup import runup_figure
     from gearengine.plots.style import MEDIA_TYPES, ImageFormat
     from gearengine.plots.sweep import sweep_figure
 
-__all__ = ["MEDIA_TYPES", "ImageFormat", "analysis_figure", "sweep_figure", "threshold_figure"]
+__all__ = [
+    "MEDIA_TYPES",
+    "ImageFormat",
+    "analysis_figure",
+    "basins_figure",
+    "runup_figure",
+    "sweep_figure",
+    "threshold_figure",
+]
 
 _HOMES = {
     "MEDIA_TYPES": ("gearengine.plots.style", "MEDIA_TYPES"),
     "ImageFormat": ("gearengine.plots.style", "ImageFormat"),
     "analysis_figure": ("gearengine.plots.analysis", "analysis_figure"),
+    "basins_figure": ("gearengine.plots.basins", "basins_figure"),
+    "runup_figure": ("gearengine.plots.runup", "runup_figure"),
     "sweep_figure": ("gearengine.plots.sweep", "sweep_figure"),
     "threshold_figure": ("gearengine.plots.analysis", "threshold_figure"),
 }

@@ -84,7 +84,8 @@ def analysis_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
     at = "" if result.engineering is None else f" at {result.engineering.speed_rpm:,.0f} rpm"
     fig.suptitle(
         f"{period} response{at}   LLE λ₁ = {lle}   "
-        f"Melnikov: chaos {'possible' if mel else 'not possible' if mel is False else 'n/a'}",
+        "Melnikov: "
+        + {True: "chaos possible", False: "chaos not possible"}.get(mel, "not applicable"),
         fontsize=11,
     )
     if hist is not None and hist.t:

@@ -8,12 +8,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.colors import BoundaryNorm, ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.patches import Patch
+from matplotlib.patches import Patch, Rectangle
 
-from gearengine.sweeps.axes import display_unit, is_dimensionless
+from gearengine.model.units import display_unit, field_label
+from gearengine.sweeps.axes import is_dimensionless
 from gearengine.sweeps.request import SweepRequest
 from gearengine.sweeps.results import SweepPoint
 
@@ -28,8 +30,6 @@ CLASSES: list[tuple[str, str]] = [
 ]
 """Response classes of the map, in legend order, with their colours."""
 
-AXIS_NAMES = {"speed": "driver speed", "torque": "mean driver torque"}
-
 
 def response_class(p: SweepPoint) -> int:
     """Index in ``CLASSES`` of a point's response."""
@@ -39,11 +39,9 @@ def response_class(p: SweepPoint) -> int:
 
 
 def axis_label(name: str) -> str:
-    """ "driver speed [rpm]", "mesh.half_backlash [um]", or the alias for a dimensionless axis."""
-    if is_dimensionless(name):
-        return f"{name} (dimensionless)"
-    unit, _ = display_unit(name)
-    return f"{AXIS_NAMES.get(name, name)} [{unit.replace('um', 'µm').replace('*', '·')}]"
+    """ "driver speed [rpm]", "half backlash [µm]" (``model.units.field_label``), or the alias
+    for a dimensionless axis."""
+    return f"{name} (dimensionless)" if is_dimensionless(name) else field_label(name)
 
 
 def _grid(request: SweepRequest) -> tuple[np.ndarray, np.ndarray]:
@@ -55,10 +53,32 @@ def _grid(request: SweepRequest) -> tuple[np.ndarray, np.ndarray]:
     return out[0], out[1]
 
 
+COEXIST_COLOUR = "#6a3d9a"
+"""Hatch colour of the cells where the basin starts found more than one attractor."""
+
+
+def _hatch_cells(ax: Axes, g0: np.ndarray, g1: np.ndarray, cells: list[tuple[int, int]]) -> None:
+    """Hatch the grid cells (i, j) (centred on g0[i], g1[j], as pcolormesh's nearest shading)."""
+    for i, j in cells:
+        x0, x1 = _cell_edges(g0, i)
+        y0, y1 = _cell_edges(g1, j)
+        ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, facecolor="none", linewidth=0,
+                               edgecolor=COEXIST_COLOUR, hatch="\\\\", zorder=2))  # fmt: skip
+
+
+def _cell_edges(g: np.ndarray, i: int) -> tuple[float, float]:
+    """Edges of cell i of a grid of centres g (half-way to the neighbours)."""
+    step = float(g[1] - g[0]) if g.size > 1 else 1.0
+    lo = g[i] - (g[i] - g[i - 1]) / 2 if i > 0 else g[i] - step / 2
+    hi = g[i] + (g[i + 1] - g[i]) / 2 if i + 1 < g.size else g[i] + step / 2
+    return float(lo), float(hi)
+
+
 def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
     """The map: response classes as colours, tooth separation and back-flank impacts as
     markers, the Melnikov boundary (where the criterion starts allowing chaos) as a black line
-    with the chaos-possible side hatched."""
+    with the chaos-possible side hatched, and with basins the cells where several attractors
+    coexist cross-hatched in purple."""
     ax0, ax1 = request.axes
     g0, g1 = _grid(request)
     s0, s1 = request.grids()
@@ -67,6 +87,7 @@ def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
     cls = np.full((len(g1), len(g0)), np.nan)
     mel = np.full((len(g1), len(g0)), np.nan)  # NaN: the criterion does not apply there
     marks: dict[str, list[tuple[float, float]]] = {"single_sided": [], "double_sided": []}
+    several: list[tuple[int, int]] = []  # cells where basins found coexisting attractors
     for p in points:
         if p.branch == "down":
             continue
@@ -76,6 +97,8 @@ def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
             mel[j, i] = 1.0 if p.melnikov_chaos_possible else 0.0
         if p.impact_regime in marks:
             marks[p.impact_regime].append((g0[i], g1[j]))
+        if p.attractors is not None and len(p.attractors) > 1:
+            several.append((i, j))
     fig = Figure(figsize=(10.0, 6.4), layout="constrained")
     ax = fig.subplots()
     cmap = ListedColormap([c for _, c in CLASSES])
@@ -86,6 +109,7 @@ def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
             xs, ys = zip(*marks[regime], strict=True)
             ax.scatter(xs, ys, marker=style[0], c=style[1], s=style[2], linewidths=0.8,
                        edgecolors="k" if style[0] == "o" else None, zorder=3)  # fmt: skip
+    _hatch_cells(ax, g0, g1, several)
     applies = np.isfinite(mel)
     if len(g0) > 1 and len(g1) > 1:
         judged = np.ma.masked_invalid(mel)  # the region and its boundary only where it applies
@@ -124,6 +148,9 @@ def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
         words = "Melnikov criterion does not apply\n(mean load above the critical torque:\n"
         handles.append(Patch(facecolor="none", edgecolor="k", hatch=".",
                              label=words + "no saddle, no homoclinic orbit)"))  # fmt: skip
+    if several:
+        handles.append(Patch(facecolor="none", edgecolor=COEXIST_COLOUR, hatch="\\\\",
+                             label="attractors coexist\n(basins: several found)"))  # fmt: skip
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8,
               title="response", title_fontsize=9, frameon=False)  # fmt: skip
     return fig

@@ -9,8 +9,8 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from gearengine.ensembles.robustness import RobustnessRequest, RobustnessResult
+from gearengine.model.units import display_unit
 from gearengine.plots.style import ImageFormat, figure_bytes
-from gearengine.sweeps.axes import display_unit
 
 PANELS = ("chaotic", "impacts", "back_flank", "dynamic_factor_above_limit")
 TITLES = {

@@ -39,9 +39,9 @@ def _branch_line(ax, branch: RunupBranch, name: str) -> None:  # type: ignore[no
         )  # fmt: skip
         ax.axvline(j.speed_rpm, color=COLOURS[name], lw=0.8, ls=":", zorder=1)
         lag = "" if j.lag_rpm is None else f" (lag {j.lag_rpm:+.0f})"
-        ax.text(j.speed_rpm, max(j.from_um, j.to_um),
-                f" {j.speed_rpm:.0f} rpm{lag}", color=COLOURS[name], fontsize=7,
-                va="bottom", ha="left" if name == "up" else "right")  # fmt: skip
+        ax.annotate(f"{j.speed_rpm:.0f} rpm{lag}", xy=(j.speed_rpm, 0.5 * (j.from_um + j.to_um)),
+                    xytext=(4, 0), textcoords="offset points", color=COLOURS[name],
+                    fontsize=7, va="center", ha="left")  # fmt: skip
 
 
 def runup_figure(result: RunupResult, fmt: ImageFormat = "png", title: str | None = None) -> bytes:

@@ -21,9 +21,10 @@ from gearengine.homoclinic.boundary import chaos_intervals_from, flips, strength
 from gearengine.homoclinic.grid import strength_grid
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
+from gearengine.model.units import display_unit
 from gearengine.plots.envelope import axis_label, envelope_map
 from gearengine.plots.style import LLE_LABEL, SYMBOLS, ImageFormat, figure_bytes
-from gearengine.sweeps.axes import display_unit, is_dimensionless, is_integer_field
+from gearengine.sweeps.axes import is_dimensionless, is_integer_field
 from gearengine.sweeps.export import agreement_table
 from gearengine.sweeps.request import SweepRequest
 from gearengine.sweeps.results import SweepBifurcation, SweepPoint
@@ -186,6 +187,12 @@ def chaos_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
         ax.contourf(g0, g1, strength, levels=[0.0, np.inf], colors="none", hatches=["//"])
         ax.contour(g0, g1, strength, levels=[0.0], colors="black", linewidths=1.6)
     ax.plot([], [], c="black", lw=1.6, label="Melnikov boundary (hatched: chaos possible)")
+    outside = np.isnan(strength)  # no saddle there (|F_m| >= F_crit): the criterion does not apply
+    if outside.any():
+        ax.contourf(g0, g1, outside.astype(float), levels=[0.5, 1.5], colors="none",
+                    hatches=["."])  # fmt: skip
+        label = "Melnikov criterion does not apply (no saddle)"
+        ax.fill([], [], fill=False, hatch=".", label=label)
     ax.legend(loc="upper left", fontsize=8, framealpha=0.9)
     ax.set_xlabel(f"{SYMBOLS[ax0.parameter]} (dimensionless)")
     ax.set_ylabel(f"{SYMBOLS[ax1.parameter]} (dimensionless)")

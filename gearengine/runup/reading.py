@@ -13,7 +13,8 @@ is one speed bin (``bin_rpm`` / rate seconds on a ramp); its standard error is t
 Jumps: between neighbouring bins in the direction of travel, the DTE changes by at least
 ``JUMP_RATIO`` times and by at least ``JUMP_MIN_B`` half backlashes; the speed of a jump is the
 edge between the two bins (for the quasi-static branches: the midpoint of two grid speeds, the
-same edge).
+same edge); such steps in one sense at neighbouring edges are one jump (a bin that caught the
+response half-way), placed at its largest step.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from gearengine.engineering import speed_windows
-from gearengine.model.units import RPM
+from gearengine.model.units import RPM, shown
 from gearengine.numerics.classify import LLE_FLOOR
 from gearengine.runup.profile import Branch, RunupPlan
 from gearengine.runup.request import RunupRequest, n_bins
@@ -39,7 +40,6 @@ from gearengine.runup.results import (
     RunupMethod,
     RunupResult,
 )
-from gearengine.sweeps.axes import shown
 from gearengine.sweeps.results import SweepPoint, SweepResult
 
 JUMP_RATIO = 1.25
@@ -55,15 +55,33 @@ BRANCH, T0, T1, SPEED, FM, STEPS, XMIN, XMAX, FMIN, FMAX, SEP, BACK, BACK_IN, DR
 
 def jumps(speeds: Sequence[float], dte: Sequence[float | None], b_um: float) -> list[RunupJump]:
     """Jumps along a sequence in the order travelled: ``speeds`` are the edges between entries
-    i and i+1 (len(dte) - 1 of them), ``dte`` [µm] the amplitudes."""
-    out = []
-    for i, edge in enumerate(speeds):
+    i and i+1 (len(dte) - 1 of them), ``dte`` [µm] the amplitudes. A jump spread over
+    neighbouring edges in one sense (a bin caught half-way) is one jump, from its first
+    amplitude to its last, at the edge of its largest step."""
+    steps: list[tuple[int, float, float]] = []
+    for i in range(len(speeds)):
         a, c = dte[i], dte[i + 1]
         if a is None or c is None:
             continue
         lo, hi = min(a, c), max(a, c)
         if hi - lo >= JUMP_MIN_B * b_um and hi >= JUMP_RATIO * max(lo, 1e-12):
-            out.append(RunupJump(speed_rpm=shown(edge), from_um=shown(a), to_um=shown(c)))
+            steps.append((i, a, c))
+    groups: list[list[tuple[int, float, float]]] = []
+    for step in steps:
+        last = groups[-1][-1] if groups else None
+        if (
+            last is not None
+            and step[0] == last[0] + 1
+            and (step[2] > step[1]) == (last[2] > last[1])
+        ):
+            groups[-1].append(step)
+        else:
+            groups.append([step])
+    out = []
+    for g in groups:
+        i = max(g, key=lambda s: abs(s[2] - s[1]))[0]
+        out.append(RunupJump(speed_rpm=shown(speeds[i]), from_um=shown(g[0][1]),
+                             to_um=shown(g[-1][2])))  # fmt: skip
     return out
 
 
@@ -77,7 +95,7 @@ def with_lags(ramp: list[RunupJump], quasi: list[RunupJump], branch: Branch) -> 
             out.append(j)
             continue
         q = min(same, key=lambda q: abs(q.speed_rpm - j.speed_rpm))
-        lag = sign * (j.speed_rpm - q.speed_rpm)
+        lag = sign * (j.speed_rpm - q.speed_rpm) + 0.0  # no -0
         out.append(j.model_copy(update={"quasi_static_speed_rpm": q.speed_rpm,
                                         "lag_rpm": shown(lag)}))  # fmt: skip
     return out

@@ -22,6 +22,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, BeforeValidator, Field, ValidationError, WithJsonSchema
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
+from gearengine.model.design import EXAMPLE_DESIGN
 from gearengine.model.params import request_config
 from gearengine.model.reduction import ParamsOrDesign
 from gearengine.model.units import (
@@ -102,7 +103,7 @@ class RunupRequest(ParamsOrDesign):
 
     model_config = request_config(
         {
-            "design": {"...": "as POST /v1/analyses"},
+            "design": EXAMPLE_DESIGN,
             "from_speed": "500 rpm",
             "to_speed": "6000 rpm",
             "rate": "1000 rpm/s",

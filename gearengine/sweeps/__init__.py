@@ -2,8 +2,9 @@
 
 Data flow: ``request`` (axes, validation) -> ``plan`` (chunks, cost) -> ``compute`` (each chunk's
 points through ``numerics.batch`` and the Melnikov verdict) -> ``results`` (documents) ->
-``export`` (JSON assembled from chunks, CSV, agreement table). Imports the model, melnikov and
-numerics rooms.
+``export`` (JSON assembled from chunks, CSV, agreement table); ``windows`` and ``gate`` read
+the results for speed windows and the CI gate. Imports the model, homoclinic and numerics rooms
+(and ``gearengine.jobs``, the job-kind registry it runs through).
 """
 
 from gearengine.sweeps.compute import compute_chunk, compute_chunk_json, run_local
@@ -11,8 +12,8 @@ from gearengine.sweeps.export import (
     agreement_table,
     chunk_bifurcations,
     chunk_json,
-    chunk_points,
     csv_rows,
+    points_of_chunk,
     result_json,
     text_blocks,
     to_csv,
@@ -39,10 +40,10 @@ __all__ = [
     "checked",
     "chunk_bifurcations",
     "chunk_json",
-    "chunk_points",
     "compute_chunk",
     "compute_chunk_json",
     "csv_rows",
+    "points_of_chunk",
     "request_errors",
     "result_json",
     "run_local",

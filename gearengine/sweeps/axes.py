@@ -15,7 +15,6 @@ An axis names one of:
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from pydantic import ValidationError
@@ -24,59 +23,16 @@ from gearengine.model.aliases import ALIASES, with_aliases, with_speed_factor
 from gearengine.model.design import Design
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import convert_design
-from gearengine.model.units import RPM
+from gearengine.model.units import Scales
 from gearengine.numerics.forcing import packed_forcing
 
 OMEGA = "Omega"
 """The axis that scales every excitation frequency together (dimensionless)."""
 
-DISPLAY_UNITS: dict[str, tuple[str, float]] = {
-    "speed": ("rpm", 1.0 / RPM),
-    "torque": ("N*m", 1.0),
-    "braking_torque": ("N*m", 1.0),
-    "half_backlash": ("um", 1e6),
-    "transmission_error": ("um", 1e6),
-    "torque_fluctuation": ("N*m", 1.0),
-    "stiffness_harmonics": ("N/m", 1.0),
-    "stiffness": ("N/m", 1.0),
-    "damping_ratio": ("1", 1.0),
-    "damping": ("N*s/m", 1.0),
-    "inertia": ("kg*m^2", 1.0),
-    "base_radius": ("mm", 1e3),
-    "module": ("mm", 1e3),
-    "face_width": ("mm", 1e3),
-    "bore": ("mm", 1e3),
-    "pressure_angle": ("deg", 180.0 / math.pi),
-    "order": ("1", 1.0),
-    "profile_shift": ("1", 1.0),
-}
-"""Display unit and factor from SI of a physical field, by the most specific name in its path
-(``transmission_error.harmonics.0.amplitude`` is shown in µm)."""
-
 
 def is_dimensionless(parameter: str) -> bool:
     """True for an alias of Eq. (9) or ``Omega``; False for a field of a design."""
     return parameter in ALIASES or parameter == OMEGA
-
-
-def shown(value: float) -> float:
-    """A value converted to display units, rounded to 12 significant digits (6000 rpm, not
-    6000.000000000001)."""
-    return float(f"{value:.12g}")
-
-
-def display_unit(path: str) -> tuple[str, float]:
-    """(unit, factor from SI) of a physical field path."""
-    for part in (path, *reversed(path.split("."))):
-        if part in DISPLAY_UNITS:
-            return DISPLAY_UNITS[part]
-    return ("SI", 1.0)
-
-
-def in_display_unit(path: str, si: float) -> float:
-    """A physical field's SI value in its display unit (``display_unit``), rounded (``shown``):
-    the number of a sweep point's ``physical`` entry and of its CSV column."""
-    return shown(si * display_unit(path)[1])
 
 
 def _set(tree: dict[str, Any], path: str, value: object) -> None:
@@ -113,6 +69,11 @@ def _get(tree: Any, path: str) -> Any:
     return tree
 
 
+def field_value(design: Design, path: str) -> Any:
+    """The design's field at ``path`` (SI units); KeyError or IndexError for a missing one."""
+    return _get(design.model_dump(), path)
+
+
 def design_with(design: Design, values: dict[str, object]) -> Design:
     """``design`` with physical fields set (unit strings or SI numbers), re-validated.
 
@@ -136,15 +97,24 @@ def fastest_frequency(params: GearParams) -> float | None:
 
 
 def point_params(params: GearParams, design: Design | None, values: dict[str, float]) -> GearParams:
-    """The dimensionless parameters of one grid point.
+    """The dimensionless parameters of one grid point (``scaled_point``)."""
+    return scaled_point(params, design, None, values)[0]
 
-    Physical fields are set on the design first (then converted), aliases and ``Omega`` on the
-    resulting parameters.
+
+def scaled_point(
+    params: GearParams, design: Design | None, scales: Scales | None, values: dict[str, float]
+) -> tuple[GearParams, Scales | None]:
+    """The dimensionless parameters of one grid point and, for a design (whose ``scales`` are
+    given), the scales that map its answers back to gear data.
+
+    Physical fields are set on the design first (then converted: its scales), aliases and
+    ``Omega`` on the resulting parameters (the static force follows an ``F_m`` axis).
     """
     physical = {k: v for k, v in values.items() if not is_dimensionless(k)}
     if physical:
         assert design is not None
-        params = convert_design(design_with(design, physical)).params
+        conversion = convert_design(design_with(design, physical))
+        params, scales = conversion.params, conversion.scales
     aliases = {k: v for k, v in values.items() if k in ALIASES}
     if aliases:
         params = with_aliases(params, aliases)
@@ -152,7 +122,7 @@ def point_params(params: GearParams, design: Design | None, values: dict[str, fl
         ref = fastest_frequency(params)
         assert ref is not None
         params = with_speed_factor(params, values[OMEGA] / ref)
-    return params
+    return params, None if scales is None else scales.at(params.mean_force)
 
 
 def dynamics_key(params: GearParams) -> tuple:

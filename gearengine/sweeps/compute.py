@@ -9,22 +9,21 @@ from collections.abc import Callable
 from typing import Any
 
 from gearengine import jobs
+from gearengine.ensembles.attractors import coexisting, points_attractors
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
+from gearengine.model.units import OUTPUTS, Scales, display_unit, in_display_unit, response_values
 from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
-from gearengine.numerics.bifurcations import Response, locate_bifurcations
+from gearengine.numerics.bifurcations import PointResponse, locate_bifurcations
 from gearengine.numerics.forcing import step_plan
 from gearengine.numerics.results import BatchPoint
 from gearengine.numerics.settings import SimulationSettings
-from gearengine.sweeps.axes import display_unit, in_display_unit, is_dimensionless
-from gearengine.sweeps.axes import shown as rounded
-from gearengine.sweeps.export import chunk_json, result_json
-from gearengine.sweeps.export import chunk_points as points_of_chunk
+from gearengine.sweeps.axes import is_dimensionless
+from gearengine.sweeps.export import chunk_json, points_of_chunk, result_json
 from gearengine.sweeps.plan import DEFAULT_CHUNK_POINTS, SweepPlan, sweep_work
 from gearengine.sweeps.request import SweepBranch, SweepRequest
 from gearengine.sweeps.results import (
-    RESPONSE_UNITS,
     PhysicalValue,
     SweepBifurcation,
     SweepPoint,
@@ -37,40 +36,35 @@ LOCAL_CHUNK_POINTS = 1024
 
 
 def _physical(
-    request: SweepRequest, values: dict[str, float], params: GearParams, bp: BatchPoint
+    values: dict[str, float], params: GearParams, scales: Scales | None, bp: BatchPoint
 ) -> dict[str, Any]:
-    """With a design: the axes in display units, the DTE in µm and the point's aliases."""
-    if request.design is None:
+    """With a design (its ``scales``): the axes in display units, the responses of
+    ``model.units.response_values`` (DTE in µm, dynamic factor) and the point's aliases."""
+    if scales is None:
         return {}
     shown = {
         name: PhysicalValue(value=in_display_unit(name, si), unit=display_unit(name)[0])
         for name, si in values.items()
         if not is_dimensionless(name)
     }
-    b = values.get("mesh.half_backlash", request.design.mesh.half_backlash)
-    response = {
-        "dte": None if bp.x_peak_to_peak is None else bp.x_peak_to_peak * b * 1e6,
-        "dynamic_factor": None  # F / F_m: the scales b k_m cancel
-        if bp.force_max is None or params.mean_force <= 0
-        else bp.force_max / params.mean_force,
-    }
-    for key, unit in RESPONSE_UNITS.items():
-        value = response[key]
+    for key, value in response_values(bp.x_peak_to_peak, bp.force_max, scales).items():
         if value is not None:
-            shown[key] = PhysicalValue(value=rounded(value), unit=unit)
+            shown[key] = PhysicalValue(value=value, unit=OUTPUTS[key].unit)
     aliases = {a: get_alias(params, a) for a in ALIASES}
     return {"physical": shown, "dimensionless": {k: v for k, v in aliases.items() if v is not None}}
 
 
 def _point(
-    request: SweepRequest,
     values: dict[str, float],
     branch: SweepBranch | None,
     params: GearParams,
+    scales: Scales | None,
     bp: BatchPoint,
+    basins: dict[str, Any],
 ) -> SweepPoint:
     """The sweep's point from the engine's verdict ``bp`` (typed and finite, built by
-    ``numerics.batch``), so ``model_construct`` skips a second validation (~0.05 ms a point)."""
+    ``numerics.batch``), so ``model_construct`` skips a second validation (~0.05 ms a point);
+    ``basins`` its attractors, basins and coexisting entries (empty without basins)."""
     possible = chaos_possible(params)
     return SweepPoint.model_construct(
         values={name: float(v) for name, v in values.items()},
@@ -86,7 +80,8 @@ def _point(
         periods_run=bp.periods_run,
         force_max=bp.force_max,
         force_min=bp.force_min,
-        **_physical(request, values, params, bp),
+        **_physical(values, params, scales, bp),
+        **basins,
     )
 
 
@@ -106,7 +101,8 @@ def _compute(
     axes = request.axes
     grids = request.grids()
     values = [{a.parameter: grids[k][ix[k]] for k, a in enumerate(axes)} for ix in chunk.points]
-    designs = [request.point(v) for v in values]
+    scaled = [request.scaled_point(v) for v in values]
+    designs = [params for params, _ in scaled]
     if not request.continuation:
         verdicts = simulate_batch(designs, request.settings)
     else:
@@ -116,9 +112,10 @@ def _compute(
             (bp,) = simulate_batch([design], settings)
             verdicts.append(bp)
             settings = _carried(request.settings, bp)
+    ensembles = _basins(request, scaled, verdicts)
     points = [
-        _point(request, v, chunk.branch, d, bp)
-        for v, d, bp in zip(values, designs, verdicts, strict=True)
+        _point(v, chunk.branch, params, scales, bp, e)
+        for v, (params, scales), bp, e in zip(values, scaled, verdicts, ensembles, strict=True)
     ]
     if not request.continuation or len(axes) != 1 or len(values) < 2:
         return points, None
@@ -126,17 +123,37 @@ def _compute(
     return points, _line_bifurcations(request, line, designs, verdicts)
 
 
+def _basins(
+    request: SweepRequest,
+    scaled: list[tuple[GearParams, Scales | None]],
+    verdicts: list[BatchPoint],
+) -> list[dict[str, Any]]:
+    """Per point, with ``settings.basins``: its attractors and basin counts
+    (``ensembles.attractors``, every point's starts in one ``run_lanes`` call; a box in units
+    read with the point's own scales) and, on a continuation line, the attractors coexisting
+    with the followed branch; else empty."""
+    if request.settings.basins is None:
+        return [{} for _ in scaled]
+    designs = [params for params, _ in scaled]
+    found = points_attractors(designs, request.settings, [sc for _, sc in scaled])
+    out: list[dict[str, Any]] = [{"attractors": a, "basins": c} for a, c in found]
+    if request.continuation:
+        for entry, bp in zip(out, verdicts, strict=True):
+            entry["coexisting"] = coexisting(bp, entry["attractors"], entry["basins"])
+    return out
+
+
 def _line_bifurcations(
     request: SweepRequest, line: list[float], designs: list[GearParams], verdicts: list[BatchPoint]
 ) -> list[SweepBifurcation]:
     """Bifurcation points of one continuation line, followed from its computed responses.
 
-    The line's points are reused (``Response``), so only Newton shooting, the location of each
+    The line's points are reused (``PointResponse``), so only Newton shooting, the location of each
     crossing and one simulation per crossing (the branch switch) are added. Incommensurate
     forcing has no Poincare period and so no multipliers: no points then.
     """
     responses = [
-        Response(
+        PointResponse(
             bp.classification,
             bp.period,
             bp.poincare[-1] if bp.poincare else None,

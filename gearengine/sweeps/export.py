@@ -5,16 +5,21 @@ and the table of agreement between the numerical and the Melnikov verdicts.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator, Mapping, Sequence
+from functools import lru_cache
+from typing import Any
 
+import numpy as np
 from pydantic import BaseModel, Field, TypeAdapter
 
-from gearengine.sweeps.axes import display_unit, in_display_unit, is_dimensionless
+from gearengine.model.units import RESPONSES, display_label, field_unit, in_display_unit
+from gearengine.sweeps.axes import is_dimensionless
 from gearengine.sweeps.request import SweepAxis
-from gearengine.sweeps.results import RESPONSE_UNITS, SweepBifurcation, SweepPoint, SweepResult
+from gearengine.sweeps.results import SweepBifurcation, SweepPoint, SweepResult
 
-_LINE_HEAD = '{"bifurcations":'
-_LINE_POINTS = ',"points":['
+BASIN_FIELDS = ("attractors", "basins", "coexisting")
+"""Point fields that exist only with settings.basins: left out of a point without them, so a
+sweep without basins keeps its bytes."""
 
 
 def chunk_json(
@@ -22,27 +27,36 @@ def chunk_json(
     bifurcations: list[SweepBifurcation] | None,
     outputs: Sequence[str] | None = None,
 ) -> str:
-    """A chunk's output (what workers exchange): the JSON array of its points, or, for a line
-    of a one-axis continuation sweep, ``{"bifurcations": [...], "points": [...]}``. With
-    ``outputs`` (``SweepRequest.outputs``) a point holds values, branch and those fields only."""
+    """A chunk's output (what workers exchange), JSON lines: the JSON array of its points and,
+    for a line of a one-axis continuation sweep, a second line with the JSON array of its
+    bifurcations. Compact JSON holds no raw newline (strings escape it), so each line is one
+    whole document. With ``outputs`` (``SweepRequest.outputs``) a point holds values, branch
+    and those fields only."""
     keep = None if outputs is None else {"values", "branch", *outputs}
-    array = ",".join(p.model_dump_json(include=keep) for p in points)
+    array = (
+        "["
+        + ",".join(
+            p.model_dump_json(
+                include=keep, exclude={k for k in BASIN_FIELDS if getattr(p, k) is None}
+            )
+            for p in points
+        )
+        + "]"
+    )
     if bifurcations is None:
-        return "[" + array + "]"
-    located = ",".join(b.model_dump_json() for b in bifurcations)
-    return _LINE_HEAD + "[" + located + "]" + _LINE_POINTS + array + "]}"
+        return array
+    return array + "\n[" + ",".join(b.model_dump_json() for b in bifurcations) + "]"
 
 
 def _chunk_parts(text: str) -> tuple[str, list[dict[str, object]] | None]:
-    """The inner text of a chunk's points array and its bifurcations (None if it has none)."""
-    text = text.strip()
-    if not text.startswith(_LINE_HEAD):
-        return text[1:-1], None
-    cut = text.index(_LINE_POINTS)
-    return text[cut + len(_LINE_POINTS) : -2], json.loads(text[len(_LINE_HEAD) : cut])
+    """The inner text of a chunk's points array (its elements, streamed as they are) and its
+    bifurcations (None if it has none), one JSON document per line (``chunk_json``)."""
+    points, *located = text.strip().split("\n")
+    inner = points.strip().removeprefix("[").removesuffix("]")
+    return inner, json.loads(located[0]) if located else None
 
 
-def chunk_points(text: str) -> list[dict[str, object]]:
+def points_of_chunk(text: str) -> list[dict[str, object]]:
     """The points of a chunk's output, as JSON objects."""
     return json.loads("[" + _chunk_parts(text)[0] + "]")
 
@@ -110,24 +124,25 @@ def to_csv(
 
 def csv_rows(
     axes: list[SweepAxis],
-    points: Iterable[SweepPoint],
+    points: Iterable[SweepPoint | PointFields],
     outputs: Sequence[str] | None = None,
     design: bool = False,
 ) -> Iterator[str]:
-    """CSV rows (header first): one column per axis (SI for a design's fields); with a
-    ``design`` (a sweep of a design in physical units) the same axes in display units
-    (``speed [rpm]``, ``torque [N*m]``) and, unless ``outputs`` leaves ``physical`` out, the
-    DTE and the dynamic factor (``dte [um]``, ``dynamic_factor``, from the point's
-    ``physical``); then the verdicts, and poincare_x as space-separated numbers. Empty cells are
-    nulls; booleans are true/false; every number is written as the JSON result writes it
-    (``_json_numbers``), the axis values rounded to the 15 significant digits they were given
-    with (``_grid_value``). With ``outputs`` (``SweepRequest.outputs``) only the columns it
-    names (and branch) are written. Rows are yielded one by one, so a streamed response never
-    holds the whole table."""
+    """CSV rows (header first): one column per axis, a design's field in SI units and titled
+    with its unit (``speed [rad/s]``, ``torque [N*m]``); with a ``design`` (a sweep of a design
+    in physical units) the axes whose display unit differs also in that unit (``speed [rpm]``)
+    and, unless ``outputs`` leaves ``physical`` out, the DTE and the dynamic factor
+    (``dte [um]``, ``dynamic_factor``, from the point's ``physical``); then the verdicts, and
+    poincare_x as space-separated numbers. Empty cells are nulls; booleans are true/false. Axis
+    cells are plain decimals (``_axis_cell``: 500, 0.000001, never 500.0 beside 1e-6), rounded
+    to the 15 significant digits they were given with (``_grid_value``); every other number is
+    written as the JSON result writes it (``_json_numbers``). With ``outputs``
+    (``SweepRequest.outputs``) only the columns it names (and branch) are written. Rows are
+    yielded one by one, so a streamed response never holds the whole table."""
     names = [a.parameter for a in axes]
     extra = _physical_columns(names, outputs) if design else []
     fields = [f for f in CSV_FIELDS if outputs is None or f == "branch" or f in outputs]
-    header = [*names, *(title for _, title, _ in extra), *fields]
+    header = [*map(_axis_title, names), *(title for _, title, _ in extra), *fields]
     yield ",".join(_text_cell(c) for c in header) + "\n"
     shown = [(key, axis) for key, _, axis in extra]
     for p in points:
@@ -154,70 +169,101 @@ def text_blocks(parts: Iterable[str], size: int = STREAM_BLOCK) -> Iterator[str]
         yield "".join(block)
 
 
+PointFields = Mapping[str, Any]
+"""A point's fields by name: a ``SweepPoint``'s ``__dict__``, or a point of a stored chunk as
+its JSON object (``points_of_chunk``), whose nested documents are plain dicts."""
+
+
 def _physical_columns(
     names: list[str], outputs: Sequence[str] | None
 ) -> list[tuple[str, str, bool]]:
     """(key, column title, is an axis) of a design's sweep: each physical axis in its display
-    unit (from the point's ``values``), then the response entries of ``RESPONSE_UNITS`` (from
+    unit (from the point's ``values``), then the responses of ``model.units.RESPONSES`` (from
     its ``physical``, unless ``outputs`` leaves that out)."""
-    axes = [(n, f"{n} [{display_unit(n)[0]}]", True) for n in names if not is_dimensionless(n)]
+    axes = [
+        (n, f"{n} [{field_unit(n).display}]", True)
+        for n in names
+        if not is_dimensionless(n) and field_unit(n).display != field_unit(n).si
+    ]
     if outputs is not None and "physical" not in outputs:
         return axes
-    response = [
-        (key, key if unit == "1" else f"{key} [{unit}]", False)
-        for key, unit in RESPONSE_UNITS.items()
-    ]
+    response = [(key, display_label(key), False) for key in RESPONSES]
     return [*axes, *response]
 
 
-def _physical(p: SweepPoint, key: str, axis: bool) -> float | None:
+def _axis_title(name: str) -> str:
+    """An axis column's title: the alias, or a design field with its SI unit."""
+    if is_dimensionless(name) or field_unit(name).si == "1":
+        return name
+    return f"{name} [{field_unit(name).si}]"
+
+
+@lru_cache(maxsize=1 << 16)
+def _axis_cell(x: float) -> str:
+    """An axis value as a plain decimal (shortest that reads back to the same float), cached:
+    the values of an axis repeat on every line of a map."""
+    return np.format_float_positional(x, trim="-")
+
+
+def _physical(p: PointFields, key: str, axis: bool) -> float | None:
     """A gear-unit cell: an axis value in its display unit (``in_display_unit``, as
-    ``physical`` holds it), or an entry of ``physical``, which points read back from the job
-    store unvalidated (``model_construct``) hold as plain dicts."""
+    ``physical`` holds it), or an entry of ``physical`` (a document, or a plain dict)."""
     if axis:
-        return in_display_unit(key, p.values[key])
-    entry = (p.physical or {}).get(key)
+        return in_display_unit(key, p["values"][key])
+    entry = (p.get("physical") or {}).get(key)
     if entry is None:
         return None
     return float(entry["value"] if isinstance(entry, dict) else entry.value)
 
 
 def _row(
-    p: SweepPoint, names: list[str], shown: list[tuple[str, bool]], fields: list[str]
+    point: SweepPoint | PointFields,
+    names: list[str],
+    shown: list[tuple[str, bool]],
+    fields: list[str],
 ) -> list[str]:
     """The text cells of a point's row: the axis values, the gear-unit values of ``shown``,
-    then each field. The floats (with the Poincaré numbers) are formatted in one
-    ``_json_numbers`` call, then taken in order."""
-    values = [getattr(p, f) for f in fields]
-    floats = [_grid_value(p.values[n]) for n in names]
-    gear = [_physical(p, key, axis) for key, axis in shown]
-    floats.extend(v for v in gear if v is not None)
-    for f, value in zip(fields, values, strict=True):
-        if f == "poincare_x":
-            floats.extend(value or [])
-        elif isinstance(value, float):
+    then each field (a field the point lacks is empty). The floats (with the Poincaré
+    numbers) are formatted in one ``_json_numbers`` call, then put in their cells."""
+    p = point.__dict__ if isinstance(point, SweepPoint) else point
+    cells = [_axis_cell(_grid_value(p["values"][n])) for n in names]
+    floats: list[float] = []
+    later: list[tuple[int, int]] = []  # (cell, count of numbers) filled after formatting
+    for key, axis in shown:
+        value = _physical(p, key, axis)
+        if axis:
+            cells.append(_axis_cell(value))
+            continue
+        if value is not None:
+            later.append((len(cells), 1))
             floats.append(value)
-    numbers = _json_numbers(floats)
-    cells = numbers[: len(names)]
-    k = len(names)
-    for v in gear:
-        cells.append("" if v is None else numbers[k])
-        k += v is not None
-    for f, value in zip(fields, values, strict=True):
+        cells.append("")
+    for f in fields:
+        value = p.get(f)
         if f == "poincare_x":
-            n = len(value or [])
-            cells.append(" ".join(numbers[k : k + n]))
-            k += n
-        elif isinstance(value, float):
-            cells.append(numbers[k])
-            k += 1
-        elif isinstance(value, bool):
-            cells.append(str(value).lower())
+            later.append((len(cells), len(value or [])))
+            cells.append("")
+            floats.extend(value or [])
+        elif value is None:
+            cells.append("")
+        elif type(value) is float:
+            later.append((len(cells), 1))
+            cells.append("")
+            floats.append(value)
+        elif type(value) is bool:
+            cells.append("true" if value else "false")
         else:
-            cells.append("" if value is None else _text_cell(str(value)))
+            cells.append(_text_cell(str(value)))
+    if floats:
+        numbers = _json_numbers(floats)
+        k = 0
+        for cell, count in later:
+            cells[cell] = numbers[k] if count == 1 else " ".join(numbers[k : k + count])
+            k += count
     return cells
 
 
+@lru_cache(maxsize=1024)
 def _text_cell(text: str) -> str:
     """A text cell quoted as the csv module quotes it (RFC 4180), only when it must be. Numbers
     never need it, so the rows are joined without scanning their long Poincaré cells."""
@@ -236,6 +282,7 @@ def _json_numbers(values: list[float]) -> list[str]:
     return _FLOATS.dump_json(values).decode()[1:-1].split(",") if values else []
 
 
+@lru_cache(maxsize=1 << 16)
 def _grid_value(x: float) -> float:
     """An axis value as the decimal it stands for: ``numpy.linspace`` computes 0.204 as
     0.20400000000000001 (an ulp away); 15 significant digits snap it back, so the cell reads

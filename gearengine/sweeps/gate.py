@@ -8,18 +8,23 @@ periodic < quasi_periodic < chaotic < diverged as in ``numerics.classify.SEVERIT
 teeth separate: drive-flank impacts, or impacts on both flanks); and numeric limits,
 which add to the classes instead of replacing them: ``max_lle`` (per unit tau), ``max_dte_um``
 (dynamic transmission error peak to peak, µm), ``max_dynamic_factor`` (largest mesh force over
-the static force F~_m).
+the static force F~_m). With basins (``settings.basins``) every attractor of a point whose
+basin fraction is above ``min_basin`` is checked against the rules, and a failing window names
+the attractors that broke it with their fractions.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Literal
 from xml.etree import ElementTree
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from gearengine.model.units import OUTPUTS, RESPONSES
 from gearengine.numerics.classify import SEVERITY
+from gearengine.sweeps.compute import run_local
+from gearengine.sweeps.request import SweepRequest
 from gearengine.sweeps.results import PhysicalValue, SpeedWindows, SweepPoint, SweepResult
 from gearengine.sweeps.windows import SPEED, runs
 
@@ -40,6 +45,13 @@ class Rules(BaseModel):
     max_dte_um: float | None = Field(None, description="Largest DTE peak to peak [µm].")
     max_dynamic_factor: float | None = Field(
         None, description="Largest dynamic factor allowed: max mesh force / static force."
+    )
+    min_basin: float | None = Field(
+        None,
+        ge=0.0,
+        lt=1.0,
+        description="With basins: only attractors whose basin fraction is above this are "
+        "checked; null checks every attractor found.",
     )
 
 
@@ -73,8 +85,66 @@ def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
     return out
 
 
-RESPONSE_KEYS = ("dte", "dynamic_factor")
-"""Keys of a point's ``physical`` that are responses, not axis levels."""
+def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
+    """(rule, who) of each rule a point breaks: with basins each attractor above
+    ``rules.min_basin`` is checked as if it were the point ("chaotic, double-sided impacts
+    from 41 % of starts" is who broke it); without, the point itself (who is empty)."""
+    if p.attractors is None:
+        return [(rule, "") for rule in point_failures(p, rules)]
+    out = []
+    least = -1.0 if rules.min_basin is None else rules.min_basin
+    for a in p.attractors:
+        if a.fraction <= least:
+            continue
+        physical = dict(p.physical or {})
+        for key, value in (("dte", a.dte_um), ("dynamic_factor", a.dynamic_factor)):
+            physical.pop(key, None)
+            if value is not None:
+                physical[key] = PhysicalValue(value=value, unit=OUTPUTS[key].unit)
+        alone = p.model_copy(update={"classification": a.classification, "period": a.period,
+                                     "lle": a.lle, "impact_regime": a.impact_regime,
+                                     "physical": physical or None})  # fmt: skip
+        who = f"{a.label} from {100 * a.fraction:.0f} % of starts"
+        out += [(rule, who) for rule in point_failures(alone, rules)]
+    return out
+
+
+ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
+"""Light integration settings of an envelope check; a design file's ``settings`` are merged
+over them (adding ``random_initial_states`` keeps the 60 + 60 periods)."""
+
+
+def envelope_axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
+    """A sweep axis from "A:B" (bare numbers in ``unit``) or "52rad/s:628rad/s".
+
+    Raises ValueError for text that is not a range.
+    """
+    ends = text.split(":")
+    if len(ends) != 2 or not all(e.strip() for e in ends):
+        raise ValueError("give a range as LOW:HIGH (two values and a colon, e.g. 500:6000)")
+    lo, hi = (e.strip() if any(c.isalpha() for c in e) else f"{e.strip()} {unit}" for e in ends)
+    return {"parameter": name, "start": lo, "stop": hi, "num": num}
+
+
+def envelope_sweep(design: object, settings: dict[str, object] | None,
+                   axes: list[dict[str, object]], label: str) -> dict[str, object]:  # fmt: skip
+    """The sweep document of an envelope check: ``axes`` (``envelope_axis``) of ``design``
+    under ``settings`` merged over ``ENVELOPE_SETTINGS``."""
+    return {"design": design, "settings": {**ENVELOPE_SETTINGS, **(settings or {})},
+            "axes": axes, "label": label}  # fmt: skip
+
+
+def check_envelope(
+    request: SweepRequest,
+    rules: Rules,
+    progress_callback: Callable[[int, int], None] | None = None,
+    workers: int = 1,
+) -> EnvelopeReport:
+    """The gate's report of one envelope sweep, computed in this process (``workers`` threads,
+    a quarter of a core's share of the points per chunk, as the CLI gate runs it)."""
+    chunk = max(1, request.n_points() // (4 * workers))
+    result = run_local(request, progress_callback, chunk_points=chunk, workers=workers)
+    return envelope_report(result, rules)
 
 
 class FailingWindow(BaseModel):
@@ -85,6 +155,11 @@ class FailingWindow(BaseModel):
     level: dict[str, PhysicalValue] = Field(description="The torque level (other axis).")
     rule: str = Field(description="The rule broken, e.g. 'chaotic', 'DTE > 20 µm'.")
     speeds_rpm: list[float] = Field(description="[first, last] failing grid speed [rpm].")
+    attractors: list[str] | None = Field(
+        None,
+        description="With basins: per failing speed, the attractors that broke the rule and "
+        "their basin fractions ('5750 rpm: chaotic, ... from 41 % of starts'); else null.",
+    )
 
 
 class EnvelopeReport(BaseModel):
@@ -108,7 +183,7 @@ class EnvelopeReport(BaseModel):
 
 def _level_key(p: SweepPoint) -> tuple:
     return tuple(sorted((k, v.value) for k, v in (p.physical or {}).items() if k not in
-                        (SPEED, *RESPONSE_KEYS)))  # fmt: skip
+                        (SPEED, *RESPONSES)))  # fmt: skip
 
 
 def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
@@ -121,15 +196,18 @@ def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
     failing = 0
     for row in rows.values():
         row.sort(key=lambda p: p.values[SPEED])
-        level = {
-            k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, *RESPONSE_KEYS)
-        }
+        level = {k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, *RESPONSES)}
         speeds = [p.physical[SPEED].value for p in row]  # type: ignore[index]
-        broken = [point_failures(p, rules) for p in row]
+        found = [attractor_failures(p, rules) for p in row]
+        broken = [[rule for rule, _ in f] for f in found]
         failing += sum(1 for b in broken if b)
         for rule in dict.fromkeys(r for b in broken for r in b):
             for span in runs(speeds, [rule if rule in b else None for b in broken]).get(rule, []):
-                failures.append(FailingWindow(level=level, rule=rule, speeds_rpm=span))
+                who = [f"{v:g} rpm: {w}" for v, f in zip(speeds, found, strict=True)
+                       if span[0] <= v <= span[1] for r, w in f if r == rule and w]  # fmt: skip
+                named = list(dict.fromkeys(who)) or None
+                failures.append(FailingWindow(level=level, rule=rule, speeds_rpm=span,
+                                              attractors=named))  # fmt: skip
     return EnvelopeReport(
         passed=not failures,
         rules=rules,
@@ -153,7 +231,8 @@ def window_text(w: FailingWindow) -> str:
     """One failing window in words: "torque 20 N*m: chaotic at 3000-3500 rpm"."""
     lo, hi = w.speeds_rpm
     span = f"{lo:g} rpm" if lo == hi else f"{lo:g}-{hi:g} rpm"
-    return f"{level_text(w.level)}: {w.rule} at {span}"
+    who = "" if not w.attractors else f" ({'; '.join(w.attractors)})"
+    return f"{level_text(w.level)}: {w.rule} at {span}{who}"
 
 
 def junit_xml(report: EnvelopeReport, name: str, levels: Sequence[dict[str, PhysicalValue]]) -> str:

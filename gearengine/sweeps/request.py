@@ -25,13 +25,15 @@ from gearengine.model.design import Design
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, WholeNumber, request_config
 from gearengine.model.reduction import ParamsOrDesign
-from gearengine.numerics.settings import SimulationSettings
+from gearengine.model.units import Scales
+from gearengine.numerics.settings import RequestSettings, SimulationSettings
 from gearengine.sweeps.axes import (
     axis_problem,
     changes_nothing,
     is_dimensionless,
     is_integer_field,
     point_params,
+    scaled_point,
     si_value,
 )
 
@@ -58,7 +60,7 @@ AxisValue = Annotated[
 SweepOutput = Literal[
     "classification", "period", "lle", "lle_stderr", "impact_regime", "melnikov_chaos_possible",
     "poincare_x", "x_peak_to_peak", "periods_run", "force_max", "force_min", "physical",
-    "dimensionless",
+    "dimensionless", "attractors", "basins", "coexisting",
 ]  # fmt: skip
 """A field of ``SweepPoint`` a sweep may keep (``SweepRequest.outputs``)."""
 
@@ -123,7 +125,7 @@ class SweepRequest(ParamsOrDesign):
         "then": {"required": ["continuation"], "properties": {"continuation": {"const": True}}},
     }  # fmt: skip
 
-    settings: SimulationSettings = Field(
+    settings: RequestSettings = Field(
         default_factory=SimulationSettings,
         description="Integration settings of every point (periods, steps, initial states).",
     )
@@ -171,6 +173,13 @@ class SweepRequest(ParamsOrDesign):
         """The dimensionless parameters at one grid point (``sweeps.axes.point_params``)."""
         assert self.params is not None
         return point_params(self.params, self.design, values)
+
+    def scaled_point(self, values: dict[str, float]) -> tuple[GearParams, Scales | None]:
+        """The parameters at one grid point and, for a design, its scales
+        (``sweeps.axes.scaled_point``)."""
+        assert self.params is not None
+        scales = None if self.conversion is None else self.conversion.scales
+        return scaled_point(self.params, self.design, scales, values)
 
 
 def request_errors(request: SweepRequest, max_points: int | None = None) -> list[InitErrorDetails]:

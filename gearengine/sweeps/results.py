@@ -8,6 +8,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
+from gearengine.numerics.results import Attractor, BasinCounts
 from gearengine.sweeps.request import SweepAxis, SweepBranch
 
 
@@ -18,10 +19,6 @@ class PhysicalValue(BaseModel):
 
     value: float
     unit: str
-
-
-RESPONSE_UNITS = {"dte": "um", "dynamic_factor": "1"}
-"""The response entries of a design point's ``physical`` (beside its axes) and their units."""
 
 
 class SweepPoint(BaseModel):
@@ -82,6 +79,20 @@ class SweepPoint(BaseModel):
         None,
         description="With physical axes: the point's dimensionless aliases (mu, F_m, F_e1, "
         "Omega_e, ...) after conversion.",
+    )
+    attractors: list[Attractor] | None = Field(
+        None,
+        description="With settings.basins: the attractors reached from the point's basin "
+        "starts, worst first (as numerics.attractors of an analysis); the fields above "
+        "describe the worst of settings' own starts.",
+    )
+    basins: BasinCounts | None = Field(
+        None, description="With settings.basins: how the point's basin starts ended."
+    )
+    coexisting: list[str] | None = Field(
+        None,
+        description="Continuation with settings.basins: the attractors other than the followed "
+        "branch's found at this point, as 'label from NN % of starts'; null otherwise.",
     )
 
 

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from gearengine.sweeps.axes import display_unit
-from gearengine.sweeps.axes import shown as rounded
+from gearengine.model.units import display_unit
+from gearengine.model.units import shown as rounded
 from gearengine.sweeps.request import SweepRequest
 from gearengine.sweeps.results import PhysicalValue, SpeedWindows, SweepPoint
 

@@ -1,6 +1,6 @@
 """Shared dependencies of the routes: settings, the job queue, API-key auth (``Owner``) and
-cached computation. The typed aliases (``Owner``, ``AppSettings``, ``Jobs``) are what routes
-declare."""
+cached computation. The typed aliases (``Owner``, ``AppSettings``, ``Jobs``, ``AppLimits``,
+``AppMetrics``, ``ReadyChecks``) are what routes declare; no route reads ``app.state``."""
 
 from __future__ import annotations
 
@@ -16,10 +16,13 @@ from fastapi import Depends, Request, Response
 from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
+from gearengine.model.errors import InputError
 from service.cache import ResponseCache, etag_for
 from service.core.config import Settings
 from service.errors import FieldError, ProblemError
 from service.jobs.runtime import SweepJobs
+from service.limits import Limits
+from service.metrics import Metrics
 
 KEYS_FILE = "api_keys.sha256"
 """File in the data directory: one sha256 hex digest of an API key per line (# comments)."""
@@ -96,8 +99,31 @@ def sweep_jobs(request: Request) -> SweepJobs:
     return request.app.state.sweep_jobs
 
 
+def app_limits(request: Request) -> Limits:
+    """The app's compute budgets."""
+    return request.app.state.limits
+
+
+def app_metrics(request: Request) -> Metrics:
+    """The app's Prometheus metrics."""
+    return request.app.state.metrics
+
+
+def response_cache(request: Request) -> ResponseCache:
+    """The app's LRU of computed responses."""
+    return request.app.state.cache
+
+
+def ready_checks(request: Request) -> dict[str, Callable[[], bool]]:
+    """The readiness checks by name (kernels warmed, job store reachable, ...)."""
+    return request.app.state.ready_checks
+
+
 AppSettings = Annotated[Settings, Depends(app_settings)]
 Jobs = Annotated[SweepJobs, Depends(sweep_jobs)]
+AppLimits = Annotated[Limits, Depends(app_limits)]
+AppMetrics = Annotated[Metrics, Depends(app_metrics)]
+ReadyChecks = Annotated[dict[str, Callable[[], bool]], Depends(ready_checks)]
 
 
 async def cached_compute(
@@ -111,14 +137,14 @@ async def cached_compute(
 
     ``compute`` returns (body, media type); it runs in a worker thread (kernels release the GIL).
     """
-    cache: ResponseCache = request.app.state.cache
+    cache = response_cache(request)
     tag = etag_for(route, canonical)
     headers = {"ETag": tag, "Cache-Control": "no-cache"}
     if tag in _if_none_match(request):
         return Response(status_code=304, headers=headers)
     hit = cache.get(tag)
     if hit is not None:
-        request.app.state.metrics.cache_hits.inc()
+        app_metrics(request).cache_hits.inc()
         body, media_type = hit
         return Response(body, media_type=media_type, headers={**headers, "X-Cache": "hit"})
     start = time.perf_counter()
@@ -137,12 +163,18 @@ async def cached_compute(
 
 
 def engine_refusal(exc: ValueError) -> ProblemError:
-    """422 for a ValueError of the engine; its message starts with the field when it names one."""
-    message = str(exc)
+    """422 for a ValueError of the engine; an ``InputError`` names its field (typed)."""
+    path = exc.path if isinstance(exc, InputError) else _untyped_path(str(exc))
+    errors = [FieldError(path=path, pointer="/" + path.replace(".", "/"), message=str(exc))]
+    return ProblemError(422, "refused", "Refused by the engine", str(exc), errors if path else [])
+
+
+def _untyped_path(message: str) -> str:
+    """The field of an untyped ValueError whose message starts "field: ". Only
+    ``homoclinic.thresholds.threshold_curve`` still raises those (its rewrite, issue 19 item 4,
+    is to raise ``InputError``); then this goes."""
     head = message.split(":", 1)[0]
-    path = head if head.replace(".", "").replace("_", "").isalnum() and head != message else ""
-    errors = [FieldError(path=path, pointer="/" + path.replace(".", "/"), message=message)]
-    return ProblemError(422, "refused", "Refused by the engine", message, errors if path else [])
+    return head if head.replace(".", "").replace("_", "").isalnum() and head != message else ""
 
 
 def _if_none_match(request: Request) -> set[str]:

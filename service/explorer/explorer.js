@@ -57,6 +57,7 @@ const SETTINGS_FIELDS = [
   ["settings.transient_periods", "transient periods", "int", 500],
   ["settings.record_periods", "recorded periods", "int", 500],
   ["settings.steps_per_period", "steps per period", "int", 200],
+  ["settings.basins.starts", "basin starts (optional: 16, 64, 256)", "int", ""],
 ];
 const ENVELOPE_FIELDS = [
   ["axes[0].start", "speed from", "unit", "500 rpm"],
@@ -321,6 +322,23 @@ function showVerdict(result) {
   $("verdict-facts").replaceChildren(...facts(result).flatMap(([k, v]) => [el("dt", { text: k }), el("dd", { text: v })]));
 }
 
+// With settings.basins: one row per attractor and the basin picture.
+function showAttractors(result, body) {
+  const found = result.numerics.attractors;
+  $("basins").hidden = !found;
+  if (!found) return;
+  const b = result.numerics.basins;
+  const pct = (x) => `${(100 * x).toFixed(0)} %`;
+  const head = el("tr", {}, ...["attractor", "basin", "95 % interval", "starts", "LLE", "DTE µm"]
+    .map((t) => el("th", { text: t })));
+  const rows = found.map((a) => el("tr", {}, ...[a.label, pct(a.fraction),
+    `${pct(a.interval[0])} – ${pct(a.interval[1])}`, String(a.count), fmt(a.lle),
+    a.dte_um === null || a.dte_um === undefined ? "—" : fmt(a.dte_um, 3)].map((t) => el("td", { text: t }))));
+  $("attractors-table").replaceChildren(head, ...rows);
+  $("basins-count").textContent = `(${b.starts} starts, ${b.diverged} diverged, ${b.unsettled} unsettled)`;
+  loadFigure($("basins-figure"), "/v1/analyses/basins/plot", body);
+}
+
 // A figure fetched with the key (an <img src> could not send it); data-state tells tests
 // and styles whether it is loading, shown or failed.
 async function loadFigure(img, path, body, note) {
@@ -373,8 +391,18 @@ async function analyse() {
     $("analyse-status").textContent = "Done.";
     $("verdict").scrollIntoView({ block: "start" });
     loadFigure($("analysis-figure"), "/v1/analyses/plot", body);
-    thresholdSubject = subject;
-    loadThresholds();
+    showAttractors(result, body);
+    thresholdSubject = result.melnikov.applicable ? subject : null;
+    if (thresholdSubject) {
+      loadThresholds();
+    } else {  // above the critical torque: no saddle, so no threshold curves to draw
+      const img = $("threshold-figure");
+      img.removeAttribute("src");
+      img.dataset.state = "failed";
+      const t = result.engineering && result.engineering.critical_torque_nm;
+      $("threshold-note").textContent = "(the Melnikov criterion does not apply at this load"
+        + (t ? ` — above the critical torque ${fmt(t, 3)} N·m` : "") + ": no threshold curves)";
+    }
   } catch (err) {
     showProblem(form, { detail: "the server did not answer: " + err.message });
     $("analyse-status").textContent = "";
@@ -535,13 +563,14 @@ async function drawEnvelope(id, result) {
       customdata: sel.map((p) => [
         p.classification.replace("_", "-"), p.period ? p.period + "T" : "none", fmt(p.lle), fmt(p.lle_stderr, 2),
         CONTACT[p.impact_regime] || "no verdict on contact",
-        p.melnikov_chaos_possible === null ? "not applicable" : p.melnikov_chaos_possible ? "possible" : "ruled out",
+        p.melnikov_chaos_possible === null ? "not applicable (above T_crit)"
+          : p.melnikov_chaos_possible ? "chaos possible" : "chaos ruled out",
         physicalText(p, "dynamic_factor", 3, ""), physicalText(p, "dte", 3, " µm"),
       ]),
       hovertemplate: "speed %{x:,.0f} rpm<br>torque %{y:,.1f} N·m"
         + "<br>class %{customdata[0]}, period %{customdata[1]}<br>LLE %{customdata[2]} ± %{customdata[3]} per unit τ"
         + "<br>%{customdata[4]}<br>dynamic factor %{customdata[6]}, DTE %{customdata[7]}"
-        + "<br>Melnikov: chaos %{customdata[5]}<extra></extra>",
+        + "<br>Melnikov: %{customdata[5]}<extra></extra>",
       marker: {
         color: CLASS_COLORS[cls], symbol: sel.map((p) => IMPACT_SYMBOLS[p.impact_regime] || "square"),
         size: sel.map((p) => factorSize(p)), line: { color: "white", width: 1 },

@@ -1,25 +1,56 @@
-"""POST /v1/analyses and /v1/analyses/plot: the numerical verdict next to the Melnikov verdict."""
+"""POST /v1/analyses, /v1/analyses/plot and /v1/analyses/basins/plot: the numerical verdict
+next to the Melnikov verdict, its figure, and the basin picture of its attractors."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Literal
 
 from fastapi import APIRouter, Depends, Request, Response
 
-from gearengine import plots  # its figures load matplotlib on first use, not at start-up
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.jsonio import dumps
 from gearengine.numerics import work
-from service.api.deps import cached_compute, require_key
+from gearengine.numerics.settings import BasinSettings
+from gearengine.plots import MEDIA_TYPES, analysis_figure, basins_figure
+from service.api.deps import AppLimits, AppMetrics, cached_compute, require_key
 from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
+from service.limits import Limits
+from service.metrics import Metrics
 
 router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 
 
-def _analysis(request: Request, body: AnalysisRequest) -> AnalysisResult:
+def check_analysis_budget(limits: Limits, body: AnalysisRequest) -> None:
+    """422 before any compute when the analysis (its starts and basin starts) is over the
+    synchronous budget; names settings.basins.starts when basins are asked for."""
+    field = "settings" if body.settings.basins is None else "settings.basins.starts"
+    limits.check_budget(work(body.params, body.settings), field=field)
+
+
+def _analysis(metrics: Metrics, body: AnalysisRequest) -> AnalysisResult:
     result = analyze(body)
-    request.app.state.metrics.analyses.labels(result.numerics.classification).inc()
+    metrics.analyses.labels(result.numerics.classification).inc()
     return result
+
+
+async def _figure(
+    request: Request,
+    body: AnalysisRequest,
+    limits: Limits,
+    metrics: Metrics,
+    fmt: Literal["png", "svg"],
+    route: str,
+    draw: Callable[[AnalysisResult, Literal["png", "svg"]], bytes],
+) -> Response:
+    """A figure of the analysis of ``body``: budget checked first, then cached by route."""
+    check_analysis_budget(limits, body)
+    return await cached_compute(
+        request,
+        f"{route}.{fmt}",
+        body.model_dump_json(),
+        lambda: (draw(_analysis(metrics, body), fmt), MEDIA_TYPES[fmt]),
+    )
 
 
 @router.post(
@@ -28,17 +59,19 @@ def _analysis(request: Request, body: AnalysisRequest) -> AnalysisResult:
     responses=CACHED,
     summary="Melnikov and numerical verdicts of one design",
 )
-async def post_analysis(body: AnalysisRequest, request: Request) -> Response:
+async def post_analysis(
+    body: AnalysisRequest, request: Request, limits: AppLimits, metrics: AppMetrics
+) -> Response:
     """Integrates Eq. (9) with RK4 and its tangent equation: period from Poincaré sections,
     largest Lyapunov exponent (Benettin), classification, gear diagnostics, and whether the
     result agrees with the Melnikov verdict. Work above the synchronous budget is refused with
     422; submit it to `/v1/sweeps`."""
-    request.app.state.limits.check_budget(work(body.params, body.settings))
+    check_analysis_budget(limits, body)
     return await cached_compute(
         request,
         "analyses",
         body.model_dump_json(),
-        lambda: (dumps(_analysis(request, body)).encode(), JSON),
+        lambda: (dumps(_analysis(metrics, body)).encode(), JSON),
     )
 
 
@@ -51,15 +84,35 @@ async def post_analysis(body: AnalysisRequest, request: Request) -> Response:
 async def post_analysis_plot(
     body: AnalysisRequest,
     request: Request,
+    limits: AppLimits,
+    metrics: AppMetrics,
     format: Literal["png", "svg"] | None = FormatQuery,
 ) -> Response:
     """The paper's Figs. 7-11 for any design: (a) time history, (b) phase plane with the
     Poincaré points, (c) Poincaré section, (d) amplitude spectrum."""
     fmt = image_format(request, format)
-    request.app.state.limits.check_budget(work(body.params, body.settings))
-    return await cached_compute(
-        request,
-        f"analyses/plot.{fmt}",
-        body.model_dump_json(),
-        lambda: (plots.analysis_figure(_analysis(request, body), fmt), plots.MEDIA_TYPES[fmt]),
-    )
+    return await _figure(request, body, limits, metrics, fmt, "analyses/plot", analysis_figure)
+
+
+@router.post(
+    "/analyses/basins/plot",
+    response_class=Response,
+    responses=IMAGE_RESPONSES,
+    summary="Basin picture of a design: the starts (x, v) coloured by the attractor they reach",
+)
+async def post_basins_plot(
+    body: AnalysisRequest,
+    request: Request,
+    limits: AppLimits,
+    metrics: AppMetrics,
+    format: Literal["png", "svg"] | None = FormatQuery,
+) -> Response:
+    """The plane of initial states coloured by attractor, each attractor's strobes on top and
+    its basin fraction with a 95 % interval in the legend; axes in µm and mm/s for a design.
+    Without `settings.basins` the default basin settings are used (16 starts)."""
+    if body.settings.basins is None:
+        settings = body.settings.model_copy(update={"basins": BasinSettings()})
+        body = body.model_copy(update={"settings": settings})
+    fmt = image_format(request, format)
+    return await _figure(request, body, limits, metrics, fmt, "analyses/basins/plot",
+                         basins_figure)  # fmt: skip

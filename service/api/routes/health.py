@@ -5,6 +5,7 @@ from __future__ import annotations
 from fastapi import APIRouter, Request, Response
 from pydantic import BaseModel, Field
 
+from service.api.deps import AppMetrics, ReadyChecks
 from service.errors import ProblemError
 
 router = APIRouter()
@@ -32,8 +33,8 @@ async def health(request: Request) -> Health:
     summary="Readiness: kernels warmed and job store reachable",
     responses={503: {"description": "Not ready yet."}},
 )
-async def ready(request: Request) -> Health:
-    checks = {name: bool(check()) for name, check in request.app.state.ready_checks.items()}
+async def ready(request: Request, ready_checks: ReadyChecks) -> Health:
+    checks = {name: bool(check()) for name, check in ready_checks.items()}
     if not all(checks.values()):
         failing = ", ".join(k for k, v in checks.items() if not v)
         raise ProblemError(503, "not-ready", "Not ready", f"not ready: {failing}")
@@ -46,5 +47,5 @@ async def ready(request: Request) -> Health:
     response_class=Response,
     responses={200: {"content": {"text/plain": {}}, "description": "Text exposition format."}},
 )
-async def metrics(request: Request) -> Response:
-    return Response(request.app.state.metrics.exposition(), media_type="text/plain; version=0.0.4")
+async def metrics(metrics: AppMetrics) -> Response:
+    return Response(metrics.exposition(), media_type="text/plain; version=0.0.4")

@@ -22,7 +22,7 @@ from pydantic import BaseModel
 from starlette.concurrency import run_in_threadpool
 
 from gearengine import jobs as job_kinds
-from service.api.deps import AppSettings, Jobs, Owner
+from service.api.deps import AppSettings, Jobs, Owner, app_limits
 from service.api.responses import JSON, PROBLEMS, RETRY_AFTER_HEADER, header
 from service.core.config import Settings
 from service.errors import ProblemError
@@ -112,7 +112,7 @@ class JobRoutes:
     ) -> Job:  # fmt: skip
         """Check, plan and store a job; 429 when the queue is full."""
         self.check(body, request, settings)
-        request.app.state.limits.check_job(self.kind, body, self.noun, self.budget_path)
+        app_limits(request).check_job(self.kind, body, self.noun, self.budget_path)
         kind = job_kinds.kind(self.kind)
         size = kind.chunk_points if self.chunk_size is None else self.chunk_size(settings)
         try:

@@ -1,18 +1,27 @@
 """/v1/runups: run-ups and run-downs of a design as durable jobs (``gearengine.runup``).
 
 The kind-generic routes of ``routes.jobs``: submit (202 + ``Location``), list, status, result
-(the document ``gearengine runup --json`` writes), cancel. Bad ramps (zero or negative rate,
+(the document ``gearengine runup --json`` writes), cancel; and the figure of a succeeded run-up
+(``/plot``, the figure of ``gearengine runup --plot``). Bad ramps (zero or negative rate,
 speeds outside the plausible range, a profile over the work budget) are 422 problems naming
-the field, from the request model, before anything is stored or computed.
+the field, from the request's checks, before anything is stored or computed.
 """
 
 from __future__ import annotations
 
-from fastapi import Request
+from typing import Annotated, Literal
 
+from fastapi import Query, Request, Response
+from starlette.concurrency import run_in_threadpool
+
+from gearengine import jobs as job_kinds
+from gearengine.plots import runup_figure
 from gearengine.runup.request import RunupRequest, checked
 from gearengine.runup.results import RunupResult
-from service.api.routes.jobs import JobRoutes
+from service.api.deps import Jobs, Owner
+from service.api.responses import PNG, PROBLEMS, SVG
+from service.api.routes.jobs import CONFLICT, NOT_FOUND, JobRoutes
+from service.api.routes.sweeps import _plot_format
 from service.core.config import Settings
 
 
@@ -28,10 +37,46 @@ RUNUPS = JobRoutes(
     submit_summary="Submit a run-up or run-down of a design",
     submit_doc="Validate and store the run-up; it runs on the workers (one chunk per ensemble "
     "member and\ntwo for the quasi-static loop). Answers 202 with the job and its "
-    "``Location``; poll it and\nfetch ``/result`` once succeeded.",
+    "``Location``; poll it and\nfetch ``/result`` or ``/plot`` once succeeded.",
     result_model=RunupResult,
     result_summary="Result of a succeeded run-up: bins against speed, jumps, quasi-static loop",
     check=_check,
     budget_path="rate",
 )
 router = RUNUPS.router()
+
+
+@router.get(
+    "/{job_id}/plot",
+    response_class=Response,
+    responses={
+        **PROBLEMS,
+        **NOT_FOUND,
+        **CONFLICT,
+        200: {"content": {PNG: {}, SVG: {}}, "description": "The figure."},
+        406: {"description": "Neither PNG nor SVG is acceptable."},
+    },
+    summary="Figure of a succeeded run-up (PNG or SVG)",
+)
+async def get_plot(
+    job_id: str,
+    request: Request,
+    owner: Owner,
+    jobs: Jobs,
+    format: Annotated[
+        Literal["png", "svg"] | None, Query(description="png or svg; else the Accept header.")
+    ] = None,
+) -> Response:
+    """Speed on x: the DTE envelope up and down over the quasi-static hysteresis loop, jumps
+    marked, contact-status bands, the finite-time Lyapunov exponent, the Melnikov window."""
+    fmt = _plot_format(format, request.headers.get("accept", ""))
+    await run_in_threadpool(RUNUPS.succeeded, jobs, job_id, owner)
+
+    def draw() -> bytes:
+        kind = job_kinds.kind("runup")
+        body = kind.request.model_validate_json(jobs.store.request_json(job_id))
+        result = kind.assemble(body, list(jobs.store.chunk_results(job_id)))
+        assert isinstance(result, RunupResult)
+        return runup_figure(result, fmt)
+
+    return Response(await run_in_threadpool(draw), media_type=PNG if fmt == "png" else SVG)

@@ -20,8 +20,8 @@ from gearengine.sweeps import (
     SweepResult,
     checked,
     chunk_bifurcations,
-    chunk_points,
     csv_rows,
+    points_of_chunk,
     result_json,
     text_blocks,
 )
@@ -64,19 +64,17 @@ def _windows(jobs: SweepJobs, job_id: str, sweep: SweepRequest) -> list[SpeedWin
     return speed_windows(sweep, list(_points(jobs, job_id)))
 
 
-def _stored_points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
-    """The stored points unvalidated (``model_construct``: the workers wrote them from valid
-    points; nested documents such as ``physical`` stay plain dicts), one chunk in memory at a
-    time: the CSV of a million-point map streams at the speed of its writer, not of
-    validation."""
+def _stored_points(jobs: SweepJobs, job_id: str) -> Iterator[dict[str, object]]:
+    """The stored points as their JSON objects (the workers wrote them from valid points; no
+    model is built: ``csv_rows`` reads the fields by name), one chunk in memory at a time: the
+    CSV of a million-point map streams at the speed of its writer."""
     for array in jobs.store.chunk_results(job_id):
-        for item in chunk_points(array):
-            yield SweepPoint.model_construct(**item)
+        yield from points_of_chunk(array)
 
 
 def _points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
     for array in jobs.store.chunk_results(job_id):
-        for item in chunk_points(array):
+        for item in points_of_chunk(array):
             yield SweepPoint.model_validate(item)
 
 

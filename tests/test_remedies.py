@@ -1,0 +1,270 @@
+"""Remedies: each suggested value, applied to the design, passes ``gearengine check`` and 10 %
+short of it fails; the Melnikov bound is where ``/v1/melnikov`` stops allowing chaos at every
+envelope point; bisection says when it is not valid; bad levers are refused before compute.
+
+The envelopes are small (5 x 2 and 3 x 2 points at the gate's light settings) on the design of
+``examples/envelope-map.json``, where 4,250-5,250 rpm at 2 and 11.5 N*m holds most of its
+chaotic points, so each answer is decided by real failing points.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import httpx
+import pytest
+from pydantic import ValidationError
+
+from gearengine.ensembles.remedies import (
+    Lever,
+    RemediesRequest,
+    RemediesResult,
+    _narrow,
+    _search,
+    envelope_points,
+    iso1328_class,
+    remedies,
+)
+from gearengine.model.design import Design
+from gearengine.model.standards import iso1328
+from gearengine.model.units import in_display_unit
+from tests.conftest import ROOT, Server
+
+EXAMPLE = ROOT / "examples" / "envelope-map.json"
+ENVELOPE = ["--speed", "4250:5250", "--speed-points", "5", "--torque", "2:11.5",
+            "--torque-points", "2", "--fail-on", "chaotic"]  # fmt: skip
+
+
+def gearengine(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "gearengine.cli", *args], capture_output=True,
+                          text=True, cwd=ROOT, check=False)  # fmt: skip
+
+
+def with_value(doc: dict, path: str, value: float, unit: str) -> dict:
+    """The design file with the field at ``path`` set to ``value`` in ``unit``."""
+    out = copy.deepcopy(doc)
+    *head, last = path.split(".")
+    node = out["design"]
+    for key in head:
+        node = node[int(key)] if key.isdigit() else node[key]
+    node[int(last) if last.isdigit() else last] = value if unit == "1" else f"{value!r} {unit}"
+    return out
+
+
+@pytest.fixture(scope="module")
+def answer(tmp_path_factory: pytest.TempPathFactory) -> RemediesResult:
+    out = tmp_path_factory.mktemp("remedies") / "remedies.json"
+    run = gearengine("remedies", str(EXAMPLE), *ENVELOPE, "--json", str(out))
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.startswith("Lower the") or run.stdout.startswith("Raise the")
+    return RemediesResult.model_validate_json(out.read_text())
+
+
+def test_remedies_list_damping_and_transmission_error(answer: RemediesResult) -> None:
+    assert not answer.passed_already and not answer.check.passed
+    numerical = {r.lever for r in answer.remedies if r.bound == "numerical"}
+    assert {"mesh.damping_ratio", "transmission_error.harmonics.0.amplitude"} <= numerical
+    for r in answer.remedies:
+        assert r.unit == {"mesh.damping_ratio": "1"}.get(r.lever, r.unit)
+        assert r.samples[0].value == r.from_ and not r.samples[0].passed
+        assert r.summary.startswith(("raise", "lower"))
+    assert answer.answer.count("numerically") == len(numerical)
+    for u in answer.unreachable:
+        assert len(u.searched) == 2 and u.why and not any(s.passed for s in u.samples)
+    searched = [(r.lever, r.bound) for r in answer.remedies]
+    searched += [(u.lever, u.bound) for u in answer.unreachable]
+    assert sum(b == "numerical" for _, b in searched) == 6  # damping, TE, k, T, b down and up
+    if not any(b == "melnikov" for _, b in searched):  # 2-11.5 N*m: above the critical torque
+        assert "the Melnikov criterion does not apply at any envelope point" in answer.answer
+
+
+def test_each_value_passes_the_gate_and_ten_percent_short_fails(
+    answer: RemediesResult, tmp_path: Path
+) -> None:
+    doc = json.loads(EXAMPLE.read_text())
+    for r in (r for r in answer.remedies if r.bound == "numerical"):
+        assert r.check.passed and r.monotone
+        short = r.to + 0.1 * abs(r.to) * (1 if r.from_ > r.to else -1)  # toward the original
+        for value, code in ((r.to, 0), (short, 1)):
+            path = tmp_path / "design.json"
+            path.write_text(json.dumps(with_value(doc, r.lever, value, r.unit)))
+            report = tmp_path / "report.json"
+            run = gearengine("check", str(path), *ENVELOPE, "--json", str(report))
+            assert run.returncode == code, (r.lever, value, run.stdout)
+    # the attached report is the gate's own report at the value (same points, same verdicts)
+    r = next(r for r in answer.remedies if r.lever == "mesh.damping_ratio")
+    path.write_text(json.dumps(with_value(doc, r.lever, r.to, r.unit)))
+    gearengine("check", str(path), *ENVELOPE, "--json", str(report))
+    checked = json.loads(report.read_text())
+    assert [(p["values"], p["classification"]) for p in checked["sweep"]["points"]] == [
+        (p.values, p.classification) for p in r.check.sweep.points
+    ]
+
+
+def test_melnikov_bound_is_where_the_service_stops_allowing_chaos(server: Server) -> None:
+    """At the bound /v1/melnikov rules chaos out (or does not apply) at every envelope point;
+    1 % short of it (toward the design's value) it allows chaos somewhere."""
+    doc = json.loads(EXAMPLE.read_text())
+    te = "transmission_error.harmonics.0.amplitude"
+    request = RemediesRequest.model_validate({
+        "design": doc["design"], "settings": doc["settings"],
+        "envelope": {"speed": "4000:5500", "speed_points": 3, "torque": "0.5:1.5",
+                     "torque_points": 2},
+        "levers": [{"lever": te, "bounds": ["0 um", "10 um"]},
+                   {"lever": "mesh.half_backlash", "bounds": ["10 um", "200 um"]}],
+    })  # fmt: skip
+    result = remedies(request)
+    bounds = [r for r in result.remedies if r.bound == "melnikov"]
+    assert {r.lever for r in bounds} == {te, "mesh.half_backlash"}
+    for r in bounds:
+        short = r.to + 0.01 * abs(r.to) * (1 if r.from_ > r.to else -1)
+        verdicts = {}
+        for value in (r.to, short):
+            design = with_value(doc, r.lever, value, r.unit)["design"]
+            verdicts[value] = []
+            for point in envelope_points(request):
+                at = {**design, "speed": f"{in_display_unit('speed', point['speed'])} rpm",
+                      "torque": f"{point['torque']!r} N*m"}  # fmt: skip
+                body = httpx.post(f"{server.url}/v1/melnikov", json={"design": at},
+                                  timeout=30).json()  # fmt: skip
+                verdicts[value].append(body["chaos_possible"])
+        assert True not in verdicts[r.to], r.lever
+        assert True in verdicts[short], r.lever
+        assert r.not_applicable_points == verdicts[r.to].count(None)
+
+
+def test_bisection_reports_a_non_monotone_response() -> None:
+    """Samples fail, pass, fail, pass, pass: bisection finds the first switch and says the
+    lever is not monotone; a response that never passes has no bracket."""
+    lever = Lever(path="mesh.damping_ratio", start=0.0, end=1.0)
+    passes = [(0.2, 0.3), (0.55, 1.0)]  # values that pass
+
+    def test(v: float) -> tuple[bool, int]:
+        ok = any(lo <= v <= hi for lo, hi in passes)
+        return ok, 0 if ok else 1
+
+    samples, monotone, bracket = _search(test, lever, 5, _narrow(1e-3, lever), 40)
+    assert [s.passed for s in samples] == [False, True, False, True, True] and not monotone
+    assert bracket is not None and bracket[1] == pytest.approx(0.2, rel=2e-3)
+    assert not test(bracket[0])[0] and test(bracket[1])[0]
+    _, monotone, bracket = _search(lambda v: (v >= 0.6, 0), lever, 5, _narrow(1e-3, lever), 40)
+    assert monotone and bracket is not None and bracket[1] == pytest.approx(0.6, rel=2e-3)
+    assert _search(lambda v: (False, 3), lever, 5, _narrow(1e-3, lever), 40)[2] is None
+
+
+@pytest.mark.parametrize(
+    ("lever", "field", "words"),
+    [
+        ({"lever": "mesh.half_backlash", "bounds": ["20 um", "5 um"]}, "bounds", "low < high"),
+        ({"lever": "mesh.half_backlash", "bounds": ["11 um", "40 um"]}, "bounds", "outside"),
+        ({"lever": "mesh.half_backlash", "bounds": ["1 kg", "40 um"]}, "bounds", "kg"),
+        ({"lever": "mesh.no_such", "bounds": [0, 1]}, "lever", "no numeric field"),
+        ({"lever": "speed", "bounds": ["1 rpm", "9000 rpm"]}, "lever", "envelope"),
+    ],
+)
+def test_bad_levers_are_refused_naming_the_field(lever: dict, field: str, words: str) -> None:
+    doc = json.loads(EXAMPLE.read_text())
+    body = {"design": doc["design"], "envelope": {"speed": "4250:5250"}, "levers": [lever]}
+    with pytest.raises(ValidationError) as err:
+        RemediesRequest.model_validate(body)
+    (e,) = err.value.errors()
+    assert e["loc"] == ("levers", 0, field) and words in e["msg"]
+
+
+def test_cli_refuses_bad_input_before_compute() -> None:
+    run = gearengine("remedies", str(EXAMPLE), "--speed", "4250", "--lever",
+                     "mesh.half_backlash=20um:5um")  # fmt: skip
+    assert run.returncode == 2
+    assert "envelope.speed:" in run.stderr and "levers[0].bounds:" in run.stderr
+
+
+SMALL = ["--speed", "4500:5000", "--speed-points", "2", "--torque", "2:11.5", "--torque-points",
+         "1", "--lever", "transmission_error.harmonics.0.amplitude=0um:10um"]  # fmt: skip
+
+
+def small_body() -> dict:
+    doc = json.loads(EXAMPLE.read_text())
+    return {"design": doc["design"], "settings": doc["settings"], "fail_on": ["chaotic"],
+            "envelope": {"speed": "4500:5000", "speed_points": 2, "torque": "2:11.5",
+                         "torque_points": 1},
+            "levers": [{"lever": "transmission_error.harmonics.0.amplitude",
+                        "bounds": ["0um", "10um"]}]}  # fmt: skip
+
+
+def finished(server: Server, url: str) -> dict:
+    for _ in range(600):
+        job = httpx.get(url, timeout=30).json()
+        if job["status"] not in ("queued", "running"):
+            return job
+        time.sleep(0.5)
+    raise AssertionError(f"{url} did not finish")
+
+
+def test_the_service_answers_the_clis_document_byte_for_byte(server: Server, tmp_path: Path
+                                                              ) -> None:  # fmt: skip
+    out = tmp_path / "remedies.json"
+    run = gearengine("remedies", str(EXAMPLE), *SMALL, "--fail-on", "chaotic", "--json", str(out))
+    assert run.returncode == 0, run.stderr
+    r = httpx.post(f"{server.url}/v1/remedies", json=small_body(), timeout=30)
+    assert r.status_code == 202, r.text
+    url = server.url + r.headers["location"]
+    assert finished(server, url)["status"] == "succeeded"
+    result = httpx.get(url + "/result", timeout=60)
+    assert result.content == out.read_bytes()
+    assert json.loads(result.content)["remedies"][0]["check"]["passed"]
+
+
+def test_cancelling_stops_the_job(server: Server) -> None:
+    body = {**small_body(), "levers": None}  # six levers: time to cancel between them
+    r = httpx.post(f"{server.url}/v1/remedies", json=body, timeout=30)
+    url = server.url + r.headers["location"]
+    cancelled = httpx.delete(url, timeout=30).json()
+    assert cancelled["status"] == "cancelled"
+    assert httpx.get(url + "/result", timeout=30).status_code == 409
+    assert finished(server, url)["status"] == "cancelled"
+
+
+@pytest.mark.parametrize(
+    ("change", "path"),
+    [
+        ({"levers": [{"lever": "mesh.half_backlash", "bounds": ["20 um", "5 um"]}]},
+         "levers[0].bounds"),
+        ({"levers": [{"lever": "mesh.half_backlash", "bounds": ["NaN um", "5 um"]}]},
+         "levers[0].bounds"),
+        ({"envelope": {"speed": "6000"}}, "envelope.speed"),
+        ({"envelope": {"speed": "500:6000", "torque": "2 kg:40 kg"}}, "envelope.torque"),
+    ],
+)  # fmt: skip
+def test_bad_requests_get_422_naming_the_field(server: Server, change: dict, path: str) -> None:
+    r = httpx.post(f"{server.url}/v1/remedies", json={**small_body(), **change}, timeout=30)
+    assert r.status_code == 422 and r.headers["content-type"] == "application/problem+json"
+    assert path in [e["path"] for e in r.json()["errors"]], r.json()
+
+
+def test_iso1328_class_that_delivers_a_transmission_error() -> None:
+    """The coarsest class whose profile tolerances bound the mesh harmonic at or below the
+    amplitude: bound(A) <= e < bound(A + 1), from ISO 1328-1:2013 Eq. (7)-(9)."""
+    design = Design.model_validate(json.loads((ROOT / "examples" / "design-geometry.json")
+                                              .read_text())["design"])  # fmt: skip
+    gears = (design.driver, design.driven)
+
+    def bound(grade: int) -> float:
+        return iso1328.mesh_error_bound(*(
+            iso1328.tolerances(grade, g.teeth, g.module * 1e3, g.face_width * 1e3).F_alpha
+            for g in gears
+        )) * 1e-6  # fmt: skip
+
+    for grade in range(1, 11):
+        between = 0.5 * (bound(grade) + bound(grade + 1))
+        assert iso1328_class(design, between) == grade
+        assert iso1328_class(design, bound(grade)) == grade
+    assert iso1328_class(design, 0.5 * bound(1)) is None
+    assert (
+        iso1328_class(Design.model_validate(json.loads(EXAMPLE.read_text())["design"]), 1e-5)
+        is None
+    )
