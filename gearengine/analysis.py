@@ -209,6 +209,8 @@ class DesignRequest(ParamsOrDesign):
 
     model_config = request_config({"design": EXAMPLE_DESIGN})
 
+    ONE_OF = ("design",)  # a conversion needs a design: its schema asks for one
+
 
 class DesignReport(BaseModel):
     """The /v1/conversions/design contract: Eq. (9)'s parameters of a design, what was derived

@@ -28,6 +28,7 @@ Every dimensionless number crosses to gear units through ``model.units.to_physic
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
@@ -36,10 +37,17 @@ from gearengine.homoclinic.boundary import chaos_intervals
 from gearengine.homoclinic.coefficients import MeanLoad
 from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
 from gearengine.homoclinic.thresholds import strength_at
-from gearengine.model.aliases import with_speed_factor
+from gearengine.model.aliases import get_alias, with_speed_factor
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import Derived, DesignConversion
-from gearengine.model.units import OUTPUTS, Scales, in_si, response_values, to_physical
+from gearengine.model.units import (
+    OUTPUTS,
+    Scales,
+    display_label,
+    in_si,
+    response_values,
+    to_physical,
+)
 from gearengine.numerics.results import NumericsResult
 
 WINDOW_SCAN = 240
@@ -169,6 +177,30 @@ CONTROLS = {
     "k_p1": "stiffness_variation_amplitude",
 }
 """Control parameter -> its output quantity (``model.units.OUTPUTS``), the engineering name."""
+
+
+@dataclass(frozen=True)
+class ThresholdUnits:
+    """A threshold figure's axes in gear units: every excitation frequency scales with the
+    driver speed, so a frequency Omega is the speed ``rpm_per_frequency * Omega``; each control
+    parameter is linear in its physical value (``model.units.to_physical``)."""
+
+    rpm_per_frequency: float
+    parameter_label: str
+    parameter_scale: float
+
+
+def threshold_units(
+    conv: DesignConversion, parameter: str, frequency_parameter: str
+) -> ThresholdUnits | None:
+    """The gear units of the threshold curves of a design (None: the swept frequency's
+    excitation is absent, so the speed of a frequency is not defined)."""
+    omega = get_alias(conv.params, frequency_parameter)
+    if not omega:
+        return None
+    output = CONTROLS[parameter]
+    label = display_label(output).replace("_", " ").replace("[um]", "[µm]")
+    return ThresholdUnits(conv.speed_rpm / omega, label, to_physical(output, 1.0, conv.scales))
 
 
 def critical(name: str, t: ParameterThreshold, scales: Scales) -> Critical:

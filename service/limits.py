@@ -22,16 +22,21 @@ class Limits:
     def document(self, spec: dict[str, Any]) -> None:
         """Write the limits that bound one field into the OpenAPI document, so that its schema
         refuses what these checks refuse: the ``num`` of a threshold curve (max_curve_points)
-        and of a sweep axis (max_sweep_points: one axis can hold no more)."""
+        and of a sweep axis (max_sweep_points: one axis can hold no more); under a cap below
+        its default, num is required."""
         schemas = spec.get("components", {}).get("schemas", {})
         caps = {
             "ThresholdsRequest": self.settings.max_curve_points,
             "SweepAxis": self.settings.max_sweep_points,
         }
         for name, cap in caps.items():
-            num = schemas.get(name, {}).get("properties", {}).get("num")
+            schema = schemas.get(name, {})
+            num = schema.get("properties", {}).get("num")
             if num is not None:
                 num["maximum"] = min(num.get("maximum", cap), cap)
+                if num.get("default", 0) > cap:  # the default is refused: num must be given
+                    del num["default"]
+                    schema.setdefault("required", []).append("num")
 
     def check_curve(self, body: ThresholdsRequest) -> None:
         cap = self.settings.max_curve_points

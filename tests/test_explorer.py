@@ -456,6 +456,59 @@ def test_a_probability_map_runs_on_the_queue_and_can_be_cancelled(page: Page) ->
     page.assert_same_origin()
 
 
+def test_a_design_page_speaks_gear_units_and_enlarges_figures(page: Page) -> None:
+    """Issue 26, item 11: the LLE per s as in the figure, threshold curves over the speed in
+    µm, a figure opens at full size, and switching forms drops the other form's refusal."""
+    page.open()
+    page.field("analyse", by="id").click()
+    page.wait(lambda d: page.text("#verdict-summary"))
+    lle = page.text("#verdict-facts").split("Largest Lyapunov exponent")[1].splitlines()[1]
+    assert " per s (" in lle and "per unit τ)" in lle
+    page.figures_done()  # the threshold figure's gear units: tests/test_threshold_units.py
+    page.field("analysis-figure", by="id").click()
+    page.wait(lambda d: d.execute_script("return document.getElementById('enlarged').open"))
+    width = page.driver.execute_script("return document.getElementById('enlarged-img').width")
+    thumb = page.driver.execute_script("return document.getElementById('analysis-figure').width")
+    assert width > thumb
+    page.show("#verdict")
+    page.screenshot("explorer-enlarged.png", height=1000)
+    page.field("enlarged", by="id").click()
+    page.wait(lambda d: not d.execute_script("return document.getElementById('enlarged').open"))
+
+    page.type("design.mesh.half_backlash", "100 m")
+    page.field("analyse", by="id").click()
+    page.wait(lambda d: page.text("#refused"))
+    page.driver.find_element("css selector", "input[name=form-mode][value=geometry]").click()
+    assert not page.driver.find_elements("css selector", "#design-form .field-error")
+    assert page.driver.find_element("id", "refused").get_attribute("hidden") is not None
+    page.assert_same_origin()
+
+
+def test_the_map_shows_impacts_and_the_dynamic_factor(page: Page) -> None:
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+
+    page.open()
+    for path, value in {"envelope.axes[0].start": "1000 rpm", "envelope.axes[0].stop": "4000 rpm",
+                        "envelope.axes[0].num": "4", "envelope.axes[1].num": "2",
+                        "envelope.settings.transient_periods": "30",
+                        "envelope.settings.record_periods": "30"}.items():  # fmt: skip
+        page.type(path, value)
+    page.field("map-range", by="id").click()
+    page.wait(lambda d: page.text("#envelope-status") == "succeeded")
+    points = page.wait(
+        lambda d: d.find_elements(By.CSS_SELECTOR, "#envelope-map .scatterlayer path.point")
+    )
+    legend = page.text("#envelope-map .legend")
+    assert "teeth always in contact" in legend and "back-flank contact" in legend
+    ActionChains(page.driver).move_to_element(points[0]).perform()
+    hover = page.wait(lambda d: page.text("#envelope-map .hoverlayer"))
+    assert "dynamic factor" in hover and "DTE" in hover and "µm" in hover
+    assert "no-impact" not in hover and "impacts no" not in hover
+    page.show("#envelope")
+    page.screenshot("explorer-envelope-impacts.png", height=1000)
+
+
 def test_basins_show_the_attractors_and_their_picture(page: Page) -> None:
     page.open()
     page.type("settings.basins.starts", "16")

@@ -71,6 +71,20 @@ def assert_committed_once(data_dir: Path, job_id: str) -> list[tuple[int, str]]:
     return log
 
 
+def leased(data_dir: Path, job_id: str) -> int:
+    """Chunks of the job leased right now (being computed)."""
+    with contextlib.closing(sqlite3.connect(data_dir / "jobs.sqlite3", timeout=30)) as db:
+        query = "SELECT count(*) FROM chunks WHERE job_id = ? AND status = 'leased'"
+        return db.execute(query, (job_id,)).fetchone()[0]
+
+
+def mid_chunk(data_dir: Path, job_id: str, done: int) -> Any:
+    """``poll``'s condition: ``done`` points committed and a chunk in flight. The progress
+    alone turns true at the instant a chunk is committed, before the dispatcher leases the next
+    one: a kill -9 then could find no chunk in flight (or an idle worker) under load."""
+    return lambda job: job["progress"]["done"] >= done and leased(data_dir, job_id) > 0
+
+
 def submit(srv: Server) -> tuple[dict[str, Any], str]:
     """POST the sweep; returns the job and its URL."""
     job = httpx.post(srv.url + "/v1/sweeps", json=SWEEP, timeout=10).json()
@@ -121,7 +135,7 @@ def test_kill9_a_worker_process_retries_its_chunk(
     srv = Server(data_dir, ENV)
     try:
         job, url = submit(srv)
-        poll_url(url, lambda j: j["progress"]["done"] >= 2 * CHUNK_POINTS)
+        poll_url(url, mid_chunk(data_dir, job["id"], 2 * CHUNK_POINTS))
         (worker,) = pool_workers(srv)
         kill9([worker])
         assert poll_url(url, finished)["status"] == "succeeded"
@@ -162,7 +176,7 @@ def test_restart_after_kill9_reclaims_the_dead_servers_leases_at_once(
     srv = Server(data_dir, env)
     try:
         job, url = submit(srv)
-        poll_url(url, lambda j: j["progress"]["done"] >= 2 * CHUNK_POINTS)
+        poll_url(url, mid_chunk(data_dir, job["id"], 2 * CHUNK_POINTS))
         children = pool_workers(srv)
         os.kill(srv.proc.pid, signal.SIGKILL)
         srv.proc.wait()

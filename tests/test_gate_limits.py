@@ -101,7 +101,8 @@ def test_envelope_settings_merge_over_the_light_defaults(tmp_path: Path) -> None
     starts = {"count": 4, "box": [[-1.5, 1.5], [-0.5, 0.5]], "seed": 3}
     path = tmp_path / "starts.json"
     path.write_text(json.dumps({**doc, "settings": {"random_initial_states": starts}}))
-    args = argparse.Namespace(file=str(path), speed="1000:2000", speed_points=3, torque=None)
+    args = argparse.Namespace(file=str(path), speed="1000:2000", speed_points=3, torque=None,
+                              starts=1)  # fmt: skip
     settings = envelope_request(args).settings
     assert (settings.transient_periods, settings.record_periods) == (60, 60)
     assert settings.steps_per_period == 128 and settings.random_initial_states.count == 4

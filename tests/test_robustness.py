@@ -26,7 +26,7 @@ from gearengine.jobs import compute_chunk_json
 from service.core.config import Settings
 from service.main import create_app
 from tests._polling import poll
-from tests.conftest import PAPER_PARAMS
+from tests.conftest import PAPER_PARAMS, started
 
 SHORT = {"transient_periods": 100, "record_periods": 100}
 GEOMETRY = {"module": "2.5 mm", "face_width": "20 mm"}
@@ -188,7 +188,7 @@ def test_conversion_gives_the_iso_tolerances(client: TestClient) -> None:
 @pytest.fixture(scope="module")
 def working(tmp_path_factory: pytest.TempPathFactory) -> Iterator[TestClient]:
     settings = Settings(data_dir=tmp_path_factory.mktemp("rw"), workers=1)
-    with TestClient(create_app(settings)) as c:
+    with started(create_app(settings)) as c:  # warm, its dispatcher running
         yield c
 
 

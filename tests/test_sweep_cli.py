@@ -48,6 +48,6 @@ def test_out_dash_streams_to_stdout_and_progress_has_no_carriage_return(
     assert "teeth: 4/4 points" in captured.err and "\r" not in captured.err
     assert main(["sweep", str(doc), "--out", "-", "--format", "csv"]) == 0
     lines = capsys.readouterr().out.splitlines()
-    assert lines[0].startswith("driver.teeth,") and len(lines) == 5
+    assert lines[0].startswith("driver.teeth") and len(lines) == 5
     assert main(["sweep", str(doc), "--out", str(tmp_path / "files")]) == 0
     assert (tmp_path / "files" / "teeth.png").read_bytes().startswith(b"\x89PNG")

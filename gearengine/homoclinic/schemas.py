@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.homoclinic.coefficients import (
     BranchCoefficients,
@@ -14,13 +14,8 @@ from gearengine.homoclinic.coefficients import (
     Method,
 )
 from gearengine.model.examples import PAPER_SECTION_41
-from gearengine.model.params import MIN_FREQUENCY, request_config
+from gearengine.model.params import MIN_FREQUENCY, WholeNumber, request_config
 from gearengine.model.reduction import ParamsOrDesign
-
-WholeNumber = Annotated[
-    int, BeforeValidator(lambda v: int(v) if isinstance(v, float) and v.is_integer() else v)
-]
-"""An integer as JSON Schema counts them: 2.0 is the integer 2 (strict mode refuses floats)."""
 
 Bounds = Annotated[list[float | None], Field(min_length=2, max_length=2)]
 """A closed interval [lo, hi] of a parameter; null marks an unbounded end. (A list, not a tuple:

@@ -20,6 +20,7 @@ import math
 from typing import Annotated, Any, Literal
 
 from pydantic import (
+    ConfigDict,
     Field,
     ModelWrapValidatorHandler,
     PrivateAttr,
@@ -31,6 +32,8 @@ from gearengine.model.params import (
     MAX_HARMONICS,
     Phase,
     StrictModel,
+    WholeNumber,
+    given,
     request_config,
 )
 from gearengine.model.tolerances import Tolerances
@@ -53,7 +56,17 @@ from gearengine.model.units import (
 class Gear(StrictModel):
     """One gear: base radius and inertia directly, or its geometry (module, face width, ...)."""
 
-    teeth: int = Field(ge=5, le=1000, description="Number of teeth z.", examples=[18])
+    model_config = ConfigDict(
+        **request_config(),
+        json_schema_extra={  # what _enough checks, in the schema
+            "allOf": [
+                {"anyOf": [given(name), {"allOf": [given("module"), given("face_width")]}]}
+                for name in ("base_radius", "inertia")
+            ]
+        },
+    )
+
+    teeth: WholeNumber = Field(ge=5, le=1000, description="Number of teeth z.", examples=[18])
     base_radius: Length | None = Field(None, description="Base-circle radius r_b.")
     inertia: Inertia | None = Field(None, description="Mass moment of inertia about the axis.")
     module: Length | None = Field(None, description="Normal module m (geometry form).")
@@ -70,8 +83,8 @@ class Gear(StrictModel):
     @model_validator(mode="after")
     def _enough(self) -> Gear:
         geometric = self.module is not None and self.face_width is not None
-        if self.base_radius is None and self.module is None:
-            raise ValueError("give base_radius, or module (and face_width) for the geometry")
+        if self.base_radius is None and not geometric:  # geometry() derives it from both
+            raise ValueError("give base_radius, or module and face_width for the geometry")
         if self.inertia is None and not geometric:
             raise ValueError("give inertia, or module and face_width to derive it")
         return self
@@ -114,6 +127,10 @@ class TorqueFluctuationHarmonic(StrictModel):
 
 class Mesh(StrictModel):
     """The tooth mesh: stiffness, damping and half backlash."""
+
+    model_config = ConfigDict(
+        **request_config(), json_schema_extra={"oneOf": [given("damping_ratio"), given("damping")]}
+    )
 
     stiffness: MeshStiffness = Field(
         description="Mean mesh stiffness k_m, or 'iso6336' to derive it from both gears' "

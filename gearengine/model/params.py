@@ -13,9 +13,9 @@ finite; bad input raises ``pydantic.ValidationError`` (a ``ValueError``) naming 
 from __future__ import annotations
 
 from collections.abc import Iterator
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr
 
 MAX_HARMONICS = 32
 """Largest number of harmonics r = 1..R accepted per excitation."""
@@ -43,6 +43,18 @@ def request_config(*examples: object) -> ConfigDict:
     if examples:
         config["json_schema_extra"] = {"examples": list(examples)}
     return config
+
+
+WholeNumber = Annotated[
+    int, BeforeValidator(lambda v: int(v) if isinstance(v, float) and v.is_integer() else v)
+]
+"""An integer as JSON Schema counts them: 2.0 is the integer 2 (strict mode refuses floats)."""
+
+
+def given(name: str) -> dict[str, Any]:
+    """JSON schema: the object has the field ``name``, and not as null (an optional field's
+    null counts as absent)."""
+    return {"required": [name], "properties": {name: {"not": {"type": "null"}}}}
 
 
 class StrictModel(BaseModel):
@@ -93,6 +105,9 @@ class Excitation(StrictModel):
 class CubicBacklash(StrictModel):
     """Cubic approximation of the backlash law, f_h(x) = -a x + c x^3 (Eq. 9)."""
 
+    model_config = request_config()
+    model_config["json_schema_extra"] = {"required": ["model"]}  # the union's tag (Backlash)
+
     model: Literal["cubic"] = Field("cubic", description="Backlash law: cubic polynomial.")
     a: Magnitude = Field(
         PAPER_A,
@@ -108,6 +123,9 @@ class CubicBacklash(StrictModel):
 
 class PiecewiseBacklash(StrictModel):
     """Exact backlash law of Eq. (8): slope alpha inside the clearance |x| <= 1, 1 outside."""
+
+    model_config = request_config()
+    model_config["json_schema_extra"] = {"required": ["model"]}  # the union's tag (Backlash)
 
     model: Literal["piecewise"] = Field(
         "piecewise", description="Backlash law: piecewise linear, Eq. (8)."

@@ -7,6 +7,7 @@ is the part of every request that carries ``params`` or a ``design``.
 from __future__ import annotations
 
 import math
+from typing import ClassVar
 
 from pydantic import (
     BaseModel,
@@ -35,7 +36,7 @@ from gearengine.model.conversion import (
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
-from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash
+from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash, given
 from gearengine.model.standards import backlash, iso1328
 from gearengine.model.units import (
     RADIUS_RATIO_TOLERANCE,
@@ -349,10 +350,14 @@ class ParamsOrDesign(BaseModel):
     def __get_pydantic_json_schema__(
         cls, core_schema: CoreSchema, handler: GetJsonSchemaHandler
     ) -> JsonSchemaValue:
-        """The schema says what validation does: exactly one of params and design."""
+        """The schema says what validation does: exactly one of params and design, given (a
+        null one counts as absent)."""
         schema = handler.resolve_ref_schema(handler(core_schema))
-        schema["oneOf"] = [{"required": ["params"]}, {"required": ["design"]}]
+        schema["oneOf"] = [given(name) for name in cls.ONE_OF]
         return schema
+
+    ONE_OF: ClassVar[tuple[str, ...]] = ("params", "design")
+    """The fields of which a request gives exactly one (in its schema's ``oneOf``)."""
 
     @property
     def conversion(self) -> DesignConversion | None:

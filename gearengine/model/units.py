@@ -21,7 +21,7 @@ from dataclasses import dataclass, field, replace
 from functools import cache
 from typing import TYPE_CHECKING, Annotated, Any
 
-from pydantic import BeforeValidator, WithJsonSchema
+from pydantic import BeforeValidator
 
 if TYPE_CHECKING:
     import pint
@@ -177,13 +177,71 @@ def _plausible(si: float, given: object, kind: QuantityKind, allow_zero: bool) -
         f"{shown} is outside the plausible range of a {kind.name}, "
         f"{kind.describe(kind.low)} to {kind.describe(kind.high)}"
     )
-    magnitude = ureg.Quantity(given).magnitude if isinstance(given, str) else si
+    magnitude = ureg.Quantity(given.strip()).magnitude if isinstance(given, str) else si
     for slip in kind.slips:
         meant = float(ureg.Quantity(abs(float(magnitude)), slip).to(kind.unit).magnitude)
         if kind.low <= meant <= kind.high and meant > 0.0:
             message += f": did you mean {magnitude:g} {ureg.Unit(slip):~P}?"
             break
     raise ValueError(message)
+
+
+NUMBER = r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?"
+"""A decimal number as pint reads it."""
+
+
+def quantity_pattern(kind: QuantityKind) -> str:
+    """The schema's pattern of a quantity string: a magnitude and one of the usual units (the
+    SI unit, the example's, a likely slip's), the magnitude's integer digits bounded so that it
+    lies in the plausible range in that unit ("30 mm", not "30000000 mm"); a unit whose range
+    no digit count fits takes any number ("20 deg"). What is read is wider (any unit of the
+    right dimension, "0.5 mm"): the pattern states the common case, and the example, so that
+    requests generated from the schema (schemathesis) are mostly valid."""
+    ureg = registry()
+    sign = "-?" if kind.low == 0.0 else ""
+    alternatives = [re.escape(kind.example)]
+    for unit in dict.fromkeys([kind.unit, kind.example.split(maxsplit=1)[-1], *kind.slips]):
+        per_si = float(ureg.Quantity(1.0, unit).to(kind.unit).magnitude)
+        digits = _integer_digits(kind.low / per_si, kind.high / per_si)
+        number = NUMBER
+        if digits is not None:
+            number = rf"{sign}[1-9]\d{{{digits[0] - 1},{digits[1] - 1}}}(\.\d{{1,3}})?"
+        alternatives.append(rf"{number} *{re.escape(unit)}")
+    return rf"^ *({'|'.join(alternatives)}) *$"
+
+
+def _integer_digits(low: float, high: float) -> tuple[int, int] | None:
+    """(fewest, most) integer digits of a number with a leading digit 1-9 that lies in
+    [low, high]: k digits span [10^(k-1), 10^k); None if no k fits."""
+    fewest = 1 if low <= 1.0 else math.ceil(math.log10(low)) + 1
+    most = math.floor(math.log10(high))
+    return (fewest, most) if fewest <= most else None
+
+
+class QuantitySchema:
+    """The JSON schema of a quantity field, made when a schema is asked for (the OpenAPI
+    document), not at import: the pattern's unit factors need pint (``registry``)."""
+
+    def __init__(self, kind: QuantityKind, allow_zero: bool, keyword: str | None) -> None:
+        self.kind, self.allow_zero, self.keyword = kind, allow_zero, keyword
+
+    def __get_pydantic_json_schema__(self, core: Any, handler: Any) -> dict[str, Any]:
+        kind = self.kind
+        low = -kind.high if kind.low == 0.0 else kind.low  # the plausible range (_plausible)
+        words = [] if self.keyword is None else [{"const": self.keyword}]
+        zero = [{"const": 0}] if self.allow_zero and kind.low > 0.0 else []
+        return {
+            "anyOf": [
+                *words,
+                {"type": "string", "pattern": quantity_pattern(kind), "examples": [kind.example]},
+                {"type": "number", "description": f"in {kind.unit}", "minimum": low,
+                 "maximum": kind.high},
+                *zero,
+            ],
+            "description": f"{kind.name}: a string with a unit (e.g. {kind.example!r}) or a "
+            f"number in {kind.unit}; plausible range {kind.describe(kind.low)} to "
+            f"{kind.describe(kind.high)}",
+        }  # fmt: skip
 
 
 def quantity_type(key: str, allow_zero: bool = False, keyword: str | None = None) -> Any:
@@ -196,19 +254,8 @@ def quantity_type(key: str, allow_zero: bool = False, keyword: str | None = None
             return keyword
         return parse_quantity(value, kind, allow_zero)
 
-    words = [] if keyword is None else [{"const": keyword}]
-    schema = {
-        "anyOf": [
-            *words,
-            {"type": "string", "examples": [kind.example]},
-            {"type": "number", "description": f"in {kind.unit}"},
-        ],
-        "description": f"{kind.name}: a string with a unit (e.g. {kind.example!r}) or a number "
-        f"in {kind.unit}; plausible range {kind.describe(kind.low)} to "
-        f"{kind.describe(kind.high)}",
-    }
     stored = float if keyword is None else float | str
-    return Annotated[stored, BeforeValidator(parse), WithJsonSchema(schema)]
+    return Annotated[stored, BeforeValidator(parse), QuantitySchema(kind, allow_zero, keyword)]
 
 
 Length = quantity_type("length")

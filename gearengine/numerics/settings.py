@@ -20,7 +20,7 @@ from pydantic import (
 )
 
 from gearengine.model.errors import InputError
-from gearengine.model.params import Finite, GearParams, request_config
+from gearengine.model.params import Finite, GearParams, WholeNumber, request_config
 from gearengine.model.units import QUANTITIES, parse_quantity
 from gearengine.numerics.forcing import step_plan
 
@@ -55,12 +55,16 @@ class RandomStarts(BaseModel):
 
     model_config = request_config()
 
-    count: int = Field(ge=1, le=MAX_STARTS, description="Number of initial states.", examples=[8])
+    count: WholeNumber = Field(
+        ge=1, le=MAX_STARTS, description="Number of initial states.", examples=[8]
+    )
     box: Annotated[list[State], Field(min_length=2, max_length=2)] = Field(
         description="[[xmin, xmax], [vmin, vmax]] of the uniform draw.",
         examples=[[[-1.5, 1.5], [-0.5, 0.5]]],
     )
-    seed: int = Field(0, ge=0, description="Seed of numpy.random.default_rng.", examples=[0])
+    seed: WholeNumber = Field(
+        0, ge=0, description="Seed of numpy.random.default_rng.", examples=[0]
+    )
 
     @model_validator(mode="after")
     def _ordered(self) -> RandomStarts:
@@ -184,21 +188,21 @@ class SimulationSettings(BaseModel):
         }
     )
 
-    transient_periods: int = Field(
+    transient_periods: WholeNumber = Field(
         500,
         ge=0,
         le=MAX_PERIODS,
         description="Intervals T0 integrated and discarded before recording.",
         examples=[500],
     )
-    record_periods: int = Field(
+    record_periods: WholeNumber = Field(
         500,
         ge=1,
         le=MAX_PERIODS,
         description="Intervals T0 recorded (strobes, Lyapunov sums, spectrum).",
         examples=[500],
     )
-    steps_per_period: int = Field(
+    steps_per_period: WholeNumber = Field(
         200,
         ge=4,
         le=MAX_STEPS_PER_PERIOD,

@@ -14,6 +14,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from gearengine.analysis import AnalysisResult
+from gearengine.engineering import ThresholdUnits
 from gearengine.homoclinic.schemas import ThresholdCurve
 from gearengine.numerics.results import SpectrumPeak
 from gearengine.plots.style import ImageFormat, figure_bytes, symbol
@@ -175,16 +176,29 @@ def _spectrum(ax: Axes, peaks: list[SpectrumPeak], record_periods: int, u: Units
 
 
 def threshold_figure(
-    curve: ThresholdCurve, fmt: ImageFormat = "png", design_frequency: float | None = None
+    curve: ThresholdCurve,
+    fmt: ImageFormat = "png",
+    design_frequency: float | None = None,
+    units: ThresholdUnits | None = None,
 ) -> bytes:
     """Critical values of the parameter against the frequency, the no-chaos band shaded, and
-    the design as a point at (``design_frequency``, ``curve.value``) when both are known."""
+    the design as a point at (``design_frequency``, ``curve.value``) when both are known; with
+    ``units`` (a design) in gear units: the parameter in its unit over the driver speed."""
     fig = Figure(figsize=(8, 5.5), layout="constrained")
     ax = fig.subplots()
-    w = np.asarray(curve.frequencies)
-    lo, hi = _band(curve.no_chaos)
+    kx, ky = (1.0, 1.0) if units is None else (units.rpm_per_frequency, units.parameter_scale)
+    w = kx * np.asarray(curve.frequencies)
+    lo, hi = (ky * b for b in _band(curve.no_chaos))
+    value = None if curve.value is None else ky * curve.value
+    if design_frequency is not None:
+        design_frequency *= kx
     sym, fsym = symbol(curve.parameter), symbol(curve.frequency_parameter)
-    bands = {branch: _band(intervals) for branch, intervals in curve.branches.items()}
+    if units is not None:
+        sym, fsym = units.parameter_label, "driver speed [rpm]"
+    bands = {
+        branch: tuple(ky * b for b in _band(intervals))
+        for branch, intervals in curve.branches.items()
+    }
     styles = {"plus": ("C3", "-", "+"), "minus": ("C2", "--", "-")}
     if len(bands) == 2 and all(
         np.array_equal(a, b, equal_nan=True) for a, b in zip(*bands.values(), strict=True)
@@ -200,15 +214,15 @@ def threshold_figure(
         )
         ax.plot(w, blo, color=color, ls=ls, lw=1.3, label=label)
         ax.plot(w, bhi, color=color, ls=ls, lw=1.3)
-    if curve.value is not None:
-        ax.axhline(curve.value, color="k", lw=0.8, ls=":", label=f"design value of {sym}")
+    if value is not None:
+        ax.axhline(value, color="k", lw=0.8, ls=":", label=f"design value of {sym}")
         if design_frequency is not None:
             ax.plot(
-                design_frequency, curve.value, "*", ms=13, color="k", mfc="gold", zorder=5,
-                label=f"design: {fsym} = {design_frequency:.4g}, {sym} = {curve.value:.4g}",
+                design_frequency, value, "*", ms=13, color="k", mfc="gold", zorder=5,
+                label=f"design: {fsym} = {design_frequency:.4g}, {sym} = {value:.4g}",
             )  # fmt: skip
     ax.set(
-        xlabel=f"{fsym} (dimensionless frequency)",
+        xlabel=fsym if units is not None else f"{fsym} (dimensionless frequency)",
         ylabel=sym,
         title=f"Melnikov thresholds of {sym} over {fsym}\nchaos possible outside the shaded band",
     )
@@ -222,8 +236,8 @@ def threshold_figure(
         if curve.parameter == "mu"
         else 5.0 * finite.min()
     )
-    if curve.value is not None:
-        span = max(span, 1.15 * abs(curve.value))
+    if value is not None:
+        span = max(span, 1.15 * abs(value))
     bottom = 0.0 if curve.parameter == "mu" else -span
     ax.set_ylim(bottom, span)
     ax.fill_between(

@@ -23,7 +23,7 @@ from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from gearengine.model.design import Design
 from gearengine.model.examples import PAPER_SECTION_41
-from gearengine.model.params import GearParams, request_config
+from gearengine.model.params import GearParams, WholeNumber, request_config
 from gearengine.model.reduction import ParamsOrDesign
 from gearengine.model.units import Scales
 from gearengine.numerics.settings import RequestSettings, SimulationSettings
@@ -90,7 +90,7 @@ class SweepAxis(BaseModel):
         examples=[0.0, "500 rpm"],
     )
     stop: AxisValue = Field(description="Last value, as start.", examples=[0.3, "6000 rpm"])
-    num: int = Field(
+    num: WholeNumber = Field(
         ge=1,
         le=MAX_AXIS_POINTS,
         description=f"Number of values, start and stop included (1..{MAX_AXIS_POINTS}).",
@@ -119,6 +119,11 @@ class SweepRequest(ParamsOrDesign):
             "direction": "forward",
         }
     )
+    model_config["json_schema_extra"] |= {  # as request_errors checks: backward needs continuation
+        "if": {"required": ["direction"],
+               "properties": {"direction": {"enum": ["backward", "both"]}}},
+        "then": {"required": ["continuation"], "properties": {"continuation": {"const": True}}},
+    }  # fmt: skip
 
     settings: RequestSettings = Field(
         default_factory=SimulationSettings,

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from fastapi import Query, Request
 
-from gearengine.plots import ImageFormat
 from service.errors import PROBLEM_JSON, Problem
+
+if TYPE_CHECKING:  # the figures' module loads matplotlib: only when a figure is drawn
+    from gearengine.plots import ImageFormat
 
 JSON = "application/json"
 PNG = "image/png"

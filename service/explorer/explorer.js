@@ -259,13 +259,22 @@ const CONTACT = {
   double_sided: "double-sided impacts: back-flank contact",
 };
 
+// the LLE in the page's units: per s with a design (as its figure), per unit τ otherwise
+function lleText(n, eng) {
+  if (n.lle === null || n.lle === undefined) return "—";
+  const tau = `${fmt(n.lle)} ± ${fmt(n.lle_stderr, 2)} per unit τ`;
+  if (!eng) return tau;
+  const s = eng.time_scale_s;
+  return `${fmt(n.lle / s)} ± ${fmt(n.lle_stderr / s, 2)} per s (${tau})`;
+}
+
 function facts(result) {
   const n = result.numerics;
   const eng = result.engineering;
   const resp = eng && eng.response;
   const rows = [["Numerical class", n.classification.replace("_", "-")],
     ["Period", n.period ? `${n.period}T` + (resp && resp.period_ms ? ` (${fmt(resp.period_ms, 3)} ms)` : "") : "none found"],
-    ["Largest Lyapunov exponent", `${fmt(n.lle)} ± ${fmt(n.lle_stderr, 2)} per unit τ`],
+    ["Largest Lyapunov exponent", lleText(n, eng)],
     ["Stability margin", n.floquet && n.floquet.stability_margin !== null && n.floquet.stability_margin !== undefined
       ? n.floquet.stability_margin.toFixed(3)
         + (n.floquet.nearest_bifurcation ? ` (nearest: ${n.floquet.nearest_bifurcation.replace("_", "-")})` : "")
@@ -528,6 +537,19 @@ function loadPlotly() {
 const pointSpeed = (p) => (p.physical && p.physical.speed ? p.physical.speed.value : p.values.speed * 30 / Math.PI);
 const pointTorque = (p) => (p.physical && p.physical.torque ? p.physical.torque.value : p.values.torque);
 
+// the map's marker of a point: its shape says how the teeth meet, its size the dynamic factor
+const IMPACT_SYMBOLS = { no_impact: "square", single_sided: "triangle-up", double_sided: "x" };
+const physicalText = (p, key, digits, unit) => (p.physical && p.physical[key] ? fmt(p.physical[key].value, digits) + unit : "—");
+function factorSize(p) {
+  const f = p.physical && p.physical.dynamic_factor ? p.physical.dynamic_factor.value : 1;
+  return Math.max(7, Math.min(20, 7 + 13 * (f - 1))); // 1 → 7 px, 2 and over → 20 px
+}
+// legend entries of the shapes (markers drawn nowhere)
+const shapeLegend = () => Object.entries(IMPACT_SYMBOLS).map(([regime, symbol]) => ({
+  type: "scatter", mode: "markers", x: [null], y: [null], name: CONTACT[regime], hoverinfo: "skip",
+  marker: { symbol, color: "#777", size: 10 },
+}));
+
 async function drawEnvelope(id, result) {
   $("envelope-progress-row").hidden = true;
   $("envelope-hint").hidden = false;
@@ -553,16 +575,21 @@ async function drawMap(map, result, height) {
       x: sel.map((p) => p.rpm), y: sel.map((p) => p.nm),
       customdata: sel.map((p) => [
         p.classification.replace("_", "-"), p.period ? p.period + "T" : "none", fmt(p.lle), fmt(p.lle_stderr, 2),
-        (p.impact_regime || "—").replace("_", "-"),
+        CONTACT[p.impact_regime] || "no verdict on contact",
         p.melnikov_chaos_possible === null ? "not applicable (above T_crit)"
           : p.melnikov_chaos_possible ? "chaos possible" : "chaos ruled out",
+        physicalText(p, "dynamic_factor", 3, ""), physicalText(p, "dte", 3, " µm"),
       ]),
       hovertemplate: "speed %{x:,.0f} rpm<br>torque %{y:,.1f} N·m"
-        + "<br>class %{customdata[0]}, period %{customdata[1]}<br>LLE %{customdata[2]} ± %{customdata[3]}"
-        + "<br>impacts %{customdata[4]}<br>Melnikov: %{customdata[5]}<extra></extra>",
-      marker: { color: CLASS_COLORS[cls], size: 11, symbol: "square", line: { color: "white", width: 1 } },
+        + "<br>class %{customdata[0]}, period %{customdata[1]}<br>LLE %{customdata[2]} ± %{customdata[3]} per unit τ"
+        + "<br>%{customdata[4]}<br>dynamic factor %{customdata[6]}, DTE %{customdata[7]}"
+        + "<br>Melnikov: %{customdata[5]}<extra></extra>",
+      marker: {
+        color: CLASS_COLORS[cls], symbol: sel.map((p) => IMPACT_SYMBOLS[p.impact_regime] || "square"),
+        size: sel.map((p) => factorSize(p)), line: { color: "white", width: 1 },
+      },
     };
-  }).filter((t) => t.x.length);
+  }).filter((t) => t.x.length).concat(shapeLegend());
   const xs = [...new Set(pts.map((p) => p.rpm))].sort((a, b) => a - b);
   const ys = [...new Set(pts.map((p) => p.nm))].sort((a, b) => a - b);
   if (xs.length > 1 && ys.length > 1) {
@@ -689,6 +716,14 @@ function openPoint(id, speedRpm, torqueNm) {
   analyse();
 }
 
+// a figure at full size in a dialog (click or Escape closes it)
+function enlarge(img) {
+  if (!img.src) return;
+  $("enlarged-img").src = img.src;
+  $("enlarged-img").alt = img.alt;
+  $("enlarged").showModal();
+}
+
 // ---------------------------------------------------------------- modes and start-up
 function setMode(m) {
   document.querySelector(`input[name=form-mode][value=${m}]`).checked = true;
@@ -697,6 +732,8 @@ function setMode(m) {
 
 function switchMode(m) {
   const design = readDesign();
+  clearErrors($("design-form")); // a refusal of the other form's fields no longer applies
+  $("refused").hidden = true;
   const other = defaults[m === "direct" ? "geometry" : "direct"];
   setMode(m);
   // keep what the user typed; fields of the new form come from its example, and the mesh
@@ -733,6 +770,8 @@ async function start() {
   $("cancel-sweep").addEventListener("click", cancelSweep);
   $("fix-it").addEventListener("click", fixIt);
   $("threshold-parameter").addEventListener("change", loadThresholds);
+  document.querySelectorAll("figure img").forEach((img) => img.addEventListener("click", () => enlarge(img)));
+  $("enlarged").addEventListener("click", () => $("enlarged").close());
   listJobs();
   document.body.dataset.ready = "true"; // for tests: the form is built and prefilled
 }

@@ -13,7 +13,7 @@ from fastapi import Query, Request, Response
 from fastapi.responses import StreamingResponse
 from starlette.concurrency import run_in_threadpool
 
-from gearengine.plots import sweep_figure
+from gearengine import plots  # its figures load matplotlib on first use, not at start-up
 from gearengine.sweeps import (
     SweepPoint,
     SweepRequest,
@@ -182,7 +182,7 @@ async def get_plot(
     def draw() -> bytes:
         sweep = SweepRequest.model_validate_json(jobs.store.request_json(job_id))
         located = chunk_bifurcations(jobs.store.chunk_results(job_id))
-        return sweep_figure(sweep, list(_points(jobs, job_id)), fmt, located)
+        return plots.sweep_figure(sweep, list(_points(jobs, job_id)), fmt, located)
 
     body = await run_in_threadpool(draw)
     return Response(body, media_type=PNG if fmt == "png" else SVG)

@@ -6,6 +6,7 @@ from typing import Literal
 
 from fastapi import APIRouter, Depends, Request, Response
 
+from gearengine.engineering import threshold_units
 from gearengine.homoclinic import ThresholdCurve
 from gearengine.homoclinic.schemas import ThresholdsRequest
 from gearengine.homoclinic.thresholds import curve_of
@@ -41,6 +42,13 @@ async def post_thresholds(body: ThresholdsRequest, request: Request, limits: App
     )
 
 
+def figure(body: ThresholdsRequest, fmt: Literal["png", "svg"]) -> bytes:
+    """The curves' figure; a design's in gear units (its parameter's unit over the speed)."""
+    conv, name, freq = body.conversion, body.parameter, body.frequency_parameter
+    units = None if conv is None else threshold_units(conv, name, freq)
+    return threshold_figure(curve_of(body), fmt, _design_frequency(body), units)
+
+
 @router.post(
     "/thresholds/plot",
     response_class=Response,
@@ -61,5 +69,5 @@ async def post_threshold_plot(
         request,
         f"thresholds/plot.{fmt}",
         body.model_dump_json(),
-        lambda: (threshold_figure(curve_of(body), fmt, _design_frequency(body)), MEDIA_TYPES[fmt]),
+        lambda: (figure(body, fmt), MEDIA_TYPES[fmt]),
     )
