@@ -92,3 +92,17 @@ def test_a_backlash_band_out_of_order_is_typed() -> None:
     with pytest.raises(InputError) as raised:
         half_backlash_band(120e-6, 80e-6, 0.35)
     assert raised.value.path == "design.tolerances.backlash"
+
+
+@pytest.mark.parametrize("route", ["/v1/melnikov", "/v1/robustness"])
+def test_a_bore_wider_than_the_gear_is_a_422_naming_the_gear(
+    client: TestClient, route: str
+) -> None:
+    """A bore at or past the reference diameter leaves no disc for the inertia: schemathesis
+    found it as a 500 on /v1/robustness, which converts designs after validation."""
+    design = copy.deepcopy(EXAMPLE_DESIGN)
+    design["driver"] = {"teeth": 18, "module": "3 mm", "face_width": "25 mm", "bore": "60 mm"}
+    r = client.post(route, json={"design": design})
+    assert r.status_code == 422
+    (error,) = r.json()["errors"]
+    assert error["path"] == "design.driver" and "bore" in error["message"]

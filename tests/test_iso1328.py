@@ -13,6 +13,7 @@ import math
 
 import pytest
 
+from gearengine.model.errors import InputError
 from gearengine.model.standards import backlash, iso1328
 
 
@@ -62,8 +63,11 @@ def test_class_5_by_hand_and_the_sqrt2_class_step() -> None:
      ((7, 23, 2.5, 2.0), "face_width"), ((7, 4, 2.5, 20.0), "teeth")],
 )  # fmt: skip
 def test_outside_the_range_of_validity_is_refused(args: tuple, field: str) -> None:
-    with pytest.raises(ValueError, match=f"^{field}:"):
+    """A typed refusal: the design field in ``path``, the standard's quantity in ``message``."""
+    with pytest.raises(InputError) as refusal:
         iso1328.tolerances(*args)
+    assert refusal.value.path.startswith("design.")
+    assert refusal.value.message.startswith(f"{field}:")
 
 
 def test_backlash_band_to_half_backlash() -> None:

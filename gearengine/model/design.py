@@ -87,6 +87,11 @@ class Gear(StrictModel):
             raise ValueError("give base_radius, or module and face_width for the geometry")
         if self.inertia is None and not geometric:
             raise ValueError("give inertia, or module and face_width to derive it")
+        if self.module is not None and self.bore >= self.module * self.teeth:
+            raise ValueError(
+                f"bore: {self.bore * 1e3:.6g} mm leaves no gear body inside the reference "
+                f"diameter m z = {self.module * self.teeth * 1e3:.6g} mm"
+            )
         return self
 
     def geometry(self) -> dict[str, Any] | None:
