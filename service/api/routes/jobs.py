@@ -15,7 +15,7 @@ No ``from __future__ import annotations`` here: the endpoints are closures whose
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal
 
 from fastapi import APIRouter, Query, Request, Response
 from pydantic import BaseModel
@@ -23,7 +23,7 @@ from starlette.concurrency import run_in_threadpool
 
 from gearengine import jobs as job_kinds
 from service.api.deps import AppSettings, Jobs, Owner, app_limits
-from service.api.responses import JSON, PROBLEMS, RETRY_AFTER_HEADER, header
+from service.api.responses import JSON, PNG, PROBLEMS, RETRY_AFTER_HEADER, SVG, header
 from service.core.config import Settings
 from service.errors import ProblemError
 from service.jobs.models import UNFINISHED, Job, JobPage, JobStatus
@@ -45,6 +45,34 @@ CONFLICT = {
         "headers": RETRY,
     }
 }
+
+PLOT_RESPONSES = {
+    **PROBLEMS,
+    **NOT_FOUND,
+    **CONFLICT,
+    200: {"content": {PNG: {}, SVG: {}}, "description": "The figure."},
+    406: {"description": "Neither PNG nor SVG is acceptable."},
+}
+"""Responses of a job's ``/{job_id}/plot`` route."""
+
+PlotFormat = Annotated[
+    Literal["png", "svg"] | None, Query(description="png or svg; else the Accept header.")
+]
+"""The ``format`` query of a job's ``/plot`` route."""
+
+
+def plot_format(fmt: str | None, accept: str) -> Literal["png", "svg"]:
+    """The figure's format: ``fmt`` when given, else the first acceptable of the ``Accept``
+    header (406 when neither PNG nor SVG is)."""
+    if fmt is not None:
+        return fmt  # type: ignore[return-value]
+    types = [part.split(";")[0].strip() for part in accept.split(",") if part.strip()]
+    for t in types or ["*/*"]:
+        if t in (PNG, "image/*", "*/*"):
+            return "png"
+        if t == SVG:
+            return "svg"
+    raise ProblemError(406, "not-acceptable", "Not acceptable", f"plots are {PNG} or {SVG}")
 
 
 def poll_headers(job: Job) -> dict[str, str]:

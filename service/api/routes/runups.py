@@ -9,9 +9,7 @@ the field, from the request's checks, before anything is stored or computed.
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
-
-from fastapi import Query, Request, Response
+from fastapi import Request, Response
 from starlette.concurrency import run_in_threadpool
 
 from gearengine import jobs as job_kinds
@@ -19,9 +17,8 @@ from gearengine.plots import runup_figure
 from gearengine.runup.request import RunupRequest, checked
 from gearengine.runup.results import RunupResult
 from service.api.deps import Jobs, Owner
-from service.api.responses import PNG, PROBLEMS, SVG
-from service.api.routes.jobs import CONFLICT, NOT_FOUND, JobRoutes
-from service.api.routes.sweeps import _plot_format
+from service.api.responses import PNG, SVG
+from service.api.routes.jobs import PLOT_RESPONSES, JobRoutes, PlotFormat, plot_format
 from service.core.config import Settings
 
 
@@ -49,13 +46,7 @@ router = RUNUPS.router()
 @router.get(
     "/{job_id}/plot",
     response_class=Response,
-    responses={
-        **PROBLEMS,
-        **NOT_FOUND,
-        **CONFLICT,
-        200: {"content": {PNG: {}, SVG: {}}, "description": "The figure."},
-        406: {"description": "Neither PNG nor SVG is acceptable."},
-    },
+    responses=PLOT_RESPONSES,
     summary="Figure of a succeeded run-up (PNG or SVG)",
 )
 async def get_plot(
@@ -63,13 +54,11 @@ async def get_plot(
     request: Request,
     owner: Owner,
     jobs: Jobs,
-    format: Annotated[
-        Literal["png", "svg"] | None, Query(description="png or svg; else the Accept header.")
-    ] = None,
+    format: PlotFormat = None,
 ) -> Response:
     """Speed on x: the DTE envelope up and down over the quasi-static hysteresis loop, jumps
     marked, contact-status bands, the finite-time Lyapunov exponent, the Melnikov window."""
-    fmt = _plot_format(format, request.headers.get("accept", ""))
+    fmt = plot_format(format, request.headers.get("accept", ""))
     await run_in_threadpool(RUNUPS.succeeded, jobs, job_id, owner)
 
     def draw() -> bytes:

@@ -29,9 +29,17 @@ from gearengine.sweeps.results import SpeedWindows
 from gearengine.sweeps.windows import SPEED, speed_windows
 from service.api.deps import Jobs, Owner
 from service.api.responses import JSON, PNG, PROBLEMS, RETRY_AFTER_HEADER, SVG, header
-from service.api.routes.jobs import CONFLICT, NOT_FOUND, PARTIAL_HEADER, JobRoutes, poll_headers
+from service.api.routes.jobs import (
+    CONFLICT,
+    NOT_FOUND,
+    PARTIAL_HEADER,
+    PLOT_RESPONSES,
+    JobRoutes,
+    PlotFormat,
+    plot_format,
+    poll_headers,
+)
 from service.core.config import Settings
-from service.errors import ProblemError
 from service.jobs.runtime import SweepJobs
 
 
@@ -140,28 +148,10 @@ def get_result(
     )
 
 
-def _plot_format(fmt: str | None, accept: str) -> Literal["png", "svg"]:
-    if fmt is not None:
-        return fmt  # type: ignore[return-value]
-    types = [part.split(";")[0].strip() for part in accept.split(",") if part.strip()]
-    for t in types or ["*/*"]:
-        if t in (PNG, "image/*", "*/*"):
-            return "png"
-        if t == SVG:
-            return "svg"
-    raise ProblemError(406, "not-acceptable", "Not acceptable", f"plots are {PNG} or {SVG}")
-
-
 @router.get(
     "/{job_id}/plot",
     response_class=Response,
-    responses={
-        **PROBLEMS,
-        **NOT_FOUND,
-        **CONFLICT,
-        200: {"content": {PNG: {}, SVG: {}}, "description": "The figure."},
-        406: {"description": "Neither PNG nor SVG is acceptable."},
-    },
+    responses=PLOT_RESPONSES,
     summary="Figure of a succeeded sweep: bifurcation diagram or chaos map (PNG or SVG)",
 )
 async def get_plot(
@@ -169,14 +159,12 @@ async def get_plot(
     request: Request,
     owner: Owner,
     jobs: Jobs,
-    format: Annotated[
-        Literal["png", "svg"] | None, Query(description="png or svg; else the Accept header.")
-    ] = None,
+    format: PlotFormat = None,
 ) -> Response:
     """One axis: Poincare x against the parameter, the LLE underneath, the Melnikov threshold
     marked. Two axes: the map coloured by LLE, the Melnikov boundary overlaid and a table of
     agreement between the numerical and the Melnikov verdicts."""
-    fmt = _plot_format(format, request.headers.get("accept", ""))
+    fmt = plot_format(format, request.headers.get("accept", ""))
     await run_in_threadpool(SWEEPS.succeeded, jobs, job_id, owner)
 
     def draw() -> bytes:
