@@ -93,6 +93,28 @@ def _rk4_region(
     """One RK4 step of length dt from time t in region ``reg``, forcing evaluated at t:
     stationary (float ``fm``) or on a speed ramp (``fm`` a ramp record, ``kernels.phase``)."""
     K0, F0 = excitation_at(t, kc, fm, fc)
+    return _rk4_region_from(reg, alpha, twomu, kc, fm, fc, K0, F0, t, dt, x, v, dx, dv)
+
+
+@njit(**JIT_OPTIONS)
+def _rk4_region_from(
+    reg: int,
+    alpha: float,
+    twomu: float,
+    kc: np.ndarray,
+    fm: float | np.ndarray,
+    fc: np.ndarray,
+    K0: float,
+    F0: float,
+    t: float,
+    dt: float,
+    x: float,
+    v: float,
+    dx: float,
+    dv: float,
+) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
+    """``_rk4_region`` given the forcing (K0, F0) at t: the bracketing and regula falsi of
+    ``kink_split`` step from one substep start many times and evaluate it once."""
     K1, F1 = excitation_at(t + 0.5 * dt, kc, fm, fc)
     K2, F2 = excitation_at(t + dt, kc, fm, fc)
     return rk4_region_kf(reg, alpha, twomu, K0, F0, K1, F1, K2, F2, dt, x, v, dx, dv)
@@ -149,8 +171,11 @@ def kink_split(
     for it in range(16):
         if not rem > 0.0:
             return x, v, dx, dv, reg
+        K0, F0 = excitation_at(tc, kc, fm, fc)  # the forcing at the substep's start
         if it > 0:
-            x1, v1, dx1, dv1 = _rk4_region(reg, alpha, twomu, kc, fm, fc, tc, rem, x, v, dx, dv)
+            x1, v1, dx1, dv1 = _rk4_region_from(
+                reg, alpha, twomu, kc, fm, fc, K0, F0, tc, rem, x, v, dx, dv
+            )
         # cubic Hermite interpolant of x over the substep, sampled at 8 points
         kfound = 0
         b = 0.0
@@ -176,13 +201,20 @@ def kink_split(
         hi = kfound / 8.0
         xlo = x
         if lo > 0.0:
-            xlo = _rk4_region(reg, alpha, twomu, kc, fm, fc, tc, lo * rem, x, v, dx, dv)[0]
-        xhi = _rk4_region(reg, alpha, twomu, kc, fm, fc, tc, hi * rem, x, v, dx, dv)[0]
+            xlo = _rk4_region_from(
+                reg, alpha, twomu, kc, fm, fc, K0, F0, tc, lo * rem, x, v, dx, dv
+            )[0]
+        # the state at hi is kept: the step to the crossing is the last bracket's hi
+        xhi, vhi, dxhi, dvhi = _rk4_region_from(
+            reg, alpha, twomu, kc, fm, fc, K0, F0, tc, hi * rem, x, v, dx, dv
+        )
+        kept = True
         glo = side * (xlo - b)
         ghi = side * (xhi - b)
         if not (glo > 0.0) or not (ghi < 0.0):
             if side * (x1 - b) < 0.0 and side * (x - b) > 0.0:
                 lo, hi, glo, ghi = 0.0, 1.0, side * (x - b), side * (x1 - b)
+                kept = False  # x1 came from the whole step's forcing: not hi's state
             else:  # grazing excursion not confirmed by RK4: accept the substep
                 return x1, v1, dx1, dv1, reg
         # Illinois regula falsi on theta in (lo, hi)
@@ -191,9 +223,10 @@ def kink_split(
             th = (lo * ghi - hi * glo) / (ghi - glo)
             if not (th > lo and th < hi):
                 th = 0.5 * (lo + hi)
-            gm = side * (
-                _rk4_region(reg, alpha, twomu, kc, fm, fc, tc, th * rem, x, v, dx, dv)[0] - b
+            xth, vth, dxth, dvth = _rk4_region_from(
+                reg, alpha, twomu, kc, fm, fc, K0, F0, tc, th * rem, x, v, dx, dv
             )
+            gm = side * (xth - b)
             if gm > 0.0:
                 lo, glo = th, gm
                 if last == -1:
@@ -201,13 +234,19 @@ def kink_split(
                 last = -1
             else:
                 hi, ghi = th, gm
+                vhi, dxhi, dvhi, kept = vth, dxth, dvth, True
                 if last == 1:
                     glo *= 0.5
                 last = 1
             if (hi - lo) * rem < 1e-13 * h or gm == 0.0:
                 break
         dt = hi * rem  # just across the boundary
-        x, v, dx, dv = _rk4_region(reg, alpha, twomu, kc, fm, fc, tc, dt, x, v, dx, dv)
+        if kept:  # the step of length hi rem was taken above: the same numbers
+            v, dx, dv = vhi, dxhi, dvhi
+        else:
+            v, dx, dv = _rk4_region_from(
+                reg, alpha, twomu, kc, fm, fc, K0, F0, tc, dt, x, v, dx, dv
+            )[1:]
         x = b  # exactly on the switching point
         tc += dt
         rem -= dt

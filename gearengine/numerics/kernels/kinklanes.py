@@ -15,7 +15,7 @@ from gearengine.numerics.kernels.intervals import (
     new_ring,
     reset_lane,
 )
-from gearengine.numerics.kernels.kink import kink_split
+from gearengine.numerics.kernels.kink import kink_split, rk4_region_kf
 from gearengine.numerics.kernels.lockstep import LANES
 from gearengine.numerics.kernels.smooth import JIT_OPTIONS, SQRT1_2, region
 
@@ -37,6 +37,16 @@ def _law_slope_offset(reg: int, alpha: float) -> tuple[float, float]:  # pragma:
     if reg < 0:
         return 1.0, -(1.0 - alpha)
     return alpha, 0.0
+
+
+@njit(**JIT_OPTIONS)
+def _region_interval(reg: int) -> tuple[float, float]:  # pragma: no cover - compiled
+    """The open interval (lo, hi) of x that is region ``reg`` of Eq. (8)."""
+    if reg > 0:
+        return 1.0, np.inf
+    if reg < 0:
+        return -np.inf, -1.0
+    return -1.0, 1.0
 
 
 @njit(**JIT_OPTIONS, parallel=True)
@@ -67,12 +77,16 @@ def run_kink_batch(
 
     Every step of every lane is first taken whole in its current region with the lane's forcing
     table (the arithmetic of ``kink.rk4_region_kf`` written out per lane, so LLVM vectorises the
-    lane loop) and bounded by its Hermite reach (``HERMITE_REACH``); the lanes whose bound
-    touches a switching point |x| = 1 go through ``kink.kink_split`` (the crossing test, the
-    regula falsi and the substeps of the scalar kernel, forcing at the time within the period).
-    So each run has the numbers of ``run_kink(..., use_table=True)`` bit for bit, while the
-    steps far from the kinks cost about what the cubic lanes' cost. Streams, lanes, refills,
-    adaptive stopping and outputs are those of ``lockstep.run_batch``.
+    lane loop) and bounded by its Hermite reach (``HERMITE_REACH``): a lane whose bound stays in
+    its region keeps the step, by selects, not branches. A lane whose bound touches a switching
+    point |x| = 1 keeps its state in that loop; a second loop, entered only when some lane is
+    near a kink, retakes its step with ``rk4_region_kf`` and hands it to ``kink.kink_split``
+    (the crossing test, the regula falsi and the substeps of the scalar kernel, forcing at the
+    time within the period). So each run has the numbers of ``run_kink(..., use_table=True)``
+    bit for bit, while the steps far from the kinks cost what the cubic lanes' cost. The forcing
+    rows are indexed in place (``Kl[2j, lane]``), not taken as row views: a view's reference
+    count is updated around every step (12 atomic calls) once the split loop may use it.
+    Streams, lanes, refills, adaptive stopping and outputs are those of ``lockstep.run_batch``.
 
     Args:
         alpha, mu, x0, v0, T: per-run slope of Eq. (8) inside the clearance, damping, initial
@@ -163,10 +177,8 @@ def _kink_stream(
     V = np.zeros(LANES)
     DX = np.full(LANES, SQRT1_2)
     DV = np.full(LANES, SQRT1_2)
-    X1 = np.zeros(LANES)
-    V1 = np.zeros(LANES)
-    DX1 = np.zeros(LANES)
-    DV1 = np.zeros(LANES)
+    LO = np.full(LANES, -1.0)  # the open interval (LO, HI) of the lane's region in x
+    HI = np.full(LANES, 1.0)
     NEAR = np.zeros(LANES, dtype=np.bool_)
     XMIN = np.full(LANES, np.inf)
     XMAX = np.full(LANES, -np.inf)
@@ -187,6 +199,7 @@ def _kink_stream(
                 PT[lane] = -1  # idle: parked on a harmless state
                 REG[lane] = 0
                 S[lane], O[lane] = _law_slope_offset(0, AL[lane])
+                LO[lane], HI[lane] = _region_interval(0)
                 continue
             taken += 1
             active += 1
@@ -205,16 +218,13 @@ def _kink_stream(
             V[lane] = v0[p]
             REG[lane] = region(x0[p])
             S[lane], O[lane] = _law_slope_offset(REG[lane], alpha[p])
+            LO[lane], HI[lane] = _region_interval(REG[lane])
         if active == 0:
             break
-        for j in range(N):
-            K0 = Kl[2 * j]
-            F0 = Fl[2 * j]
-            K1 = Kl[2 * j + 1]
-            F1 = Fl[2 * j + 1]
-            K2 = Kl[2 * j + 2]
-            F2 = Fl[2 * j + 2]
-            for lane in range(LANES):  # the whole step in the lane's region
+        for j in range(N):  # K and F at the step's start, middle and end: Kl[2j + 0, 1, 2]
+            j0, j1, j2 = 2 * j, 2 * j + 1, 2 * j + 2
+            near = 0
+            for lane in range(LANES):  # the whole step in the lane's region, kept if inside it
                 s = S[lane]
                 o = O[lane]
                 twomu = TM[lane]
@@ -224,55 +234,63 @@ def _kink_stream(
                 v = V[lane]
                 dx = DX[lane]
                 dv = DV[lane]
-                b1 = -twomu * v - K0[lane] * (x * s - o) + F0[lane]
-                d1 = -twomu * dv - K0[lane] * s * dx
+                b1 = -twomu * v - Kl[j0, lane] * (x * s - o) + Fl[j0, lane]
+                d1 = -twomu * dv - Kl[j0, lane] * s * dx
                 xs_, a2, dxs, c2 = x + h2 * v, v + h2 * b1, dx + h2 * dv, dv + h2 * d1
-                b2 = -twomu * a2 - K1[lane] * (xs_ * s - o) + F1[lane]
-                d2 = -twomu * c2 - K1[lane] * s * dxs
+                b2 = -twomu * a2 - Kl[j1, lane] * (xs_ * s - o) + Fl[j1, lane]
+                d2 = -twomu * c2 - Kl[j1, lane] * s * dxs
                 xs_, a3, dxs, c3 = x + h2 * a2, v + h2 * b2, dx + h2 * c2, dv + h2 * d2
-                b3 = -twomu * a3 - K1[lane] * (xs_ * s - o) + F1[lane]
-                d3 = -twomu * c3 - K1[lane] * s * dxs
+                b3 = -twomu * a3 - Kl[j1, lane] * (xs_ * s - o) + Fl[j1, lane]
+                d3 = -twomu * c3 - Kl[j1, lane] * s * dxs
                 xs_, a4, dxs, c4 = x + h * a3, v + h * b3, dx + h * c3, dv + h * d3
-                b4 = -twomu * a4 - K2[lane] * (xs_ * s - o) + F2[lane]
-                d4 = -twomu * c4 - K2[lane] * s * dxs
+                b4 = -twomu * a4 - Kl[j2, lane] * (xs_ * s - o) + Fl[j2, lane]
+                d4 = -twomu * c4 - Kl[j2, lane] * s * dxs
                 h6 = H6[lane]
                 xn = x + h6 * (v + 2.0 * (a2 + a3) + a4)
                 vn = v + h6 * (b1 + 2.0 * (b2 + b3) + b4)
-                X1[lane] = xn
-                V1[lane] = vn
-                DX1[lane] = dx + h6 * (dv + 2.0 * (c2 + c3) + c4)
-                DV1[lane] = dv + h6 * (d1 + 2.0 * (d2 + d3) + d4)
+                dxn = dx + h6 * (dv + 2.0 * (c2 + c3) + c4)
+                dvn = dv + h6 * (d1 + 2.0 * (d2 + d3) + d4)
                 reach = HERMITE_REACH * h * (abs(v) + abs(vn)) + ROUNDING_MARGIN
-                lo = min(x, xn) - reach
-                hi = max(x, xn) + reach
-                r = REG[lane]
-                inside = (
-                    (r == 0 and lo > -1.0 and hi < 1.0)
-                    or (r > 0 and lo > 1.0)
-                    or (r < 0 and hi < -1.0)
-                )
+                inside = (min(x, xn) - reach > LO[lane]) & (max(x, xn) + reach < HI[lane])
                 NEAR[lane] = not inside
+                near += not inside
+                # a lane near a kink keeps its state for the split below (selects, no branch)
+                X[lane] = xn if inside else x
+                V[lane] = vn if inside else v
+                DX[lane] = dxn if inside else dx
+                DV[lane] = dvn if inside else dv
+                force = Kl[j2, lane] * (xn * s - o) + twomu * vn  # mesh force at the step end
+                XMIN[lane] = min(XMIN[lane], xn if inside else np.inf)
+                XMAX[lane] = max(XMAX[lane], xn if inside else -np.inf)
+                FMIN[lane] = min(FMIN[lane], force if inside else np.inf)
+                FMAX[lane] = max(FMAX[lane], force if inside else -np.inf)
+            if near == 0:
+                continue
             for lane in range(LANES):  # steps near a kink: the scalar kernel's split
                 p = PT[lane]
                 if not NEAR[lane] or p < 0:
                     continue
                 q = owner[p]
-                X1[lane], V1[lane], DX1[lane], DV1[lane], REG[lane] = kink_split(
-                    REG[lane], AL[lane], TM[lane], kc[q, :, : nk[q]], fm[q],
-                    fc[q, :, : nf[q]], j * H[lane], H[lane], X[lane], V[lane], DX[lane],
-                    DV[lane], X1[lane], V1[lane], DX1[lane], DV1[lane],
+                al = AL[lane]
+                twomu = TM[lane]
+                h = H[lane]
+                x, v, dx, dv = X[lane], V[lane], DX[lane], DV[lane]
+                x1, v1, dx1, dv1 = rk4_region_kf(
+                    REG[lane], al, twomu, Kl[j0, lane], Fl[j0, lane], Kl[j1, lane],
+                    Fl[j1, lane], Kl[j2, lane], Fl[j2, lane], h, x, v, dx, dv,
                 )  # fmt: skip
-                S[lane], O[lane] = _law_slope_offset(REG[lane], AL[lane])
-            for lane in range(LANES):  # accept, extremes and mesh force at the step end
-                x = X1[lane]
-                v = V1[lane]
+                x, v, DX[lane], DV[lane], reg = kink_split(
+                    REG[lane], al, twomu, kc[q, :, : nk[q]], fm[q], fc[q, :, : nf[q]],
+                    j * h, h, x, v, dx, dv, x1, v1, dx1, dv1,
+                )  # fmt: skip
                 X[lane] = x
                 V[lane] = v
-                DX[lane] = DX1[lane]
-                DV[lane] = DV1[lane]
+                REG[lane] = reg
+                S[lane], O[lane] = _law_slope_offset(reg, al)
+                LO[lane], HI[lane] = _region_interval(reg)
                 XMIN[lane] = min(XMIN[lane], x)
                 XMAX[lane] = max(XMAX[lane], x)
-                force = K2[lane] * (x * S[lane] - O[lane]) + TM[lane] * v
+                force = Kl[j2, lane] * (x * S[lane] - O[lane]) + twomu * v
                 FMIN[lane] = min(FMIN[lane], force)
                 FMAX[lane] = max(FMAX[lane], force)
         for lane in range(LANES):  # end of an interval T0 for every lane
