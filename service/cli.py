@@ -2,8 +2,8 @@
 
 The engine's command line knows nothing of the service: it loads the entry points of the group
 ``gearengine.commands`` (declared in ``pyproject.toml``), and ``register`` here adds these two
-commands. At import time this module needs only the engine and the settings (pydantic-settings);
-fastapi and uvicorn are imported when a command runs.
+commands. At import time this module needs only the engine's command line: the settings
+(pydantic-settings), fastapi and uvicorn are imported when a command runs.
 """
 
 from __future__ import annotations
@@ -13,7 +13,6 @@ import ipaddress
 from pathlib import Path
 
 from gearengine.cli.documents import EXIT_OK, InvalidInputError
-from service.core.config import Settings
 
 
 def _is_loopback(host: str) -> bool:
@@ -30,6 +29,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     import uvicorn
 
     from service.api.deps import load_key_hashes
+    from service.core.config import Settings
     from service.main import create_app
     from service.server import (
         EXIT_STARTUP_FAILURE,
@@ -87,6 +87,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
 
 def cmd_worker(args: argparse.Namespace) -> int:
     """Run sweep workers on the data directory's job store (``service.jobs.worker``)."""
+    from service.core.config import Settings
     from service.jobs.worker import run_worker
 
     flags = {"data_dir": args.data_dir, "workers": args.workers, "dask_scheduler": args.dask}

@@ -1,7 +1,5 @@
 """``python -m gearengine.cli``: the ``gearengine`` command."""
 
-import sys
+from gearengine.cli.main import command
 
-from gearengine.cli.main import main
-
-sys.exit(main())
+command()

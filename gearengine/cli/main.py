@@ -27,6 +27,7 @@ so the engine's commands work without the web stack installed.
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import logging
 import os
@@ -34,6 +35,7 @@ import sys
 import traceback
 from collections.abc import Callable, Sequence
 from importlib.metadata import entry_points
+from typing import NoReturn
 
 from gearengine.cli.documents import EXIT_INTERNAL, EXIT_INVALID, EXIT_PIPE, InvalidInputError
 from gearengine.model.units import QUANTITIES, parse_quantity
@@ -272,3 +274,15 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("gearengine: internal error (please report it)", file=sys.stderr)
         return EXIT_INTERNAL
     return code
+
+
+def command() -> NoReturn:
+    """The ``gearengine`` console script and ``python -m gearengine.cli``: ``main``, then exit.
+
+    The objects left are frozen (``gc.freeze``) before the interpreter exits: its final
+    collections then skip the module graph of numba, scipy and pint, which otherwise takes
+    0.2-0.4 s after a command's work is done (measured on ``check``). Atexit handlers and
+    stream flushes still run."""
+    code = main()
+    gc.freeze()
+    sys.exit(code)

@@ -20,7 +20,6 @@ from pathlib import Path
 
 from gearengine.cli.documents import EXIT_OK, read_document, validated_input
 from gearengine.jsonio import dumps
-from gearengine.plots.sweep import sweep_figure
 from gearengine.sweeps.compute import run_local
 from gearengine.sweeps.export import to_csv
 from gearengine.sweeps.request import SweepRequest, validated
@@ -104,6 +103,8 @@ def _sweep(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)
     (out / f"{stem}.json").write_text(dumps(result))
     (out / f"{stem}.csv").write_text("".join(csv))
+    from gearengine.plots.sweep import sweep_figure  # matplotlib: only when a figure is made
+
     (out / f"{stem}.png").write_bytes(
         sweep_figure(request, result.points, "png", result.bifurcations)
     )
