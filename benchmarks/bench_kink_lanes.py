@@ -9,8 +9,8 @@ tangent equation, fixed length (``"adaptive": false``), one start, through
 ``numerics.batch.run_lanes`` on one numba thread. gear_ref.c (gcc -O3 -march=native, built in a
 temporary directory) runs the same points with ``--kink --batch Fe 0 0.3 301`` (its scalar
 kink-splitting path, one thread). Times are CPU seconds of this process's run (1 thread) and of
-the gear_ref child process, so a shared machine changes them little; best of 3. Writes its
-section of benchmarks/README.md.
+the gear_ref child process, so a shared machine changes them little; the median of 5 runs, the
+piecewise and cubic runs interleaved. Writes its section of benchmarks/README.md.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ from gearengine.numerics.simulation import warm_up
 GEAR_REF = Path("/work/shared/reference/gear_ref.c")
 N_TRANS, N_REC, STEPS = 200, 200, 200
 FE = np.linspace(0.0, 0.3, 301)
-REPEATS = 3
+REPEATS = 5
 
 
 def paper(fe: float, model: str) -> GearParams:
@@ -47,33 +47,30 @@ def paper(fe: float, model: str) -> GearParams:
 
 
 def cpu_ns_per_point_step(points: list[GearParams]) -> tuple[float, list]:
-    """Best CPU time of ``run_lanes`` over the points (one start each), ns per point-step."""
+    """CPU time of one ``run_lanes`` over the points (one start each), ns per point-step."""
     settings = SimulationSettings(
         transient_periods=N_TRANS, record_periods=N_REC, steps_per_period=STEPS, adaptive=False
     )
     lanes = [(i, (0.01, 0.01)) for i in range(len(points))]
-    best, out = np.inf, []
-    for _ in range(REPEATS):
-        t = time.process_time()
-        out = run_lanes(points, lanes, settings)
-        best = min(best, time.process_time() - t)
-    return best * 1e9 / (len(points) * (N_TRANS + N_REC) * STEPS), out
+    t = time.process_time()
+    out = run_lanes(points, lanes, settings)
+    return (time.process_time() - t) * 1e9 / (len(points) * (N_TRANS + N_REC) * STEPS), out
 
 
 def gear_ref_kink_ns(tmp: Path) -> float:
-    """CPU ns per point-step of ``gear_ref --kink --batch Fe 0 0.3 301`` (best of 3)."""
+    """CPU ns per point-step of ``gear_ref --kink --batch Fe 0 0.3 301`` (median of 5)."""
     gcc = shutil.which("gcc") or sys.exit("gcc is needed to build gear_ref")
     exe = tmp / "gear_ref"
     subprocess.run([gcc, "-O3", "-march=native", "-o", exe, GEAR_REF, "-lm"], check=True)
     args = [exe, "--kink", "--batch", "Fe", "0", "0.3", str(FE.size), "0.07", "0.25", "0.5",
             "0.01", "0", "1", "0", "1", "pw", str(STEPS), str(N_TRANS), str(N_REC)]  # fmt: skip
-    best = np.inf
+    times = []
     for _ in range(REPEATS):
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         subprocess.run(args, check=True, capture_output=True)
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
-        best = min(best, (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime))
-    return best * 1e9 / (FE.size * (N_TRANS + N_REC) * STEPS)
+        times.append((after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime))
+    return float(np.median(times)) * 1e9 / (FE.size * (N_TRANS + N_REC) * STEPS)
 
 
 def main() -> None:
@@ -81,8 +78,14 @@ def main() -> None:
     numba.set_num_threads(1)
     piecewise = [paper(fe, "piecewise") for fe in FE]
     cubic = [paper(fe, "cubic") for fe in FE]
-    pw_ns, pw_out = cpu_ns_per_point_step(piecewise)
-    cubic_ns, _ = cpu_ns_per_point_step(cubic)
+    cpu_ns_per_point_step(piecewise[:16]), cpu_ns_per_point_step(cubic[:16])  # compiled
+    pw, cu, ratios = [], [], []
+    for _ in range(REPEATS):  # interleaved, so a slower minute slows both alike
+        ns, pw_out = cpu_ns_per_point_step(piecewise)
+        pw.append(ns)
+        cu.append(cpu_ns_per_point_step(cubic)[0])
+        ratios.append(pw[-1] / cu[-1])
+    pw_ns, cubic_ns = float(np.median(pw)), float(np.median(cu))
     with tempfile.TemporaryDirectory() as tmp:
         ref_ns = gear_ref_kink_ns(Path(tmp))
     regimes = {r: sum(o.impact_regime == r for o in pw_out) for r in
@@ -95,7 +98,8 @@ def main() -> None:
         "| --- | ---: | ---: |",
         f"| piecewise lanes `run_kink_batch` (1 thread) | {pw_ns:.2f} | 1.00x |",
         f"| cubic lanes `run_batch`, same points (1 thread) | {cubic_ns:.2f} | "
-        f"piecewise / cubic **{pw_ns / cubic_ns:.2f}x** |",
+        f"piecewise / cubic **{pw_ns / cubic_ns:.2f}x** (per run: "
+        f"{', '.join(f'{r:.2f}' for r in ratios)}) |",
         f"| gear_ref --kink --batch (scalar, 1 thread) | {ref_ns:.2f} | "
         f"gear_ref / piecewise lanes **{ref_ns / pw_ns:.1f}x** |",
     ]
@@ -106,7 +110,8 @@ def main() -> None:
         f"{regimes}, {classes}), {N_TRANS} + {N_REC} periods x {STEPS} RK4 steps with the "
         "tangent, fixed length, one start, `run_lanes` on one thread; the cubic row runs the "
         "same points with the cubic law; gear_ref.c with `--kink --batch` on the same points "
-        "(its scalar kink-splitting path). CPU time of the run (best of 3), so a shared "
+        "(its scalar kink-splitting path). CPU time of the run (median of 5, piecewise and "
+        "cubic runs interleaved), so a shared "
         "machine changes the ratios little. Targets (issue 20): piecewise lanes <= 2x the "
         "cubic lanes' cost per point-step, >= 4x gear_ref --kink's throughput per core.\n\n"
         + "\n".join(lines)

@@ -13,9 +13,12 @@ use, so importing this module loads no kind.
 
 from __future__ import annotations
 
+import gc
 import importlib
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -61,10 +64,40 @@ def kind(name: str) -> JobKind:
     return getattr(importlib.import_module(module), attribute)
 
 
+_pause_lock = threading.Lock()
+_pauses = [0, False]  # chunks computing now, and whether the collector was on before the first
+
+
+@contextmanager
+def cyclic_gc_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector off while a chunk computes (on again after the last
+    of concurrent chunks, if it was on before the first).
+
+    A chunk makes its results as many small containers (a 100 x 100 map: 10,000 points of 64
+    strobes, ~650,000 lists), and each allocation burst makes the collector traverse every
+    live container again: that traversal was 85 % of the time of those lists and a quarter of
+    the chunk's time (measured on ``bench_map_serve``'s map). The chunk's objects hold no
+    cycles that live past it; reference counting frees them as before."""
+    with _pause_lock:
+        if _pauses[0] == 0:
+            _pauses[1] = gc.isenabled()
+            gc.disable()
+        _pauses[0] += 1
+    try:
+        yield
+    finally:
+        with _pause_lock:
+            _pauses[0] -= 1
+            if _pauses[0] == 0 and _pauses[1]:
+                gc.enable()
+
+
 def compute_chunk_json(name: str, request_json: str, index: int, chunk_points: int) -> str:
-    """Chunk ``index`` of a job of kind ``name`` from its request's JSON text (what workers run)."""
+    """Chunk ``index`` of a job of kind ``name`` from its request's JSON text (what workers run),
+    with the cyclic collector paused (``cyclic_gc_paused``)."""
     job = kind(name)
-    return job.compute_chunk(job.request.model_validate_json(request_json), index, chunk_points)
+    with cyclic_gc_paused():
+        return job.compute_chunk(job.request.model_validate_json(request_json), index, chunk_points)
 
 
 def run_local(

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import gc
 import io
 import json
 import os
@@ -17,6 +18,7 @@ from pydantic import ValidationError
 from gearengine.cli import main
 from gearengine.homoclinic.thresholds import chaos_possible, verdict_flips
 from gearengine.homoclinic.verdict import melnikov
+from gearengine.jobs import cyclic_gc_paused
 from gearengine.jsonio import error_lines
 from gearengine.model.aliases import with_aliases
 from gearengine.numerics.settings import work
@@ -26,6 +28,7 @@ from gearengine.sweeps import (
     SweepPlan,
     SweepResult,
     agreement_table,
+    balanced_chunk_points,
     compute_chunk,
     compute_chunk_json,
     export,
@@ -299,3 +302,32 @@ def test_threads_under_numbas_workqueue_layer_take_turns() -> None:
     )  # fmt: skip
     assert run.returncode == 0, run.stderr[-2000:]
     assert run.stdout.split() == ["12"]
+
+
+@pytest.mark.parametrize(
+    ("n", "workers", "smallest", "size"),
+    [(200, 2, 64, 64), (4000, 2, 64, 500), (20000, 1, 64, 1024), (115, 2, 1, 15), (3, 0, 1, 1)],
+)
+def test_balanced_chunks_are_about_four_per_worker_within_bounds(
+    n: int, workers: int, smallest: int, size: int
+) -> None:
+    assert balanced_chunk_points(n, workers, smallest) == size
+
+
+def test_the_cyclic_collector_is_paused_while_chunks_compute_and_restored_after() -> None:
+    """Concurrent chunks (threads) share the pause: on again only after the last one."""
+    assert gc.isenabled()
+    first, second = cyclic_gc_paused(), cyclic_gc_paused()
+    with first:
+        assert not gc.isenabled()
+        second.__enter__()
+    assert not gc.isenabled()  # the second chunk still computes
+    second.__exit__(None, None, None)
+    assert gc.isenabled()
+    gc.disable()
+    try:
+        with cyclic_gc_paused():
+            pass
+        assert not gc.isenabled()  # off before: left off
+    finally:
+        gc.enable()

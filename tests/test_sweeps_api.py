@@ -265,3 +265,17 @@ def test_a_design_sweep_csv_from_the_service_is_in_gear_units(working: TestClien
     request = validated(doc)
     local = "".join(to_csv(run_local(request), request.outputs, design=True))
     assert text == local
+
+
+@pytest.mark.parametrize(("setting", "stored"), [(None, 1000), (4, 4)])
+def test_a_sweep_is_chunked_for_its_workers_unless_the_size_is_set(
+    tmp_path: Path, setting: int | None, stored: int
+) -> None:
+    """Unset, about four chunks per worker (balanced_chunk_points; no embedded worker counts as
+    one): 4000 points in chunks of 1000. The size is stored with the job, so a resumed job keeps
+    its chunks."""
+    app = create_app(Settings(data_dir=tmp_path, workers=0, sweep_chunk_points=setting))
+    with TestClient(app) as c:
+        assert c.post("/v1/sweeps", json=body(num=4000)).status_code == 202
+        claims = app.state.sweep_jobs.store.claim("test-worker", 60.0, 3, 10_000)
+    assert {cl.chunk_points for cl in claims} == {stored} and len(claims) == 4000 // stored

@@ -18,7 +18,12 @@ from gearengine.sweeps.export import (
     text_blocks,
     to_csv,
 )
-from gearengine.sweeps.plan import DEFAULT_CHUNK_POINTS, SweepPlan, sweep_work
+from gearengine.sweeps.plan import (
+    DEFAULT_CHUNK_POINTS,
+    SweepPlan,
+    balanced_chunk_points,
+    sweep_work,
+)
 from gearengine.sweeps.request import (
     SweepAxis,
     SweepRequest,
@@ -37,6 +42,7 @@ __all__ = [
     "SweepRequest",
     "SweepResult",
     "agreement_table",
+    "balanced_chunk_points",
     "checked",
     "chunk_bifurcations",
     "chunk_json",

@@ -21,7 +21,12 @@ from gearengine.numerics.results import BatchPoint
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.sweeps.axes import is_dimensionless
 from gearengine.sweeps.export import chunk_json, points_of_chunk, result_json
-from gearengine.sweeps.plan import DEFAULT_CHUNK_POINTS, SweepPlan, sweep_work
+from gearengine.sweeps.plan import (
+    DEFAULT_CHUNK_POINTS,
+    LARGEST_CHUNK_POINTS,
+    SweepPlan,
+    sweep_work,
+)
 from gearengine.sweeps.request import SweepBranch, SweepRequest
 from gearengine.sweeps.results import (
     PhysicalValue,
@@ -30,9 +35,6 @@ from gearengine.sweeps.results import (
     SweepResult,
 )
 from gearengine.sweeps.windows import SPEED, speed_windows
-
-LOCAL_CHUNK_POINTS = 1024
-"""Default chunk of ``run_local`` without continuation (see there)."""
 
 
 def _physical(
@@ -222,12 +224,12 @@ def run_local(
     does not depend on it; under numba's workqueue threading layer, which cannot run two
     parallel kernels at once, the chunks run one after the other.
 
-    ``chunk_points`` defaults to ``LOCAL_CHUNK_POINTS`` without continuation: the batch
+    ``chunk_points`` defaults to ``LARGEST_CHUNK_POINTS`` without continuation: the batch
     kernel refills a lane as soon as its point stops early (adaptive stopping), which pays
     only when a lane has several points to run; points do not depend on their chunk.
     """
     if chunk_points is None:
-        chunk_points = DEFAULT_CHUNK_POINTS if request.continuation else LOCAL_CHUNK_POINTS
+        chunk_points = DEFAULT_CHUNK_POINTS if request.continuation else LARGEST_CHUNK_POINTS
     if workers > 1 and not threads_may_share_kernels():
         workers = 1  # numba's workqueue layer: one kernel call at a time, or it aborts
     result = jobs.run_local("sweep", request, progress_callback, chunk_points, workers)

@@ -25,6 +25,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from gearengine.model.units import OUTPUTS, RESPONSES
 from gearengine.numerics.classify import SEVERITY
 from gearengine.sweeps.compute import run_local
+from gearengine.sweeps.plan import balanced_chunk_points
 from gearengine.sweeps.request import SweepRequest
 from gearengine.sweeps.results import PhysicalValue, SpeedWindows, SweepPoint, SweepResult
 from gearengine.sweeps.windows import SPEED, runs
@@ -163,8 +164,8 @@ def check_envelope(
     workers: int = 1,
 ) -> EnvelopeReport:
     """The gate's report of one envelope sweep, computed in this process (``workers`` threads,
-    a quarter of a core's share of the points per chunk, as the CLI gate runs it)."""
-    chunk = max(1, request.n_points() // (4 * workers))
+    ``balanced_chunk_points`` down to one point per chunk, as the CLI gate runs it)."""
+    chunk = balanced_chunk_points(request.n_points(), workers, smallest=1)
     result = run_local(request, progress_callback, chunk_points=chunk, workers=workers)
     return envelope_report(result, rules)
 

@@ -15,7 +15,25 @@ from gearengine.numerics.settings import work
 from gearengine.sweeps.request import SweepBranch, SweepRequest
 
 DEFAULT_CHUNK_POINTS = 64
-"""Points per chunk without continuation (the service's sweep_chunk_points default)."""
+"""Fewest points per chunk of ``balanced_chunk_points`` (and a continuation's default)."""
+LARGEST_CHUNK_POINTS = 1024
+"""Most points per chunk of ``balanced_chunk_points``."""
+CHUNKS_PER_WORKER = 4
+"""Chunks per worker that ``balanced_chunk_points`` aims at."""
+
+
+def balanced_chunk_points(n_points: int, workers: int, smallest: int = DEFAULT_CHUNK_POINTS) -> int:
+    """Points per chunk of a sweep of ``n_points`` on ``workers`` workers: about
+    ``CHUNKS_PER_WORKER`` chunks each (so the last chunks to finish leave little idle time),
+    within [smallest, ``LARGEST_CHUNK_POINTS``].
+
+    A chunk is one call of the lock-step kernel, whose lanes take the chunk's next point as
+    soon as theirs stops early (adaptive stopping): small chunks leave lanes idle behind their
+    slowest (chaotic) points. On the 100 x 100 chaos map through a warm service, 64-point
+    chunks took 3.5 s, 256-point chunks 3.0 s (``benchmarks/bench_map_serve.py``).
+    """
+    share = math.ceil(n_points / (CHUNKS_PER_WORKER * max(1, workers)))
+    return max(smallest, min(LARGEST_CHUNK_POINTS, share))
 
 
 FREQUENCY_ALIASES = frozenset({"Omega_k", "Omega_e", "Omega_p"})

@@ -71,8 +71,12 @@ class Settings(BaseSettings):
     max_queued_jobs: int = Field(
         64, ge=1, description="Most unfinished (queued or running) sweep jobs; then 429."
     )
-    sweep_chunk_points: int = Field(
-        64, ge=1, le=10_000, description="Points per chunk of a sweep without continuation."
+    sweep_chunk_points: int | None = Field(
+        None,
+        ge=1,
+        le=10_000,
+        description="Points per chunk of a sweep without continuation; unset, about four chunks "
+        "per worker, 64 to 1024 points (gearengine.sweeps.plan.balanced_chunk_points).",
     )
     lease_seconds: float = Field(
         30.0, gt=0.0, le=3600.0, description="Lease of a claimed chunk, renewed every third."

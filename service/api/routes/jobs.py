@@ -96,7 +96,7 @@ class JobRoutes:
         result_model, result_summary, result_doc: the result route's model and texts.
         check: ``(body, request, settings)``: refusals beyond the model (422 problems), before
             the work budget (the kind's ``work`` against max_sweep_steps) is checked.
-        chunk_size: ``settings -> units of work per chunk`` (default: the kind's).
+        chunk_size: ``(request, settings) -> units of work per chunk`` (default: the kind's).
         budget_path: the field a refusal over the work budget names.
     """
 
@@ -110,7 +110,7 @@ class JobRoutes:
     result_summary: str = ""
     result_doc: str = ""
     check: Callable[[Any, Request, Settings], None] = no_check
-    chunk_size: Callable[[Settings], int] | None = None
+    chunk_size: Callable[[Any, Settings], int] | None = None
     budget_path: str = "axes"
 
     def job_or_404(self, jobs: SweepJobs, job_id: str, owner: str | None) -> Job:
@@ -142,7 +142,7 @@ class JobRoutes:
         self.check(body, request, settings)
         app_limits(request).check_job(self.kind, body, self.noun, self.budget_path)
         kind = job_kinds.kind(self.kind)
-        size = kind.chunk_points if self.chunk_size is None else self.chunk_size(settings)
+        size = kind.chunk_points if self.chunk_size is None else self.chunk_size(body, settings)
         try:
             job = jobs.store.submit(
                 owner, body.model_dump_json(), kind.chunk_counts(body, size), size,

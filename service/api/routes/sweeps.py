@@ -15,9 +15,11 @@ from starlette.concurrency import run_in_threadpool
 
 from gearengine import plots  # its figures load matplotlib on first use, not at start-up
 from gearengine.sweeps import (
+    DEFAULT_CHUNK_POINTS,
     SweepPoint,
     SweepRequest,
     SweepResult,
+    balanced_chunk_points,
     checked,
     chunk_bifurcations,
     csv_rows,
@@ -47,6 +49,16 @@ def _check(body: SweepRequest, request: Request, settings: Settings) -> None:
     checked(body, settings.max_sweep_points)
 
 
+def _chunk_points(body: SweepRequest, settings: Settings) -> int:
+    """The job's points per chunk: the setting, or ``balanced_chunk_points`` over the workers
+    (a continuation sweep keeps ``DEFAULT_CHUNK_POINTS``: its chunks are its lines)."""
+    if settings.sweep_chunk_points is not None:
+        return settings.sweep_chunk_points
+    if body.continuation:
+        return DEFAULT_CHUNK_POINTS
+    return balanced_chunk_points(body.n_points(), settings.workers)
+
+
 SWEEPS = JobRoutes(
     kind="sweep",
     prefix="sweeps",
@@ -57,7 +69,7 @@ SWEEPS = JobRoutes(
     "and its\n``Location``; poll it (``Retry-After``) and fetch ``/result`` or ``/plot`` once "
     "succeeded.",
     check=_check,
-    chunk_size=lambda settings: settings.sweep_chunk_points,
+    chunk_size=_chunk_points,
 )
 router = SWEEPS.router(result=False)
 
