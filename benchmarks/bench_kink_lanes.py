@@ -9,8 +9,8 @@ tangent equation, fixed length (``"adaptive": false``), one start, through
 ``numerics.batch.run_lanes`` on one numba thread. gear_ref.c (gcc -O3 -march=native, built in a
 temporary directory) runs the same points with ``--kink --batch Fe 0 0.3 301`` (its scalar
 kink-splitting path, one thread). Times are CPU seconds of this process's run (1 thread) and of
-the gear_ref child process, so a shared machine changes them little; the median of 5 runs, the
-piecewise and cubic runs interleaved. Writes its section of benchmarks/README.md.
+the gear_ref child process, so a shared machine changes them little; the median of 7 runs (4 calls
+each), the piecewise and cubic runs interleaved. Writes its section of benchmarks/README.md.
 """
 
 from __future__ import annotations
@@ -36,7 +36,9 @@ from gearengine.numerics.simulation import warm_up
 GEAR_REF = Path("/work/shared/reference/gear_ref.c")
 N_TRANS, N_REC, STEPS = 200, 200, 200
 FE = np.linspace(0.0, 0.3, 301)
-REPEATS = 5
+REPEATS = 7
+CALLS = 4
+"""Calls per timed run (about a second of CPU), so the VM's jitter averages out."""
 
 
 def paper(fe: float, model: str) -> GearParams:
@@ -47,18 +49,21 @@ def paper(fe: float, model: str) -> GearParams:
 
 
 def cpu_ns_per_point_step(points: list[GearParams]) -> tuple[float, list]:
-    """CPU time of one ``run_lanes`` over the points (one start each), ns per point-step."""
+    """CPU time of ``CALLS`` calls of ``run_lanes`` over the points (one start each), ns per
+    point-step."""
     settings = SimulationSettings(
         transient_periods=N_TRANS, record_periods=N_REC, steps_per_period=STEPS, adaptive=False
     )
     lanes = [(i, (0.01, 0.01)) for i in range(len(points))]
     t = time.process_time()
-    out = run_lanes(points, lanes, settings)
-    return (time.process_time() - t) * 1e9 / (len(points) * (N_TRANS + N_REC) * STEPS), out
+    for _ in range(CALLS):
+        out = run_lanes(points, lanes, settings)
+    steps = CALLS * len(points) * (N_TRANS + N_REC) * STEPS
+    return (time.process_time() - t) * 1e9 / steps, out
 
 
 def gear_ref_kink_ns(tmp: Path) -> float:
-    """CPU ns per point-step of ``gear_ref --kink --batch Fe 0 0.3 301`` (median of 5)."""
+    """CPU ns per point-step of ``gear_ref --kink --batch Fe 0 0.3 301`` (median of 7)."""
     gcc = shutil.which("gcc") or sys.exit("gcc is needed to build gear_ref")
     exe = tmp / "gear_ref"
     subprocess.run([gcc, "-O3", "-march=native", "-o", exe, GEAR_REF, "-lm"], check=True)
@@ -110,7 +115,8 @@ def main() -> None:
         f"{regimes}, {classes}), {N_TRANS} + {N_REC} periods x {STEPS} RK4 steps with the "
         "tangent, fixed length, one start, `run_lanes` on one thread; the cubic row runs the "
         "same points with the cubic law; gear_ref.c with `--kink --batch` on the same points "
-        "(its scalar kink-splitting path). CPU time of the run (median of 5, piecewise and "
+        "(its scalar kink-splitting path). CPU time of the run (median of 7 runs of 4 calls, "
+        "piecewise and "
         "cubic runs interleaved), so a shared "
         "machine changes the ratios little. Targets (issue 20): piecewise lanes <= 2x the "
         "cubic lanes' cost per point-step, >= 4x gear_ref --kink's throughput per core.\n\n"
