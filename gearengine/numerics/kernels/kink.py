@@ -83,27 +83,6 @@ def _rk4_region(
     kc: np.ndarray,
     fm: float | np.ndarray,
     fc: np.ndarray,
-    t: float,
-    dt: float,
-    x: float,
-    v: float,
-    dx: float,
-    dv: float,
-) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
-    """One RK4 step of length dt from time t in region ``reg``, forcing evaluated at t:
-    stationary (float ``fm``) or on a speed ramp (``fm`` a ramp record, ``kernels.phase``)."""
-    K0, F0 = excitation_at(t, kc, fm, fc)
-    return _rk4_region_from(reg, alpha, twomu, kc, fm, fc, K0, F0, t, dt, x, v, dx, dv)
-
-
-@njit(**JIT_OPTIONS)
-def _rk4_region_from(
-    reg: int,
-    alpha: float,
-    twomu: float,
-    kc: np.ndarray,
-    fm: float | np.ndarray,
-    fc: np.ndarray,
     K0: float,
     F0: float,
     t: float,
@@ -113,8 +92,10 @@ def _rk4_region_from(
     dx: float,
     dv: float,
 ) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
-    """``_rk4_region`` given the forcing (K0, F0) at t: the bracketing and regula falsi of
-    ``kink_split`` step from one substep start many times and evaluate it once."""
+    """One RK4 step of length dt from time t in region ``reg``, the forcing (K0, F0) at t given
+    and the rest evaluated: stationary (float ``fm``) or on a speed ramp (``fm`` a ramp record,
+    ``kernels.phase``). The bracketing and regula falsi of ``kink_split`` step from one substep
+    start many times and evaluate its forcing once."""
     K1, F1 = excitation_at(t + 0.5 * dt, kc, fm, fc)
     K2, F2 = excitation_at(t + dt, kc, fm, fc)
     return rk4_region_kf(reg, alpha, twomu, K0, F0, K1, F1, K2, F2, dt, x, v, dx, dv)
@@ -139,7 +120,8 @@ def kink_step(
 
     Returns the new (x, v, dx, dv) and region; public because ``kernels.monodromy`` steps the
     two columns of the monodromy matrix with it."""
-    x1, v1, dx1, dv1 = _rk4_region(reg, alpha, twomu, kc, fm, fc, t, h, x, v, dx, dv)
+    K0, F0 = excitation_at(t, kc, fm, fc)
+    x1, v1, dx1, dv1 = _rk4_region(reg, alpha, twomu, kc, fm, fc, K0, F0, t, h, x, v, dx, dv)
     return kink_split(reg, alpha, twomu, kc, fm, fc, t, h, x, v, dx, dv, x1, v1, dx1, dv1)
 
 
@@ -173,7 +155,7 @@ def kink_split(
             return x, v, dx, dv, reg
         K0, F0 = excitation_at(tc, kc, fm, fc)  # the forcing at the substep's start
         if it > 0:
-            x1, v1, dx1, dv1 = _rk4_region_from(
+            x1, v1, dx1, dv1 = _rk4_region(
                 reg, alpha, twomu, kc, fm, fc, K0, F0, tc, rem, x, v, dx, dv
             )
         # cubic Hermite interpolant of x over the substep, sampled at 8 points
@@ -201,11 +183,9 @@ def kink_split(
         hi = kfound / 8.0
         xlo = x
         if lo > 0.0:
-            xlo = _rk4_region_from(
-                reg, alpha, twomu, kc, fm, fc, K0, F0, tc, lo * rem, x, v, dx, dv
-            )[0]
+            xlo = _rk4_region(reg, alpha, twomu, kc, fm, fc, K0, F0, tc, lo * rem, x, v, dx, dv)[0]
         # the state at hi is kept: the step to the crossing is the last bracket's hi
-        xhi, vhi, dxhi, dvhi = _rk4_region_from(
+        xhi, vhi, dxhi, dvhi = _rk4_region(
             reg, alpha, twomu, kc, fm, fc, K0, F0, tc, hi * rem, x, v, dx, dv
         )
         kept = True
@@ -223,7 +203,7 @@ def kink_split(
             th = (lo * ghi - hi * glo) / (ghi - glo)
             if not (th > lo and th < hi):
                 th = 0.5 * (lo + hi)
-            xth, vth, dxth, dvth = _rk4_region_from(
+            xth, vth, dxth, dvth = _rk4_region(
                 reg, alpha, twomu, kc, fm, fc, K0, F0, tc, th * rem, x, v, dx, dv
             )
             gm = side * (xth - b)
@@ -244,16 +224,15 @@ def kink_split(
         if kept:  # the step of length hi rem was taken above: the same numbers
             v, dx, dv = vhi, dxhi, dvhi
         else:
-            v, dx, dv = _rk4_region_from(
-                reg, alpha, twomu, kc, fm, fc, K0, F0, tc, dt, x, v, dx, dv
-            )[1:]
+            v, dx, dv = _rk4_region(reg, alpha, twomu, kc, fm, fc, K0, F0, tc, dt, x, v, dx, dv)[1:]
         x = b  # exactly on the switching point
         tc += dt
         rem -= dt
         # new region from the direction of motion
         reg = (1 if v > 0.0 else 0) if b > 0.0 else (-1 if v < 0.0 else 0)
     if rem > 0.0:  # more than 16 crossings in one step: finish without splitting
-        x, v, dx, dv = _rk4_region(reg, alpha, twomu, kc, fm, fc, tc, rem, x, v, dx, dv)
+        K0, F0 = excitation_at(tc, kc, fm, fc)
+        x, v, dx, dv = _rk4_region(reg, alpha, twomu, kc, fm, fc, K0, F0, tc, rem, x, v, dx, dv)
         reg = region(x)
     return x, v, dx, dv, reg
 
