@@ -60,3 +60,24 @@ def test_a_sweep_as_a_dataframe_and_numpy_grids(design: dict) -> None:
         i, j = list(axes[0]).index(p.values["speed"]), list(axes[1]).index(p.values["torque"])
         assert dte[j, i] == p.physical["dte"].value
     assert np.array_equal(result.grid("lle")[1].ravel(), [p.lle for p in result.points])
+
+
+@pytest.mark.parametrize("source", ["design", "params"])
+def test_a_dumped_analysis_loads_back_equal(design: dict, source: str) -> None:
+    """model_dump_json -> model_validate_json -> the same JSON: the per-unit Melnikov
+    coefficients the thresholds use are not serialised, and read back as None."""
+    doc = {"design": design} if source == "design" else {"params": PAPER}
+    result = analyze(gearengine.AnalysisRequest.model_validate({**doc, "settings": LIGHT}))
+    text = result.model_dump_json()
+    back = gearengine.AnalysisResult.model_validate_json(text)
+    assert back.model_dump_json() == text
+    if source == "params":
+        assert back.melnikov is not None and back.melnikov.coefficients is not None
+        assert back.melnikov.coefficients["plus"].damping_per_unit is None
+
+
+PAPER = {
+    "damping": 0.07,
+    "mean_force": 0.01,
+    "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 0.2}]},
+}

@@ -87,8 +87,11 @@ class Term(BaseModel):
     frequency: float = Field(description="r Omega (dimensionless).")
     phase: float = Field(description="Phase phi_r, radians.")
     coefficient: float = Field(description="B, same units as M.")
-    per_unit: float = Field(
-        exclude=True, description="B per unit amplitude of the harmonic (for thresholds)."
+    per_unit: float | None = Field(
+        None,
+        exclude=True,
+        description="B per unit amplitude of the harmonic (for thresholds); not serialised, so "
+        "None on a result read back from JSON.",
     )
 
 
@@ -99,8 +102,11 @@ class BranchCoefficients(BaseModel):
     model_config = ConfigDict(frozen=True)
 
     damping: float = Field(description="Constant part A = -(8/3) mu a^(3/2) / c.")
-    damping_per_unit: float = Field(
-        exclude=True, description="A per unit mu: -(8/3) a^(3/2) / c (for thresholds)."
+    damping_per_unit: float | None = Field(
+        None,
+        exclude=True,
+        description="A per unit mu: -(8/3) a^(3/2) / c (for thresholds); not serialised, so "
+        "None on a result read back from JSON.",
     )
     terms: list[Term]
 

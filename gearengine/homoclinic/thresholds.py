@@ -134,6 +134,9 @@ def verdict_flips(
 
 def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum] | None:
     """Split M = m0 + p g for the control parameter p (None if p's excitation is absent)."""
+    if coef.damping_per_unit is None:
+        raise ValueError("coefficients read back from JSON carry no per-unit values (they are "
+                         "not serialised): compute them again from the parameters")  # fmt: skip
     m = coef.trig_sum()
     zeros = np.zeros_like(m.amplitudes)
     if parameter == "mu":
