@@ -273,3 +273,29 @@ def test_iso1328_class_that_delivers_a_transmission_error() -> None:
         iso1328_class(Design.model_validate(json.loads(EXAMPLE.read_text())["design"]), 1e-5)
         is None
     )
+
+
+def test_two_levers_together_when_neither_alone_clears_the_envelope(tmp_path: Path) -> None:
+    """Damping up to 0.145 and the TE down to 2 µm each leave chaotic points alone (the single
+    remedies need 0.15 and 1.2 µm); together, at the grid point the combination names, the
+    gate passes, and with either lever back at its start it fails."""
+    out = tmp_path / "remedies.json"
+    levers = ["--lever", "mesh.damping_ratio=0.05:0.145",
+              "--lever", "transmission_error.harmonics.0.amplitude=2um:10um"]  # fmt: skip
+    run = gearengine("remedies", str(EXAMPLE), *ENVELOPE, *levers, "--json", str(out))
+    assert run.returncode == 0, run.stderr
+    answer = RemediesResult.model_validate_json(out.read_text())
+    assert answer.remedies == [] and answer.combination is not None
+    settings = answer.combination.levers
+    assert [s.lever for s in settings] == ["mesh.damping_ratio",
+                                            "transmission_error.harmonics.0.amplitude"]  # fmt: skip
+    assert answer.combination.check.passed
+    doc = json.loads(EXAMPLE.read_text())
+    path = tmp_path / "design.json"
+    both = doc
+    for s in settings:
+        both = with_value(both, s.lever, s.to, s.unit)
+    alone = [(with_value(doc, s.lever, s.to, s.unit), 1) for s in settings]
+    for design, code in [(both, 0), *alone]:
+        path.write_text(json.dumps(design))
+        assert gearengine("check", str(path), *ENVELOPE).returncode == code
