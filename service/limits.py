@@ -12,6 +12,14 @@ from gearengine.homoclinic.schemas import ThresholdsRequest
 from service.core.config import Settings
 from service.errors import FieldError, ProblemError
 
+SWEEP_HINT = "submit it as a sweep job: POST /v1/sweeps"
+"""Where an analysis over the synchronous budget can run."""
+BASINS_HINT = (
+    "use fewer basin starts or periods, or run it where no budget applies: "
+    "gearengine basins FILE --plot OUT.png"
+)
+"""Where one design's basins over the synchronous budget can run (no job kind runs them)."""
+
 
 @dataclass(frozen=True)
 class Limits:
@@ -43,16 +51,16 @@ class Limits:
         if body.num > cap:
             raise over_limit("num", f"at most {cap} frequencies per curve (max_curve_points)")
 
-    def check_budget(self, steps: int, sweep_hint: bool = True, field: str = "settings") -> None:
+    def check_budget(self, steps: int, hint: str = SWEEP_HINT, field: str = "settings") -> None:
         """Refuse work over the synchronous budget, naming ``field`` (``settings.basins.starts``
-        when basin starts are asked for: they multiply the cost)."""
+        when basin starts are asked for: they multiply the cost) and saying where such work
+        can run (``hint``)."""
         cap = self.settings.max_sync_steps
         if steps > cap:
-            hint = "; submit it as a sweep job: POST /v1/sweeps" if sweep_hint else ""
             raise over_limit(
                 field,
                 f"this analysis needs {steps} RK4 steps, over the synchronous compute budget of "
-                f"{cap} steps (max_sync_steps){hint}",
+                f"{cap} steps (max_sync_steps); {hint}",
                 kind="over-budget",
             )
 

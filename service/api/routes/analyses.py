@@ -15,7 +15,7 @@ from gearengine.numerics.settings import BasinSettings
 from gearengine.plots import MEDIA_TYPES, analysis_figure, basins_figure
 from service.api.deps import AppLimits, AppMetrics, cached_compute, require_key
 from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
-from service.limits import Limits
+from service.limits import BASINS_HINT, Limits
 from service.metrics import Metrics
 
 router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
@@ -24,8 +24,11 @@ router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 def check_analysis_budget(limits: Limits, body: AnalysisRequest) -> None:
     """422 before any compute when the analysis (its starts and basin starts) is over the
     synchronous budget; names settings.basins.starts when basins are asked for."""
-    field = "settings" if body.settings.basins is None else "settings.basins.starts"
-    limits.check_budget(work(body.params, body.settings), field=field)
+    if body.settings.basins is None:
+        limits.check_budget(work(body.params, body.settings))
+    else:
+        steps = work(body.params, body.settings)
+        limits.check_budget(steps, hint=BASINS_HINT, field="settings.basins.starts")
 
 
 def _analysis(metrics: Metrics, body: AnalysisRequest) -> AnalysisResult:
