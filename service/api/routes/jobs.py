@@ -269,6 +269,36 @@ class JobRoutes:
             self._result_route(router)
         return router
 
+    def plot_route(
+        self,
+        router: APIRouter,
+        summary: str,
+        description: str,
+        draw: Callable[[SweepJobs, str, Literal["png", "svg"]], bytes],
+    ) -> None:
+        """Add ``GET /{job_id}/plot`` to ``router``: the figure ``draw(jobs, job_id, fmt)`` of a
+        succeeded job of the kind (409 before), PNG or SVG by ``?format`` or ``Accept``."""
+        routes = self
+
+        async def plot(
+            job_id: str, request: Request, owner: Owner, jobs: Jobs, format: PlotFormat = None
+        ) -> Response:
+            fmt = plot_format(format, request.headers.get("accept", ""))
+            await run_in_threadpool(routes.succeeded, jobs, job_id, owner)
+            body = await run_in_threadpool(draw, jobs, job_id, fmt)
+            return Response(body, media_type=PNG if fmt == "png" else SVG)
+
+        router.add_api_route(
+            "/{job_id}/plot",
+            plot,
+            methods=["GET"],
+            name="get_plot",
+            response_class=Response,
+            responses=PLOT_RESPONSES,
+            summary=summary,
+            description=description,
+        )
+
     def _result_route(self, router: APIRouter) -> None:
         routes = self
         kind = job_kinds.kind(self.kind)

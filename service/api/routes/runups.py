@@ -9,17 +9,17 @@ the field, from the request's checks, before anything is stored or computed.
 
 from __future__ import annotations
 
-from fastapi import Request, Response
-from starlette.concurrency import run_in_threadpool
+from typing import Literal
+
+from fastapi import Request
 
 from gearengine import jobs as job_kinds
 from gearengine.plots import runup_figure
 from gearengine.runup.request import RunupRequest, checked
 from gearengine.runup.results import RunupResult
-from service.api.deps import Jobs, Owner
-from service.api.responses import PNG, SVG
-from service.api.routes.jobs import PLOT_RESPONSES, JobRoutes, PlotFormat, plot_format
+from service.api.routes.jobs import JobRoutes
 from service.core.config import Settings
+from service.jobs.runtime import SweepJobs
 
 
 def _check(body: RunupRequest, request: Request, settings: Settings) -> None:
@@ -43,29 +43,18 @@ RUNUPS = JobRoutes(
 router = RUNUPS.router()
 
 
-@router.get(
-    "/{job_id}/plot",
-    response_class=Response,
-    responses=PLOT_RESPONSES,
-    summary="Figure of a succeeded run-up (PNG or SVG)",
+def _draw(jobs: SweepJobs, job_id: str, fmt: Literal["png", "svg"]) -> bytes:
+    kind = job_kinds.kind("runup")
+    body = kind.request.model_validate_json(jobs.store.request_json(job_id))
+    result = kind.assemble(body, list(jobs.store.chunk_results(job_id)))
+    assert isinstance(result, RunupResult)
+    return runup_figure(result, fmt)
+
+
+RUNUPS.plot_route(
+    router,
+    "Figure of a succeeded run-up (PNG or SVG)",
+    "Speed on x: the DTE envelope up and down over the quasi-static hysteresis loop, jumps\n"
+    "marked, contact-status bands, the finite-time Lyapunov exponent, the Melnikov window.",
+    _draw,
 )
-async def get_plot(
-    job_id: str,
-    request: Request,
-    owner: Owner,
-    jobs: Jobs,
-    format: PlotFormat = None,
-) -> Response:
-    """Speed on x: the DTE envelope up and down over the quasi-static hysteresis loop, jumps
-    marked, contact-status bands, the finite-time Lyapunov exponent, the Melnikov window."""
-    fmt = plot_format(format, request.headers.get("accept", ""))
-    await run_in_threadpool(RUNUPS.succeeded, jobs, job_id, owner)
-
-    def draw() -> bytes:
-        kind = job_kinds.kind("runup")
-        body = kind.request.model_validate_json(jobs.store.request_json(job_id))
-        result = kind.assemble(body, list(jobs.store.chunk_results(job_id)))
-        assert isinstance(result, RunupResult)
-        return runup_figure(result, fmt)
-
-    return Response(await run_in_threadpool(draw), media_type=PNG if fmt == "png" else SVG)

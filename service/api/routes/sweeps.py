@@ -11,7 +11,6 @@ from typing import Annotated, Literal
 
 from fastapi import Query, Request, Response
 from fastapi.responses import StreamingResponse
-from starlette.concurrency import run_in_threadpool
 
 from gearengine import plots  # its figures load matplotlib on first use, not at start-up
 from gearengine.sweeps import (
@@ -30,15 +29,12 @@ from gearengine.sweeps import (
 from gearengine.sweeps.results import SpeedWindows
 from gearengine.sweeps.windows import SPEED, speed_windows
 from service.api.deps import Jobs, Owner
-from service.api.responses import JSON, PNG, PROBLEMS, RETRY_AFTER_HEADER, SVG, header
+from service.api.responses import JSON, PROBLEMS, RETRY_AFTER_HEADER, header
 from service.api.routes.jobs import (
     CONFLICT,
     NOT_FOUND,
     PARTIAL_HEADER,
-    PLOT_RESPONSES,
     JobRoutes,
-    PlotFormat,
-    plot_format,
     poll_headers,
 )
 from service.core.config import Settings
@@ -160,29 +156,17 @@ def get_result(
     )
 
 
-@router.get(
-    "/{job_id}/plot",
-    response_class=Response,
-    responses=PLOT_RESPONSES,
-    summary="Figure of a succeeded sweep: bifurcation diagram or chaos map (PNG or SVG)",
+def _draw(jobs: SweepJobs, job_id: str, fmt: Literal["png", "svg"]) -> bytes:
+    sweep = SweepRequest.model_validate_json(jobs.store.request_json(job_id))
+    located = chunk_bifurcations(jobs.store.chunk_results(job_id))
+    return plots.sweep_figure(sweep, list(_points(jobs, job_id)), fmt, located)
+
+
+SWEEPS.plot_route(
+    router,
+    "Figure of a succeeded sweep: bifurcation diagram or chaos map (PNG or SVG)",
+    "One axis: Poincare x against the parameter, the LLE underneath, the Melnikov threshold\n"
+    "marked. Two axes: the map coloured by LLE, the Melnikov boundary overlaid and a table of\n"
+    "agreement between the numerical and the Melnikov verdicts.",
+    _draw,
 )
-async def get_plot(
-    job_id: str,
-    request: Request,
-    owner: Owner,
-    jobs: Jobs,
-    format: PlotFormat = None,
-) -> Response:
-    """One axis: Poincare x against the parameter, the LLE underneath, the Melnikov threshold
-    marked. Two axes: the map coloured by LLE, the Melnikov boundary overlaid and a table of
-    agreement between the numerical and the Melnikov verdicts."""
-    fmt = plot_format(format, request.headers.get("accept", ""))
-    await run_in_threadpool(SWEEPS.succeeded, jobs, job_id, owner)
-
-    def draw() -> bytes:
-        sweep = SweepRequest.model_validate_json(jobs.store.request_json(job_id))
-        located = chunk_bifurcations(jobs.store.chunk_results(job_id))
-        return plots.sweep_figure(sweep, list(_points(jobs, job_id)), fmt, located)
-
-    body = await run_in_threadpool(draw)
-    return Response(body, media_type=PNG if fmt == "png" else SVG)
