@@ -12,8 +12,9 @@ point, Melnikov verdicts, report) and the sweep alone in this process. A second 
 command on the README design as it is (piecewise law, three excitations), which gear_ref's
 batch cannot run, and rows time that design (``examples/ci/design.json``) in process too: with
 its one start and with 64 random starts per point (``random_initial_states``, box x in
-[-1.5, 1.5], v in [-0.5, 0.5], seed 0; one run). Best of 3; prints the load average; writes its
-section of benchmarks/README.md.
+[-1.5, 1.5], v in [-0.5, 0.5], seed 0). Each timed run is a new design (``varied``); min and
+median of 5 runs (3 with 64 starts); prints the load average; writes its section of
+benchmarks/README.md.
 """
 
 from __future__ import annotations
@@ -27,16 +28,16 @@ import sys
 import tempfile
 from pathlib import Path
 
-from common import best_of  # benchmarks/common.py
+from common import min_median, timings  # benchmarks/common.py
 from report import write_section  # benchmarks/report.py (the script's own folder)
 
 from gearengine.model.design import EXAMPLE_DESIGN
-from gearengine.sweeps import run_local, validated
+from gearengine.sweeps import SweepRequest, balanced_chunk_points, run_local, validated
 from gearengine.sweeps.gate import ENVELOPE_SETTINGS
 
 ROOT = Path(__file__).resolve().parents[1]
 GEAR_REF = Path("/work/shared/reference/gear_ref.c")
-REPEATS = 3
+REPEATS = 5
 SPEEDS, TORQUES = (500.0, 6000.0, 23), (20.0, 200.0, 5)
 
 
@@ -62,34 +63,52 @@ def readme_design() -> dict:
     return json.loads((ROOT / "examples" / "ci" / "design.json").read_text())["design"]
 
 
-def in_process_seconds(design: dict, starts: int, repeats: int) -> float:
-    """Best wall time of the envelope sweep of ``design`` in this process (every core), with
-    ``starts`` random initial states per point when more than one."""
-    doc = sweep_doc(design)
-    if starts > 1:
-        box = [[-1.5, 1.5], [-0.5, 0.5]]
-        rand = {"count": starts, "box": box, "seed": 0}
-        doc["settings"] = {**doc["settings"], "random_initial_states": rand}
-    req = validated(doc)
+def varied(design: dict, k: int) -> dict:
+    """``design`` with its damping ratio raised by 0.2 % x k: each timed run a new design, so
+    the Melnikov and conversion caches of an earlier run do not serve it."""
+    d = copy.deepcopy(design)
+    d["mesh"]["damping_ratio"] = d["mesh"]["damping_ratio"] * (1.0 + 0.002 * k)
+    return d
+
+
+def in_process_seconds(design: dict, starts: int, repeats: int) -> tuple[float, float]:
+    """(min, median) wall time of the envelope sweep of ``repeats`` varied copies of ``design``
+    in this process (every core), with ``starts`` random initial states per point when more
+    than one."""
     cores = os.cpu_count() or 1
-    chunk = max(1, req.n_points() // (4 * cores))
-    run_local(validated(sweep_doc(design)), chunk_points=chunk, workers=cores)  # warm
-    return best_of(lambda: run_local(req, chunk_points=chunk, workers=cores), repeats)
+
+    def request(k: int) -> SweepRequest:
+        doc = sweep_doc(varied(design, k))
+        if starts > 1:
+            box = [[-1.5, 1.5], [-0.5, 0.5]]
+            rand = {"count": starts, "box": box, "seed": 0}
+            doc["settings"] = {**doc["settings"], "random_initial_states": rand}
+        return validated(doc)
+
+    chunk = balanced_chunk_points(request(0).n_points(), cores, smallest=1)
+    run_local(request(-1), chunk_points=chunk, workers=cores)  # kernels compiled or loaded
+    requests = [request(k) for k in range(1, repeats + 1)]
+    calls = [lambda r=r: run_local(r, chunk_points=chunk, workers=cores) for r in requests]
+    return min_median(timings(calls))
 
 
-def command_seconds(design: dict, tmp: Path, *extra: str) -> float:
-    """Best wall time of the whole ``gearengine check`` command (a new process) on the default
-    envelope of ``design``, with the options ``extra``."""
-    path = tmp / "design.json"
-    path.write_text(json.dumps({"design": design}))
+def command_seconds(design: dict, tmp: Path, *extra: str) -> tuple[float, float]:
+    """(min, median) wall time of the whole ``gearengine check`` command (a new process) on the
+    default envelope of ``REPEATS`` varied copies of ``design``, with the options ``extra``."""
     speed, torque = f"{SPEEDS[0]:g}:{SPEEDS[1]:g}", f"{TORQUES[0]:g}:{TORQUES[1]:g}"
-    args = [sys.executable, "-m", "gearengine.cli", "check", str(path), "--speed", speed,
-            "--torque", torque, *extra]  # fmt: skip
-    return best_of(lambda: subprocess.run(args, capture_output=True, check=False), REPEATS)
+    calls = []
+    for k in range(1, REPEATS + 1):
+        path = tmp / f"design-{k}.json"
+        path.write_text(json.dumps({"design": varied(design, k)}))
+        args = [sys.executable, "-m", "gearengine.cli", "check", str(path), "--speed", speed,
+                "--torque", torque, *extra]  # fmt: skip
+        calls.append(lambda args=args: subprocess.run(args, capture_output=True, check=False))
+    return min_median(timings(calls))
 
 
-def gear_ref_seconds(tmp: Path) -> float:
-    """Wall time of one ``gear_ref --simd --batch We`` per torque level, summed."""
+def gear_ref_seconds(tmp: Path) -> tuple[float, float]:
+    """(min, median) wall time of one ``gear_ref --simd --batch We`` per torque level, summed
+    (plain C, no cache: the same points each time)."""
     exe = tmp / "gear_ref"
     gcc = shutil.which("gcc") or sys.exit("gcc is needed to build gear_ref")
     subprocess.run([gcc, "-O3", "-march=native", "-o", exe, GEAR_REF, "-lm"], check=True)
@@ -110,7 +129,7 @@ def gear_ref_seconds(tmp: Path) -> float:
         for call in calls:
             subprocess.run(call, check=True, capture_output=True)
 
-    return best_of(run, REPEATS)
+    return min_median(timings([run] * REPEATS))
 
 
 def main() -> None:
@@ -123,22 +142,29 @@ def main() -> None:
         readme = command_seconds(readme_design(), tmp)
         readme_1 = command_seconds(readme_design(), tmp, "--starts", "1")
         readme_sweep = in_process_seconds(readme_design(), 1, REPEATS)
-        readme_64 = in_process_seconds(readme_design(), 64, 1)
+        readme_64 = in_process_seconds(readme_design(), 64, 3)
     n = SPEEDS[2] * TORQUES[2]
     load = os.getloadavg()[0]
+
+    def mm(t: tuple[float, float]) -> str:
+        return f"{t[0]:.2f} / {t[1]:.2f} s"
+
+    def ratio(t: tuple[float, float]) -> str:
+        return f"{t[1] / ref[1]:.1f}x"
+
     rows = [
-        f"| sweep of the {n} points in process, {cores} threads | {sweep:.2f} s | "
-        f"{ref:.2f} s | {sweep / ref:.1f}x |",
-        f"| whole `gearengine check` command (new process) | {command:.2f} s | {ref:.2f} s | "
-        f"{command / ref:.1f}x |",
+        f"| sweep of the {n} points in process, {cores} threads | {mm(sweep)} | {mm(ref)} | "
+        f"{ratio(sweep)} |",
+        f"| whole `gearengine check` command (new process) | {mm(command)} | {mm(ref)} | "
+        f"{ratio(command)} |",
         f"| README design (examples/ci/design.json: piecewise law, 3 excitations), sweep in "
-        f"process | {readme_sweep:.2f} s | – | – |",
-        f"| whole command, README design, one start per point (`--starts 1`) | {readme_1:.2f} s "
+        f"process | {mm(readme_sweep)} | – | – |",
+        f"| whole command, README design, one start per point (`--starts 1`) | {mm(readme_1)} "
         "| – | – |",
         f"| whole command, README design, the gate's default 16 basin starts per point | "
-        f"{readme:.2f} s | – | – |",
-        f"| README design, 64 random starts per point, sweep in process (one run) | "
-        f"{readme_64:.2f} s | – | – |",
+        f"{mm(readme)} | – | – |",
+        f"| README design, 64 random starts per point, sweep in process (3 runs) | "
+        f"{mm(readme_64)} | – | – |",
     ]
     write_section(
         "envelope",
@@ -146,7 +172,9 @@ def main() -> None:
         f"Default grid {SPEEDS[2]} speeds x {TORQUES[2]} torques, 60 + 60 periods of 128 RK4 "
         "steps; the README design with its transmission error only and the cubic law, so that "
         "gear_ref --simd --batch (one call per torque level over the speeds) runs the same "
-        "points. Best of 3, `benchmarks/bench_envelope.py`. Targets (issue 20) for the README "
+        "points. Times are min / median of 5 runs (3 with 64 starts), each run a new design "
+        "(the damping ratio raised by 0.2 % per run, so no cache of an earlier run serves it); "
+        "ratios of medians. `benchmarks/bench_envelope.py`. Targets (issue 20) for the README "
         "design: <= 0.4 s in process, <= 1.5 s as a whole command (one start per point, the "
         "gate's default when the issue was written; issue 21 then made it 16 basin starts), "
         "<= 6 s in process with 64 starts per point.\n\n"

@@ -28,6 +28,24 @@ def best_of(fn: Callable[[], object], repeats: int) -> float:
     return min(times)
 
 
+def timings(calls: list[Callable[[], object]]) -> list[float]:
+    """Wall time of each call, seconds: each call its own input (a varied design), so no cache
+    of an earlier call's input flatters the next."""
+    times = []
+    for call in calls:
+        t = time.perf_counter()
+        call()
+        times.append(time.perf_counter() - t)
+    return times
+
+
+def min_median(times: list[float]) -> tuple[float, float]:
+    """(min, median) of ``times``."""
+    ordered = sorted(times)
+    n = len(ordered)
+    return ordered[0], (ordered[n // 2] if n % 2 else 0.5 * (ordered[n // 2 - 1] + ordered[n // 2]))
+
+
 def wait_ready(client: httpx.Client, seconds: float = 120.0) -> None:
     """Poll ``/v1/ready`` until it answers 200 (kernels warm, job store open) or time runs out."""
     deadline = time.monotonic() + seconds
