@@ -22,7 +22,7 @@ from report import write_section  # benchmarks/report.py (the script's own folde
 
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.settings import SimulationSettings
-from gearengine.sweeps.request import SweepRequest
+from gearengine.studies.sweep.request import SweepRequest
 
 ROOT = Path(__file__).resolve().parents[1]
 BLOCK = 1600

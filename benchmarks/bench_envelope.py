@@ -31,9 +31,9 @@ from pathlib import Path
 from common import min_median, timings  # benchmarks/common.py
 from report import write_section  # benchmarks/report.py (the script's own folder)
 
+from gearengine.gate.envelope import ENVELOPE_SETTINGS
 from gearengine.model.design import EXAMPLE_DESIGN
-from gearengine.sweeps import SweepRequest, balanced_chunk_points, run_local, validated
-from gearengine.sweeps.gate import ENVELOPE_SETTINGS
+from gearengine.studies.sweep import SweepRequest, balanced_chunk_points, run_local, validated
 
 ROOT = Path(__file__).resolve().parents[1]
 GEAR_REF = Path("/work/shared/reference/gear_ref.c")

@@ -107,7 +107,7 @@ def floor_seconds(num: int, points: list[dict]) -> tuple[float, float]:
     from gearengine.numerics.batch import simulate_batch
     from gearengine.numerics.kernels.adaptive import ADAPT_SETTLE, ADAPT_WINDOW
     from gearengine.numerics.settings import SimulationSettings
-    from gearengine.sweeps.request import validated
+    from gearengine.studies.sweep.request import validated
 
     request = validated(map_doc(num, False))
     full = [request.point(p["values"]) for p in points if p["classification"] in FULL_LENGTH]

@@ -20,8 +20,8 @@ from pathlib import Path
 
 from report import write_section  # benchmarks/report.py (the script's own folder)
 
-from gearengine.ensembles.remedies import RemediesRequest, remedies
-from gearengine.sweeps.gate import check_envelope
+from gearengine.gate.envelope import check_envelope
+from gearengine.gate.remedies import RemediesRequest, remedies
 
 ROOT = Path(__file__).resolve().parents[1]
 DESIGN = ROOT / "examples" / "ci" / "design.json"

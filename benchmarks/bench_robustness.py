@@ -18,9 +18,9 @@ import time
 from report import write_section  # benchmarks/report.py (the script's own folder)
 
 from gearengine.cli.envelope import ENVELOPE_SETTINGS
-from gearengine.ensembles.robustness import RobustnessRequest, checked, run_local
-from gearengine.sweeps import run_local as run_sweep
-from gearengine.sweeps import validated
+from gearengine.studies.robustness.study import RobustnessRequest, checked, run_local
+from gearengine.studies.sweep import run_local as run_sweep
+from gearengine.studies.sweep import validated
 
 GEOMETRY = {"module": "2.5 mm", "face_width": "20 mm"}
 DESIGN = {

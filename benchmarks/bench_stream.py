@@ -26,8 +26,7 @@ from common import served  # benchmarks/common.py
 from report import write_section  # benchmarks/report.py (the script's own folder)
 
 from gearengine.numerics.simulation import warm_up
-from gearengine.sweeps.export import to_csv
-from gearengine.sweeps.results import SweepResult
+from gearengine.studies.sweep.results import SweepResult, to_csv
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -11,7 +11,7 @@ The public facade, short verbs on a design (as ChaosTools.jl):
 
 Rooms (subpackages) follow the data flow, a diamond rather than a chain: ``model`` feeds both
 ``homoclinic`` (the Melnikov analysis of the homoclinic orbits) and ``numerics``, which know
-nothing of each other; ``ensembles.attractors`` runs many starts of one design, ``analysis``
+nothing of each other; ``numerics.attractors`` runs many starts of one design, ``analysis``
 and ``engineering`` join them, then ``sweeps`` -> ``plots`` -> ``cli``;
 ``docs/architecture.md`` draws it. The engine imports no web code.
 """
@@ -24,8 +24,7 @@ from gearengine.lazyload import lazy_names
 
 if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDEs
     from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
-    from gearengine.ensembles.attractors import of_design as attractors
-    from gearengine.ensembles.remedies import RemediesRequest, RemediesResult, remedies
+    from gearengine.gate.remedies import RemediesRequest, RemediesResult, remedies
     from gearengine.homoclinic import MelnikovResult, chaos_possible, melnikov, threshold_curve
     from gearengine.model.design import Design
     from gearengine.model.examples import PAPER_SECTION_41
@@ -38,10 +37,11 @@ if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDE
         simulate_batch,
         warm_up,
     )
-    from gearengine.runup import RunupRequest, RunupResult
-    from gearengine.runup import run_local as run_runup
-    from gearengine.sweeps import SweepRequest, SweepResult
-    from gearengine.sweeps import run_local as run_sweep
+    from gearengine.numerics.attractors import of_design as attractors
+    from gearengine.studies.runup import RunupRequest, RunupResult
+    from gearengine.studies.runup import run_local as run_runup
+    from gearengine.studies.sweep import SweepRequest, SweepResult
+    from gearengine.studies.sweep import run_local as run_sweep
 
 __all__ = [
     "PAPER_SECTION_41",
@@ -79,22 +79,22 @@ _HOMES: dict[str, tuple[str, str]] = {
     "Design": ("gearengine.model.design", "Design"),
     "GearParams": ("gearengine.model.params", "GearParams"),
     "MelnikovResult": ("gearengine.homoclinic", "MelnikovResult"),
-    "RemediesRequest": ("gearengine.ensembles.remedies", "RemediesRequest"),
-    "RemediesResult": ("gearengine.ensembles.remedies", "RemediesResult"),
-    "RunupRequest": ("gearengine.runup", "RunupRequest"),
-    "RunupResult": ("gearengine.runup", "RunupResult"),
+    "RemediesRequest": ("gearengine.gate.remedies", "RemediesRequest"),
+    "RemediesResult": ("gearengine.gate.remedies", "RemediesResult"),
+    "RunupRequest": ("gearengine.studies.runup", "RunupRequest"),
+    "RunupResult": ("gearengine.studies.runup", "RunupResult"),
     "SimulationSettings": ("gearengine.numerics", "SimulationSettings"),
-    "SweepRequest": ("gearengine.sweeps", "SweepRequest"),
-    "SweepResult": ("gearengine.sweeps", "SweepResult"),
+    "SweepRequest": ("gearengine.studies.sweep", "SweepRequest"),
+    "SweepResult": ("gearengine.studies.sweep", "SweepResult"),
     "analyze": ("gearengine.analysis", "analyze"),
-    "attractors": ("gearengine.ensembles.attractors", "of_design"),
+    "attractors": ("gearengine.numerics.attractors", "of_design"),
     "chaos_possible": ("gearengine.homoclinic", "chaos_possible"),
     "lyapunov": ("gearengine.numerics", "lyapunov"),
     "melnikov": ("gearengine.homoclinic", "melnikov"),
     "poincare": ("gearengine.numerics", "poincare"),
-    "remedies": ("gearengine.ensembles.remedies", "remedies"),
-    "run_runup": ("gearengine.runup", "run_local"),
-    "run_sweep": ("gearengine.sweeps", "run_local"),
+    "remedies": ("gearengine.gate.remedies", "remedies"),
+    "run_runup": ("gearengine.studies.runup", "run_local"),
+    "run_sweep": ("gearengine.studies.sweep", "run_local"),
     "simulate": ("gearengine.numerics", "simulate"),
     "simulate_batch": ("gearengine.numerics", "simulate_batch"),
     "threshold_curve": ("gearengine.homoclinic", "threshold_curve"),
@@ -109,17 +109,16 @@ _SUBMODULES = frozenset(
         "analysis",
         "cli",
         "engineering",
-        "ensembles",
         "homoclinic",
         "jitcache",
-        "jobs",
         "jsonio",
         "lazyload",
         "model",
         "numerics",
         "plots",
-        "runup",
-        "sweeps",
+        "gate",
+        "signals",
+        "studies",
     }
 )
 """The package's own modules: ``gearengine.numerics`` after a bare ``import gearengine`` still

@@ -6,7 +6,7 @@ verdicts are consistent unless the numerics find chaos where Melnikov rules it o
 
 This module joins the homoclinic (Melnikov) and numerics rooms on a request of the model room,
 and adds the engineering block (``engineering``: answers in gear units) for a design.
-With ``settings.basins`` it adds the attractors of ``ensembles.attractors``.
+With ``settings.basins`` it adds the attractors of ``numerics.attractors``.
 """
 
 from __future__ import annotations
@@ -16,7 +16,6 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.engineering import IMPACT_WORDS, Engineering, engineering
-from gearengine.ensembles.attractors import attractors, coexistence, headline
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
 from gearengine.homoclinic.verdict import melnikov
 from gearengine.model.design import EXAMPLE_DESIGN, Design
@@ -24,6 +23,7 @@ from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
+from gearengine.numerics.attractors import attractors, coexistence, headline
 from gearengine.numerics.results import NumericsResult
 from gearengine.numerics.settings import RequestSettings, SimulationSettings
 from gearengine.numerics.simulation import simulate

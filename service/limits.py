@@ -7,8 +7,8 @@ from typing import Any
 
 from pydantic import BaseModel
 
-from gearengine import jobs
 from gearengine.homoclinic.schemas import ThresholdsRequest
+from gearengine.studies import jobs
 from service.core.config import Settings
 from service.errors import FieldError, ProblemError
 

@@ -12,7 +12,7 @@ from scipy.integrate import solve_ivp
 
 from gearengine.model.params import GearParams
 from gearengine.numerics.forcing import forcing_coefficients, law, step_plan
-from gearengine.numerics.periodicity import attractor_size, detect_period
+from gearengine.signals.periodicity import attractor_size, detect_period
 
 GEAR_REF_SOURCE = Path("/work/shared/reference/gear_ref.c")
 

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from gearengine.gate.envelope import Rules, envelope_report
 from gearengine.model.params import GearParams
 from gearengine.numerics import kernels
 from gearengine.numerics.batch import simulate_batch
@@ -22,9 +23,8 @@ from gearengine.numerics.kernels.adaptive import (
     ADAPT_WINDOW,
 )
 from gearengine.numerics.settings import SimulationSettings
-from gearengine.sweeps import run_local, validated
-from gearengine.sweeps.gate import Rules, envelope_report
-from gearengine.sweeps.request import SweepRequest
+from gearengine.studies.sweep import run_local, validated
+from gearengine.studies.sweep.request import SweepRequest
 from tests.conftest import ROOT
 
 LIGHT = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}

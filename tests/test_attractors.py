@@ -1,4 +1,4 @@
-"""Coexisting attractors (``ensembles.attractors``) against an independent integration, and the
+"""Coexisting attractors (``numerics.attractors``) against an independent integration, and the
 basin settings' refusals.
 
 The design is the envelope example at 5,750 rpm and 2 N*m (examples/envelope-map.json, the
@@ -22,7 +22,7 @@ from fastapi.testclient import TestClient
 from pydantic import ValidationError
 
 from gearengine.analysis import AnalysisRequest, analyze
-from gearengine.ensembles.attractors import attractors, basin_starts
+from gearengine.numerics.attractors import attractors, basin_starts
 from gearengine.numerics.forcing import forcing_coefficients, step_plan
 from gearengine.numerics.settings import BasinSettings, SimulationSettings
 from tests._gear_cases import gear_ref_binary

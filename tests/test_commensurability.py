@@ -16,7 +16,7 @@ from gearengine.model.frequencies import MAX_DENOMINATOR, forcing_period, poinca
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import convert_design
 from gearengine.numerics.forcing import step_plan
-from gearengine.sweeps import run_local, validated
+from gearengine.studies.sweep import run_local, validated
 
 LIGHT = {"transient_periods": 40, "record_periods": 40, "steps_per_period": 64}
 

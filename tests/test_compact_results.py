@@ -15,7 +15,7 @@ import pytest
 from fastapi.testclient import TestClient
 from pydantic import ValidationError
 
-from gearengine.sweeps import compute_chunk_json, csv_rows, run_local, validated
+from gearengine.studies.sweep import compute_chunk_json, csv_rows, run_local, validated
 from service.core.config import Settings
 from service.jobs.store import DB_FILE, pack, unpack
 from service.main import create_app

@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 from distributed import LocalCluster
 
-from gearengine.sweeps import SweepPlan, run_local, validated
+from gearengine.studies.sweep import SweepPlan, run_local, validated
 from service.jobs.backends import DaskCluster
 from service.jobs.dispatcher import Dispatcher
 from service.jobs.store import JobStore

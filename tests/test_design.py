@@ -338,7 +338,7 @@ def test_an_analysis_and_a_one_point_sweep_give_the_same_response() -> None:
     """One definition of the DTE and the dynamic factor (``model.units.response_values``, from
     the kernel's per-step extremes): /v1/analyses and a one-point speed sweep at the design's
     speed give the same numbers (before: dynamic factor 1.093296 against 1.093390)."""
-    from gearengine.sweeps import run_local, validated
+    from gearengine.studies.sweep import run_local, validated
 
     light = {"transient_periods": 60, "record_periods": 60}
     analysis = analyze(AnalysisRequest.model_validate({"design": EXAMPLE_DESIGN,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from gearengine.analysis import AnalysisRequest, analyze
-from gearengine.numerics.diagnostics import impact_regime
+from gearengine.signals.diagnostics import impact_regime
 
 
 @pytest.mark.parametrize(

@@ -17,11 +17,11 @@ import xmlschema
 from pydantic import ValidationError
 
 from gearengine.analysis import AnalysisRequest, analyze
+from gearengine.gate.envelope import Rules, envelope_report
 from gearengine.homoclinic import melnikov
 from gearengine.homoclinic.boundary import flips
 from gearengine.model.design import EXAMPLE_DESIGN
-from gearengine.sweeps import run_local, validated
-from gearengine.sweeps.gate import Rules, envelope_report
+from gearengine.studies.sweep import run_local, validated
 from tests.conftest import PAPER_PARAMS, ROOT, Server
 
 LIGHT = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}

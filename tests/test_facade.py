@@ -11,7 +11,7 @@ import pytest
 import gearengine
 from gearengine import Design, SimulationSettings, SweepRequest, analyze, run_sweep
 from gearengine.model import design as design_module
-from gearengine.sweeps.export import to_csv
+from gearengine.studies.sweep.results import to_csv
 from tests.conftest import ROOT
 
 LIGHT = SimulationSettings(transient_periods=40, record_periods=40, steps_per_period=128)

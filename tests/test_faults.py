@@ -16,7 +16,7 @@ import httpx
 import psutil
 import pytest
 
-from gearengine.sweeps import run_local, validated
+from gearengine.studies.sweep import run_local, validated
 from service.jobs.store import JobStore
 from tests._polling import finished, poll
 from tests.conftest import PAPER_PARAMS, Server

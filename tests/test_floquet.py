@@ -29,7 +29,7 @@ from gearengine.numerics.kernels import monodromy
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate
 from gearengine.plots.sweep import bifurcation_label, sweep_figure
-from gearengine.sweeps import run_local, validated
+from gearengine.studies.sweep import run_local, validated
 from service.core.config import Settings
 from service.main import create_app
 from tests._gear_cases import paper

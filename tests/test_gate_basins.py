@@ -17,7 +17,7 @@ import pytest
 
 import gearengine
 from gearengine.cli import main
-from gearengine.sweeps.gate import ENVELOPE_SETTINGS, GATE_STARTS
+from gearengine.gate.envelope import ENVELOPE_SETTINGS, GATE_STARTS
 from tests.conftest import ROOT
 
 GOLDEN = ROOT / "tests" / "data" / "gate-starts-1"
@@ -81,8 +81,8 @@ def test_the_default_gate_fails_where_any_attractor_is_chaotic_and_names_it(
 
 
 def test_continuation_names_the_attractors_beside_the_followed_branch() -> None:
-    from gearengine.sweeps.compute import run_local
-    from gearengine.sweeps.request import validated
+    from gearengine.studies.sweep.compute import run_local
+    from gearengine.studies.sweep.request import validated
 
     design = json.loads(ENVELOPE.read_text())["design"]
     doc = {"design": {**design, "torque": "2 N*m"},
@@ -107,8 +107,8 @@ def test_the_envelope_map_hatches_where_attractors_coexist() -> None:
     from matplotlib.patches import Rectangle
 
     from gearengine.plots.envelope import COEXIST_COLOUR, envelope_map
-    from gearengine.sweeps.compute import run_local
-    from gearengine.sweeps.request import validated
+    from gearengine.studies.sweep.compute import run_local
+    from gearengine.studies.sweep.request import validated
 
     design = json.loads(ENVELOPE.read_text())["design"]
     axes = [{"parameter": "speed", "start": "5750 rpm", "stop": "6000 rpm", "num": 2},

@@ -12,8 +12,8 @@ import pytest
 from gearengine.cli.documents import InvalidInputError
 from gearengine.cli.envelope import envelope_request
 from gearengine.cli.main import build_parser, main
-from gearengine.sweeps.gate import Rules, point_failures
-from gearengine.sweeps.results import SweepPoint
+from gearengine.gate.envelope import Rules, point_failures
+from gearengine.studies.sweep.points import SweepPoint
 from tests.conftest import PAPER_PARAMS, ROOT
 
 LIGHT = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}

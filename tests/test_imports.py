@@ -36,7 +36,7 @@ def test_the_facade_imports_nothing_until_used() -> None:
 
 def test_every_public_name_is_its_modules_object() -> None:
     import gearengine.homoclinic as homoclinic
-    import gearengine.sweeps as sweeps
+    import gearengine.studies.sweep as sweeps
 
     for name in gearengine.__all__:
         assert getattr(gearengine, name) is not None, name

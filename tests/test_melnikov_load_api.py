@@ -7,9 +7,9 @@ from __future__ import annotations
 import pytest
 from fastapi.testclient import TestClient
 
+from gearengine.gate.envelope import Rules, envelope_report
 from gearengine.homoclinic.coefficients import critical_mean_force
-from gearengine.sweeps import run_local, validated
-from gearengine.sweeps.gate import Rules, envelope_report
+from gearengine.studies.sweep import run_local, validated
 from tests.conftest import PAPER_PARAMS
 from tests.test_design import LIGHT, design
 

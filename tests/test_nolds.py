@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from gearengine.numerics.nolds_check import first_decorrelation
 from gearengine.numerics.simulation import SimulationSettings, simulate
+from gearengine.signals.nolds_check import first_decorrelation
 from tests._gear_cases import paper
 
 NOLDS = SimulationSettings(lyapunov_nolds=True)

@@ -12,8 +12,8 @@ from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.homoclinic.verdict import melnikov
 from gearengine.jsonio import dumps
 from gearengine.model.params import GearParams
-from gearengine.numerics.classify import severity
 from gearengine.numerics.simulation import SimulationSettings
+from gearengine.signals.classify import severity
 
 
 def strict_json(text: str) -> object:

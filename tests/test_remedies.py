@@ -20,16 +20,11 @@ import httpx
 import pytest
 from pydantic import ValidationError
 
-from gearengine.ensembles.remedies import (
-    Lever,
-    RemediesRequest,
-    RemediesResult,
-    _narrow,
-    _search,
-    envelope_points,
-    iso1328_class,
-    remedies,
-)
+from gearengine.gate.remedies.compute import remedies
+from gearengine.gate.remedies.levers import iso1328_class
+from gearengine.gate.remedies.request import Lever, RemediesRequest
+from gearengine.gate.remedies.results import RemediesResult
+from gearengine.gate.remedies.search import _narrow, _search, envelope_points
 from gearengine.model.design import Design
 from gearengine.model.standards import iso1328
 from gearengine.model.units import in_display_unit

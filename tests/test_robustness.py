@@ -14,15 +14,15 @@ import pytest
 from fastapi.testclient import TestClient
 
 from gearengine.analysis import AnalysisRequest, analyze
-from gearengine.ensembles import sensitivity
-from gearengine.ensembles.robustness import RobustnessRequest, checked, compute_chunk, run_local
-from gearengine.ensembles.tolerances import (
+from gearengine.studies.jobs import compute_chunk_json
+from gearengine.studies.robustness import sensitivity
+from gearengine.studies.robustness.study import RobustnessRequest, checked, compute_chunk, run_local
+from gearengine.studies.robustness.tolerances import (
     base_design,
     probability,
     sample_design,
     sample_values,
 )
-from gearengine.jobs import compute_chunk_json
 from service.core.config import Settings
 from service.main import create_app
 from tests._polling import poll

@@ -10,8 +10,8 @@ from xml.etree import ElementTree
 import pytest
 
 from gearengine.cli.main import main
-from gearengine.ensembles.robustness import RobustnessRequest, run_local
-from gearengine.sweeps.gate import ENVELOPE_SETTINGS
+from gearengine.gate.envelope import ENVELOPE_SETTINGS
+from gearengine.studies.robustness.study import RobustnessRequest, run_local
 from tests.test_robustness import DESIGN
 
 

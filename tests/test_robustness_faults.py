@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from gearengine.ensembles.robustness import RobustnessRequest, run_local
+from gearengine.studies.robustness.study import RobustnessRequest, run_local
 from service.jobs.store import JobStore
 from tests.test_faults import crash_and_resume, data_dir  # noqa: F401
 from tests.test_robustness import DESIGN

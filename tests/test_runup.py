@@ -1,7 +1,7 @@
-"""Run-ups (gearengine.runup): the kernel on the integrated driver angle against an independent
-DOP853 integration of Eq. (7) in SI units with events at the backlash edges, the quasi-static
-jump speeds at a slow rate, the lag at a fast one, refusals before any compute, and the job
-through a real server equal to the CLI's document."""
+"""Run-ups (gearengine.studies.runup): the kernel on the integrated driver angle against an
+independent DOP853 integration of Eq. (7) in SI units with events at the backlash edges, the
+quasi-static jump speeds at a slow rate, the lag at a fast one, refusals before any compute,
+and the job through a real server equal to the CLI's document."""
 
 from __future__ import annotations
 
@@ -18,18 +18,18 @@ from pydantic import ValidationError
 from scipy.integrate import solve_ivp
 
 from gearengine.cli.main import main
+from gearengine.gate.envelope import Rules
+from gearengine.gate.runup import runup_failures
 from gearengine.jsonio import dumps, error_lines
 from gearengine.model.units import RPM
 from gearengine.numerics.forcing import packed_forcing
 from gearengine.numerics.kernels.phase import ramp_forcing_at
 from gearengine.numerics.kernels.smooth import forcing_at
-from gearengine.runup import run_local
-from gearengine.runup.compute import compute_chunk
-from gearengine.runup.gate import runup_failures
-from gearengine.runup.profile import ramp_forcing
-from gearengine.runup.reading import jumps
-from gearengine.runup.request import RunupRequest, validated
-from gearengine.sweeps.gate import Rules
+from gearengine.studies.runup import run_local
+from gearengine.studies.runup.compute import compute_chunk
+from gearengine.studies.runup.profile import ramp_forcing, validated
+from gearengine.studies.runup.reading import jumps
+from gearengine.studies.runup.request import RunupRequest
 from tests._polling import poll
 from tests.conftest import ROOT, Server
 

@@ -11,8 +11,8 @@ import pytest
 from pydantic import ValidationError
 
 from gearengine.cli.main import main
-from gearengine.sweeps import validated
-from gearengine.sweeps.results import SweepResult
+from gearengine.studies.sweep import validated
+from gearengine.studies.sweep.results import SweepResult
 from tests.conftest import ROOT
 
 LIGHT = {"transient_periods": 40, "record_periods": 40, "steps_per_period": 128}

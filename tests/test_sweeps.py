@@ -18,13 +18,13 @@ from pydantic import ValidationError
 from gearengine.cli import main
 from gearengine.homoclinic.thresholds import chaos_possible, verdict_flips
 from gearengine.homoclinic.verdict import melnikov
-from gearengine.jobs import cyclic_gc_paused
 from gearengine.jsonio import error_lines
 from gearengine.model.aliases import with_aliases
 from gearengine.numerics.settings import work
 from gearengine.numerics.simulation import SimulationSettings, simulate_batch
 from gearengine.plots.sweep import sweep_figure
-from gearengine.sweeps import (
+from gearengine.studies.jobs import cyclic_gc_paused
+from gearengine.studies.sweep import (
     SweepPlan,
     SweepResult,
     agreement_table,
@@ -283,7 +283,7 @@ def test_csv_of_a_design_sweep_has_its_values_in_gear_units() -> None:
 
 WORKQUEUE_RUN = """
 import json, sys
-from gearengine.sweeps import run_local, validated
+from gearengine.studies.sweep import run_local, validated
 doc = json.loads(sys.argv[1])
 result = run_local(validated(doc), chunk_points=4, workers=2)
 print(len(result.points))

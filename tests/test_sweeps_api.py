@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
-from gearengine.sweeps import compute_chunk_json, run_local, to_csv, validated
+from gearengine.studies.sweep import compute_chunk_json, run_local, to_csv, validated
 from service.core.config import Settings
 from service.main import create_app
 from tests._polling import poll

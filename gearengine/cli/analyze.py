@@ -1,7 +1,7 @@
 """``gearengine analyze FILE [--json]`` and the CI gate ``gearengine check FILE``.
 
 ``check`` exits 0 when the design passes, 1 when it fails a rule, 2 on invalid input;
-``--fail-on X`` fails on X or anything worse (``numerics.classify.SEVERITY``);
+``--fail-on X`` fails on X or anything worse (``signals.classify.SEVERITY``);
 ``--min-stability-margin X`` fails a periodic response whose Floquet stability margin
 1 - max |lambda| is below X (or could not be computed).
 """
@@ -14,10 +14,10 @@ from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.cli.documents import EXIT_FAIL, EXIT_OK, InvalidInputError, read_request
 from gearengine.cli.envelope import cmd_envelope, physical_limits, rules_of
 from gearengine.cli.melnikov import fmt_value, render_engineering, render_melnikov
+from gearengine.gate.envelope import Rules, point_failures
 from gearengine.jsonio import dumps
 from gearengine.model.units import OUTPUTS, RESPONSES
-from gearengine.sweeps.gate import Rules, point_failures
-from gearengine.sweeps.results import PhysicalValue, SweepPoint
+from gearengine.studies.sweep.points import PhysicalValue, SweepPoint
 
 
 def cmd_analyze(args: argparse.Namespace) -> int:
@@ -71,7 +71,7 @@ def margin_failure(r: AnalysisResult, min_margin: float) -> str | None:
 def gate_point(r: AnalysisResult) -> SweepPoint:
     """The analysis as one operating point of the envelope gate (its worst start, its DTE and
     dynamic factor in µm and 1), so one design and an envelope are judged by one set of rules,
-    ``sweeps.gate.point_failures``."""
+    ``gate.envelope.point_failures``."""
     worst = r.numerics.worst_case
     resp = None if r.engineering is None else r.engineering.response
     values = (None, None) if resp is None else (resp.dte_peak_to_peak_um, resp.dynamic_factor)

@@ -14,8 +14,8 @@ from pathlib import Path
 
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.cli.documents import EXIT_OK, read_document, validated_input
-from gearengine.ensembles.attractors import percent
 from gearengine.jsonio import dumps
+from gearengine.numerics.attractors import percent
 
 
 def basins_request(args: argparse.Namespace) -> AnalysisRequest:

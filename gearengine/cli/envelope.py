@@ -2,7 +2,7 @@
 envelope.
 
 Sweeps the design over a grid of driver speeds (rpm unless a unit is given) and mean torques
-(N m unless a unit is given), checks every point against the rules (``sweeps.gate``), prints
+(N m unless a unit is given), checks every point against the rules (``gate.envelope``), prints
 the failing windows, and exits 1 when any point fails, 0 when none does, 2 on invalid input.
 Each point runs ``--starts N`` initial states (default ``GATE_STARTS``, a grid over the
 default basin box) and every attractor found whose basin fraction is above ``--min-basin``
@@ -32,9 +32,7 @@ from gearengine.cli.documents import (
     validated_input,
 )
 from gearengine.cli.sweep import progress
-from gearengine.jsonio import dumps
-from gearengine.numerics.settings import SimulationSettings
-from gearengine.sweeps.gate import (
+from gearengine.gate.envelope import (
     EnvelopeReport,
     Rules,
     check_envelope,
@@ -46,14 +44,17 @@ from gearengine.sweeps.gate import (
     level_text,
     window_text,
 )
-from gearengine.sweeps.request import SweepRequest, validated
-from gearengine.sweeps.results import SpeedWindows, SweepResult
+from gearengine.jsonio import dumps
+from gearengine.numerics.settings import SimulationSettings
+from gearengine.studies.sweep.points import SpeedWindows
+from gearengine.studies.sweep.request import SweepRequest, validated
+from gearengine.studies.sweep.results import SweepResult
 
 POLL_SECONDS = 1.0
 
 
 def axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
-    """``sweeps.gate.envelope_axis``, its error naming the option."""
+    """``gate.envelope.envelope_axis``, its error naming the option."""
     try:
         return envelope_axis(name, text, unit, num)
     except ValueError as exc:
@@ -219,8 +220,8 @@ def cmd_envelope(args: argparse.Namespace) -> int:
         report = envelope_report(run_on_server(args.server, request, key, tick), rules)
     else:
         report = check_envelope(request, rules, tick, workers=os.cpu_count() or 1)
-    if getattr(args, "runup", None) is not None:  # run-ups through the range (runup.gate)
-        from gearengine.runup.gate import gate_envelope
+    if getattr(args, "runup", None) is not None:  # run-ups through the range (gate.runup)
+        from gearengine.gate.runup import gate_envelope
 
         report = validated_input(lambda r: gate_envelope(report, request, r), args.runup, "--runup")
     print_report(report)

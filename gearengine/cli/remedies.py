@@ -1,11 +1,11 @@
 """``gearengine remedies DESIGN --speed 500:6000 --torque 2:40``: what to change, by how much.
 
 For a design that fails its envelope under the gate's rules (``gearengine check``'s options),
-searches each lever (``ensembles.remedies``) for the smallest change that makes the envelope pass,
-with the Melnikov guarantee beside it, and prints the ranked answer. ``--lever PATH=LOW:HIGH``
-(repeatable) searches the given levers instead of the default ones. ``--json FILE`` writes the
-document ``POST /v1/remedies`` returns. Exit 0 when a remedy (or the design itself) passes, 1 when
-nothing found clears the envelope, 2 on invalid input.
+searches each lever (``gate.remedies.search``) for the smallest change that makes the
+envelope pass, with the Melnikov guarantee beside it, and prints the ranked answer.
+``--lever PATH=LOW:HIGH`` (repeatable) searches the given levers instead of the default ones.
+``--json FILE`` writes the document ``POST /v1/remedies`` returns. Exit 0 when a remedy (or the
+design itself) passes, 1 when nothing found clears the envelope, 2 on invalid input.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from gearengine.cli.documents import (
 )
 from gearengine.cli.envelope import rules_of
 from gearengine.cli.sweep import progress
-from gearengine.ensembles.remedies import RemediesRequest, RemediesResult, remedies
+from gearengine.gate.remedies import RemediesRequest, RemediesResult, remedies
 from gearengine.jsonio import dumps
 
 

@@ -23,14 +23,14 @@ from gearengine.cli.documents import (
 )
 from gearengine.cli.envelope import axis
 from gearengine.cli.sweep import progress
-from gearengine.ensembles.robustness import (
+from gearengine.gate.envelope import ENVELOPE_SETTINGS
+from gearengine.model.units import display_unit
+from gearengine.studies.robustness.study import (
     RobustnessRequest,
     RobustnessResult,
     checked,
     run_local,
 )
-from gearengine.model.units import display_unit
-from gearengine.sweeps.gate import ENVELOPE_SETTINGS
 
 GATED = ("chaotic", "quasi_periodic", "diverged", "impacts", "back_flank",
          "dynamic_factor_above_limit", "melnikov_chaos_possible")  # fmt: skip

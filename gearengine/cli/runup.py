@@ -17,9 +17,10 @@ from pathlib import Path
 from gearengine.cli.documents import EXIT_OK, InvalidInputError, read_document, validated_input
 from gearengine.cli.sweep import progress_bar
 from gearengine.jsonio import dumps
-from gearengine.runup.compute import run_local
-from gearengine.runup.request import RunupRequest, validated
-from gearengine.runup.results import RunupBranch, RunupResult
+from gearengine.studies.runup.compute import run_local
+from gearengine.studies.runup.profile import validated
+from gearengine.studies.runup.request import RunupRequest
+from gearengine.studies.runup.results import RunupBranch, RunupResult
 
 OPTIONS = {  # option -> (request field, unit of a bare number)
     "from_speed": ("from_speed", "rpm"),

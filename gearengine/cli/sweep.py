@@ -20,9 +20,9 @@ from pathlib import Path
 
 from gearengine.cli.documents import EXIT_OK, read_document, validated_input
 from gearengine.jsonio import dumps
-from gearengine.sweeps.compute import run_local
-from gearengine.sweeps.export import to_csv
-from gearengine.sweeps.request import SweepRequest, validated
+from gearengine.studies.sweep.compute import run_local
+from gearengine.studies.sweep.request import SweepRequest, validated
+from gearengine.studies.sweep.results import to_csv
 
 BAR = 30
 """Width of the progress bar, characters."""

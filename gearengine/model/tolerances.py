@@ -12,7 +12,8 @@ and offers two standards as shortcuts: ``"accuracy": {"standard": "ISO 1328-1:20
 7}`` (both gears; needs their geometry form; the mesh-frequency transmission-error amplitude,
 ``model.standards.iso1328.mesh_error_bound``) and ``"backlash": {"min": "80 um", "max": "120
 um"}`` (a circumferential backlash band, ``model.standards.backlash``). Correlated inputs are not
-modelled: every field varies independently. ``gearengine.ensembles.tolerances`` samples them.
+modelled: every field varies independently.
+``gearengine.studies.robustness.tolerances`` samples them.
 """
 
 from __future__ import annotations

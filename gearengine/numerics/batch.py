@@ -17,12 +17,12 @@ import numpy as np
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams
 from gearengine.numerics import kernels
-from gearengine.numerics.classify import DIVERGENCE_BOUND, severity
 from gearengine.numerics.forcing import StepPlan, law, packed_forcing, step_plan
 from gearengine.numerics.lanes import lane_point, lane_verdicts, last_strobes
 from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
 from gearengine.numerics.runs import Run, finite_or_none, integrate, start_verdict
 from gearengine.numerics.settings import SimulationSettings, check_work
+from gearengine.signals.classify import DIVERGENCE_BOUND, severity
 
 Lane = tuple[int, tuple[float, float]]
 """One run of a request: (index of its parameter point, initial state (x0, v0))."""

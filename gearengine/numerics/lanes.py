@@ -12,12 +12,12 @@ import math
 
 import numpy as np
 
-from gearengine.numerics.classify import classify
-from gearengine.numerics.diagnostics import impact_regime
-from gearengine.numerics.lyapunov import benettin_rows
-from gearengine.numerics.periodicity import attractor_size, detect_period
 from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
 from gearengine.numerics.runs import finite_or_none
+from gearengine.signals.classify import classify
+from gearengine.signals.diagnostics import impact_regime
+from gearengine.signals.lyapunov import benettin_rows
+from gearengine.signals.periodicity import attractor_size, detect_period
 
 
 def lane_lle(

@@ -7,7 +7,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from gearengine.numerics.nolds_check import NoldsResult
+from gearengine.signals.nolds_check import NoldsResult
 
 BATCH_POINCARE = 64
 """Strobes returned per point by ``simulate_batch``."""
@@ -81,7 +81,7 @@ class FloquetResult(_Result):
 
 
 class Attractor(_Result):
-    """One attractor found from the basin starts (``ensembles.attractors``, docs/basins.md)."""
+    """One attractor found from the basin starts (``numerics.attractors``, docs/basins.md)."""
 
     label: str = Field(
         description="How the gate and the summary name it: 'periodic 1T, no impacts', "

@@ -15,13 +15,13 @@ import numpy as np
 
 from gearengine.model.params import GearParams
 from gearengine.numerics import kernels
-from gearengine.numerics.classify import DIVERGENCE_BOUND, Classification, classify
-from gearengine.numerics.diagnostics import impact_regime
 from gearengine.numerics.forcing import Law, StepPlan, law, packed_forcing, step_plan
-from gearengine.numerics.lyapunov import LyapunovEstimate, benettin
-from gearengine.numerics.periodicity import attractor_size, detect_period
 from gearengine.numerics.results import StartSummary
 from gearengine.numerics.settings import SimulationSettings
+from gearengine.signals.classify import DIVERGENCE_BOUND, Classification, classify
+from gearengine.signals.diagnostics import impact_regime
+from gearengine.signals.lyapunov import LyapunovEstimate, benettin
+from gearengine.signals.periodicity import attractor_size, detect_period
 
 MAX_HISTORY_SAMPLES = 2**15
 """Largest number of (x, v) samples kept from the record for spectrum, RMS and nolds."""

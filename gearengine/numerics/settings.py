@@ -76,7 +76,7 @@ class RandomStarts(BaseModel):
 
 class BasinSettings(BaseModel):
     """Many starts of one design, to find every attractor and the fraction of starts reaching
-    each (``ensembles.attractors``).
+    each (``numerics.attractors``).
 
     The default box, x in [-3, 3] half backlashes and v = dx/dtau in [-3, 3], covers the states
     a running gear pair can be thrown into: from 2 b onto the back flank, through the whole

@@ -20,17 +20,8 @@ from typing import Any
 
 from gearengine.model.params import GearParams
 from gearengine.numerics.batch import simulate_batch
-from gearengine.numerics.classify import DIVERGENCE_BOUND, severity
-from gearengine.numerics.diagnostics import (
-    impact_regime,
-    poincare_points,
-    rms,
-    spectrum_peaks,
-    time_history,
-)
 from gearengine.numerics.floquet import floquet_of
 from gearengine.numerics.forcing import StepPlan, step_plan
-from gearengine.numerics.nolds_check import lyap_r_check
 from gearengine.numerics.results import NumericsResult, SpectrumPeak, TimeHistory
 from gearengine.numerics.runs import (
     Run,
@@ -42,6 +33,15 @@ from gearengine.numerics.runs import (
     start_verdict,
 )
 from gearengine.numerics.settings import SimulationSettings, check_work
+from gearengine.signals.classify import DIVERGENCE_BOUND, severity
+from gearengine.signals.diagnostics import (
+    impact_regime,
+    poincare_points,
+    rms,
+    spectrum_peaks,
+    time_history,
+)
+from gearengine.signals.nolds_check import lyap_r_check
 
 
 def simulate(params: GearParams, settings: SimulationSettings | None = None) -> NumericsResult:

@@ -15,9 +15,9 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 
 from gearengine.model.units import display_unit, field_label
-from gearengine.sweeps.axes import is_dimensionless
-from gearengine.sweeps.request import SweepRequest
-from gearengine.sweeps.results import SweepPoint
+from gearengine.studies.sweep.axes import is_dimensionless
+from gearengine.studies.sweep.points import SweepPoint
+from gearengine.studies.sweep.request import SweepRequest
 
 CLASSES: list[tuple[str, str]] = [
     ("periodic 1T", "#c6dbef"),

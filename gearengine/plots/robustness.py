@@ -1,6 +1,6 @@
 """The probability map of a robustness study: over speed x torque (two axes) each panel colours
 one outcome's probability, each cell labelled with its 95 % upper bound; over one axis the
-probability with its interval band. Rendering only (``ensembles.robustness`` computes).
+probability with its interval band. Rendering only (``studies.robustness.study`` computes).
 """
 
 from __future__ import annotations
@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from gearengine.ensembles.robustness import RobustnessRequest, RobustnessResult
 from gearengine.model.units import display_unit
 from gearengine.plots.style import ImageFormat, figure_bytes
+from gearengine.studies.robustness.study import RobustnessRequest, RobustnessResult
 
 PANELS = ("chaotic", "impacts", "back_flank", "dynamic_factor_above_limit")
 TITLES = {

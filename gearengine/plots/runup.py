@@ -11,7 +11,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from gearengine.plots.style import ImageFormat, figure_bytes
-from gearengine.runup.results import RunupBranch, RunupResult
+from gearengine.studies.runup.results import RunupBranch, RunupResult
 
 COLOURS = {"up": "#1f77b4", "down": "#d62728"}
 """Line colour of each branch."""

@@ -24,10 +24,10 @@ from gearengine.model.params import GearParams
 from gearengine.model.units import display_unit
 from gearengine.plots.envelope import axis_label, envelope_map
 from gearengine.plots.style import LLE_LABEL, SYMBOLS, ImageFormat, figure_bytes
-from gearengine.sweeps.axes import is_dimensionless, is_integer_field
-from gearengine.sweeps.export import agreement_table
-from gearengine.sweeps.request import SweepRequest
-from gearengine.sweeps.results import SweepBifurcation, SweepPoint
+from gearengine.studies.sweep.axes import is_dimensionless, is_integer_field
+from gearengine.studies.sweep.export import agreement_table
+from gearengine.studies.sweep.points import SweepBifurcation, SweepPoint
+from gearengine.studies.sweep.request import SweepRequest
 
 BOUNDARY_GRID = 160
 """Samples per axis of the sign-change strength for the Melnikov boundary."""

@@ -76,7 +76,7 @@ class Settings(BaseSettings):
         ge=1,
         le=10_000,
         description="Points per chunk of a sweep without continuation; unset, about four chunks "
-        "per worker, 64 to 1024 points (gearengine.sweeps.plan.balanced_chunk_points).",
+        "per worker, 64 to 1024 points (gearengine.studies.sweep.plan.balanced_chunk_points).",
     )
     lease_seconds: float = Field(
         30.0, gt=0.0, le=3600.0, description="Lease of a claimed chunk, renewed every third."

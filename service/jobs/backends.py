@@ -1,7 +1,7 @@
 """Where chunks run: a local process pool or a Dask distributed cluster.
 
 Both hand back futures with ``done()``, ``result()`` and ``add_done_callback``; the dispatcher
-treats them alike. Workers only compute (``gearengine.jobs.compute_chunk_json`` with the
+treats them alike. Workers only compute (``gearengine.studies.jobs.compute_chunk_json`` with the
 claim's kind, whatever the kind); they never touch the store, so a worker that dies or hangs
 cannot corrupt it.
 """
@@ -14,7 +14,7 @@ from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any, Protocol
 
-from gearengine.jobs import compute_chunk_json
+from gearengine.studies.jobs import compute_chunk_json
 from service.jobs.store import Claim
 from service.lifetime import exit_with_parent
 

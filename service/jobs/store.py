@@ -1,6 +1,6 @@
 """The durable job store: one SQLite file (WAL) holding jobs and the results of finished chunks.
 
-Tables: ``jobs`` (one row per job, of any kind of ``gearengine.jobs.KINDS``: its ``kind``
+Tables: ``jobs`` (one row per job, of any kind of ``gearengine.studies.jobs.KINDS``: its ``kind``
 column names it; a store written before kinds existed gains the column, every old job a sweep),
 ``chunks`` (one row per chunk: status pending | leased |
 done | failed | cancelled, lease owner and expiry, attempts, result JSON) and ``commits`` (an
@@ -128,7 +128,7 @@ class Claim:
     chunk_points: int
     attempt: int
     kind: str
-    """The job's kind (``gearengine.jobs.KINDS``): what computes the chunk."""
+    """The job's kind (``gearengine.studies.jobs.KINDS``): what computes the chunk."""
 
     @property
     def key(self) -> tuple[str, int]:

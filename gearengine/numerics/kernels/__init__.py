@@ -32,8 +32,8 @@ Forcing coefficients are packed as kc, fc of shape (3, n_terms): rows amplitude,
 (see ``gearengine.numerics.forcing``); K(t) = 1 + sum kc0 cos(kc1 t + kc2),
 F(t) = fm + sum fc0 cos(fc1 t + fc2).
 
-The kernels call each other across these files and freeze constants of ``numerics.periodicity``,
-``numerics.lyapunov`` and ``numerics.classify``; ``gearengine.jitcache`` drops their numba cache
+The kernels call each other across these files and freeze constants of ``signals.periodicity``,
+``signals.lyapunov`` and ``signals.classify``; ``gearengine.jitcache`` drops their numba cache
 when any of those sources changes (numba itself watches only the defining file).
 """
 
@@ -72,7 +72,10 @@ drop_stale(  # before any kernel runs: numba loads a cached kernel on its first 
     "adaptive,intervals,kink,kinklanes,lockstep,monodromy,phase,ramp,smooth",
     [
         *_HERE.glob("*.py"),
-        *(_HERE.parent / f"{m}.py" for m in ("periodicity", "lyapunov", "classify")),
+        *(
+            _HERE.parents[1] / "signals" / f"{m}.py"
+            for m in ("periodicity", "lyapunov", "classify")
+        ),
     ],
     _HERE / "__pycache__",
 )

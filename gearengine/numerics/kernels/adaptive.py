@@ -6,7 +6,7 @@ every interval after the first ``min(n_trans, ADAPT_SETTLE) + ADAPT_MAX_PERIOD``
 the earliest after ``min(n_trans, ADAPT_SETTLE) + ADAPT_WINDOW`` intervals:
 
 1. **Candidate period** (a cheap prefilter). The tolerance is the one of
-   ``numerics.periodicity``: ``REL_TOL`` x the peak-to-peak of x over every step of the last
+   ``signals.periodicity``: ``REL_TOL`` x the peak-to-peak of x over every step of the last
    ``ADAPT_WINDOW`` intervals (floored by ``SIZE_FLOOR``; refreshed every ``ADAPT_PROBE``
    intervals). The current strobe X_m is compared with X_{m-q}, q = 1..ADAPT_MAX_PERIOD; the
    smallest q with |X_m - X_{m-q}| < tol is the candidate. A streak counts the consecutive
@@ -23,7 +23,7 @@ the earliest after ``min(n_trans, ADAPT_SETTLE) + ADAPT_WINDOW`` intervals:
    ``ADAPT_DRIFT`` of its value at the start), not a decaying transient. The window
    holds at least ADAPT_WINDOW / ADAPT_MAX_PERIOD = 10 repetitions of the cycle, all after a
    discarded transient of at least ``min(n_trans, ADAPT_SETTLE)`` intervals.
-3. **Converged LLE.** The Benettin logs of the window, split as ``numerics.lyapunov.benettin``
+3. **Converged LLE.** The Benettin logs of the window, split as ``signals.lyapunov.benettin``
    splits them (``BLOCKS`` equal blocks of ADAPT_WINDOW / BLOCKS = 12 intervals, a multiple of
    periods 1, 2, 3, 4, 6 and 12), give lle and the standard error of the block estimates; the run
    stops only if stderr <= max(``ADAPT_LLE_STDERR``, ``ADAPT_LLE_REL`` |lle|) (converged) and
@@ -42,7 +42,7 @@ extremes of x and of the mesh force over their steps); chaotic, quasi-periodic, 
 **The LLE rule** (chaotic and quasi-periodic runs, ``lle_known``): in the record, whenever the
 number k of recorded intervals is a multiple of ``BLOCKS`` and at least ``ADAPT_LLE_MIN_RECORD``,
 the Benettin estimate over those k intervals, lle = sum l_i / (k T0), and its standard error
-over ``BLOCKS`` equal blocks (as ``numerics.lyapunov.benettin``) are taken; the run stops when
+over ``BLOCKS`` equal blocks (as ``signals.lyapunov.benettin``) are taken; the run stops when
 
     stderr <= max(lle_stderr_abs, lle_stderr_rel |lle|)        (the tolerances of the settings)
 
@@ -68,10 +68,10 @@ import math
 import numpy as np
 from numba import njit
 
-from gearengine.numerics.classify import LLE_FLOOR
 from gearengine.numerics.kernels.smooth import JIT_OPTIONS
-from gearengine.numerics.lyapunov import BLOCKS
-from gearengine.numerics.periodicity import MAX_PERIOD, REL_TOL, SIZE_FLOOR, _smallest_period
+from gearengine.signals.classify import LLE_FLOOR
+from gearengine.signals.lyapunov import BLOCKS
+from gearengine.signals.periodicity import MAX_PERIOD, REL_TOL, SIZE_FLOOR, _smallest_period
 
 ADAPT_WINDOW = 120
 """Intervals T0 of the record of an early-stopped run (a multiple of ``BLOCKS``)."""

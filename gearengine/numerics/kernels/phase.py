@@ -15,7 +15,7 @@ force is -e~'' of e~ = F~_er cos(q psi_a + phi) (Eq. 7, -m e'' / (b k_m)):
 which is the stationary (r Omega_e)^2 F~_er cos(...) of Eq. (9) when beta = 0. The mean force
 is F~_m0 + F~_m1 tau (a torque ramp, and the force that accelerates the driven inertia).
 
-Arguments as the kernels take them (``gearengine.runup.profile`` packs them):
+Arguments as the kernels take them (``gearengine.studies.runup.profile`` packs them):
 
 * ``kc`` (3, n): stiffness terms, rows amplitude 2 k~_pr, order q, phase;
 * ``ramp`` (5,): F~_m0, F~_m1, Omega_0, beta, psi_0, with tau counted from the segment start;

@@ -1,6 +1,6 @@
 """The routes every kind of durable job has: submit, list, status, result, cancel.
 
-``JobRoutes(kind, prefix, ...).router()`` gives, for a kind of ``gearengine.jobs.KINDS``:
+``JobRoutes(kind, prefix, ...).router()`` gives, for a kind of ``gearengine.studies.jobs.KINDS``:
 ``POST /v1/<prefix>`` (202, ``Location``, ``Retry-After``), ``GET /v1/<prefix>`` (the caller's
 jobs of that kind, newest first), ``GET /v1/<prefix>/{id}``, ``GET /v1/<prefix>/{id}/result``
 (409 until succeeded; ``?partial=true`` for the finished chunks) and ``DELETE
@@ -21,7 +21,7 @@ from fastapi import APIRouter, Query, Request, Response
 from pydantic import BaseModel
 from starlette.concurrency import run_in_threadpool
 
-from gearengine import jobs as job_kinds
+from gearengine.studies import jobs as job_kinds
 from service.api.deps import AppSettings, Jobs, Owner, app_limits
 from service.api.responses import JSON, PNG, PROBLEMS, RETRY_AFTER_HEADER, SVG, header
 from service.core.config import Settings
@@ -89,7 +89,7 @@ class JobRoutes:
     """The routes of one kind of job.
 
     Attributes:
-        kind: its name in ``gearengine.jobs.KINDS``.
+        kind: its name in ``gearengine.studies.jobs.KINDS``.
         prefix: the routes' prefix, ``/v1/<prefix>``.
         noun, plural: how messages, summaries and operation ids name one job and several.
         submit_summary, submit_doc: the POST route's summary and description.

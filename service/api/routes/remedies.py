@@ -1,13 +1,13 @@
 """/v1/remedies: what to change in a failing design, by how much, as a durable job.
 
-One chunk per lever (``gearengine.ensembles.remedies``), then the two-lever combination; the
+One chunk per lever (``gearengine.gate.remedies.search``), then the two-lever combination; the
 result is the document ``gearengine remedies --json`` writes. Bad levers and envelopes are
 refused (422 naming the field) by the request model, before any compute.
 """
 
 from __future__ import annotations
 
-from gearengine.ensembles.remedies import RemediesResult
+from gearengine.gate.remedies import RemediesResult
 from service.api.routes.jobs import JobRoutes
 
 REMEDIES = JobRoutes(

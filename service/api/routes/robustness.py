@@ -1,11 +1,11 @@
 """/v1/robustness: probabilities of chaos and rattle for the gears that will be built (a durable
-job of kind ``robustness``, ``gearengine.ensembles.robustness``), on the generic job routes."""
+job of kind ``robustness``, ``gearengine.studies.robustness.study``), on the generic job routes."""
 
 from __future__ import annotations
 
 from fastapi import Request
 
-from gearengine.ensembles.robustness import RobustnessRequest, RobustnessResult, checked
+from gearengine.studies.robustness.study import RobustnessRequest, RobustnessResult, checked
 from service.api.routes.jobs import JobRoutes
 from service.core.config import Settings
 

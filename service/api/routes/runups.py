@@ -1,4 +1,4 @@
-"""/v1/runups: run-ups and run-downs of a design as durable jobs (``gearengine.runup``).
+"""/v1/runups: run-ups and run-downs of a design as durable jobs (``gearengine.studies.runup``).
 
 The kind-generic routes of ``routes.jobs``: submit (202 + ``Location``), list, status, result
 (the document ``gearengine runup --json`` writes), cancel; and the figure of a succeeded run-up
@@ -13,10 +13,11 @@ from typing import Literal
 
 from fastapi import Request
 
-from gearengine import jobs as job_kinds
 from gearengine.plots import runup_figure
-from gearengine.runup.request import RunupRequest, checked
-from gearengine.runup.results import RunupResult
+from gearengine.studies import jobs as job_kinds
+from gearengine.studies.runup.profile import checked
+from gearengine.studies.runup.request import RunupRequest
+from gearengine.studies.runup.results import RunupResult
 from service.api.routes.jobs import JobRoutes
 from service.core.config import Settings
 from service.jobs.runtime import SweepJobs

@@ -13,7 +13,7 @@ from fastapi import Query, Request, Response
 from fastapi.responses import StreamingResponse
 
 from gearengine import plots  # its figures load matplotlib on first use, not at start-up
-from gearengine.sweeps import (
+from gearengine.studies.sweep import (
     DEFAULT_CHUNK_POINTS,
     SweepPoint,
     SweepRequest,
@@ -26,8 +26,8 @@ from gearengine.sweeps import (
     result_json,
     text_blocks,
 )
-from gearengine.sweeps.results import SpeedWindows
-from gearengine.sweeps.windows import SPEED, speed_windows
+from gearengine.studies.sweep.points import SpeedWindows
+from gearengine.studies.sweep.windows import SPEED, speed_windows
 from service.api.deps import Jobs, Owner
 from service.api.responses import JSON, PROBLEMS, RETRY_AFTER_HEADER, header
 from service.api.routes.jobs import (

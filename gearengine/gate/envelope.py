@@ -1,0 +1,280 @@
+"""The CI gate over an operating envelope: which grid points of a speed x torque sweep break
+which rule, gathered into failing speed windows per torque level, and the JUnit XML report
+that GitHub, GitLab and Jenkins show.
+
+Rules (``Rules``): ``fail_on`` classes (``chaotic`` fails chaotic and diverged points, ordered
+periodic < quasi_periodic < chaotic < diverged as in ``signals.classify.SEVERITY``),
+``melnikov`` (the criterion allows chaos), ``impacts`` (back-flank contact), ``separation`` (the
+teeth separate: drive-flank impacts, or impacts on both flanks); and numeric limits,
+which add to the classes instead of replacing them: ``max_lle`` (per unit tau), ``max_dte_um``
+(dynamic transmission error peak to peak, µm), ``max_dynamic_factor`` (largest mesh force over
+the static force F~_m). With basins (``settings.basins``) every attractor of a point whose
+basin fraction is above ``min_basin`` is checked against the rules, and a failing window names
+the attractors that broke it with their fractions.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from typing import Literal
+from xml.etree import ElementTree
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from gearengine.model.units import OUTPUTS, RESPONSES
+from gearengine.signals.classify import SEVERITY
+from gearengine.studies.sweep.compute import run_local
+from gearengine.studies.sweep.plan import balanced_chunk_points
+from gearengine.studies.sweep.points import PhysicalValue, SpeedWindows, SweepPoint
+from gearengine.studies.sweep.request import SweepRequest
+from gearengine.studies.sweep.results import SweepResult
+from gearengine.studies.sweep.windows import SPEED, runs
+
+FailOn = Literal["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"]
+
+
+class Rules(BaseModel):
+    """What fails the gate at a grid point."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    fail_on: list[FailOn] = Field(
+        default_factory=lambda: ["chaotic"],
+        description="Classes that fail (and anything worse), melnikov, impacts (back-flank "
+        "contact), separation (the teeth separate: drive-flank or back-flank impacts).",
+    )
+    max_lle: float | None = Field(None, description="Largest LLE allowed, per unit tau.")
+    max_dte_um: float | None = Field(None, description="Largest DTE peak to peak [µm].")
+    max_dynamic_factor: float | None = Field(
+        None, description="Largest dynamic factor allowed: max mesh force / static force."
+    )
+    min_basin: float | None = Field(
+        None,
+        ge=0.0,
+        lt=1.0,
+        description="With basins: only attractors whose basin fraction is above this are "
+        "checked; null checks every attractor found.",
+    )
+
+
+SEPARATING = ("single_sided", "double_sided")
+"""Impact regimes in which the teeth separate (``signals.diagnostics.impact_regime``)."""
+
+
+def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
+    """The rules one point breaks, as short labels ("chaotic", "DTE > 20 µm", ...)."""
+    out = []
+    for name in rules.fail_on:
+        if name in SEVERITY and SEVERITY[p.classification] >= SEVERITY[name]:
+            out.append(p.classification.replace("_", "-"))
+            break
+    if "melnikov" in rules.fail_on and p.melnikov_chaos_possible:
+        out.append("Melnikov: chaos possible")
+    if "impacts" in rules.fail_on and p.impact_regime == "double_sided":
+        out.append("back-flank impacts")
+    if "separation" in rules.fail_on and p.impact_regime in SEPARATING:
+        out.append("tooth separation")
+    if rules.max_lle is not None and (p.lle is None or p.lle > rules.max_lle):
+        out.append(f"LLE > {rules.max_lle:g}")
+    dte = (p.physical or {}).get("dte")
+    if rules.max_dte_um is not None and (dte is None or dte.value > rules.max_dte_um):
+        out.append(f"DTE > {rules.max_dte_um:g} µm")
+    factor = (p.physical or {}).get("dynamic_factor")
+    if rules.max_dynamic_factor is not None and (
+        factor is None or factor.value > rules.max_dynamic_factor
+    ):
+        out.append(f"dynamic factor > {rules.max_dynamic_factor:g}")
+    return out
+
+
+def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
+    """(rule, who) of each rule a point breaks: with basins each attractor above
+    ``rules.min_basin`` is checked as if it were the point ("chaotic, double-sided impacts
+    from 41 % of starts" is who broke it); without, the point itself (who is empty)."""
+    if p.attractors is None:
+        return [(rule, "") for rule in point_failures(p, rules)]
+    out = []
+    least = -1.0 if rules.min_basin is None else rules.min_basin
+    for a in p.attractors:
+        if a.fraction <= least:
+            continue
+        physical = dict(p.physical or {})
+        for key, value in (("dte", a.dte_um), ("dynamic_factor", a.dynamic_factor)):
+            physical.pop(key, None)
+            if value is not None:
+                physical[key] = PhysicalValue(value=value, unit=OUTPUTS[key].unit)
+        alone = p.model_copy(update={"classification": a.classification, "period": a.period,
+                                     "lle": a.lle, "impact_regime": a.impact_regime,
+                                     "physical": physical or None})  # fmt: skip
+        who = f"{a.label} from {100 * a.fraction:.0f} % of starts"
+        out += [(rule, who) for rule in point_failures(alone, rules)]
+    return out
+
+
+ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
+"""Light integration settings of an envelope check; a design file's ``settings`` are merged
+over them (adding ``random_initial_states`` keeps the 60 + 60 periods)."""
+
+
+GATE_STARTS = 16
+"""Basin starts per operating point of the gate unless ``--starts`` or the file's
+``settings.basins`` say otherwise: a 4 x 4 grid over the default box (benchmarks/README.md has
+its cost); ``--starts 1`` checks the settings' own start alone, as before basins."""
+
+
+def gate_settings(settings: dict, starts: int | None) -> dict:
+    """The gate's settings with its basin starts: ``starts`` (a grid when it is a square, else
+    random draws), else the file's basins, else ``GATE_STARTS``; ``starts`` 1 leaves basins
+    out."""
+    if starts is None:
+        starts = None if settings.get("basins") is not None else GATE_STARTS
+    if starts is None:
+        return settings
+    if starts == 1:
+        return {k: v for k, v in settings.items() if k != "basins"}
+    basins = dict(settings.get("basins") or {})
+    basins.update(starts=starts, grid=math.isqrt(max(starts, 0)) ** 2 == starts)
+    return {**settings, "basins": basins}
+
+
+def envelope_axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
+    """A sweep axis from "A:B" (bare numbers in ``unit``) or "52rad/s:628rad/s".
+
+    Raises ValueError for text that is not a range.
+    """
+    ends = text.split(":")
+    if len(ends) != 2 or not all(e.strip() for e in ends):
+        raise ValueError("give a range as LOW:HIGH (two values and a colon, e.g. 500:6000)")
+    lo, hi = (e.strip() if any(c.isalpha() for c in e) else f"{e.strip()} {unit}" for e in ends)
+    return {"parameter": name, "start": lo, "stop": hi, "num": num}
+
+
+def envelope_sweep(design: object, settings: dict[str, object] | None,
+                   axes: list[dict[str, object]], label: str) -> dict[str, object]:  # fmt: skip
+    """The sweep document of an envelope check: ``axes`` (``envelope_axis``) of ``design``
+    under ``settings`` merged over ``ENVELOPE_SETTINGS``."""
+    return {"design": design, "settings": {**ENVELOPE_SETTINGS, **(settings or {})},
+            "axes": axes, "label": label}  # fmt: skip
+
+
+def check_envelope(
+    request: SweepRequest,
+    rules: Rules,
+    progress_callback: Callable[[int, int], None] | None = None,
+    workers: int = 1,
+) -> EnvelopeReport:
+    """The gate's report of one envelope sweep, computed in this process (``workers`` threads,
+    ``balanced_chunk_points`` down to one point per chunk, as the CLI gate runs it)."""
+    chunk = balanced_chunk_points(request.n_points(), workers, smallest=1)
+    result = run_local(request, progress_callback, chunk_points=chunk, workers=workers)
+    return envelope_report(result, rules)
+
+
+class FailingWindow(BaseModel):
+    """A run of grid speeds at one torque level that breaks one rule."""
+
+    model_config = ConfigDict(frozen=True)
+
+    level: dict[str, PhysicalValue] = Field(description="The torque level (other axis).")
+    rule: str = Field(description="The rule broken, e.g. 'chaotic', 'DTE > 20 µm'.")
+    speeds_rpm: list[float] = Field(description="[first, last] failing grid speed [rpm].")
+    attractors: list[str] | None = Field(
+        None,
+        description="With basins: per failing speed, the attractors that broke the rule and "
+        "their basin fractions ('5750 rpm: chaotic, ... from 41 % of starts'); else null.",
+    )
+
+
+class EnvelopeReport(BaseModel):
+    """The verdict of the gate over an envelope (``gearengine check --speed --torque``)."""
+
+    model_config = ConfigDict(frozen=True)
+
+    passed: bool
+    rules: Rules
+    points: int = Field(description="Grid points checked.")
+    failing_points: int
+    melnikov_not_judged: int = Field(
+        0,
+        description="Grid points where the Melnikov criterion does not apply (above the critical "
+        "torque, or no saddle): --fail-on melnikov never fails them.",
+    )
+    failures: list[FailingWindow]
+    windows: list[SpeedWindows] = Field(description="All response windows, failing or not.")
+    sweep: SweepResult = Field(description="The sweep result (the API's document).")
+
+
+def _level_key(p: SweepPoint) -> tuple:
+    return tuple(sorted((k, v.value) for k, v in (p.physical or {}).items() if k not in
+                        (SPEED, *RESPONSES)))  # fmt: skip
+
+
+def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
+    """Failing windows of a sweep over the driver speed (and another axis) under ``rules``."""
+    rows: dict[tuple, list[SweepPoint]] = {}
+    for p in result.points:
+        if p.branch != "down":
+            rows.setdefault(_level_key(p), []).append(p)
+    failures: list[FailingWindow] = []
+    failing = 0
+    for row in rows.values():
+        row.sort(key=lambda p: p.values[SPEED])
+        level = {k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, *RESPONSES)}
+        speeds = [p.physical[SPEED].value for p in row]  # type: ignore[index]
+        found = [attractor_failures(p, rules) for p in row]
+        broken = [[rule for rule, _ in f] for f in found]
+        failing += sum(1 for b in broken if b)
+        for rule in dict.fromkeys(r for b in broken for r in b):
+            for span in runs(speeds, [rule if rule in b else None for b in broken]).get(rule, []):
+                who = [f"{v:g} rpm: {w}" for v, f in zip(speeds, found, strict=True)
+                       if span[0] <= v <= span[1] for r, w in f if r == rule and w]  # fmt: skip
+                named = list(dict.fromkeys(who)) or None
+                failures.append(FailingWindow(level=level, rule=rule, speeds_rpm=span,
+                                              attractors=named))  # fmt: skip
+    return EnvelopeReport(
+        passed=not failures,
+        rules=rules,
+        points=sum(len(r) for r in rows.values()),
+        failing_points=failing,
+        melnikov_not_judged=sum(
+            1 for r in rows.values() for p in r if p.melnikov_chaos_possible is None
+        ),
+        failures=failures,
+        windows=result.windows or [],
+        sweep=result,
+    )
+
+
+def level_text(level: dict[str, PhysicalValue]) -> str:
+    """ "torque 40 N*m", or "all" for a one-axis sweep."""
+    return ", ".join(f"{k} {v.value:g} {v.unit}" for k, v in level.items()) or "all"
+
+
+def window_text(w: FailingWindow) -> str:
+    """One failing window in words: "torque 20 N*m: chaotic at 3000-3500 rpm"."""
+    lo, hi = w.speeds_rpm
+    span = f"{lo:g} rpm" if lo == hi else f"{lo:g}-{hi:g} rpm"
+    who = "" if not w.attractors else f" ({'; '.join(w.attractors)})"
+    return f"{level_text(w.level)}: {w.rule} at {span}{who}"
+
+
+def junit_xml(report: EnvelopeReport, name: str, levels: Sequence[dict[str, PhysicalValue]]) -> str:
+    """JUnit XML: one test case per torque level, one failure element per failing window."""
+    suites = ElementTree.Element("testsuites", name="gearchaos envelope")
+    suite = ElementTree.SubElement(suites, "testsuite", name=name)
+    failed = 0
+    for level in levels:
+        case = ElementTree.SubElement(
+            suite, "testcase", classname="gearchaos.envelope", name=level_text(level), time="0"
+        )
+        mine = [w for w in report.failures if w.level == level]
+        failed += bool(mine)
+        for w in mine:
+            node = ElementTree.SubElement(case, "failure", message=window_text(w), type=w.rule)
+            node.text = window_text(w)
+    for node in (suites, suite):
+        node.set("tests", str(len(levels)))
+        node.set("failures", str(failed))
+        node.set("errors", "0")
+    return ElementTree.tostring(suites, encoding="unicode", xml_declaration=True) + "\n"

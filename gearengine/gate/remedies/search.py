@@ -1,0 +1,223 @@
+"""Remedies: the smallest change of one design lever that makes a whole operating envelope pass.
+
+A lever is a design field path, as in sweeps (``mesh.damping_ratio``,
+``transmission_error.harmonics.0.amplitude``, ``mesh.half_backlash``, ...), searched from the
+design's value v0 toward a far end v1 along v(t) = v0 + t (v1 - v0), t in [0, 1]. Two bounds per
+lever:
+
+* **Melnikov bound**: the smallest t after which the Melnikov criterion (paper Eqs. 20-24,
+  ``homoclinic.thresholds.chaos_possible``) rules out a transverse homoclinic tangle at every
+  envelope point. A guarantee for that mechanism only; a point where the criterion does not apply
+  (``chaos_possible`` None: no saddle of the cubic fit, e.g. a load above the critical torque)
+  counts as "not judged", never as a failure, and the summary says how many there were.
+  Bisection to ``MELNIKOV_RTOL`` (microseconds a point).
+* **Numerical bound**: the smallest t after which the gate (``gate.envelope``: the same rules,
+  settings and grid as ``gearengine check --speed --torque``) passes, by bisection with full
+  envelope runs; the value returned is one that was run, and its report is attached.
+
+Each search first samples the bracket (``SAMPLES`` values, v0 and v1 included). The lever is
+called monotone when the samples switch from fail to pass exactly once; then bisection between
+the last failing and the first passing sample is valid. Otherwise bisection still returns a
+switch (the first one from v0), but other values may pass too: the remedy says the value found
+is not unique. A lever whose samples never pass is ``unreachable`` (with the range searched and
+the failures at its far end). When no single lever clears the envelope, ``combination``
+suggests two levers together, from a 3 x 3 grid of the two levers that left the fewest failing
+points at their far ends.
+
+A job of kind ``remedies`` (``gearengine.studies.jobs``): one chunk per lever, and a last chunk
+for the combination; a chunk depends only on (request, index).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from gearengine.gate.envelope import (
+    EnvelopeReport,
+    check_envelope,
+)
+from gearengine.gate.remedies.levers import accuracy_classes, contact_ratio
+from gearengine.gate.remedies.request import (
+    MAX_BISECTIONS,
+    MELNIKOV_RTOL,
+    MELNIKOV_SAMPLES,
+    SAMPLES,
+    Lever,
+    RemediesRequest,
+)
+from gearengine.gate.remedies.results import Remedy, Sample, Unreachable
+from gearengine.homoclinic.thresholds import chaos_possible
+from gearengine.model.design import Design
+from gearengine.model.reduction import convert_design
+from gearengine.studies.sweep.axes import design_with
+
+
+def envelope_points(request: RemediesRequest) -> list[dict[str, float]]:
+    """The envelope's grid points as sweep values (SI), speed fastest as in the sweep."""
+    sweep = request.sweep()
+    names = [a.parameter for a in sweep.axes]
+    grids = sweep.grids()
+    rows = [[]] if len(grids) == 1 else [[(names[1], t)] for t in grids[1]]
+    return [dict([(names[0], v), *row]) for row in rows for v in grids[0]]
+
+
+def melnikov_failures(design: Design, points: list[dict[str, float]],
+                      values: dict[str, float]) -> tuple[int, int]:  # fmt: skip
+    """(points where the criterion allows chaos, points where it does not apply) over the
+    envelope ``points`` of ``design`` with the fields ``values`` set (SI): each point's
+    ``chaos_possible``, as the sweep's ``melnikov_chaos_possible``."""
+    verdicts = [chaos_possible(convert_design(design_with(design, {**values, **p})).params)
+                for p in points]  # fmt: skip
+    return sum(v is True for v in verdicts), sum(v is None for v in verdicts)
+
+
+def _search(test: Callable[[float], tuple[bool, int]], lever: Lever, samples: int,
+            width: Callable[[float, float], bool], max_steps: int
+            ) -> tuple[list[Sample], bool, tuple[float, float] | None]:  # fmt: skip
+    """Bracket samples of v(t), monotone on them?, and [last failing, first passing] value (SI)
+    after bisection (None when no sample passes). ``test(v) -> (passed, failing points)``."""
+    ts = [k / (samples - 1) for k in range(samples)]
+    results = [test(lever.at(t)) for t in ts]
+    shown = [Sample(value=lever.shown(lever.at(t)), passed=r[0], failing_points=r[1])
+             for t, r in zip(ts, results, strict=True)]  # fmt: skip
+    passes = [r[0] for r in results]
+    if not any(passes):
+        return shown, False, None
+    j = passes.index(True)
+    monotone = j > 0 and all(passes[j:])
+    if j == 0:
+        return shown, monotone, (lever.at(0.0), lever.at(0.0))
+    fail, good = lever.at(ts[j - 1]), lever.at(ts[j])
+    for _ in range(max_steps):
+        if width(fail, good):
+            break
+        mid = 0.5 * (fail + good)
+        if test(mid)[0]:
+            good = mid
+        else:
+            fail = mid
+    return shown, monotone, (fail, good)
+
+
+def _narrow(rtol: float, lever: Lever) -> Callable[[float, float], bool]:
+    """Bracket [a, b] narrow enough: |b - a| <= rtol x min(|change|, |value|) (the change alone
+    when the value is 0)."""
+
+    def done(a: float, b: float) -> bool:
+        change = abs(b - lever.start)
+        scale = min(change, abs(b)) if b != 0 else change
+        return abs(b - a) <= rtol * scale
+
+    return done
+
+
+def lever_words(path: str) -> str:
+    """A lever's name in words: "damping ratio", "transmission error (harmonic 2)"."""
+    names = {"damping_ratio": "damping ratio", "damping": "damping",
+             "half_backlash": "half backlash", "profile_shift": "profile shift"}  # fmt: skip
+    parts = path.split(".")
+    if parts[-1] in names:
+        gear = f"{parts[0]}'s " if parts[0] in ("driver", "driven") else ""
+        return gear + names[parts[-1]]
+    kind = {"transmission_error": "transmission error", "stiffness_harmonics":
+            "stiffness variation", "torque_fluctuation": "torque fluctuation"}  # fmt: skip
+    for part in parts:
+        if part in kind:
+            index = next((p for p in parts if p.isdigit()), "0")
+            return kind[part] + ("" if index == "0" else f" (harmonic {int(index) + 1})")
+    return path
+
+
+def change_words(lever: Lever, to: float) -> str:
+    """ "raise the damping ratio from 0.05 to 0.071" """
+    verb = "raise" if lever.end > lever.start else "lower"
+    unit = lever.suffix
+    return (f"{verb} the {lever_words(lever.path)} from {lever.shown(lever.start):.4g} to "
+            f"{lever.shown(to):.4g}{unit}")  # fmt: skip
+
+
+def _uniqueness(monotone: bool) -> str:
+    return ("" if monotone else "; the response is not monotone on the bracket samples, so "
+            "this is one switch from the design's value, not a unique bound")  # fmt: skip
+
+
+def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeReport
+                  ) -> tuple[list[Remedy], list[Unreachable]]:  # fmt: skip
+    """Both bounds of one lever."""
+    rules = request.rules()
+    reports: dict[float, EnvelopeReport] = {lever.start: baseline}
+
+    def run(value: float) -> EnvelopeReport:
+        if value not in reports:
+            design = design_with(request.design, {lever.path: value})
+            reports[value] = check_envelope(request.sweep(design), rules)
+        return reports[value]
+
+    def numerical(value: float) -> tuple[bool, int]:
+        report = run(value)
+        return report.passed, report.failing_points
+
+    points = envelope_points(request)
+
+    def melnikov(value: float) -> tuple[bool, int]:
+        possible, _ = melnikov_failures(request.design, points, {lever.path: value})
+        return possible == 0, possible
+
+    searched = [f"{lever.shown(v):g}{lever.suffix}" for v in (lever.start, lever.end)]
+    remedies: list[Remedy] = []
+    unreachable: list[Unreachable] = []
+    for bound, test, samples, rtol, steps in (
+        ("numerical", numerical, SAMPLES, request.tolerance, MAX_BISECTIONS),
+        ("melnikov", melnikov, MELNIKOV_SAMPLES, MELNIKOV_RTOL, 60),
+    ):
+        shown, monotone, bracket = _search(test, lever, samples, _narrow(rtol, lever), steps)
+        if bracket is None:
+            unreachable.append(Unreachable(
+                lever=lever.path, bound=bound, searched=searched, samples=shown,
+                why=_why(bound, lever, shown, run(lever.end) if bound == "numerical" else None),
+            ))  # fmt: skip
+            continue
+        fail, to = bracket
+        if bound == "melnikov" and to == lever.start:
+            continue  # the criterion rules chaos out already: no change needed for it
+        report = run(to)
+        blind = None
+        if bound == "melnikov":
+            blind = melnikov_failures(request.design, points, {lever.path: to})[1]
+        remedies.append(Remedy(
+            lever=lever.path, from_=lever.shown(lever.start), to=lever.shown(to),
+            unit=lever.unit, bound=bound, monotone=monotone,
+            bracket=[lever.shown(fail), lever.shown(to)], samples=shown,
+            not_applicable_points=blind, check=report,
+            contact_ratio=contact_ratio(design_with(request.design, {lever.path: to})),
+            iso1328_class=accuracy_classes(request.design, lever, to),
+            summary=_summary(bound, lever, to, monotone, report, blind),
+        ))  # fmt: skip
+    return remedies, unreachable
+
+
+def _summary(bound: str, lever: Lever, to: float, monotone: bool, report: EnvelopeReport,
+             blind: int | None) -> str:  # fmt: skip
+    run = (f"the envelope check passes there ({report.points} points run)" if report.passed
+           else f"the envelope check still fails there at {report.failing_points} of "
+           f"{report.points} points")  # fmt: skip
+    if bound == "numerical":
+        return f"{change_words(lever, to)}: {run}{_uniqueness(monotone)}"
+    na = (f"; the criterion does not apply at {blind} of {report.points} points (no saddle "
+          "under that load: not judged there)" if blind else "")  # fmt: skip
+    return (f"{change_words(lever, to)}: the Melnikov criterion rules out homoclinic chaos at "
+            f"every envelope point{na}; {run}{_uniqueness(monotone)}")  # fmt: skip
+
+
+def _why(bound: str, lever: Lever, samples: list[Sample], far: EnvelopeReport | None) -> str:
+    values = ", ".join(f"{s.value:g}" for s in samples)
+    if bound == "melnikov":
+        return (f"the Melnikov criterion allows chaos somewhere in the envelope at every sampled "
+                f"{lever_words(lever.path)} ({values}{lever.suffix})")  # fmt: skip
+    assert far is not None
+    return (f"no sampled {lever_words(lever.path)} ({values}{lever.suffix}) clears the envelope; "
+            f"at {lever.shown(lever.end):g}{lever.suffix} {far.failing_points} of {far.points} "
+            "points still fail")  # fmt: skip
+
+
+# --- the job ----------------------------------------------------------------------------------

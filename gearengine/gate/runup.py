@@ -1,0 +1,115 @@
+"""The run-up in the CI gate (``gearengine check ... --runup 1000``): a run-up and run-down
+through the envelope's speed range at each torque level, failing on the envelope's rules.
+
+Rules on the bins of each branch (``gate.envelope.Rules``): ``chaotic`` in ``fail_on`` fails a
+run of chaotic bins (ensemble FTLE clearly positive, or above ``max_lle`` when given) that lasts
+longer than ``chaos_seconds``: a ramp crossing a chaotic window quickly may pass, one lingering
+in it fails. ``impacts`` fails back-flank impacts, ``separation`` any loss of contact,
+``max_dte_um`` and ``max_dynamic_factor`` their limits, each bin by itself. Failures name the
+branch and the speeds.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from gearengine.gate.envelope import EnvelopeReport, FailingWindow, Rules
+from gearengine.model.units import RPM
+from gearengine.studies.runup.compute import run_local
+from gearengine.studies.runup.profile import validated
+from gearengine.studies.runup.results import RunupBin, RunupResult
+from gearengine.studies.sweep.points import PhysicalValue
+from gearengine.studies.sweep.request import SweepRequest
+from gearengine.studies.sweep.windows import runs
+
+CHAOS_SECONDS = 0.05
+"""Longest time a run-up may spend in chaotic bins before the gate fails it [s]."""
+GATE_ENSEMBLE = 4
+"""Ensemble members of a gate's run-up (the FTLE's standard error over 4 starts)."""
+
+
+def bin_failures(b: RunupBin, rules: Rules) -> list[str]:
+    """The per-bin rules a bin breaks (chaos is judged over runs, see ``runup_failures``)."""
+    out = []
+    if "impacts" in rules.fail_on and (b.back_flank_impacts or 0) > 0:
+        out.append("back-flank impacts")
+    if "separation" in rules.fail_on and (b.separation_fraction or 0) > 0:
+        out.append("tooth separation")
+    if rules.max_dte_um is not None and (
+        b.dte_peak_to_peak_um is None or b.dte_peak_to_peak_um > rules.max_dte_um
+    ):
+        out.append(f"DTE > {rules.max_dte_um:g} µm")
+    if rules.max_dynamic_factor is not None and (
+        b.dynamic_factor is None or b.dynamic_factor > rules.max_dynamic_factor
+    ):
+        out.append(f"dynamic factor > {rules.max_dynamic_factor:g}")
+    return out
+
+
+def _chaotic(b: RunupBin, rules: Rules) -> bool:
+    if b.lle is None:
+        return True  # a diverged member: worse than chaos
+    return b.lle > rules.max_lle if rules.max_lle is not None else bool(b.chaotic)
+
+
+def runup_failures(
+    result: RunupResult, rules: Rules, level: dict[str, PhysicalValue],
+    chaos_seconds: float = CHAOS_SECONDS,
+) -> list[FailingWindow]:  # fmt: skip
+    """The failing windows of one run-up at one torque ``level``."""
+    out: list[FailingWindow] = []
+    for name in ("up", "down"):
+        branch = getattr(result, name)
+        if branch is None:
+            continue
+        bins = sorted(branch.bins, key=lambda b: b.speed_rpm[0])
+        starts = [b.speed_rpm[0] for b in bins]
+        broken = [bin_failures(b, rules) for b in bins]
+        for rule in dict.fromkeys(r for f in broken for r in f):
+            for lo, hi in runs(starts, [rule if rule in f else None for f in broken]).get(rule, []):
+                top = next(b.speed_rpm[1] for b in bins if b.speed_rpm[0] == hi)
+                out.append(FailingWindow(level=level, rule=f"run-{name}: {rule}",
+                                         speeds_rpm=[lo, top]))  # fmt: skip
+        if "chaotic" not in rules.fail_on and rules.max_lle is None:
+            continue
+        flags = ["chaos" if _chaotic(b, rules) else None for b in bins]
+        for lo, hi in runs(starts, flags).get("chaos", []):
+            inside = [b for b in bins if lo <= b.speed_rpm[0] <= hi]
+            seconds = sum(b.time_s[1] - b.time_s[0] for b in inside)
+            if seconds > chaos_seconds:
+                what = "FTLE clearly positive" if rules.max_lle is None else (
+                    f"FTLE > {rules.max_lle:g}")  # fmt: skip
+                rule = f"run-{name}: chaotic ({what}) for {seconds:.3g} s"
+                out.append(FailingWindow(level=level, rule=rule,
+                                         speeds_rpm=[lo, inside[-1].speed_rpm[1]]))  # fmt: skip
+    return out
+
+
+def gate_envelope(
+    report: EnvelopeReport, sweep: SweepRequest, rate_rpm_s: float,
+    progress: Callable[[int, int], None] | None = None, workers: int = 1,
+) -> EnvelopeReport:  # fmt: skip
+    """``report`` with the failing windows of a run-up and run-down at ``rate_rpm_s`` [rpm/s]
+    through the envelope sweep's speed range (its grid step as the bins) at each of its torque
+    levels. Raises ``ValidationError`` naming the field of a bad ramp."""
+    assert sweep.design is not None
+    axes = {a.parameter: (a, g) for a, g in zip(sweep.axes, sweep.grids(), strict=True)}
+    axis, grid = axes["speed"]
+    lo, hi = grid[0] / RPM, grid[-1] / RPM
+    if axis.num < 2 or not lo < hi:
+        raise ValueError("--runup: give the envelope a speed range, --speed LOW:HIGH")
+    levels = [w.level for w in report.windows] or [{}]
+    design = sweep.design.model_dump()
+    failures = list(report.failures)
+    for k, level in enumerate(levels):
+        torque = level["torque"].value if "torque" in level else sweep.design.torque
+        request = validated({
+            "design": {**design, "torque": torque},
+            "from_speed": f"{lo!r} rpm", "to_speed": f"{hi!r} rpm",
+            "rate": f"{rate_rpm_s!r} rpm/s", "direction": "up_down",
+            "bin_rpm": (hi - lo) / (axis.num - 1), "ensemble": {"size": GATE_ENSEMBLE},
+        })  # fmt: skip
+        failures += runup_failures(run_local(request, workers=workers), report.rules, level)
+        if progress is not None:
+            progress(k + 1, len(levels))
+    return report.model_copy(update={"failures": failures, "passed": not failures})

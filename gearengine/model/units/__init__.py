@@ -1,0 +1,78 @@
+"""Units: the one door between gear data and the engine's numbers.
+
+``quantities`` reads what engineers type ("1500 rpm", "50 um", "40 N*m") with pint, refusing
+what no spur-gear pair can have; ``outputs`` maps answers back to SI and display units (the one
+output table). Everything else imports units from here.
+"""
+
+from gearengine.model.units.outputs import (
+    OUTPUTS,
+    RADIUS_RATIO_TOLERANCE,
+    RESPONSES,
+    RPM,
+    TORQUE_BALANCE_TOLERANCE,
+    Scales,
+    display_label,
+    display_unit,
+    field_label,
+    field_unit,
+    in_display_unit,
+    in_si,
+    response_values,
+    shown,
+    to_physical,
+)
+from gearengine.model.units.quantities import (
+    QUANTITIES,
+    Angle,
+    Bore,
+    Damping,
+    Duration,
+    ErrorAmplitude,
+    HalfBacklash,
+    Inertia,
+    Length,
+    MeshStiffness,
+    Speed,
+    StiffnessVariation,
+    Time,
+    Torque,
+    parse_quantity,
+    readings,
+    registry,
+)
+
+__all__ = [
+    "OUTPUTS",
+    "QUANTITIES",
+    "RADIUS_RATIO_TOLERANCE",
+    "RESPONSES",
+    "RPM",
+    "TORQUE_BALANCE_TOLERANCE",
+    "Angle",
+    "Bore",
+    "Damping",
+    "Duration",
+    "ErrorAmplitude",
+    "HalfBacklash",
+    "Inertia",
+    "Length",
+    "MeshStiffness",
+    "Scales",
+    "Speed",
+    "StiffnessVariation",
+    "Time",
+    "Torque",
+    "display_label",
+    "display_unit",
+    "field_label",
+    "field_unit",
+    "in_display_unit",
+    "in_si",
+    "parse_quantity",
+    "readings",
+    "registry",
+    "response_values",
+    "shown",
+    "to_physical",
+]

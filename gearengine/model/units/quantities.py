@@ -1,0 +1,274 @@
+"""Physical quantities as engineers type them: "1500 rpm", "50 um", "40 N*m", parsed with pint.
+
+A field of a physical design takes a string with a unit, or a bare number in SI units. Each
+kind of quantity (``QUANTITIES``) names its pint dimension, its SI unit and the range an actual
+spur-gear pair can have; a value outside that range is refused, and when reading the number in
+a neighbouring unit would put it inside ("100 m" for a backlash), the refusal says what was
+probably meant ("did you mean 100 µm?"). Errors are ``ValueError`` whose message pydantic puts
+after the field's path, so a 422 names the field, the unit given and the dimension expected.
+
+Reference: H. E. Grecco et al., pint (https://pint.readthedocs.io), the registry used here.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass, field
+from functools import cache
+from typing import TYPE_CHECKING, Annotated, Any
+
+from pydantic import BeforeValidator
+
+if TYPE_CHECKING:
+    import pint
+
+
+@cache
+def registry() -> pint.UnitRegistry:
+    """The one pint registry of the engine (rpm = revolution per minute, µm and um alike),
+    made when a quantity is first read: importing pint costs ~0.15 s, which every command and
+    the service's start-up would otherwise pay for designs given as plain numbers."""
+    import pint
+
+    return pint.UnitRegistry()
+
+
+@dataclass(frozen=True)
+class QuantityKind:
+    """A kind of physical quantity: its dimension, SI unit, plausible range and the units a
+    slip of the keyboard most likely meant (tried, in order, when a value is out of range)."""
+
+    name: str
+    unit: str
+    low: float
+    high: float
+    slips: tuple[str, ...]
+    example: str
+    spellings: dict[str, str] = field(default_factory=dict)
+    """Units as engineers type them that pint reads otherwise (``Nm``: pint's N is Avogadro's
+    number), and the unit meant; the whole unit text must match."""
+
+    @property
+    def dimensionality(self) -> Any:
+        return registry().Quantity(1.0, self.unit).dimensionality
+
+    def describe(self, si: float) -> str:
+        """``si`` in the kind's unit, 6 significant digits."""
+        return f"{si:.6g} {self.unit}"
+
+
+TORQUE_SPELLINGS = {"Nm": "N*m", "kNm": "kN*m", "MNm": "MN*m", "Nmm": "N*mm"}
+"""Torque units as typed on drawings and in spreadsheets, read as newton metres (pint reads
+``Nm`` as a number-metre, ``N`` being Avogadro's number there; ``N.m`` and ``N m`` it reads
+right)."""
+
+_READINGS: ContextVar[list[str] | None] = ContextVar("readings", default=None)
+
+
+@contextmanager
+def readings() -> Iterator[list[str]]:
+    """Collect, while validating inside this block, what ``parse_quantity`` understood from a
+    spelling of ``QuantityKind.spellings`` (one sentence each, for the notes of a design)."""
+    found: list[str] = []
+    token = _READINGS.set(found)
+    try:
+        yield found
+    finally:
+        _READINGS.reset(token)
+
+
+_NUMBER_AND_UNIT = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)\s*")
+
+
+def _respelled(text: str, kind: QuantityKind) -> str:
+    """``text`` with an engineer's spelling of the unit (``40 Nm``) written as pint reads it
+    (``40 N*m``), noted in the current ``readings``; other text unchanged."""
+    match = _NUMBER_AND_UNIT.fullmatch(text)
+    if match is None or match.group(2) not in kind.spellings:
+        return text
+    meant = f"{match.group(1)} {kind.spellings[match.group(2)]}"
+    found = _READINGS.get()
+    if found is not None:
+        found.append(f"{kind.name} {text.strip()!r} read as {meant!r}")
+    return meant
+
+
+QUANTITIES: dict[str, QuantityKind] = {
+    "length": QuantityKind("length", "m", 1e-9, 10.0, ("um", "mm"), "30 mm"),
+    "half_backlash": QuantityKind("half backlash", "m", 1e-7, 5e-3, ("um", "mm"), "50 um"),
+    "error": QuantityKind("transmission error", "m", 0.0, 1e-3, ("um", "mm"), "5 um"),
+    "speed": QuantityKind(
+        "shaft speed", "rad/s", 2 * math.pi / 60, 2e5 * 2 * math.pi / 60, ("rpm",), "1500 rpm"
+    ),
+    "torque": QuantityKind("torque", "N*m", 0.0, 1e6, (), "40 N*m", TORQUE_SPELLINGS),
+    "stiffness": QuantityKind("mesh stiffness", "N/m", 1e6, 1e11, ("N/um", "N/mm"), "1e8 N/m"),
+    "stiffness_variation": QuantityKind(
+        "stiffness variation", "N/m", 0.0, 1e11, ("N/um", "N/mm"), "1e7 N/m"
+    ),
+    "inertia": QuantityKind("inertia", "kg*m^2", 1e-9, 1e4, ("kg*cm^2", "kg*mm^2"), "2e-3 kg*m^2"),
+    "damping": QuantityKind("damping", "N*s/m", 0.0, 1e7, (), "1100 N*s/m"),
+    "angle": QuantityKind("angle", "rad", math.radians(10), math.radians(35), ("deg",), "20 deg"),
+    "displacement": QuantityKind("displacement", "m", 0.0, 1e-2, ("um", "mm"), "-30 um"),
+    "velocity": QuantityKind("velocity", "m/s", 0.0, 100.0, ("mm/s",), "200 mm/s"),
+    "speed_rate": QuantityKind(
+        "rate of change of shaft speed",
+        "rad/s^2",
+        2 * math.pi / 60,
+        1e6 * 2 * math.pi / 60,
+        ("rpm/s",),
+        "1000 rpm/s",
+    ),
+    "duration": QuantityKind("duration", "s", 1e-3, 3600.0, ("ms", "min"), "5 s"),
+}
+"""Kinds of quantity by key; ``low``/``high`` bound plausible magnitudes in SI units."""
+
+# Lengths of gear bodies (radius, module, face width, bore) may be zero only for a bore.
+POSITIVE_KINDS = frozenset({"length", "half_backlash", "speed", "stiffness", "inertia", "angle"})
+
+
+def parse_quantity(value: object, kind: QuantityKind, allow_zero: bool = False) -> float:
+    """``value`` (a string with a unit, or a number in SI units) in the kind's SI unit.
+
+    Raises ValueError naming the unit given and the dimension expected, or the plausible range
+    with a guess at the intended unit.
+    """
+    ureg = registry()
+    if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+        raise ValueError(f"give a number in {kind.unit} or a string with a unit, e.g. "
+                         f"{kind.example!r}")  # fmt: skip
+    if isinstance(value, str):
+        value = _respelled(value, kind)
+        try:
+            quantity = ureg.Quantity(value.strip())
+        except Exception as exc:
+            raise ValueError(f"cannot read {value!r} as a quantity ({exc}); write e.g. "
+                             f"{kind.example!r}") from None  # fmt: skip
+        if not isinstance(quantity, ureg.Quantity):
+            quantity = ureg.Quantity(float(quantity), kind.unit)
+        elif quantity.dimensionless and kind.unit not in ("rad",):
+            quantity = ureg.Quantity(quantity.magnitude, kind.unit)
+        if quantity.dimensionality != kind.dimensionality:
+            raise ValueError(
+                f"{value!r} has the unit {quantity.units:~} ({quantity.dimensionality}); "
+                f"a {kind.name} needs a unit of dimension {kind.dimensionality}, e.g. "
+                f"{kind.example!r}"
+            )
+        si = float(quantity.to(kind.unit).magnitude)
+    else:
+        si = float(value)
+    return _plausible(si, value, kind, allow_zero)
+
+
+def _plausible(si: float, given: object, kind: QuantityKind, allow_zero: bool) -> float:
+    """``si`` if finite and in the kind's range; else a refusal with the likely slip."""
+    if not math.isfinite(si):
+        raise ValueError(f"{given!r} is not a finite {kind.name}")
+    if si == 0.0 and allow_zero:
+        return si
+    if kind.low <= abs(si) <= kind.high and (si > 0.0 or kind.low == 0.0):
+        return si
+    ureg = registry()
+    shown = given if isinstance(given, str) else kind.describe(si)
+    message = (
+        f"{shown} is outside the plausible range of a {kind.name}, "
+        f"{kind.describe(kind.low)} to {kind.describe(kind.high)}"
+    )
+    magnitude = ureg.Quantity(given.strip()).magnitude if isinstance(given, str) else si
+    for slip in kind.slips:
+        meant = float(ureg.Quantity(abs(float(magnitude)), slip).to(kind.unit).magnitude)
+        if kind.low <= meant <= kind.high and meant > 0.0:
+            message += f": did you mean {magnitude:g} {ureg.Unit(slip):~P}?"
+            break
+    raise ValueError(message)
+
+
+NUMBER = r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?"
+"""A decimal number as pint reads it."""
+
+
+def quantity_pattern(kind: QuantityKind) -> str:
+    """The schema's pattern of a quantity string: a magnitude and one of the usual units (the
+    SI unit, the example's, a likely slip's), the magnitude's integer digits bounded so that it
+    lies in the plausible range in that unit ("30 mm", not "30000000 mm"); a unit whose range
+    no digit count fits takes any number ("20 deg"). What is read is wider (any unit of the
+    right dimension, "0.5 mm"): the pattern states the common case, and the example, so that
+    requests generated from the schema (schemathesis) are mostly valid."""
+    ureg = registry()
+    sign = "-?" if kind.low == 0.0 else ""
+    alternatives = [re.escape(kind.example)]
+    for unit in dict.fromkeys([kind.unit, kind.example.split(maxsplit=1)[-1], *kind.slips]):
+        per_si = float(ureg.Quantity(1.0, unit).to(kind.unit).magnitude)
+        digits = _integer_digits(kind.low / per_si, kind.high / per_si)
+        number = NUMBER
+        if digits is not None:
+            number = rf"{sign}[1-9]\d{{{digits[0] - 1},{digits[1] - 1}}}(\.\d{{1,3}})?"
+        alternatives.append(rf"{number} *{re.escape(unit)}")
+    return rf"^ *({'|'.join(alternatives)}) *$"
+
+
+def _integer_digits(low: float, high: float) -> tuple[int, int] | None:
+    """(fewest, most) integer digits of a number with a leading digit 1-9 that lies in
+    [low, high]: k digits span [10^(k-1), 10^k); None if no k fits."""
+    fewest = 1 if low <= 1.0 else math.ceil(math.log10(low)) + 1
+    most = math.floor(math.log10(high))
+    return (fewest, most) if fewest <= most else None
+
+
+class QuantitySchema:
+    """The JSON schema of a quantity field, made when a schema is asked for (the OpenAPI
+    document), not at import: the pattern's unit factors need pint (``registry``)."""
+
+    def __init__(self, kind: QuantityKind, allow_zero: bool, keyword: str | None) -> None:
+        self.kind, self.allow_zero, self.keyword = kind, allow_zero, keyword
+
+    def __get_pydantic_json_schema__(self, core: Any, handler: Any) -> dict[str, Any]:
+        kind = self.kind
+        low = -kind.high if kind.low == 0.0 else kind.low  # the plausible range (_plausible)
+        words = [] if self.keyword is None else [{"const": self.keyword}]
+        zero = [{"const": 0}] if self.allow_zero and kind.low > 0.0 else []
+        return {
+            "anyOf": [
+                *words,
+                {"type": "string", "pattern": quantity_pattern(kind), "examples": [kind.example]},
+                {"type": "number", "description": f"in {kind.unit}", "minimum": low,
+                 "maximum": kind.high},
+                *zero,
+            ],
+            "description": f"{kind.name}: a string with a unit (e.g. {kind.example!r}) or a "
+            f"number in {kind.unit}; plausible range {kind.describe(kind.low)} to "
+            f"{kind.describe(kind.high)}",
+        }  # fmt: skip
+
+
+def quantity_type(key: str, allow_zero: bool = False, keyword: str | None = None) -> Any:
+    """A pydantic field type: a string with a unit or an SI number, stored in SI units; a
+    ``keyword`` (such as "iso6336": derive it) passes through as the string itself."""
+    kind = QUANTITIES[key]
+
+    def parse(value: object) -> float | str:
+        if keyword is not None and value == keyword:
+            return keyword
+        return parse_quantity(value, kind, allow_zero)
+
+    stored = float if keyword is None else float | str
+    return Annotated[stored, BeforeValidator(parse), QuantitySchema(kind, allow_zero, keyword)]
+
+
+Length = quantity_type("length")
+Bore = quantity_type("length", allow_zero=True)
+HalfBacklash = quantity_type("half_backlash")
+ErrorAmplitude = quantity_type("error", allow_zero=True)
+Speed = quantity_type("speed")
+Torque = quantity_type("torque", allow_zero=True)
+Stiffness = quantity_type("stiffness")
+MeshStiffness = quantity_type("stiffness", keyword="iso6336")
+StiffnessVariation = quantity_type("stiffness_variation", allow_zero=True)
+Inertia = quantity_type("inertia")
+Damping = quantity_type("damping", allow_zero=True)
+Angle = quantity_type("angle")
+Duration = quantity_type("duration")
+Time = quantity_type("duration", allow_zero=True)

@@ -1,0 +1,333 @@
+"""Robustness studies: the probability of each response of the gears that will be built, at one
+operating point or over an envelope (speed x torque), and which tolerance matters. A kind of
+durable job (``gearengine.studies.jobs``): chunks of samples.
+
+A request is a design with ``tolerances``, integration settings, ``samples`` (N), a ``seed``,
+optional ``axes`` (physical fields of the design, as in sweeps) and ``sensitivity``. Its runs
+are the rows of the sample matrix (N rows; with sensitivity the N (D + 2) rows of the Saltelli
+design, ``studies.robustness.sensitivity``) at every operating point; chunk k holds rows
+[k c, (k + 1) c) at every point, so a chunk's result depends only on (request, k, c), and a
+resumed job equals an uninterrupted one. Every (point, row) is one design, analysed from every
+start of the settings by ``numerics.batch.simulate_batch`` (lanes of ``run_lanes``; the sample
+counts as its worst start, as the single analysis does), with the Melnikov verdict beside it.
+
+A chunk stores, per point and row: class code, contact code, Melnikov flag, DTE [µm] and
+dynamic factor F_max / F_m (compact JSON, ``RUN_FIELDS``).
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel, Field, ValidationError
+from pydantic_core import PydanticCustomError
+
+from gearengine.homoclinic.thresholds import chaos_possible
+from gearengine.model.design import Design
+from gearengine.model.params import request_config
+from gearengine.model.reduction import convert_design
+from gearengine.model.units import Scales, in_display_unit, response_values
+from gearengine.numerics.batch import simulate_batch
+from gearengine.numerics.settings import SimulationSettings, work
+from gearengine.studies import jobs
+from gearengine.studies.robustness import sensitivity
+from gearengine.studies.robustness.tolerances import (
+    ToleranceError,
+    Variable,
+    base_design,
+    probability,
+    sample_design,
+    sample_values,
+    sobol_points,
+    variables,
+)
+from gearengine.studies.sweep.axes import axis_problem, design_with, is_dimensionless
+from gearengine.studies.sweep.request import SweepAxis
+
+CLASSES = ("periodic", "quasi_periodic", "chaotic", "diverged")
+CONTACTS = ("no_impact", "single_sided", "double_sided")
+RUN_FIELDS = ("class", "contact", "melnikov", "dte_um", "dynamic_factor")
+"""The entries of one stored run, in order."""
+EVENTS = ("impacts", "back_flank", "dynamic_factor_above_limit", "melnikov_chaos_possible")
+OUTPUTS = ("chaotic", "impacts", "back_flank", "dte", "dynamic_factor")
+"""The outputs whose Sobol indices are reported."""
+DEFAULT_CHUNK_ROWS = 16
+MAX_SAMPLES = 4096
+
+
+class RobustnessRequest(BaseModel):
+    """A robustness study of a design with tolerances."""
+
+    model_config = request_config()
+
+    label: str | None = Field(None, max_length=200, description="Free text shown with the job.")
+    design: Design = Field(description="The nominal pair, with its tolerances.")
+    settings: SimulationSettings = Field(
+        default_factory=SimulationSettings, description="Integration settings of every run."
+    )
+    samples: int = Field(
+        256, ge=2, le=MAX_SAMPLES, description="Samples N of the tolerances (a power of 2)."
+    )
+    seed: int = Field(0, ge=0, le=2**32 - 1, description="Seed of the scrambled Sobol samples.")
+    sensitivity: bool = Field(
+        False, description="Also Sobol indices (SALib): N (D + 2) runs per point, D the fields."
+    )
+    dynamic_factor_limit: float = Field(
+        1.5, gt=1.0, le=100.0, allow_inf_nan=False,
+        description="The event dynamic_factor_above_limit: F_max / F_m above this.",
+    )  # fmt: skip
+    axes: list[SweepAxis] = Field(
+        default_factory=list,
+        max_length=2,
+        description="Operating envelope: physical fields of the design (speed, torque, ...); "
+        "none: the design's operating point.",
+    )
+
+    def variables(self) -> list[Variable]:
+        """The toleranced fields (``studies.robustness.tolerances.variables``)."""
+        return variables(self.design)
+
+    def unit_rows(self) -> np.ndarray:
+        """Every run's point of the unit cube, shape (rows, D)."""
+        d = len(self.variables())
+        if self.sensitivity:
+            return sensitivity.saltelli_points(d, self.samples, self.seed)
+        return sobol_points(d, self.samples, self.seed)
+
+    def n_rows(self) -> int:
+        d = len(self.variables())
+        return self.samples * (d + 2) if self.sensitivity else self.samples
+
+    def points(self) -> list[dict[str, float]]:
+        """The operating points (SI values of the axes' fields), first axis fastest."""
+        grids = [a.values(self.design) for a in self.axes]
+        names = [a.parameter for a in self.axes]
+        return [
+            dict(zip(names, values[::-1], strict=True))
+            for values in itertools.product(*grids[::-1])
+        ]
+
+
+def request_errors(request: RobustnessRequest) -> list[Any]:
+    """Checks needing the design: every tolerance (naming its field), every axis, N a power
+    of 2 (the Sobol sequence's balance)."""
+    errors: list[Any] = []
+    try:
+        request.variables()
+    except ToleranceError as exc:
+        errors.append(exc.details())
+    if request.samples & (request.samples - 1):
+        errors.append(_error(("samples",), "give a power of 2 (the Sobol points' balance)", 0))
+    for i, axis in enumerate(request.axes):
+        if is_dimensionless(axis.parameter):
+            errors.append(_error(("axes", i, "parameter"), "a physical field of the design", 0))
+            continue
+        problem = axis_problem(convert_design(request.design).params, request.design,
+                               axis.parameter, axis.start, axis.stop, {})  # fmt: skip
+        if problem is not None:
+            errors.append(_error(("axes", i, problem[0]), problem[1], axis.parameter))
+    return errors
+
+
+def _error(loc: tuple, message: str, value: object) -> Any:
+    return {"type": PydanticCustomError("robustness", message), "loc": loc, "input": value}
+
+
+def checked(request: RobustnessRequest, max_points: int | None = None) -> RobustnessRequest:
+    """``request`` if its tolerances and axes are sound; else ``ValidationError`` naming each
+    field (what the API and the CLI share)."""
+    errors = request_errors(request)
+    n = math.prod(a.num for a in request.axes)
+    if not errors and max_points is not None and n > max_points:
+        errors.append(_error(("axes",), f"{n} points, the limit is {max_points}", n))
+    if errors:
+        raise ValidationError.from_exception_data("RobustnessRequest", errors)
+    return request
+
+
+def chunk_counts(request: RobustnessRequest, rows: int) -> list[int]:
+    """Runs (point x row) of each chunk of ``rows`` rows."""
+    n, p = request.n_rows(), max(1, len(request.points()))
+    return [p * (min(n, lo + rows) - lo) for lo in range(0, n, rows)]
+
+
+def robustness_work(request: RobustnessRequest) -> int:
+    """RK4 steps of every run (nominal design at each point, times the rows)."""
+    base = base_design(request.design)
+    per_point = [
+        work(convert_design(design_with(base, values)).params, request.settings)
+        for values in request.points() or [{}]
+    ]
+    return request.n_rows() * sum(per_point)
+
+
+def _run(bp: Any, params: Any, scales: Scales) -> list[Any]:
+    """One run's row: class, contact, Melnikov verdict, DTE [um] and dynamic factor (the one
+    definition, ``model.units.response_values``)."""
+    response = response_values(bp.x_peak_to_peak, bp.force_max, scales)
+    contact = CONTACTS.index(bp.impact_regime) if bp.impact_regime in CONTACTS else None
+    return [
+        CLASSES.index(bp.classification),
+        contact,
+        chaos_possible(params),
+        response["dte"],
+        response["dynamic_factor"],
+    ]
+
+
+def compute_chunk(request: RobustnessRequest, index: int, rows: int) -> str:
+    """Chunk ``index``: rows [index rows, (index + 1) rows) at every point, as compact JSON
+    ``{"index", "first_row", "runs": [[run per row] per point]}``."""
+    variables_ = request.variables()
+    lo, hi = index * rows, min(request.n_rows(), (index + 1) * rows)
+    if not 0 <= lo < hi:
+        raise IndexError(f"chunk {index} out of range")
+    values = sample_values(variables_, request.unit_rows()[lo:hi])
+    base = base_design(request.design)
+    points = request.points() or [{}]
+    designs = [sample_design(base, {**v, **p}) for p in points for v in values]
+    conversions = [convert_design(d) for d in designs]
+    params = [c.params for c in conversions]
+    verdicts = simulate_batch(params, request.settings)
+    runs = [_run(bp, c.params, c.scales) for bp, c in zip(verdicts, conversions, strict=True)]
+    per_point = [runs[i * len(values) : (i + 1) * len(values)] for i in range(len(points))]
+    return json.dumps({"index": index, "first_row": lo, "runs": per_point}, separators=(",", ":"))
+
+
+class Probability(BaseModel):
+    """k of n samples, with the Clopper-Pearson 95 % interval."""
+
+    value: float | None = Field(description="k / n (null without samples).")
+    interval: list[float] | None = Field(description="95 % interval [low, high].")
+    count: int = Field(description="Samples k with the outcome.")
+    samples: int = Field(description="Samples n counted.")
+
+
+class RobustnessPoint(BaseModel):
+    """The answer at one operating point."""
+
+    values: dict[str, float] = Field(description="The axes' values (SI).")
+    shown: dict[str, float] = Field(description="The axes' values in gear units (rpm, N*m).")
+    samples: int = Field(description="Samples counted at this point.")
+    probabilities: dict[str, Probability] = Field(
+        description="Of each class (periodic, quasi_periodic, chaotic, diverged) and event "
+        "(impacts: any tooth separation; back_flank: back-flank impacts; "
+        "dynamic_factor_above_limit; melnikov_chaos_possible)."
+    )
+    dte_um: dict[str, float | None] = Field(description="DTE over the samples: mean, p5, p95.")
+    sensitivity: dict[str, dict[str, dict[str, float | None]] | None] | None = Field(
+        None, description="Sobol indices by output (chaotic, impacts, back_flank, dte, "
+        "dynamic_factor) and field: first, total, and their 95 % half-widths.",
+    )  # fmt: skip
+    ranking: list[str] | None = Field(None, description="The indices in plain words.")
+
+
+class RobustnessVariable(BaseModel):
+    path: str = Field(description="The field.")
+    distribution: str = Field(description="Its distribution, in words (SI units).")
+
+
+class RobustnessResult(BaseModel):
+    """Probabilities with intervals per operating point, and Sobol indices."""
+
+    points: list[RobustnessPoint]
+    samples: int = Field(description="Samples N requested.")
+    seed: int
+    variables: list[RobustnessVariable] = Field(description="The toleranced fields.")
+    partial: bool = Field(False, description="True when chunks are missing.")
+    model: list[str] = Field(description="What the sampling and the TE model assume.")
+
+
+ASSUMPTIONS = [
+    "tolerances vary independently; samples are scrambled Sobol points (seeded) mapped by "
+    "each distribution's inverse CDF; intervals are Clopper-Pearson 95 %",
+    "ISO 1328 class: the profile deviations drive the mesh-frequency transmission error; one "
+    "gear's TE amplitude is at most F_alpha / 2, two gears add as a root-sum-square, and the "
+    "amplitude is uniform between 0 and that bound (pitch deviations not modelled)",
+    "backlash band: circumferential j_t, b = j_t cos(alpha_wt) / 2, uniform within the band",
+    "a sample counts as its worst start (the single analysis' verdict)",
+]
+
+
+def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[int],
+                  complete: bool, variables_: list[Variable]) -> dict[str, Any]:  # fmt: skip
+    names, d = [v.path for v in variables_], len(variables_)
+    counted = set(sensitivity.base_rows(request.n_rows(), d)) if request.sensitivity else None
+    base = [r for row, r in zip(rows, runs, strict=True) if counted is None or row in counted]
+    n = len(base)
+    probs = {c: probability(sum(r[0] == k for r in base), n) for k, c in enumerate(CLASSES)}
+    probs["impacts"] = probability(sum(r[1] in (1, 2) for r in base), n)
+    probs["back_flank"] = probability(sum(r[1] == 2 for r in base), n)
+    limit = request.dynamic_factor_limit
+    probs["dynamic_factor_above_limit"] = probability(
+        sum(r[4] is not None and r[4] > limit for r in base), n
+    )
+    probs["melnikov_chaos_possible"] = probability(sum(r[2] is True for r in base), n)
+    dte = np.array([r[3] for r in base if r[3] is not None], dtype=float)
+    stats_ = {"mean": None, "p5": None, "p95": None}
+    if dte.size:
+        stats_ = {"mean": round(float(dte.mean()), 4),
+                  "p5": round(float(np.percentile(dte, 5)), 4),
+                  "p95": round(float(np.percentile(dte, 95)), 4)}  # fmt: skip
+    out: dict[str, Any] = {"samples": n, "probabilities": probs, "dte_um": stats_}
+    if request.sensitivity and complete:
+        ys = {
+            "chaotic": [r[0] == 2 for r in runs],
+            "impacts": [r[1] in (1, 2) for r in runs],
+            "back_flank": [r[1] == 2 for r in runs],
+            "dte": [math.nan if r[3] is None else r[3] for r in runs],
+            "dynamic_factor": [math.nan if r[4] is None else r[4] for r in runs],
+        }
+        table = {k: sensitivity.indices(names, np.array(y, float), request.seed)
+                 for k, y in ys.items()}  # fmt: skip
+        out["sensitivity"] = table
+        labels = {v.path: v.name for v in variables_}
+        out["ranking"] = [sensitivity.ranked(k, t, labels) for k, t in table.items()]
+    return out
+
+
+def assemble(request: RobustnessRequest, chunks: list[str]) -> RobustnessResult:
+    """The result from the chunks present (any subset, any order: a partial result counts the
+    samples it has; Sobol indices need every chunk)."""
+    variables_ = request.variables()
+    points = request.points() or [{}]
+    decoded = sorted((json.loads(c) for c in chunks), key=lambda c: c["first_row"])
+    complete = sum(len(c["runs"][0]) for c in decoded) == request.n_rows()
+    answers = []
+    for i, values in enumerate(points):
+        runs = [r for c in decoded for r in c["runs"][i]]
+        rows = [c["first_row"] + j for c in decoded for j in range(len(c["runs"][i]))]
+        answer = _point_answer(request, runs, rows, complete, variables_)
+        shown = {k: in_display_unit(k, v) for k, v in values.items()}
+        answers.append(RobustnessPoint.model_validate({"values": values, "shown": shown, **answer}))
+    return RobustnessResult(
+        points=answers,
+        samples=request.samples,
+        seed=request.seed,
+        variables=[RobustnessVariable(path=v.path, distribution=v.words) for v in variables_],
+        partial=not complete,
+        model=ASSUMPTIONS,
+    )
+
+
+def run_local(request: RobustnessRequest, progress_callback=None, workers: int = 1):
+    """Every chunk in this process (``jobs.run_local``): the CLI's document equals the API's."""
+    result = jobs.run_local("robustness", request, progress_callback, None, workers)
+    assert isinstance(result, RobustnessResult)
+    return result
+
+
+ROBUSTNESS_JOB = jobs.JobKind(
+    name="robustness",
+    request=RobustnessRequest,
+    chunk_points=DEFAULT_CHUNK_ROWS,
+    chunk_counts=chunk_counts,
+    work=robustness_work,
+    compute_chunk=compute_chunk,
+    assemble=assemble,
+)
+"""Robustness studies as a kind of job (``gearengine.studies.jobs.KINDS``)."""

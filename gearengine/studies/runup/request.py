@@ -1,0 +1,221 @@
+"""What a run-up asks for: a design, a driver-speed profile in time, and how to read it.
+
+The profile is a linear ramp between ``from_speed`` and ``to_speed`` (``from_speed`` below
+``to_speed``) at a ``rate`` or over a ``duration`` (each leg), run ``up`` (from -> to), ``down``
+(to -> from) or ``up_down`` (up, then down from where the up leg ended); or a list of
+``points`` [time, speed], linear between them. Speeds are strings with units ("500 rpm") or
+numbers in rad/s, rates "1000 rpm/s" or rad/s^2, times "5 s" or seconds. The torque may ramp
+linearly in time from the design's torque to ``to_torque`` over the whole profile.
+
+Refused before any compute (422 naming the field): a rate that is zero or negative, speeds
+outside the plausible range of a shaft (``model.units``), a profile whose integration is over
+the work budget (``MAX_RUNUP_STEPS``), a params-only request (a run-up needs the design's time
+scale), the cubic-fit law (the run-up kernel is the kink-accurate piecewise one).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, BeforeValidator, Field, WithJsonSchema
+from pydantic_core import InitErrorDetails, PydanticCustomError
+
+from gearengine.model.design import EXAMPLE_DESIGN
+from gearengine.model.params import request_config
+from gearengine.model.reduction import ParamsOrDesign
+from gearengine.model.units import (
+    QUANTITIES,
+    Duration,
+    Speed,
+    Time,
+    Torque,
+    parse_quantity,
+    registry,
+)
+from gearengine.numerics.settings import SimulationSettings
+
+MAX_RUNUP_STEPS = 200_000_000
+"""Cap on the RK4 steps of one run-up (every ensemble member, the quasi-static sweep aside)."""
+MAX_PROFILE_POINTS = 1000
+"""Most [time, speed] points of a profile."""
+MAX_ENSEMBLE = 64
+"""Most ensemble members (slightly perturbed starts) of the finite-time Lyapunov exponent."""
+
+
+def _positive_rate(value: object) -> float:
+    """A rate of change of speed: > 0 (the direction says up or down), then plausible."""
+    kind = QUANTITIES["speed_rate"]
+    try:
+        return parse_quantity(value, kind)
+    except ValueError:
+        magnitude = value
+        if isinstance(value, str):
+            try:
+                magnitude = registry().Quantity(value.strip()).magnitude
+            except Exception:  # pint's own errors: parse_quantity's message says it all
+                raise ValueError(f"cannot read {value!r}; write e.g. {kind.example!r}") from None
+        number = isinstance(magnitude, (int, float)) and not isinstance(magnitude, bool)
+        if number and magnitude <= 0:  # type: ignore[operator]
+            raise ValueError(
+                f"the rate must be positive, got {value!r}: the direction (up, down, up_down) "
+                "says which way the speed goes"
+            ) from None
+        raise
+
+
+SpeedRate = Annotated[
+    float,
+    BeforeValidator(_positive_rate),
+    WithJsonSchema(
+        {
+            "anyOf": [{"type": "string", "examples": ["1000 rpm/s"]}, {"type": "number"}],
+            "description": "rate of change of the driver speed: a string with a unit (e.g. "
+            "'1000 rpm/s') or a number in rad/s^2; positive (direction says up or down)",
+        }
+    ),
+]
+
+RunupDirection = Literal["up", "down", "up_down"]
+
+
+class Ensemble(BaseModel):
+    """The slightly perturbed starts of the finite-time Lyapunov exponent."""
+
+    model_config = request_config()
+
+    size: int = Field(8, ge=1, le=MAX_ENSEMBLE, description="Members (the nominal start first).")
+    perturbation: float = Field(
+        1e-6, gt=0.0, le=1e-2, description="Standard deviation of the start perturbation of "
+        "x and x' (units of b and b w_n)."
+    )  # fmt: skip
+    seed: int = Field(0, ge=0, description="Seed of numpy.random.default_rng.")
+
+
+QUASI_STATIC_SETTINGS = {"transient_periods": 60, "record_periods": 40, "steps_per_period": 128}
+"""Settings of each point of the quasi-static continuation sweep unless the request gives them."""
+
+
+class RunupRequest(ParamsOrDesign):
+    """A run-up, run-down or both of a design through a range of driver speeds."""
+
+    model_config = request_config(
+        {
+            "design": EXAMPLE_DESIGN,
+            "from_speed": "500 rpm",
+            "to_speed": "6000 rpm",
+            "rate": "1000 rpm/s",
+            "direction": "up_down",
+            "bin_rpm": 50,
+        }
+    )
+
+    from_speed: Speed | None = Field(None, description="Lower speed of a linear ramp.")
+    to_speed: Speed | None = Field(None, description="Upper speed of a linear ramp.")
+    rate: SpeedRate | None = Field(None, description="Ramp rate (give rate or duration).")
+    duration: Duration | None = Field(None, description="Duration of each leg of the ramp.")
+    direction: RunupDirection = Field("up", description="up, down, or up then down.")
+    points: (
+        Annotated[
+            list[Annotated[tuple[Time, Speed], Field(strict=False)]],
+            Field(min_length=2, max_length=MAX_PROFILE_POINTS),
+        ]
+        | None
+    ) = Field(
+        None,
+        description="Instead of a ramp: [[time, speed], ...], times increasing from 0, speed "
+        "linear in between; rising stretches are read as up, falling ones as down.",
+        examples=[[["0 s", "500 rpm"], ["3 s", "6000 rpm"], ["5 s", "2000 rpm"]]],
+    )
+    to_torque: Torque | None = Field(
+        None, description="Torque at the end of the profile (linear in time from the design's)."
+    )
+    bin_rpm: float = Field(
+        50.0, gt=0.0, le=10_000.0, allow_inf_nan=False, description="Width of a speed bin [rpm]."
+    )  # fmt: skip
+    steps_per_period: int = Field(
+        64, ge=16, le=1000, description="RK4 steps per period of the fastest of the natural "
+        "frequency and the excitations, at the segment's top speed."
+    )  # fmt: skip
+    settle_periods: int = Field(
+        100, ge=0, le=100_000, description="Mesh periods at the start speed before the ramp."
+    )
+    ensemble: Ensemble = Field(default_factory=Ensemble)
+    quasi_static: SimulationSettings = Field(
+        default_factory=lambda: SimulationSettings(**QUASI_STATIC_SETTINGS),  # type: ignore[arg-type]
+        description="Settings of each point of the quasi-static continuation sweep (bin centres).",
+    )
+    label: str | None = Field(None, max_length=200, description="The client's name for it.")
+
+    def leg_seconds(self) -> float:
+        """Duration of one leg of a linear ramp [s]."""
+        assert self.from_speed is not None and self.to_speed is not None
+        if self.duration is not None:
+            return self.duration
+        assert self.rate is not None
+        return (self.to_speed - self.from_speed) / self.rate
+
+    def knots(self) -> list[tuple[float, float]]:
+        """The profile as [(time s, speed rad/s)], linear in between."""
+        if self.points is not None:
+            return [(float(t), float(w)) for t, w in self.points]
+        lo, hi, leg = self.from_speed, self.to_speed, self.leg_seconds()
+        assert lo is not None and hi is not None
+        return {
+            "up": [(0.0, lo), (leg, hi)],
+            "down": [(0.0, hi), (leg, lo)],
+            "up_down": [(0.0, lo), (leg, hi), (2.0 * leg, lo)],
+        }[self.direction]
+
+    def speed_range(self) -> tuple[float, float]:
+        """Lowest and highest speed of the profile [rad/s]."""
+        speeds = [w for _, w in self.knots()]
+        return min(speeds), max(speeds)
+
+    def duration_s(self) -> float:
+        """Length of the profile [s]."""
+        return self.knots()[-1][0]
+
+
+def request_errors(request: RunupRequest) -> list[InitErrorDetails]:
+    """Checks across fields, as pydantic error details naming each field: a design with the
+    piecewise law, one profile (points, or from/to with rate or duration), ordered speeds and
+    times (the work budget is ``profile.checked``'s), all before any compute."""
+    errors: list[InitErrorDetails] = []
+
+    def add(loc: tuple[str | int, ...], message: str, value: object) -> None:
+        errors.append({"type": PydanticCustomError("runup", message), "loc": loc, "input": value})
+
+    design = request.design
+    if design is None:
+        add(("design",), "a run-up needs a design in physical units (its time scale)", None)
+    elif design.backlash_law != "piecewise":
+        add(("design", "backlash_law"), "run-ups integrate the piecewise law (Eq. 6)",
+            design.backlash_law)  # fmt: skip
+    ramp = {"from_speed": request.from_speed, "to_speed": request.to_speed,
+            "rate": request.rate, "duration": request.duration}  # fmt: skip
+    if request.points is not None:
+        for name, value in ramp.items():
+            if value is not None:
+                add((name,), "give points or a ramp (from_speed, to_speed, rate), not both", value)
+        if request.direction != "up":
+            add(("direction",), "a points profile says its own direction", request.direction)
+        times = [t for t, _ in request.points]
+        if times[0] != 0.0 or any(b <= a for a, b in itertools.pairwise(times)):
+            add(("points",), "times must start at 0 s and increase", times)
+    else:
+        for name in ("from_speed", "to_speed"):
+            if ramp[name] is None:
+                add((name,), "give from_speed and to_speed (or points)", None)
+        lo, hi = request.from_speed, request.to_speed
+        if lo is not None and hi is not None and not lo < hi:
+            add(("to_speed",), "must be above from_speed (direction down runs down)", hi)
+        if (request.rate is None) == (request.duration is None):
+            add(("rate",), "give rate or duration (one of them)", request.rate)
+    return errors
+
+
+def n_bins(lo_rpm: float, hi_rpm: float, width: float) -> int:
+    """Bins of ``width`` rpm from ``lo_rpm`` covering ``hi_rpm`` (the last one may be short)."""
+    return max(1, math.ceil((hi_rpm - lo_rpm) / width - 1e-9))

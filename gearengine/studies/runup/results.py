@@ -1,0 +1,120 @@
+"""The documents a run-up returns (``POST /v1/runups`` and ``gearengine runup --json``)."""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, ConfigDict, Field
+
+
+class _Result(BaseModel):
+    model_config = ConfigDict(frozen=True)
+
+
+class RunupBin(_Result):
+    """What the gear did while its speed crossed one bin (on one branch)."""
+
+    speed_rpm: list[float] = Field(description="[low, high] driver speed of the bin [rpm].")
+    time_s: list[float] = Field(description="[first, last] time the profile spent in it [s].")
+    dte_peak_to_peak_um: float | None = Field(
+        description="Dynamic transmission error b (x_max - x_min) over the bin [µm]."
+    )
+    force_max_n: float | None = Field(description="Largest dynamic mesh force [N].")
+    force_min_n: float | None = Field(description="Smallest dynamic mesh force [N].")
+    dynamic_factor: float | None = Field(
+        description="Largest mesh force over the mean force F^_m of the moment (torque ramp "
+        "and acceleration included)."
+    )
+    separation_fraction: float | None = Field(
+        description="Share of the time with no tooth contact (|x| <= 1)."
+    )
+    back_flank_fraction: float | None = Field(description="Share of the time on the back flank.")
+    contact: str | None = Field(
+        description="drive_flank (always in contact), no_contact (loses contact at times), "
+        "both_flanks (reaches the back flank)."
+    )
+    back_flank_impacts: int | None = Field(description="Entries onto the back flank.")
+    drive_flank_impacts: int | None = Field(
+        description="Re-engagements of the drive flank after a separation."
+    )
+    lle: float | None = Field(
+        description="Ensemble-averaged finite-time Lyapunov exponent over the bin, per unit "
+        "tau (x 1/time_scale_s for 1/s); null where a member diverged."
+    )
+    lle_stderr: float | None = Field(description="Its standard error over the ensemble.")
+    chaotic: bool | None = Field(
+        description="lle > 1e-3 and > 3 lle_stderr (signals.classify's rule)."
+    )
+
+
+class RunupJump(_Result):
+    """A sudden change of the response amplitude between neighbouring bins."""
+
+    speed_rpm: float = Field(description="Where it happened: the edge between the two bins.")
+    from_um: float = Field(description="DTE before it, in the direction of travel [µm].")
+    to_um: float = Field(description="DTE after it [µm].")
+    quasi_static_speed_rpm: float | None = Field(
+        None, description="The quasi-static jump of the same branch and sense nearest to it."
+    )
+    lag_rpm: float | None = Field(
+        None, description="How far past the quasi-static jump, in the direction of travel, "
+        "the ramp jumped [rpm] (positive: later)."
+    )  # fmt: skip
+
+
+class RunupBranch(_Result):
+    """One direction of the profile: its bins in the order travelled, and its jumps."""
+
+    bins: list[RunupBin]
+    jumps: list[RunupJump]
+
+
+class QuasiStaticPoint(_Result):
+    """The steady state of the continuation sweep at one bin centre."""
+
+    speed_rpm: float
+    dte_peak_to_peak_um: float | None
+    dynamic_factor: float | None
+    classification: str | None
+    impact_regime: str | None
+    lle: float | None = Field(description="Largest Lyapunov exponent per unit tau.")
+
+
+class QuasiStaticBranch(_Result):
+    """One branch of the hysteresis loop (continuation up or down, in that order)."""
+
+    points: list[QuasiStaticPoint]
+    jumps: list[RunupJump]
+
+
+class QuasiStatic(_Result):
+    """The quasi-static answer: the continuation sweep on the bin centres, up and down."""
+
+    up: QuasiStaticBranch
+    down: QuasiStaticBranch
+    grid_step_rpm: float = Field(description="Spacing of the sweep's speeds [rpm].")
+    torque_nm: float = Field(description="Torque of the sweep (the design's) [N m].")
+
+
+class RunupMethod(_Result):
+    """How the run-up was integrated and read, in words and numbers."""
+
+    integration: str
+    lyapunov: str
+    jumps: str
+    ensemble: int
+    steps: int = Field(description="RK4 steps of all members.")
+    bin_rpm: float
+
+
+class RunupResult(_Result):
+    """A run-up or run-down of a design: bins against speed, jumps, and the quasi-static loop."""
+
+    up: RunupBranch | None
+    down: RunupBranch | None
+    quasi_static: QuasiStatic
+    melnikov_windows_rpm: list[list[float]] = Field(
+        description="Speeds [rpm] where the Melnikov criterion allows chaos (design's torque)."
+    )
+    time_scale_s: float = Field(description="1 / w_n [s]: tau = t / time_scale_s.")
+    duration_s: float
+    method: RunupMethod
+    notes: list[str]

@@ -1,0 +1,256 @@
+"""Computing a sweep's chunks: the numerical verdict of each point (``numerics.batch``) with the
+Melnikov verdict beside it; continuation carries the final state along a line, and on a
+one-axis sweep locates the line's bifurcation points, carried in the chunk's output.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from gearengine.homoclinic.thresholds import chaos_possible
+from gearengine.model.aliases import ALIASES, get_alias
+from gearengine.model.params import GearParams
+from gearengine.model.units import OUTPUTS, Scales, display_unit, in_display_unit, response_values
+from gearengine.numerics.attractors import coexisting, points_attractors
+from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
+from gearengine.numerics.bifurcations import PointResponse, locate_bifurcations
+from gearengine.numerics.forcing import step_plan
+from gearengine.numerics.results import BatchPoint
+from gearengine.numerics.settings import SimulationSettings
+from gearengine.studies import jobs
+from gearengine.studies.sweep.axes import is_dimensionless
+from gearengine.studies.sweep.export import chunk_json, points_of_chunk, result_json
+from gearengine.studies.sweep.plan import (
+    DEFAULT_CHUNK_POINTS,
+    LARGEST_CHUNK_POINTS,
+    SweepPlan,
+    sweep_work,
+)
+from gearengine.studies.sweep.points import PhysicalValue, SweepBifurcation, SweepPoint
+from gearengine.studies.sweep.request import SweepBranch, SweepRequest
+from gearengine.studies.sweep.results import SweepResult
+from gearengine.studies.sweep.windows import SPEED, speed_windows
+
+
+def _physical(
+    values: dict[str, float], params: GearParams, scales: Scales | None, bp: BatchPoint
+) -> dict[str, Any]:
+    """With a design (its ``scales``): the axes in display units, the responses of
+    ``model.units.response_values`` (DTE in µm, dynamic factor) and the point's aliases."""
+    if scales is None:
+        return {}
+    shown = {
+        name: PhysicalValue(value=in_display_unit(name, si), unit=display_unit(name)[0])
+        for name, si in values.items()
+        if not is_dimensionless(name)
+    }
+    for key, value in response_values(bp.x_peak_to_peak, bp.force_max, scales).items():
+        if value is not None:
+            shown[key] = PhysicalValue(value=value, unit=OUTPUTS[key].unit)
+    aliases = {a: get_alias(params, a) for a in ALIASES}
+    return {"physical": shown, "dimensionless": {k: v for k, v in aliases.items() if v is not None}}
+
+
+def _point(
+    values: dict[str, float],
+    branch: SweepBranch | None,
+    params: GearParams,
+    scales: Scales | None,
+    bp: BatchPoint,
+    basins: dict[str, Any],
+) -> SweepPoint:
+    """The sweep's point from the engine's verdict ``bp`` (typed and finite, built by
+    ``numerics.batch``), so ``model_construct`` skips a second validation (~0.05 ms a point);
+    ``basins`` its attractors, basins and coexisting entries (empty without basins)."""
+    possible = chaos_possible(params)
+    return SweepPoint.model_construct(
+        values={name: float(v) for name, v in values.items()},
+        branch=branch,
+        classification=bp.classification,
+        period=bp.period,
+        lle=bp.lle,
+        lle_stderr=bp.lle_stderr,
+        impact_regime=bp.impact_regime,
+        melnikov_chaos_possible=None if possible is None else bool(possible),
+        poincare_x=[s[0] for s in bp.poincare],
+        x_peak_to_peak=bp.x_peak_to_peak,
+        periods_run=bp.periods_run,
+        force_max=bp.force_max,
+        force_min=bp.force_min,
+        **_physical(values, params, scales, bp),
+        **basins,
+    )
+
+
+def compute_chunk(
+    request: SweepRequest, chunk_index: int, chunk_points: int = DEFAULT_CHUNK_POINTS
+) -> list[SweepPoint]:
+    """Verdicts of the points of one chunk, in the chunk's order (deterministic)."""
+    return _compute(request, chunk_index, chunk_points)[0]
+
+
+def _compute(
+    request: SweepRequest, chunk_index: int, chunk_points: int
+) -> tuple[list[SweepPoint], list[SweepBifurcation] | None]:
+    """A chunk's points and, for a line of a one-axis continuation sweep, the bifurcation
+    points located on it (``numerics.bifurcations``; None for other chunks)."""
+    chunk = SweepPlan(request, chunk_points).chunk(chunk_index)
+    axes = request.axes
+    grids = request.grids()
+    values = [{a.parameter: grids[k][ix[k]] for k, a in enumerate(axes)} for ix in chunk.points]
+    scaled = [request.scaled_point(v) for v in values]
+    designs = [params for params, _ in scaled]
+    if not request.continuation:
+        verdicts = simulate_batch(designs, request.settings)
+    else:
+        verdicts = []
+        settings = request.settings
+        for design in designs:
+            (bp,) = simulate_batch([design], settings)
+            verdicts.append(bp)
+            settings = _carried(request.settings, bp)
+    ensembles = _basins(request, scaled, verdicts)
+    points = [
+        _point(v, chunk.branch, params, scales, bp, e)
+        for v, (params, scales), bp, e in zip(values, scaled, verdicts, ensembles, strict=True)
+    ]
+    if not request.continuation or len(axes) != 1 or len(values) < 2:
+        return points, None
+    line = [v[axes[0].parameter] for v in values]
+    return points, _line_bifurcations(request, line, designs, verdicts)
+
+
+def _basins(
+    request: SweepRequest,
+    scaled: list[tuple[GearParams, Scales | None]],
+    verdicts: list[BatchPoint],
+) -> list[dict[str, Any]]:
+    """Per point, with ``settings.basins``: its attractors and basin counts
+    (``numerics.attractors``, every point's starts in one ``run_lanes`` call; a box in units
+    read with the point's own scales) and, on a continuation line, the attractors coexisting
+    with the followed branch; else empty."""
+    if request.settings.basins is None:
+        return [{} for _ in scaled]
+    designs = [params for params, _ in scaled]
+    found = points_attractors(designs, request.settings, [sc for _, sc in scaled])
+    out: list[dict[str, Any]] = [{"attractors": a, "basins": c} for a, c in found]
+    if request.continuation:
+        for entry, bp in zip(out, verdicts, strict=True):
+            entry["coexisting"] = coexisting(bp, entry["attractors"], entry["basins"])
+    return out
+
+
+def _line_bifurcations(
+    request: SweepRequest, line: list[float], designs: list[GearParams], verdicts: list[BatchPoint]
+) -> list[SweepBifurcation]:
+    """Bifurcation points of one continuation line, followed from its computed responses.
+
+    The line's points are reused (``PointResponse``), so only Newton shooting, the location of each
+    crossing and one simulation per crossing (the branch switch) are added. Incommensurate
+    forcing has no Poincare period and so no multipliers: no points then.
+    """
+    responses = [
+        PointResponse(
+            bp.classification,
+            bp.period,
+            bp.poincare[-1] if bp.poincare else None,
+            None if bp.final_state is None else (bp.final_state[0], bp.final_state[1]),
+        )
+        for bp in verdicts
+    ]
+    alias = request.axes[0].parameter
+    steps = request.settings.steps_per_period
+    if any(step_plan(d, steps).omega0 is None for d in designs):
+        return []
+
+    def path(v: float) -> GearParams:
+        return request.point({alias: v})
+
+    assert request.params is not None
+    events = locate_bifurcations(
+        request.params, alias, line, request.settings, responses=responses, path=path
+    )
+    if is_dimensionless(alias):
+        return [SweepBifurcation.model_validate(e) for e in events]
+    unit = display_unit(alias)[0]
+    return [
+        SweepBifurcation.model_validate(
+            {**e, "physical": None if e["value"] is None else
+             PhysicalValue(value=in_display_unit(alias, e["value"]), unit=unit)}
+        )
+        for e in events
+    ]  # fmt: skip
+
+
+def _carried(settings: SimulationSettings, bp: BatchPoint) -> SimulationSettings:
+    """Settings starting from the final state of ``bp`` (the original starts if it diverged)."""
+    if bp.final_state is None:
+        return settings
+    return settings.model_copy(
+        update={
+            "initial_state": list(bp.final_state),
+            "initial_states": None,
+            "random_initial_states": None,
+        }
+    )
+
+
+def _chunk_text(request: SweepRequest, chunk_index: int, chunk_points: int) -> str:
+    return chunk_json(*_compute(request, chunk_index, chunk_points), request.outputs)
+
+
+def compute_chunk_json(request_json: str, chunk_index: int, chunk_points: int) -> str:
+    """``compute_chunk`` on JSON text, returning the chunk's output (what workers exchange):
+    a JSON array of points, or for a continuation line also its bifurcations (``chunk_json``)."""
+    return _chunk_text(SweepRequest.model_validate_json(request_json), chunk_index, chunk_points)
+
+
+def run_local(
+    request: SweepRequest,
+    progress_callback: Callable[[int, int], None] | None = None,
+    chunk_points: int | None = None,
+    workers: int = 1,
+) -> SweepResult:
+    """Compute every chunk in this process (``jobs.run_local``); ``progress_callback(done,
+    total)`` in points.
+
+    ``workers`` > 1 computes chunks on that many threads: the kernels release the GIL
+    (``nogil``), so one chunk's verdicts (Python) overlap another's integration. The result
+    does not depend on it; under numba's workqueue threading layer, which cannot run two
+    parallel kernels at once, the chunks run one after the other.
+
+    ``chunk_points`` defaults to ``LARGEST_CHUNK_POINTS`` without continuation: the batch
+    kernel refills a lane as soon as its point stops early (adaptive stopping), which pays
+    only when a lane has several points to run; points do not depend on their chunk.
+    """
+    if chunk_points is None:
+        chunk_points = DEFAULT_CHUNK_POINTS if request.continuation else LARGEST_CHUNK_POINTS
+    if workers > 1 and not threads_may_share_kernels():
+        workers = 1  # numba's workqueue layer: one kernel call at a time, or it aborts
+    result = jobs.run_local("sweep", request, progress_callback, chunk_points, workers)
+    assert isinstance(result, SweepResult)
+    return result
+
+
+def assemble(request: SweepRequest, arrays: list[str]) -> SweepResult:
+    """The ``SweepResult`` of a sweep from its chunks' outputs in index order (with speed
+    windows for a speed axis)."""
+    windows = None  # only a speed axis has windows: else the points are not read back
+    if any(a.parameter == SPEED for a in request.axes):
+        points = [SweepPoint.model_validate(p) for text in arrays for p in points_of_chunk(text)]
+        windows = speed_windows(request, points)
+    text = "".join(result_json(request.axes, arrays, windows=windows))
+    return SweepResult.model_validate_json(text)
+
+
+SWEEP_JOB = jobs.JobKind(
+    name="sweep",
+    request=SweepRequest,
+    chunk_points=DEFAULT_CHUNK_POINTS,
+    chunk_counts=lambda request, size: SweepPlan(request, size).point_counts(),
+    work=sweep_work,
+    compute_chunk=_chunk_text,
+    assemble=assemble,
+)
+"""Sweeps as a kind of job (``gearengine.studies.jobs.KINDS``)."""
