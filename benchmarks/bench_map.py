@@ -101,13 +101,13 @@ def floor_seconds(num: int, points: list[dict]) -> tuple[float, float]:
     no adaptive run can avoid, at fixed length: (1) the chaotic and quasi-periodic points over
     all 1000 periods (issue 13 keeps their LLE unchanged, so they run to the end) and (2) the
     periodic points over the fewest periods the stopping rule allows, ``ADAPT_SETTLE +
-    ADAPT_WINDOW`` (numerics/kernels/adaptive.py). Diverged points count as free, and so does
-    every verdict, document and figure."""
-    from gearengine.numerics import kernels
+    ADAPT_WINDOW`` (systems/spur_pair/kernels/adaptive.py). Diverged points count as free, and so
+    does every verdict, document and figure."""
     from gearengine.numerics.batch import simulate_batch
-    from gearengine.numerics.kernels.adaptive import ADAPT_SETTLE, ADAPT_WINDOW
     from gearengine.numerics.settings import SimulationSettings
     from gearengine.studies.sweep.request import validated
+    from gearengine.systems.spur_pair import kernels
+    from gearengine.systems.spur_pair.kernels.adaptive import ADAPT_SETTLE, ADAPT_WINDOW
 
     request = validated(map_doc(num, False))
     full = [request.point(p["values"]) for p in points if p["classification"] in FULL_LENGTH]
@@ -230,7 +230,7 @@ def main() -> None:
         f"previous implementation (commit {BASELINE}, extracted with `git archive`, its numba "
         "cache warmed first) and of this one with adaptive stopping (default) and with "
         '`"adaptive": false`; and `gear_ref --simd --batch We` single-threaded, one call per '
-        "F_e1 line, on the same points. Adaptive stopping: numerics/kernels/adaptive.py. "
+        "F_e1 line, on the same points. Adaptive stopping: systems/spur_pair/kernels/adaptive.py. "
         "Wall times on a shared machine vary; the CPU time of each command is beside it.\n\n"
         f"{table}\n{summary}\n",
     )

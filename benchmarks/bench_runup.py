@@ -21,13 +21,13 @@ from report import write_section  # benchmarks/report.py (the script's own folde
 
 from gearengine.model.design import EXAMPLE_DESIGN
 from gearengine.model.units import RPM
-from gearengine.numerics.forcing import packed_forcing
-from gearengine.numerics.kernels import run_kink
 from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.studies.runup import run_local
 from gearengine.studies.runup.compute import compute_chunk
 from gearengine.studies.runup.profile import runup_plan, validated
 from gearengine.studies.sweep.axes import point_params
+from gearengine.systems.spur_pair.forcing import packed_forcing
+from gearengine.systems.spur_pair.kernels import run_kink
 
 REPEATS = 3
 

@@ -11,8 +11,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from gearengine.model.params import GearParams
-from gearengine.numerics.forcing import forcing_coefficients, law, step_plan
 from gearengine.signals.periodicity import attractor_size, detect_period
+from gearengine.systems.spur_pair.forcing import forcing_coefficients, law, step_plan
 
 GEAR_REF_SOURCE = Path("/work/shared/reference/gear_ref.c")
 

@@ -1,5 +1,5 @@
-"""Adaptive stopping (``numerics.kernels.adaptive``) against the fixed-length run on a 40 x 40
-subsample of the chaos map, the mesh-force extremes of the three kernels, and the gate's
+"""Adaptive stopping (``systems.spur_pair.kernels.adaptive``) against the fixed-length run on a 40
+x 40 subsample of the chaos map, the mesh-force extremes of the three kernels, and the gate's
 --max-dynamic-factor rule."""
 
 from __future__ import annotations
@@ -14,17 +14,17 @@ import pytest
 
 from gearengine.gate.envelope import Rules, envelope_report
 from gearengine.model.params import GearParams
-from gearengine.numerics import kernels
 from gearengine.numerics.batch import simulate_batch
-from gearengine.numerics.forcing import law, packed_forcing, step_plan
-from gearengine.numerics.kernels.adaptive import (
+from gearengine.numerics.settings import SimulationSettings
+from gearengine.studies.sweep import run_local, validated
+from gearengine.studies.sweep.request import SweepRequest
+from gearengine.systems.spur_pair import kernels
+from gearengine.systems.spur_pair.forcing import law, packed_forcing, step_plan
+from gearengine.systems.spur_pair.kernels.adaptive import (
     ADAPT_LLE_MIN_RECORD,
     ADAPT_SETTLE,
     ADAPT_WINDOW,
 )
-from gearengine.numerics.settings import SimulationSettings
-from gearengine.studies.sweep import run_local, validated
-from gearengine.studies.sweep.request import SweepRequest
 from tests.conftest import ROOT
 
 LIGHT = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}

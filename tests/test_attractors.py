@@ -23,8 +23,8 @@ from pydantic import ValidationError
 
 from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.numerics.attractors import attractors, basin_starts
-from gearengine.numerics.forcing import forcing_coefficients, step_plan
 from gearengine.numerics.settings import BasinSettings, SimulationSettings
+from gearengine.systems.spur_pair.forcing import forcing_coefficients, step_plan
 from tests._gear_cases import gear_ref_binary
 from tests.conftest import ROOT
 

@@ -15,8 +15,8 @@ from gearengine.model.design import Design
 from gearengine.model.frequencies import MAX_DENOMINATOR, forcing_period, poincare_frequency
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import convert_design
-from gearengine.numerics.forcing import step_plan
 from gearengine.studies.sweep import run_local, validated
+from gearengine.systems.spur_pair.forcing import step_plan
 
 LIGHT = {"transient_periods": 40, "record_periods": 40, "steps_per_period": 64}
 

@@ -23,8 +23,8 @@ from gearengine.model.conversion import to_dimensionless
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import convert_design, physical_data
-from gearengine.numerics.forcing import forcing_coefficients
 from gearengine.numerics.results import NumericsResult
+from gearengine.systems.spur_pair.forcing import forcing_coefficients
 from tests.test_conversion import dimensionless_response, physical_response
 
 

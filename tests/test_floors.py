@@ -13,23 +13,25 @@ from tests.conftest import ROOT
 FLOORS: dict[str, int] = {
     "gearengine.lazyload": 0,
     "gearengine.jitcache": 0,
-    "gearengine.jsonio": 2,
     "gearengine.model": 1,
-    "gearengine.systems": 2,
+    "gearengine.jsonio": 2,
     "gearengine.signals": 2,
-    "gearengine.numerics": 3,
-    "gearengine.homoclinic": 3,
-    "gearengine.engineering": 4,
-    "gearengine.analysis": 5,
-    "gearengine.studies": 6,
-    "gearengine.gate": 7,
-    "gearengine.plots": 8,
-    "gearengine.cli": 9,
-    "gearengine": 9,  # the facade, gearengine/__init__.py
+    "gearengine.systems": 3,
+    "gearengine.numerics": 4,
+    "gearengine.homoclinic": 4,
+    "gearengine.engineering": 5,
+    "gearengine.analysis": 6,
+    "gearengine.studies": 7,
+    "gearengine.gate": 8,
+    "gearengine.plots": 9,
+    "gearengine.cli": 10,
+    "gearengine": 10,  # the facade, gearengine/__init__.py
 }
 """Room (a package or module of the engine) -> its floor; the data flows upwards: model ->
-systems -> numerics and homoclinic (signals reads their series) -> one point's verdicts ->
-studies (job kinds) -> gates -> plots -> commands and the facade."""
+systems (their kernels) -> numerics (drives any system) and homoclinic -> one point's verdicts
+-> studies (job kinds) -> gates -> plots -> commands and the facade. ``signals`` reads a series
+with array functions only (a rig's or a simulation's), so it stands on the model alone and the
+kernels and numerics hand their series to it."""
 
 MAX_LINES = 450
 LONG_KERNELS: frozenset[str] = frozenset()

@@ -21,15 +21,15 @@ from scipy.optimize import brentq, root
 
 from gearengine.cli import main
 from gearengine.model.params import GearParams
-from gearengine.numerics import kernels
 from gearengine.numerics.bifurcations import feigenbaum_ratios, locate_bifurcations
 from gearengine.numerics.floquet import NEWTON_MAX_STEPS, floquet, floquet_of
-from gearengine.numerics.forcing import packed_forcing
-from gearengine.numerics.kernels import monodromy
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate
 from gearengine.plots.sweep import bifurcation_label, sweep_figure
 from gearengine.studies.sweep import run_local, validated
+from gearengine.systems.spur_pair import kernels
+from gearengine.systems.spur_pair.forcing import packed_forcing
+from gearengine.systems.spur_pair.kernels import monodromy
 from service.core.config import Settings
 from service.main import create_app
 from tests._gear_cases import paper

@@ -12,7 +12,7 @@ import pytest
 
 import gearengine
 import gearengine.homoclinic
-import gearengine.numerics.kernels as kernels
+import gearengine.systems.spur_pair.kernels as kernels
 from gearengine.jitcache import STAMP_SUFFIX, drop_stale, sources_digest
 
 
@@ -96,7 +96,9 @@ def test_importing_the_engine_with_a_moved_cache_writes_no_stamp(tmp_path: Path)
     shutil.copytree(Path(gearengine.__file__).parent, copy / "gearengine",
                     ignore=shutil.ignore_patterns("__pycache__"))  # fmt: skip
     env = {**os.environ, "PYTHONPATH": str(copy), "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
-    code = "import gearengine.numerics.kernels, gearengine.homoclinic as h; print(h.__file__)"
+    code = (
+        "import gearengine.systems.spur_pair.kernels, gearengine.homoclinic as h; print(h.__file__)"
+    )
     run = subprocess.run([sys.executable, "-c", code], env=env, cwd=tmp_path, check=True,
                          timeout=300, capture_output=True, text=True)  # fmt: skip
     assert run.stdout.startswith(str(copy))

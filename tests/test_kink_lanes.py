@@ -7,11 +7,11 @@ import pytest
 
 from gearengine.model.params import GearParams
 from gearengine.numerics.batch import run_lanes
-from gearengine.numerics.kernels.adaptive import ADAPT_LLE_MIN_RECORD
 from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate
 from gearengine.signals.lyapunov import BLOCKS
+from gearengine.systems.spur_pair.kernels.adaptive import ADAPT_LLE_MIN_RECORD
 from tests._gear_cases import paper
 
 STARTS = [(0.01, 0.01), (1.5, 0.0), (-1.2, 0.3)]

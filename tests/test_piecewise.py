@@ -9,9 +9,9 @@ import pytest
 
 from gearengine.model.backlash import LAWS
 from gearengine.model.params import GearParams
-from gearengine.numerics import kernels
-from gearengine.numerics.forcing import packed_forcing, step_plan
 from gearengine.numerics.simulation import SimulationSettings, simulate
+from gearengine.systems.spur_pair import kernels
+from gearengine.systems.spur_pair.forcing import packed_forcing, step_plan
 from tests._gear_cases import gear_ref_binary, gear_ref_summary, paper, scipy_run
 
 PIECEWISE = LAWS["piecewise"].kernel_code

@@ -22,14 +22,14 @@ from gearengine.gate.envelope import Rules
 from gearengine.gate.runup import runup_failures
 from gearengine.jsonio import dumps, error_lines
 from gearengine.model.units import RPM
-from gearengine.numerics.forcing import packed_forcing
-from gearengine.numerics.kernels.phase import ramp_forcing_at
-from gearengine.numerics.kernels.smooth import forcing_at
 from gearengine.studies.runup import run_local
 from gearengine.studies.runup.compute import compute_chunk
 from gearengine.studies.runup.profile import ramp_forcing, validated
 from gearengine.studies.runup.reading import jumps
 from gearengine.studies.runup.request import RunupRequest
+from gearengine.systems.spur_pair.forcing import packed_forcing
+from gearengine.systems.spur_pair.kernels.phase import ramp_forcing_at
+from gearengine.systems.spur_pair.kernels.smooth import forcing_at
 from tests._polling import poll
 from tests.conftest import ROOT, Server
 

@@ -1,6 +1,6 @@
 """The Melnikov function packed for the compiled kernels: the one door into ``kernels``.
 
-As ``numerics.forcing.packed_forcing`` packs the forcing of Eq. (9) for the RK4 kernels,
+As ``systems.spur_pair.forcing.packed_forcing`` packs the forcing of Eq. (9) for the RK4 kernels,
 ``packed_terms`` packs what M(tau0) = A + sum_i B_i sin(Omega_i tau0 + phi_i) (Eq. 19) needs:
 
     terms   shape (5, n): fundamental Omega, harmonic number r, excitation kind, amplitude F_r,

@@ -188,7 +188,7 @@ class BacklashLaw:
 
     Attributes:
         name: the ``backlash.model`` of the parameters (``cubic`` or ``piecewise``).
-        kernel_code: the ``law`` argument of the numba kernels (``numerics.kernels``).
+        kernel_code: the ``law`` argument of the numba kernels (``systems.spur_pair.kernels``).
         f_h: f_h(model, x) on arrays, x and f_h in units of the half backlash b.
         melnikov_cubic: (a, c, notes) of the cubic law the Melnikov analysis uses for it.
         label: the law in words, for figures and notes.

@@ -33,12 +33,14 @@ from gearengine.model.design import Design
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import ParamsOrDesign
 from gearengine.model.units import Scales, response_values
-from gearengine.numerics.batch import run_lanes
-from gearengine.numerics.forcing import step_plan
+from gearengine.numerics.batch import run_lanes, run_verdict
 from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint
+from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import BasinSettings, SimulationSettings
 from gearengine.signals.classify import severity
 from gearengine.signals.periodicity import SIZE_FLOOR
+from gearengine.systems.base import System
+from gearengine.systems.spur_pair.forcing import step_plan
 
 ORBIT_TOL = 1e-2
 """Distance, relative to the attractor size, within which two strobes are the same point."""
@@ -73,8 +75,10 @@ def _size(bp: BatchPoint) -> float:
 
 
 def _orbit(bp: BatchPoint) -> np.ndarray:
-    """The strobes that identify the start's attractor: its n-cycle, else its cloud."""
-    pts = np.asarray(bp.poincare, dtype=float).reshape(-1, 2)
+    """The strobes that identify the start's attractor: its n-cycle, else its cloud; shape
+    (k, n) for a system of state dimension n ((x, v) for the pair)."""
+    pts = np.asarray(bp.poincare, dtype=float)
+    pts = pts.reshape(len(pts), -1) if len(pts) else pts.reshape(-1, 2)
     return pts[-bp.period :] if bp.period else pts
 
 
@@ -84,7 +88,10 @@ def same_orbit(a: BatchPoint, b: BatchPoint) -> bool:
         return False
     tol = ORBIT_TOL * max(_size(a), _size(b))
     oa, ob = _orbit(a), _orbit(b)
-    d = np.hypot(oa[:, None, 0] - ob[None, :, 0], oa[:, None, 1] - ob[None, :, 1])
+    if oa.shape[1] == 2:
+        d = np.hypot(oa[:, None, 0] - ob[None, :, 0], oa[:, None, 1] - ob[None, :, 1])
+    else:
+        d = np.linalg.norm(oa[:, None, :] - ob[None, :, :], axis=2)
     return bool((d.min(axis=1) < tol).all() and (d.min(axis=0) < tol).all())
 
 
@@ -142,7 +149,6 @@ def describe(classification: str, period: int | None, impact: str | None) -> str
 def _attractor(
     members: list[tuple[tuple[float, float], BatchPoint]],
     n: int,
-    params: GearParams,
     scales: Scales | None,
 ) -> Attractor:
     """One group of starts as an ``Attractor``: its first start represents it; LLE the mean
@@ -178,7 +184,7 @@ def _attractor(
 
 
 def attractors(
-    params: GearParams,
+    params: GearParams | System,
     settings: SimulationSettings,
     scales: Scales | None = None,
 ) -> tuple[list[Attractor], BasinCounts]:
@@ -186,7 +192,10 @@ def attractors(
     larger basin), and how the starts ended.
 
     Args:
-        params: the design, dimensionless (Eq. 9).
+        params: the design, dimensionless (Eq. 9: its starts run as lock-step lanes), or any
+            ``System`` (each start of the mesh coordinate, the other coordinates at rest, run
+            by its own integrator; attractors told apart by their strobes of all n
+            coordinates).
         settings: periods and steps of every run; ``settings.basins`` the starts.
         scales: with a design, its scales (a box in units; DTE and dynamic factor).
 
@@ -194,7 +203,14 @@ def attractors(
         The attractors, and the ``BasinCounts`` with each start's label (its attractor's index
         in the returned list, -1 diverged, -2 unsettled).
     """
-    return points_attractors([params], settings, [scales])[0]
+    if isinstance(params, GearParams):
+        return points_attractors([params], settings, [scales])[0]
+    basins = settings.basins or BasinSettings()
+    starts = basin_starts(basins, scales)
+    plan = params.plan(settings.steps_per_period)
+    runs = [run_verdict(integrate(params, settings, params.start_state(*s)), s, plan, k)
+            for k, s in enumerate(starts)]  # fmt: skip
+    return _group(plan.omega0 is not None, scales, basins, starts, runs)
 
 
 def points_attractors(
@@ -217,26 +233,25 @@ def points_attractors(
     out = []
     for i, (params, sc) in enumerate(zip(points, scales, strict=True)):
         mine = runs[i * len(starts[i]) : (i + 1) * len(starts[i])]
-        out.append(_group(params, settings, sc, basins, starts[i], mine))
+        commensurate = step_plan(params, settings.steps_per_period).omega0 is not None
+        out.append(_group(commensurate, sc, basins, starts[i], mine))
     return out
 
 
 def _group(
-    params: GearParams,
-    settings: SimulationSettings,
+    commensurate: bool,
     scales: Scales | None,
     basins: BasinSettings,
     starts: list[tuple[float, float]],
     points: list[BatchPoint],
 ) -> tuple[list[Attractor], BasinCounts]:
     """The attractors and counts of one point's runs ``points`` from ``starts``."""
-    commensurate = step_plan(params, settings.steps_per_period).omega0 is not None
     labels = cluster(points, commensurate)
     groups: dict[int, list] = {}
     for label, s, bp in zip(labels, starts, points, strict=True):
         if label >= 0:
             groups.setdefault(label, []).append((s, bp))
-    found = [_attractor(m, len(starts), params, scales) for m in groups.values()]
+    found = [_attractor(m, len(starts), scales) for m in groups.values()]
     order = sorted(range(len(found)), key=lambda k: (severity(found[k].classification,
                    found[k].period), found[k].count), reverse=True)  # fmt: skip
     keys = list(groups)

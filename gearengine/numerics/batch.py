@@ -16,19 +16,19 @@ import numpy as np
 
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams
-from gearengine.numerics import kernels
-from gearengine.numerics.forcing import StepPlan, law, packed_forcing, step_plan
 from gearengine.numerics.lanes import lane_point, lane_verdicts, last_strobes
 from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
 from gearengine.numerics.runs import Run, finite_or_none, integrate, start_verdict
 from gearengine.numerics.settings import SimulationSettings, check_work
 from gearengine.signals.classify import DIVERGENCE_BOUND, severity
+from gearengine.systems.spur_pair import kernels
+from gearengine.systems.spur_pair.forcing import StepPlan, law, packed_forcing, step_plan
 
 Lane = tuple[int, tuple[float, float]]
 """One run of a request: (index of its parameter point, initial state (x0, v0))."""
 
 
-def run_verdict(run: Run, start: tuple[float, float], plan: StepPlan, lane: int) -> BatchPoint:
+def run_verdict(run: Run, start: Sequence[float], plan: StepPlan, lane: int) -> BatchPoint:
     """The ``BatchPoint`` of one run of the single kernels (``runs.integrate``), numbered
     ``lane``.
 
@@ -44,13 +44,18 @@ def run_verdict(run: Run, start: tuple[float, float], plan: StepPlan, lane: int)
         lle_stderr=v.summary.lle_stderr,
         final_state=v.summary.final_state,
         impact_regime=v.summary.impact_regime,
-        poincare=np.column_stack([run.xs[:n_ok], run.vs[:n_ok]])[-BATCH_POINCARE:].tolist(),
+        poincare=_strobes(run)[:n_ok][-BATCH_POINCARE:].tolist(),
         start_index=lane,
         x_peak_to_peak=None if run.diverged else finite_or_none(run.xmax - run.xmin),
         periods_run=int(run.done),
         force_max=None if run.diverged else finite_or_none(run.fmax),
         force_min=None if run.diverged else finite_or_none(run.fmin),
     )
+
+
+def _strobes(run: Run) -> np.ndarray:
+    """The strobes of a run, shape (k, n): (x, v) for the pair, the full state otherwise."""
+    return np.column_stack([run.xs, run.vs]) if run.strobes is None else run.strobes
 
 
 def step_plans(points: Sequence[GearParams], steps_per_period: int) -> list[StepPlan]:

@@ -28,10 +28,11 @@ import numpy as np
 
 from gearengine.model.aliases import with_alias
 from gearengine.model.params import GearParams
-from gearengine.numerics.floquet import Flow, refine, stroboscopic_flow
+from gearengine.numerics.floquet import refine, stroboscopic_flow
 from gearengine.numerics.results import FloquetResult
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate
+from gearengine.systems.base import StroboscopicFlow
 
 Path = Callable[[float], GearParams]
 """The parameters of Eq. (9) at a value of the swept parameter."""
@@ -75,7 +76,7 @@ class _OrbitLostError(Exception):
         self.parent = parent
 
 
-def _strobes(flow: Flow, X: np.ndarray, n: int) -> list[np.ndarray]:
+def _strobes(flow: StroboscopicFlow, X: np.ndarray, n: int) -> list[np.ndarray]:
     """The strobes X, P(X), ..., P^(n-1)(X) of the period-n orbit through X."""
     out = [X]
     for _ in range(n - 1):
@@ -83,7 +84,7 @@ def _strobes(flow: Flow, X: np.ndarray, n: int) -> list[np.ndarray]:
     return out
 
 
-def _refine_deflated(flow: Flow, X: np.ndarray, n: int, avoid: Sequence[np.ndarray]):
+def _refine_deflated(flow: StroboscopicFlow, X: np.ndarray, n: int, avoid: Sequence[np.ndarray]):
     """Deflated Newton from X (the strobes ``avoid`` of a shorter orbit repel it), then plain
     Newton to polish: deflation slows convergence to a root close to a deflated one (a young
     period-doubled orbit). The caller checks the result against collapse (``_shorter_period``).
@@ -92,7 +93,7 @@ def _refine_deflated(flow: Flow, X: np.ndarray, n: int, avoid: Sequence[np.ndarr
     return refine(flow, np.array(fl.orbit_state), n) if avoid else fl
 
 
-def _shorter_period(flow: Flow, X: np.ndarray, n: int) -> int | None:
+def _shorter_period(flow: StroboscopicFlow, X: np.ndarray, n: int) -> int | None:
     """Largest proper divisor d of n with P^d(X) = X (to COLLAPSE_TOL), else None."""
     divisors = sorted({n // q for q in range(2, n + 1) if n % q == 0}, reverse=True)
     for d in divisors:
@@ -102,7 +103,7 @@ def _shorter_period(flow: Flow, X: np.ndarray, n: int) -> int | None:
     return None
 
 
-def _parent(flow: Flow, X: np.ndarray, n: int) -> FloquetResult | None:
+def _parent(flow: StroboscopicFlow, X: np.ndarray, n: int) -> FloquetResult | None:
     """A shorter orbit (period a proper divisor of n, largest first) Newton finds from X: what
     a period-n orbit that no longer exists (met from the doubled side) has merged into."""
     for d in sorted({n // q for q in range(2, n + 1) if n % q == 0}, reverse=True):
@@ -112,7 +113,7 @@ def _parent(flow: Flow, X: np.ndarray, n: int) -> FloquetResult | None:
     return None
 
 
-def _follow(flow: Flow, orbit: FloquetResult) -> FloquetResult:
+def _follow(flow: StroboscopicFlow, orbit: FloquetResult) -> FloquetResult:
     """Newton-refine ``orbit``'s branch at a new parameter value, starting from ``orbit``.
 
     When Newton lands on a shorter orbit (a young period-doubled orbit collapsing onto its
@@ -218,7 +219,7 @@ def _walk(
     raise _OrbitLostError
 
 
-def _beyond(flow: Flow, orbit: FloquetResult) -> FloquetResult | None:
+def _beyond(flow: StroboscopicFlow, orbit: FloquetResult) -> FloquetResult | None:
     """``orbit``'s branch followed to ``flow``'s parameter value, None when lost."""
     try:
         return _follow(flow, orbit)

@@ -1,4 +1,5 @@
-"""Stability margins of periodic responses of Eq. (9): Floquet multipliers by Newton shooting.
+"""Stability margins of periodic responses: Floquet multipliers by Newton shooting, for any
+``System`` (n x n monodromy matrix); written here for the spur pair of Eq. (9), n = 2.
 
     x' = v,   v' = -2 mu v - K(t) f_h(x) + F(t)                              (Eq. 9)
 
@@ -39,15 +40,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from gearengine.model.params import GearParams
-from gearengine.numerics.forcing import Law, law, packed_forcing, step_plan
-from gearengine.numerics.kernels import monodromy
 from gearengine.numerics.results import Bifurcation, FloquetResult, NumericsResult
+from gearengine.numerics.runs import as_system
 from gearengine.numerics.settings import SimulationSettings
+from gearengine.systems.base import StroboscopicFlow, System
 
 NEWTON_MAX_STEPS = 8
 """Largest number of Newton updates of the orbit state."""
@@ -57,12 +57,16 @@ LIOUVILLE_WARN = 1e-4
 """liouville_error above which the result carries a note (Phi inaccurate)."""
 
 
-def multipliers(phi: np.ndarray) -> tuple[complex, complex]:
-    """Eigenvalues of the 2x2 monodromy matrix, largest modulus first.
+def multipliers(phi: np.ndarray) -> tuple[complex, ...]:
+    """Eigenvalues of the n x n monodromy matrix, largest modulus first.
 
-    From trace and determinant; the smaller real one is det / lambda_1 (no cancellation, so
-    tiny multipliers of long, strongly damped orbits keep their relative accuracy).
+    For n = 2 from trace and determinant; the smaller real one is det / lambda_1 (no
+    cancellation, so tiny multipliers of long, strongly damped orbits keep their relative
+    accuracy). For n > 2 from ``numpy.linalg.eigvals``.
     """
+    if phi.shape != (2, 2):
+        lam = np.linalg.eigvals(phi)
+        return tuple(complex(v) for v in sorted(lam, key=abs, reverse=True))
     tr = float(phi[0, 0] + phi[1, 1])
     det = float(phi[0, 0] * phi[1, 1] - phi[0, 1] * phi[1, 0])
     disc = 0.25 * tr * tr - det
@@ -74,10 +78,23 @@ def multipliers(phi: np.ndarray) -> tuple[complex, complex]:
     return complex(big), complex(small)
 
 
-def liouville_error(det: float, mu: float, duration: float) -> float:
-    """|det Phi - exp(-2 mu t)| / exp(-2 mu t) over t = ``duration`` (tau units), computed in
-    logarithms (exp(-2 mu t) underflows for long, strongly damped orbits)."""
-    log_exact = -2.0 * mu * duration
+def determinant(phi: np.ndarray) -> float:
+    """det Phi (the 2 x 2 formula for the pair, as its multipliers use)."""
+    if phi.shape == (2, 2):
+        return float(phi[0, 0] * phi[1, 1] - phi[0, 1] * phi[1, 0])
+    return float(np.linalg.det(phi))
+
+
+def norm(v: np.ndarray) -> float:
+    """Euclidean norm of a state (``numpy.hypot`` for the pair's (x, v))."""
+    return float(np.hypot(*v)) if v.shape == (2,) else math.hypot(*v)
+
+
+def liouville_error(det: float, trace_rate: float, duration: float) -> float:
+    """|det Phi - exp(tr J t)| / exp(tr J t) over t = ``duration`` (tau units; tr J = -2 mu for
+    the pair), computed in logarithms (the exponential underflows for long, strongly damped
+    orbits)."""
+    log_exact = trace_rate * duration
     if det > 0.0:
         return abs(math.expm1(min(math.log(det) - log_exact, 700.0)))
     return 1.0 + (math.exp(min(math.log(-det) - log_exact, 700.0)) if det < 0.0 else 0.0)
@@ -90,38 +107,11 @@ def classify_multiplier(lam: complex) -> Bifurcation:
     return "period_doubling" if lam.real < 0.0 else "fold"
 
 
-@dataclass(frozen=True)
-class Flow:
-    """The stroboscopic flow of one parameter point: kernel arguments of ``monodromy``.
-
-    ``flow(X, n)`` gives phi_{n T0}(X) and its Jacobian Phi (2 x 2).
-    """
-
-    law: Law
-    mu: float
-    kc: np.ndarray
-    fm: float
-    fc: np.ndarray
-    period: float
-    steps: int
-
-    def __call__(self, X: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-        lw = self.law
-        x, v, phi = monodromy(
-            lw.code, lw.a, lw.c, lw.alpha, self.mu, float(X[0]), float(X[1]), self.kc, self.fm,
-            self.fc, self.period, self.steps, n,
-        )  # fmt: skip
-        return np.array([x, v]), phi
-
-
-def stroboscopic_flow(params: GearParams, steps_per_period: int) -> Flow:
-    """The flow of ``params`` sampled every T0 (RK4 grid as ``simulate``'s); ValueError when
-    the forcing is incommensurate (no Poincare period)."""
-    plan = step_plan(params, steps_per_period)
-    if plan.omega0 is None:
-        raise ValueError("incommensurate forcing: no Poincare period, hence no periodic orbit")
-    kc, fm, fc = packed_forcing(params)
-    return Flow(law(params), params.damping, kc, fm, fc, plan.period, plan.steps)
+def stroboscopic_flow(model: GearParams | System, steps_per_period: int) -> StroboscopicFlow:
+    """The flow of a system (a parameter point of Eq. 9: the spur pair) sampled every T0 (RK4
+    grid as ``simulate``'s); ValueError when the forcing is incommensurate (no Poincare
+    period)."""
+    return as_system(model).stroboscopic_flow(steps_per_period)
 
 
 def _deflation(X: np.ndarray, u: np.ndarray, avoid: Sequence[np.ndarray]) -> float:
@@ -140,7 +130,7 @@ def _deflation(X: np.ndarray, u: np.ndarray, avoid: Sequence[np.ndarray]) -> flo
 
 
 def _shoot(
-    flow: Flow, X: np.ndarray, n: int, avoid: Sequence[np.ndarray] = ()
+    flow: StroboscopicFlow, X: np.ndarray, n: int, avoid: Sequence[np.ndarray] = ()
 ) -> tuple[np.ndarray, np.ndarray, float, int]:
     """Newton shooting on G(X) = phi_{n T0}(X) - X, DG = Phi - I (Seydel 2010, sec. 7.3).
 
@@ -152,11 +142,11 @@ def _shoot(
     end, phi = flow(X, n)
     if not (np.all(np.isfinite(end)) and np.all(np.isfinite(phi))):
         raise ValueError(f"the flow from {X.tolist()} over {n} T0 is not finite")
-    res = float(np.hypot(*(end - X)))
+    res = norm(end - X)
     steps = 0
-    while res >= NEWTON_TOL * max(1.0, float(np.hypot(*X))) and steps < NEWTON_MAX_STEPS:
+    while res >= NEWTON_TOL * max(1.0, norm(X)) and steps < NEWTON_MAX_STEPS:
         try:
-            u = np.linalg.solve(phi - np.eye(2), X - end)
+            u = np.linalg.solve(phi - np.eye(len(X)), X - end)
         except np.linalg.LinAlgError:
             break
         X_new = X + _deflation(X, u, avoid) * u
@@ -164,19 +154,20 @@ def _shoot(
         if not (np.all(np.isfinite(end_new)) and np.all(np.isfinite(phi_new))):
             break
         X, end, phi = X_new, end_new, phi_new
-        res = float(np.hypot(*(end - X)))
+        res = norm(end - X)
         steps += 1
     return X, phi, res, steps
 
 
-def refine(flow: Flow, X: np.ndarray, n: int, avoid: Sequence[np.ndarray] = ()) -> FloquetResult:
+def refine(
+    flow: StroboscopicFlow, X: np.ndarray, n: int, avoid: Sequence[np.ndarray] = ()
+) -> FloquetResult:
     """Newton-refined period-n orbit through X (the states ``avoid`` deflated) and its
     multipliers, margin, Liouville check and notes."""
     X, phi, res, steps = _shoot(flow, X, n, avoid)
     lam = multipliers(phi)
-    det = float(phi[0, 0] * phi[1, 1] - phi[0, 1] * phi[1, 0])
-    lv_error = liouville_error(det, flow.mu, n * flow.period)
-    converged = res < NEWTON_TOL * max(1.0, float(np.hypot(*X)))
+    lv_error = liouville_error(determinant(phi), flow.trace_rate, n * flow.period)
+    converged = res < NEWTON_TOL * max(1.0, norm(X))
     notes = []
     if not converged:
         notes.append(
@@ -188,7 +179,7 @@ def refine(flow: Flow, X: np.ndarray, n: int, avoid: Sequence[np.ndarray] = ()) 
             f"det Phi misses exp(-2 mu n T0) by {lv_error:.3g} (relative): Phi is inaccurate "
             "(too few steps per period, or the smaller multiplier is below its rounding error)"
         )
-    if lam[0].imag != 0.0:
+    if lam[0].imag != 0.0 and len(X) == 2:
         notes.append(
             f"complex pair of modulus exp(-mu n T0) = {abs(lam[0]):.6g}: with constant "
             "damping det Phi is fixed, so the pair cannot reach the unit circle; stability can "
@@ -200,7 +191,7 @@ def refine(flow: Flow, X: np.ndarray, n: int, avoid: Sequence[np.ndarray] = ()) 
         multipliers=[[m.real, m.imag] for m in lam],
         stability_margin=1.0 - abs(lam[0]),
         nearest_bifurcation=classify_multiplier(lam[0]),
-        orbit_state=[float(X[0]), float(X[1])],
+        orbit_state=[float(x) for x in X],
         orbit_residual=res,
         newton_steps=steps,
         converged=converged,
@@ -210,12 +201,16 @@ def refine(flow: Flow, X: np.ndarray, n: int, avoid: Sequence[np.ndarray] = ()) 
 
 
 def floquet(
-    params: GearParams, settings: SimulationSettings, state: Sequence[float], period_n: int
+    params: GearParams | System,
+    settings: SimulationSettings,
+    state: Sequence[float],
+    period_n: int,
 ) -> FloquetResult:
     """Floquet multipliers and stability margin of the period-n response through ``state``.
 
     Args:
-        params: parameter point of Eq. (9); its forcing must be periodic (commensurate).
+        params: parameter point of Eq. (9), or any ``System``; its forcing must be periodic
+            (commensurate).
         settings: only ``steps_per_period`` is used (RK4 steps per period of the fastest
             excitation, as in ``simulate``).
         state: a strobe [x, v] of the settled response at a time t = 0 mod T0, e.g. the last
@@ -236,16 +231,22 @@ def floquet(
 
 
 def floquet_of(
-    params: GearParams, settings: SimulationSettings, result: NumericsResult
+    params: GearParams | System,
+    settings: SimulationSettings,
+    result: NumericsResult,
+    state: Sequence[float] | None = None,
 ) -> tuple[FloquetResult | None, str | None]:
     """The ``floquet`` and ``floquet_note`` fields of ``simulate(params, settings)``'s result:
-    the Floquet result of its (worst start's) periodic response, or None and the reason."""
+    the Floquet result of its (worst start's) periodic response, or None and the reason.
+    ``state``: the full last strobe of a system with more than (x, v) (the pair's is the last
+    Poincare point)."""
     if result.classification != "periodic" or result.period is None or not result.poincare:
         return None, f"the response is {result.classification}: no periodic orbit to linearise"
     if result.forcing_period is None:
         return None, "incommensurate forcing: no Poincare period, hence no Floquet multipliers"
     try:
-        fl = floquet(params, settings, result.poincare[-1], result.period)
+        last = result.poincare[-1] if state is None else state
+        fl = floquet(params, settings, last, result.period)
     except ValueError as exc:
         return None, f"Floquet analysis failed: {exc}"
     if not fl.converged:

@@ -22,7 +22,7 @@ from pydantic import (
 from gearengine.model.errors import InputError
 from gearengine.model.params import Finite, GearParams, WholeNumber, request_config
 from gearengine.model.units import QUANTITIES, parse_quantity
-from gearengine.numerics.forcing import step_plan
+from gearengine.systems.spur_pair.forcing import step_plan
 
 MAX_PERIODS = 100_000
 """Upper cap of transient_periods and record_periods."""
@@ -226,7 +226,7 @@ class SimulationSettings(BaseModel):
     )
     adaptive: bool = Field(
         True,
-        description="Sweeps and batches: let a run stop early (numerics.kernels.adaptive) once "
+        description="Sweeps and batches: let a run stop early (the kernels' adaptive rule) once "
         "its strobes repeat with a period <= 12 over the last 120 intervals and its LLE has "
         "converged below zero, or, chaotic and quasi-periodic runs, once at least 200 intervals "
         "are recorded, the LLE's standard error over the 10 blocks of the record so far is "

@@ -5,10 +5,12 @@ Public entry points: ``simulate`` (one parameter point, one or several initial s
 ``lyapunov`` and ``poincare`` (short verbs), ``warm_up`` (compile/load every kernel);
 ``numerics.batch.simulate_batch`` runs a sweep's points.
 
-Integrators (``numerics.kernels``, chosen in ``numerics.runs.INTEGRATORS``): classical fixed-step
-RK4 with the tangent equation for the cubic law; for the piecewise law of Eq. (8) the
-kink-splitting RK4 (steps split at |x| = 1). The largest Lyapunov exponent is the tangent-space
-estimate of Benettin, Galgani, Giorgilli & Strelcyn (Meccanica 15, 1980); the period is read from
+Any ``System`` runs through ``simulate``; the spur pair of Eq. (9) is the default. Its
+integrators (``systems.spur_pair.kernels``, chosen in ``systems.spur_pair.system.INTEGRATORS``):
+classical fixed-step RK4 with the tangent equation for the cubic law; for the piecewise law of
+Eq. (8) the kink-splitting RK4 (steps split at |x| = 1). The largest Lyapunov exponent is the
+tangent-space estimate of Benettin, Galgani, Giorgilli & Strelcyn (Meccanica 15, 1980); the period
+is read from
 the Poincare (stroboscopic) section; see Parker & Chua, *Practical Numerical Algorithms for
 Chaotic Systems* (Springer 1989), ch. 6.
 """
@@ -21,15 +23,14 @@ from typing import Any
 from gearengine.model.params import GearParams
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.floquet import floquet_of
-from gearengine.numerics.forcing import StepPlan, step_plan
 from gearengine.numerics.results import NumericsResult, SpectrumPeak, TimeHistory
 from gearengine.numerics.runs import (
     Run,
     StartVerdict,
+    as_system,
     finite_or_none,
     history_stride,
     integrate,
-    method_of,
     start_verdict,
 )
 from gearengine.numerics.settings import SimulationSettings, check_work
@@ -42,10 +43,15 @@ from gearengine.signals.diagnostics import (
     time_history,
 )
 from gearengine.signals.nolds_check import lyap_r_check
+from gearengine.systems.base import System
+from gearengine.systems.spur_pair.forcing import StepPlan
 
 
-def simulate(params: GearParams, settings: SimulationSettings | None = None) -> NumericsResult:
-    """Integrate Eq. (9) from every start of ``settings`` and return the numerical verdict.
+def simulate(
+    params: GearParams | System, settings: SimulationSettings | None = None
+) -> NumericsResult:
+    """Integrate Eq. (9) (or any ``System``) from every start of ``settings`` and return the
+    numerical verdict.
 
     The detailed fields (LLE statistics, spectrum, Poincare points, time history, nolds) describe
     the worst start; ``starts`` holds a summary per start. A periodic worst start under
@@ -54,13 +60,15 @@ def simulate(params: GearParams, settings: SimulationSettings | None = None) -> 
     says why there are none.
     """
     settings = settings or SimulationSettings()
-    plan = step_plan(params, settings.steps_per_period)
+    system = as_system(params)
+    plan = system.plan(settings.steps_per_period)
     check_work(settings, plan.steps)
     commensurate = plan.omega0 is not None
     notes = list(plan.notes)
     runs: list[tuple[Run, StartVerdict]] = []
-    for start in settings.starts():
-        run = integrate(params, settings, start)
+    for x0, v0 in settings.starts():
+        start = system.start_state(x0, v0)
+        run = integrate(system, settings, start)
         runs.append((run, start_verdict(run, start, plan.period, commensurate)))
     worst, wv = max(runs, key=lambda rv: severity(rv[1].classification, rv[1].period))
     base: dict[str, Any] = {
@@ -69,7 +77,7 @@ def simulate(params: GearParams, settings: SimulationSettings | None = None) -> 
         "forcing_period": plan.period if commensurate else None,
         "sampling_interval": plan.period,
         "steps_per_forcing_period": plan.steps,
-        "method": method_of(params, plan),
+        "method": system.method(plan),
         "starts": [v.summary for _, v in runs],
         "worst_case": wv.summary,
     }
@@ -77,7 +85,9 @@ def simulate(params: GearParams, settings: SimulationSettings | None = None) -> 
         result = _diverged(base, worst, plan, notes)
     else:
         result = _detailed(base, worst, wv, plan, settings, notes)
-    orbit, why = floquet_of(params, settings, result)
+    full = worst.strobes is not None and worst.recorded > 0
+    last = worst.strobes[worst.recorded - 1] if full else None
+    orbit, why = floquet_of(system, settings, result, last)
     return result.model_copy(update={"floquet": orbit, "floquet_note": why})
 
 

@@ -3,7 +3,8 @@ reading).
 
 Data flow: ``request`` (profile, validation) -> ``profile`` (segments linear in time, forcing on
 the integrated driver angle, step plan) -> ``compute`` (a job: one chunk per ensemble member
-through ``numerics.kernels.ramp``, two quasi-static continuation lines through the sweeps room)
+through ``systems.spur_pair.kernels.ramp``, two quasi-static continuation lines through the sweeps
+room)
 -> ``reading`` (bins against speed, jumps, finite-time Lyapunov exponent, lag behind the
 quasi-static loop) -> ``results`` (the document).
 """

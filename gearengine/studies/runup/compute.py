@@ -1,5 +1,5 @@
 """Computing a run-up as a job: one chunk per ensemble member (the whole profile, kink-accurate
-RK4 on the integrated driver angle, ``numerics.kernels.ramp``), and the two lines of the
+RK4 on the integrated driver angle, ``systems.spur_pair.kernels.ramp``), and the two lines of the
 quasi-static continuation sweep (up and down, ``sweeps.compute``, on the bin centres); the
 assembly reads them into bins, jumps and lags (``runup.reading``).
 
@@ -19,8 +19,6 @@ import numpy as np
 
 from gearengine.model.params import PiecewiseBacklash
 from gearengine.model.units import RPM
-from gearengine.numerics.kernels.ramp import run_ramp
-from gearengine.numerics.kernels.smooth import SQRT1_2
 from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.studies import jobs
 from gearengine.studies.runup.profile import RunupPlan, mid_speeds_rpm, runup_plan, segment_angle
@@ -29,6 +27,8 @@ from gearengine.studies.runup.request import RunupRequest, n_bins
 from gearengine.studies.runup.results import RunupResult
 from gearengine.studies.sweep.plan import sweep_work
 from gearengine.studies.sweep.request import SweepRequest
+from gearengine.systems.spur_pair.kernels.ramp import run_ramp
+from gearengine.systems.spur_pair.kernels.smooth import SQRT1_2
 
 QUASI_STATIC_CHUNKS = 2
 """Chunks after the members: the up and the down line of the continuation sweep."""

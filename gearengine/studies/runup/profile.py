@@ -4,8 +4,8 @@ integrated driver angle, their RK4 step and blocks.
 Time: Eq. (9) runs in tau = w_n t with w_n = sqrt(k_m / m), which does not depend on the speed
 (docs/conversion.md), so the design's own time scale maps seconds to tau for the whole profile
 and the speed enters only through the excitation phases and the transmission-error force
-(``numerics.kernels.phase``). On a segment from speed w0 at t0 to w1 at t1 the driver angle is
-psi_a = psi_0 + Omega_0 tau + beta tau^2 / 2 exactly, Omega = w / w_n, beta = (w1 - w0) /
+(``systems.spur_pair.kernels.phase``). On a segment from speed w0 at t0 to w1 at t1 the driver
+angle is psi_a = psi_0 + Omega_0 tau + beta tau^2 / 2 exactly, Omega = w / w_n, beta = (w1 - w0) /
 (t1 - t0) / w_n^2; psi_0 carries over from the segment before, so the phases are continuous.
 
 Mean force: the driver follows the profile (speed-controlled) against the braking torque that
@@ -27,9 +27,9 @@ from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from gearengine.model.params import GearParams
 from gearengine.model.units import RPM, in_si
-from gearengine.numerics.forcing import packed_forcing
 from gearengine.studies.runup.request import MAX_RUNUP_STEPS, RunupRequest, request_errors
 from gearengine.studies.sweep.axes import point_params
+from gearengine.systems.spur_pair.forcing import packed_forcing
 
 BLOCKS_PER_BIN = 4
 """Blocks (the kernel's unit of output) per speed bin on a ramp."""

@@ -225,9 +225,9 @@ def read_runup(
         duration_s=plan.duration,
         method=RunupMethod(
             integration="RK4 split at every backlash edge |x| = 1 (kink-accurate, "
-            f"numerics.kernels.kink), {request.steps_per_period} steps per period of the "
+            f"systems.spur_pair.kernels.kink), {request.steps_per_period} steps per period of the "
             "fastest of the natural frequency and the excitations at each segment's top "
-            "speed; excitations at the integrated driver angle (numerics.kernels.phase)",
+            "speed; excitations at the integrated driver angle (systems.spur_pair.kernels.phase)",
             lyapunov="ensemble-averaged finite-time Lyapunov exponent over each bin's window: "
             "tangent equation renormalised every block (Benettin 1980), averaged over "
             f"{request.ensemble.size} perturbed starts (Janosi & Tel, Phys. Rev. E 105, "

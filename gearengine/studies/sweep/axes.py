@@ -24,7 +24,7 @@ from gearengine.model.design import Design
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import convert_design
 from gearengine.model.units import Scales
-from gearengine.numerics.forcing import packed_forcing
+from gearengine.systems.spur_pair.forcing import packed_forcing
 
 OMEGA = "Omega"
 """The axis that scales every excitation frequency together (dimensionless)."""

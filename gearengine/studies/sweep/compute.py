@@ -15,7 +15,6 @@ from gearengine.model.units import OUTPUTS, Scales, display_unit, in_display_uni
 from gearengine.numerics.attractors import coexisting, points_attractors
 from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
 from gearengine.numerics.bifurcations import PointResponse, locate_bifurcations
-from gearengine.numerics.forcing import step_plan
 from gearengine.numerics.results import BatchPoint
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies import jobs
@@ -31,6 +30,7 @@ from gearengine.studies.sweep.points import PhysicalValue, SweepBifurcation, Swe
 from gearengine.studies.sweep.request import SweepBranch, SweepRequest
 from gearengine.studies.sweep.results import SweepResult
 from gearengine.studies.sweep.windows import SPEED, speed_windows
+from gearengine.systems.spur_pair.forcing import step_plan
 
 
 def _physical(

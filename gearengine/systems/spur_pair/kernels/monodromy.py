@@ -16,8 +16,8 @@ import math
 import numpy as np
 from numba import njit
 
-from gearengine.numerics.kernels.kink import kink_step
-from gearengine.numerics.kernels.smooth import JIT_OPTIONS, forcing_at, law_force, region
+from gearengine.systems.spur_pair.kernels.kink import kink_step
+from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, forcing_at, law_force, region
 
 
 @njit(**JIT_OPTIONS)
@@ -79,7 +79,7 @@ def monodromy(
     Args:
         law, a, c, alpha: backlash law (0 cubic -a x + c x^3, 1 piecewise Eq. 8, slope alpha).
         mu: damping ratio mu~; x0, v0: state at t = 0 (a strobe time), units of b and b/tau.
-        kc, fm, fc: packed forcing (``numerics.forcing.packed_forcing``).
+        kc, fm, fc: packed forcing (``systems.spur_pair.forcing.packed_forcing``).
         T: sampling interval T0 (units of tau); N: RK4 steps per T0; n_periods: intervals n.
 
     Returns:

@@ -35,7 +35,7 @@ import numpy as np
 from numba import njit, types
 from numba.extending import overload
 
-from gearengine.numerics.kernels.smooth import JIT_OPTIONS, forcing_at
+from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, forcing_at
 
 
 @njit(**JIT_OPTIONS)

@@ -7,17 +7,17 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from gearengine.numerics.kernels.adaptive import ADAPT_SETTLE
-from gearengine.numerics.kernels.intervals import (
+from gearengine.systems.spur_pair.kernels.adaptive import ADAPT_SETTLE
+from gearengine.systems.spur_pair.kernels.intervals import (
     adaptive_window,
     end_interval,
     new_outputs,
     new_ring,
     reset_lane,
 )
-from gearengine.numerics.kernels.kink import kink_split, rk4_region_kf
-from gearengine.numerics.kernels.lockstep import LANES
-from gearengine.numerics.kernels.smooth import JIT_OPTIONS, SQRT1_2, region
+from gearengine.systems.spur_pair.kernels.kink import kink_split, rk4_region_kf
+from gearengine.systems.spur_pair.kernels.lockstep import LANES
+from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, SQRT1_2, region
 
 HERMITE_REACH = 0.15
 """Bound (> 4/27, the largest |Hermite basis h10|, |h11| on [0, 1]) of how far the cubic
@@ -93,7 +93,7 @@ def run_kink_batch(
             state and period T0, shape (P,).
         Ktab, Ftab: forcing tables from ``forcing_table`` of the M parameter points, shape
             (M, 2N+1); owner: the point of each run, shape (P,), values in 0..M-1.
-        kc, fc: forcing coefficients of the points (``numerics.forcing.packed_forcing``)
+        kc, fc: forcing coefficients of the points (``systems.spur_pair.forcing.packed_forcing``)
             padded to shapes (M, 3, max terms); nk, nf: their numbers of terms, shape (M,);
             fm: mean force, shape (M,). The substeps of split steps evaluate the forcing from
             them.

@@ -20,6 +20,7 @@ import numpy as np
 from gearengine.model.backlash import LAWS
 from gearengine.model.frequencies import incommensurate_reason, poincare_frequency
 from gearengine.model.params import CubicBacklash, GearParams
+from gearengine.systems.base import StepPlan
 
 
 @dataclass(frozen=True)
@@ -45,31 +46,6 @@ class Law:
     a: float
     c: float
     alpha: float
-
-
-@dataclass(frozen=True)
-class StepPlan:
-    """Fixed-step RK4 grid.
-
-    Attributes:
-        omega0: common frequency Omega_0 of the forcing, or None when incommensurate.
-        period: sampling interval T0 (time units): 2 pi / Omega_0, or the period of the fastest
-            excitation when there is no common period.
-        steps: RK4 steps N per sampling interval; step h = period / steps.
-        omega_ref: frequency the spectrum orders refer to, 2 pi / period.
-        notes: human-readable remarks on the choices made.
-    """
-
-    omega0: float | None
-    period: float
-    steps: int
-    omega_ref: float
-    notes: tuple[str, ...]
-
-    @property
-    def h(self) -> float:
-        """RK4 step h = T0 / N (time units)."""
-        return self.period / self.steps
 
 
 def forcing_coefficients(params: GearParams) -> ForcingCoefficients:

@@ -8,8 +8,8 @@ import math
 import numpy as np
 from numba import njit
 
-from gearengine.numerics.kernels.phase import excitation_at
-from gearengine.numerics.kernels.smooth import (
+from gearengine.systems.spur_pair.kernels.phase import excitation_at
+from gearengine.systems.spur_pair.kernels.smooth import (
     JIT_OPTIONS,
     SQRT1_2,
     forcing_table,

@@ -6,15 +6,15 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from gearengine.numerics.kernels.adaptive import ADAPT_SETTLE
-from gearengine.numerics.kernels.intervals import (
+from gearengine.systems.spur_pair.kernels.adaptive import ADAPT_SETTLE
+from gearengine.systems.spur_pair.kernels.intervals import (
     adaptive_window,
     end_interval,
     new_outputs,
     new_ring,
     reset_lane,
 )
-from gearengine.numerics.kernels.smooth import JIT_OPTIONS, SQRT1_2
+from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, SQRT1_2
 
 LANES = 16
 """Lanes advanced together in ``run_batch``."""

@@ -16,9 +16,9 @@ import math
 import numpy as np
 from numba import njit
 
-from gearengine.numerics.kernels.kink import kink_step
-from gearengine.numerics.kernels.phase import ramp_forcing_at
-from gearengine.numerics.kernels.smooth import JIT_OPTIONS, region, region_force
+from gearengine.systems.spur_pair.kernels.kink import kink_step
+from gearengine.systems.spur_pair.kernels.phase import ramp_forcing_at
+from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, region, region_force
 
 BLOCK_COLUMNS = (
     "x_min", "x_max", "force_min", "force_max", "steps_separated", "steps_back_flank",

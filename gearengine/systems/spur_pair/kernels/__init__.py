@@ -29,7 +29,7 @@ recorded intervals. A run stops early (diverged) when |x| or |v| is not below ``
 interval end (this also catches NaN).
 
 Forcing coefficients are packed as kc, fc of shape (3, n_terms): rows amplitude, omega, phase
-(see ``gearengine.numerics.forcing``); K(t) = 1 + sum kc0 cos(kc1 t + kc2),
+(see ``gearengine.systems.spur_pair.forcing``); K(t) = 1 + sum kc0 cos(kc1 t + kc2),
 F(t) = fm + sum fc0 cos(fc1 t + fc2).
 
 The kernels call each other across these files and freeze constants of ``signals.periodicity``,
@@ -40,11 +40,11 @@ when any of those sources changes (numba itself watches only the defining file).
 from pathlib import Path
 
 from gearengine.jitcache import drop_stale
-from gearengine.numerics.kernels.kink import run_kink
-from gearengine.numerics.kernels.kinklanes import run_kink_batch
-from gearengine.numerics.kernels.lockstep import LANES, run_batch
-from gearengine.numerics.kernels.monodromy import monodromy
-from gearengine.numerics.kernels.smooth import (
+from gearengine.systems.spur_pair.kernels.kink import run_kink
+from gearengine.systems.spur_pair.kernels.kinklanes import run_kink_batch
+from gearengine.systems.spur_pair.kernels.lockstep import LANES, run_batch
+from gearengine.systems.spur_pair.kernels.monodromy import monodromy
+from gearengine.systems.spur_pair.kernels.smooth import (
     SQRT1_2,
     forcing_at,
     forcing_table,
@@ -73,7 +73,7 @@ drop_stale(  # before any kernel runs: numba loads a cached kernel on its first 
     [
         *_HERE.glob("*.py"),
         *(
-            _HERE.parents[1] / "signals" / f"{m}.py"
+            _HERE.parents[2] / "signals" / f"{m}.py"
             for m in ("periodicity", "lyapunov", "classify")
         ),
     ],

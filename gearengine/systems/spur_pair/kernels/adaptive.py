@@ -68,10 +68,10 @@ import math
 import numpy as np
 from numba import njit
 
-from gearengine.numerics.kernels.smooth import JIT_OPTIONS
 from gearengine.signals.classify import LLE_FLOOR
 from gearengine.signals.lyapunov import BLOCKS
 from gearengine.signals.periodicity import MAX_PERIOD, REL_TOL, SIZE_FLOOR, _smallest_period
+from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS
 
 ADAPT_WINDOW = 120
 """Intervals T0 of the record of an early-stopped run (a multiple of ``BLOCKS``)."""

@@ -22,7 +22,7 @@ import math
 import numpy as np
 from numba import njit
 
-from gearengine.numerics.kernels.adaptive import (
+from gearengine.systems.spur_pair.kernels.adaptive import (
     ADAPT_MAX_PERIOD,
     ADAPT_PROBE,
     ADAPT_RECHECK,
@@ -32,7 +32,7 @@ from gearengine.numerics.kernels.adaptive import (
     smallest_lag,
     window_tol,
 )
-from gearengine.numerics.kernels.smooth import JIT_OPTIONS, SQRT1_2
+from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, SQRT1_2
 
 
 @njit(**JIT_OPTIONS)

@@ -1,0 +1,130 @@
+"""The System interface: a forced, piecewise-smooth oscillator that the numerics drive.
+
+A system is an ODE y' = f(y, t) of state dimension n with its tangent equation
+dy' = J(y, t) dy, forced periodically (or quasi-periodically) in t. Its first two coordinates are
+the mesh coordinate x (the relative deflection along the line of action in units of the half
+backlash b) and its rate v; every reading of a response (period, impacts, DTE, contact) is made
+on them, and the full state identifies an attractor.
+
+How to add a system (the contract, as ``scipy.integrate.OdeSolver`` states its own):
+
+1. Subclass ``System``; set ``name``, ``n`` and ``coordinates`` (``coordinates[:2]`` the mesh
+   coordinate and its rate).
+2. ``plan(steps_per_period)``: the fixed RK4 grid (``StepPlan``) aligned to the Poincare period
+   T0 of the forcing, or to the fastest excitation when it has none.
+3. ``integrate(plan, start, n_trans, n_rec, stride)``: the transient and the record from
+   ``start`` (shape (n,)) with the tangent vector renormalised every T0 (Benettin); a ``Run``.
+   Write the step once per law (a numba kernel, ``cache=True``) and register it by law name.
+4. ``stroboscopic_flow(steps_per_period)``: phi_{m T0}(X) and its n x n Jacobian (monodromy
+   matrix) for Newton shooting and Floquet multipliers; ``trace_rate`` is trace J, constant for
+   linear damping, so that det Phi = exp(trace_rate m T0) (Liouville) checks Phi.
+5. ``method(plan)``: the integrator in words; ``start_state(x, v)``: a full start from a start of
+   the mesh coordinate (the other coordinates at rest), as the basin starts are drawn.
+
+The spur pair of the paper (Eq. 9, ``spur_pair``) is the first system.
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class StepPlan:
+    """Fixed-step RK4 grid.
+
+    Attributes:
+        omega0: common frequency Omega_0 of the forcing, or None when incommensurate.
+        period: sampling interval T0 (time units): 2 pi / Omega_0, or the period of the fastest
+            excitation when there is no common period.
+        steps: RK4 steps N per sampling interval; step h = period / steps.
+        omega_ref: frequency the spectrum orders refer to, 2 pi / period.
+        notes: human-readable remarks on the choices made.
+    """
+
+    omega0: float | None
+    period: float
+    steps: int
+    omega_ref: float
+    notes: tuple[str, ...]
+
+    @property
+    def h(self) -> float:
+        """RK4 step h = T0 / N (time units)."""
+        return self.period / self.steps
+
+
+@dataclass(frozen=True)
+class Run:
+    """What a system's integrator gives for one start (the spur pair's shapes are those of
+    ``spur_pair.kernels.run_rk4``): the mesh coordinate x and its rate v at the strobes
+    (``xs``, ``vs``, shape (n_rec,)), the log-stretching of the tangent vector per interval
+    (``logs``), a thinned history (``hx``, ``hv``), the extremes of x and of the mesh force
+    (fmin, fmax) over the record's steps, ``done`` intervals run (the record is
+    ``xs[:recorded]``, shorter than n_rec when the run stopped early), and the ``final`` state of
+    all n coordinates. ``strobes``: the full state at the strobes, shape (n_rec, n), for systems
+    with n > 2 (None for the pair, whose state is (x, v))."""
+
+    xs: np.ndarray
+    vs: np.ndarray
+    logs: np.ndarray
+    hx: np.ndarray
+    hv: np.ndarray
+    xmin: float
+    xmax: float
+    done: int
+    final: tuple[float, ...]
+    diverged: bool
+    recorded: int
+    fmin: float = math.nan
+    fmax: float = math.nan
+    strobes: np.ndarray | None = None
+
+
+class StroboscopicFlow(Protocol):
+    """The flow of a system sampled every T0: ``flow(X, m)`` gives phi_{m T0}(X), shape (n,),
+    and its Jacobian Phi, shape (n, n); with the grid (``period``, ``steps``) and trace J."""
+
+    period: float
+    steps: int
+    trace_rate: float
+
+    def __call__(self, X: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]: ...
+
+
+class System(ABC):
+    """A forced oscillator of state dimension ``n`` that the numerics drive (see the module
+    doc for the contract)."""
+
+    name: str
+    n: int
+    coordinates: tuple[str, ...]
+
+    @abstractmethod
+    def plan(self, steps_per_period: int) -> StepPlan:
+        """The RK4 grid with ``steps_per_period`` steps per period of the fastest excitation."""
+
+    @abstractmethod
+    def integrate(
+        self, plan: StepPlan, start: Sequence[float], n_trans: int, n_rec: int, stride: int
+    ) -> Run:
+        """Transient (``n_trans`` intervals T0) and record (``n_rec``) from ``start`` (n,),
+        keeping every ``stride``-th step of the record in the history."""
+
+    @abstractmethod
+    def stroboscopic_flow(self, steps_per_period: int) -> StroboscopicFlow:
+        """The flow sampled every T0; ValueError when the forcing has no Poincare period."""
+
+    @abstractmethod
+    def method(self, plan: StepPlan) -> str:
+        """How ``integrate`` runs this system, in words."""
+
+    def start_state(self, x: float, v: float) -> tuple[float, ...]:
+        """A full start from (x, v) of the mesh coordinate, every other coordinate at rest."""
+        return (x, v) + (0.0,) * (self.n - 2)
