@@ -31,7 +31,7 @@ WORKER = r"""
 import json, random, sys, time
 from gearengine.homoclinic.thresholds import chaos_possible, parameter_threshold
 from gearengine.homoclinic.verdict import melnikov
-from gearengine.model.backlash import melnikov_cubic
+from gearengine.systems.spur_pair.laws import melnikov_cubic
 from gearengine.model.params import GearParams
 
 ONE = GearParams.model_validate({"damping": 0.07, "mean_force": 0.01,

@@ -12,7 +12,8 @@ from scipy.integrate import solve_ivp
 
 from gearengine.model.params import GearParams
 from gearengine.signals.periodicity import attractor_size, detect_period
-from gearengine.systems.spur_pair.forcing import forcing_coefficients, law, step_plan
+from gearengine.systems.spur_pair.forcing import packed_forcing, step_plan
+from gearengine.systems.spur_pair.laws import law
 
 GEAR_REF_SOURCE = Path("/work/shared/reference/gear_ref.c")
 
@@ -38,7 +39,7 @@ def scipy_run(
 
     Returns (period, LLE per unit time, final state).
     """
-    co = forcing_coefficients(params)
+    kc, fm, fc = packed_forcing(params)
     lw = law(params)
     twomu = 2.0 * params.damping
 
@@ -52,8 +53,8 @@ def scipy_run(
         return lw.alpha * x, lw.alpha
 
     def rhs(t: float, y: np.ndarray) -> list[float]:
-        K = 1.0 + np.sum(co.k_amp * np.cos(co.k_omega * t + co.k_phase))
-        F = co.mean_force + np.sum(co.f_amp * np.cos(co.f_omega * t + co.f_phase))
+        K = 1.0 + np.sum(kc[0] * np.cos(kc[1] * t + kc[2]))
+        F = fm + np.sum(fc[0] * np.cos(fc[1] * t + fc[2]))
         fh, dfh = force(y[0])
         return [y[1], -twomu * y[1] - K * fh + F, y[3], -twomu * y[3] - K * dfh * y[2]]
 

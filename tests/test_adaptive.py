@@ -19,12 +19,13 @@ from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies.sweep import run_local, validated
 from gearengine.studies.sweep.request import SweepRequest
 from gearengine.systems.spur_pair import kernels
-from gearengine.systems.spur_pair.forcing import law, packed_forcing, step_plan
+from gearengine.systems.spur_pair.forcing import packed_forcing, step_plan
 from gearengine.systems.spur_pair.kernels.adaptive import (
     ADAPT_LLE_MIN_RECORD,
     ADAPT_SETTLE,
     ADAPT_WINDOW,
 )
+from gearengine.systems.spur_pair.laws import law
 from tests.conftest import ROOT
 
 LIGHT = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}

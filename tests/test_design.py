@@ -18,13 +18,13 @@ from gearengine.engineering import response, speed_windows
 from gearengine.homoclinic import melnikov
 from gearengine.homoclinic.schemas import MelnikovRequest
 from gearengine.model.aliases import with_speed_factor
-from gearengine.model.backlash import LAWS
 from gearengine.model.conversion import to_dimensionless
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import convert_design, physical_data
 from gearengine.numerics.results import NumericsResult
-from gearengine.systems.spur_pair.forcing import forcing_coefficients
+from gearengine.systems.spur_pair.forcing import packed_forcing
+from gearengine.systems.spur_pair.laws import LAWS
 from tests.test_conversion import dimensionless_response, physical_response
 
 
@@ -230,8 +230,8 @@ def test_margin_to_chaos_sign_follows_the_verdict() -> None:
 
 def mesh_force(params: GearParams, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Dimensionless mesh force K(tau) f_h(x) + 2 mu~ x' at the samples (Eq. 9's left side)."""
-    co = forcing_coefficients(params)
-    stiffness = 1.0 + np.cos(np.multiply.outer(t, co.k_omega) + co.k_phase) @ co.k_amp
+    kc, _, _ = packed_forcing(params)
+    stiffness = 1.0 + np.cos(np.multiply.outer(t, kc[1]) + kc[2]) @ kc[0]
     return stiffness * LAWS[params.backlash.model].f_h(params.backlash, x) + 2 * params.damping * v
 
 

@@ -37,7 +37,7 @@ from tests._polling import poll
 from tests.conftest import PAPER_PARAMS, started
 
 MU, FM, WE, A, C = 0.07, 0.01, 0.5, 0.1667, 0.1667
-CUBIC, PIECEWISE = 0, 1  # kernel codes of model.backlash.LAWS
+CUBIC, PIECEWISE = 0, 1  # kernel codes of systems.spur_pair.laws.LAWS
 T0 = 2.0 * math.pi / WE
 FEIGENBAUM = 4.669201609
 GRID = np.linspace(0.2, 0.235, 141)  # F_e1 step 2.5e-4

@@ -8,11 +8,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gearengine.model.backlash import LAWS
 from gearengine.model.params import GearParams
 from gearengine.numerics.simulation import SimulationSettings, simulate, simulate_batch
 from gearengine.systems.spur_pair import kernels
 from gearengine.systems.spur_pair.forcing import packed_forcing, step_plan
+from gearengine.systems.spur_pair.laws import LAWS
 from tests._gear_cases import gear_ref_binary, gear_ref_summary, paper
 
 CUBIC = LAWS["cubic"].kernel_code

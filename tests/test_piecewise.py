@@ -7,11 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from gearengine.model.backlash import LAWS
 from gearengine.model.params import GearParams
 from gearengine.numerics.simulation import SimulationSettings, simulate
 from gearengine.systems.spur_pair import kernels
 from gearengine.systems.spur_pair.forcing import packed_forcing, step_plan
+from gearengine.systems.spur_pair.laws import LAWS
 from tests._gear_cases import gear_ref_binary, gear_ref_summary, paper, scipy_run
 
 PIECEWISE = LAWS["piecewise"].kernel_code

@@ -52,10 +52,10 @@ from gearengine.homoclinic.thresholds import (
 )
 from gearengine.homoclinic.verdict import applicability
 from gearengine.model.aliases import get_alias
-from gearengine.model.backlash import melnikov_cubic
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.frequencies import poincare_period
 from gearengine.model.params import GearParams, request_config
+from gearengine.systems.spur_pair.laws import melnikov_cubic
 
 MAX_DESIGNS = 10_000
 """Largest number of designs in one POST /v1/melnikov/batch."""

@@ -19,8 +19,8 @@ from gearengine.homoclinic.coefficients import MeanLoad, loop_load, saddle_loop
 from gearengine.homoclinic.terms import packed_data
 from gearengine.homoclinic.thresholds import strength_at
 from gearengine.model.aliases import ALIASES, aliased_data
-from gearengine.model.backlash import melnikov_cubic
 from gearengine.model.params import GearParams
+from gearengine.systems.spur_pair.laws import melnikov_cubic
 
 
 def _set_aliases(data: dict, values: dict[str, float]) -> dict | None:

@@ -34,9 +34,9 @@ from gearengine.homoclinic.schemas import (
 )
 from gearengine.homoclinic.terms import packed_terms
 from gearengine.model.aliases import get_alias, with_alias, with_aliases
-from gearengine.model.backlash import melnikov_cubic
 from gearengine.model.errors import InputError
 from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash
+from gearengine.systems.spur_pair.laws import melnikov_cubic
 
 CONTROL_PARAMETERS = ("F_e1", "mu", "k_p1", "F_p1")
 """Control parameters with thresholds; the amplitudes are first harmonics."""

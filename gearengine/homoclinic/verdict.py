@@ -35,9 +35,9 @@ from gearengine.homoclinic.thresholds import (
     parameter_threshold,
     unit_coefficients,
 )
-from gearengine.model.backlash import melnikov_cubic
 from gearengine.model.frequencies import poincare_period
 from gearengine.model.params import GearParams
+from gearengine.systems.spur_pair.laws import melnikov_cubic
 
 
 def branch_verdict(ext: Extrema) -> BranchVerdict:

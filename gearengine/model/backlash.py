@@ -21,8 +21,6 @@ Two ways to get (a, c) from the piecewise law are provided (``docs/backlash-fit.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -30,7 +28,7 @@ from numpy.polynomial import Polynomial
 from numpy.typing import ArrayLike, NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
-from gearengine.model.params import CubicBacklash, PiecewiseBacklash
+from gearengine.model.params import CubicBacklash
 
 FitMethod = Literal["least_squares", "collocation"]
 
@@ -177,67 +175,3 @@ def paper_cubic() -> CubicFit:
 def _check_alpha(alpha: float) -> None:
     if not 0.0 <= alpha < 1.0:
         raise ValueError(f"alpha must satisfy 0 <= alpha < 1, got {alpha}")
-
-
-# --- The registry of backlash laws ------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class BacklashLaw:
-    """One backlash law f_h, as every part of the engine uses it.
-
-    Attributes:
-        name: the ``backlash.model`` of the parameters (``cubic`` or ``piecewise``).
-        kernel_code: the ``law`` argument of the numba kernels (``systems.spur_pair.kernels``).
-        f_h: f_h(model, x) on arrays, x and f_h in units of the half backlash b.
-        melnikov_cubic: (a, c, notes) of the cubic law the Melnikov analysis uses for it.
-        label: the law in words, for figures and notes.
-    """
-
-    name: str
-    kernel_code: int
-    f_h: Callable[[CubicBacklash | PiecewiseBacklash, ArrayLike], NDArray[np.float64]]
-    melnikov_cubic: Callable[[CubicBacklash | PiecewiseBacklash], tuple[float, float, list[str]]]
-    label: str
-
-
-def _cubic_as_is(model: CubicBacklash | PiecewiseBacklash) -> tuple[float, float, list[str]]:
-    assert isinstance(model, CubicBacklash)
-    return model.a, model.c, []
-
-
-def _piecewise_fit(model: CubicBacklash | PiecewiseBacklash) -> tuple[float, float, list[str]]:
-    """The piecewise law has no smooth homoclinic orbit: the Melnikov analysis uses its cubic
-    through x = 0, 1, 2 (``collocation_fit``), which is the paper's a = c = 1/6 for alpha = 0."""
-    assert isinstance(model, PiecewiseBacklash)
-    fit = collocation_fit(model.alpha)
-    return (
-        fit.a,
-        fit.c,
-        [
-            f"the Melnikov criterion needs a smooth law: the exact piecewise backlash "
-            f"(alpha = {model.alpha:g}) is replaced there by its cubic fit "
-            f"f_h = -{fit.a:.6g} x + {fit.c:.6g} x^3 ({fit.note}); the numerical verdict uses "
-            "the exact law"
-        ],
-    )
-
-
-LAWS: dict[str, BacklashLaw] = {
-    "cubic": BacklashLaw(
-        "cubic", 0, lambda m, x: fh_cubic(x, m.a, m.c), _cubic_as_is, "cubic -a x + c x^3 (Eq. 9)"
-    ),
-    "piecewise": BacklashLaw(
-        "piecewise",
-        1,
-        lambda m, x: fh_piecewise(x, m.alpha),
-        _piecewise_fit,
-        "piecewise linear (Eq. 8)",
-    ),
-}
-"""Backlash laws by name (the ``backlash.model`` field), as scipy's ``METHODS`` of solve_ivp."""
-
-
-def melnikov_cubic(model: CubicBacklash | PiecewiseBacklash) -> tuple[float, float, list[str]]:
-    """(a, c, notes) of the cubic law the Melnikov analysis uses for a backlash model."""
-    return LAWS[model.model].melnikov_cubic(model)

@@ -218,13 +218,8 @@ def tolerance_derived(design: Design) -> dict[str, Derived]:
         return out
     if tol.accuracy is not None:
         grade = tol.accuracy.tolerance_class
-        profile = {}
-        for role, gear in (("driver", design.driver), ("driven", design.driven)):
-            assert gear.module is not None and gear.face_width is not None
-            values = iso1328.tolerances(
-                grade, gear.teeth, gear.module * 1e3, gear.face_width * 1e3, role
-            )
-            profile[role] = values.F_alpha
+        pair = iso1328.pair_tolerances(grade, design.driver, design.driven)
+        for role, values in zip(("driver", "driven"), pair, strict=True):
             for name, formula in iso1328.FORMULAS.items():
                 out[f"{name}_{role}"] = Derived(
                     value=getattr(values, name),
@@ -232,7 +227,7 @@ def tolerance_derived(design: Design) -> dict[str, Derived]:
                     source=f"{iso1328.STANDARD} class {grade}, 5.3 Eq. {formula}, rounded (5.2.3)",
                 )
         out["transmission_error_bound"] = Derived(
-            value=iso1328.mesh_error_bound(profile["driver"], profile["driven"]) * 1e-6,
+            value=iso1328.pair_te_bound(grade, design.driver, design.driven),
             unit="m",
             source="mesh-harmonic TE amplitude bound sqrt(F_alpha_driver^2 + F_alpha_driven^2)/2 "
             "(profile deviations drive the mesh harmonic; amplitude drawn uniformly below it)",

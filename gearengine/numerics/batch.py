@@ -22,7 +22,8 @@ from gearengine.numerics.runs import Run, finite_or_none, integrate, start_verdi
 from gearengine.numerics.settings import SimulationSettings, check_work
 from gearengine.signals.classify import DIVERGENCE_BOUND, severity
 from gearengine.systems.spur_pair import kernels
-from gearengine.systems.spur_pair.forcing import StepPlan, law, packed_forcing, step_plan
+from gearengine.systems.spur_pair.forcing import StepPlan, packed_forcing, step_plan
+from gearengine.systems.spur_pair.laws import LAWS, law
 
 Lane = tuple[int, tuple[float, float]]
 """One run of a request: (index of its parameter point, initial state (x0, v0))."""
@@ -105,10 +106,6 @@ def run_lanes(
     return _run_lanes(points, step_plans(points, settings.steps_per_period), lanes, settings)
 
 
-LOCKSTEP_LAWS = ("cubic", "piecewise")
-"""Backlash laws whose lanes with commensurate forcing run in a lock-step kernel."""
-
-
 def _run_lanes(
     points: Sequence[GearParams],
     plans: list[StepPlan],
@@ -120,7 +117,7 @@ def _run_lanes(
     for k, (i, s) in enumerate(lanes):
         plan = plans[i]
         name = points[i].backlash.model
-        if name in LOCKSTEP_LAWS and plan.omega0 is not None:
+        if LAWS[name].lanes is not None and plan.omega0 is not None:
             groups.setdefault((name, plan.steps), []).append(k)
         else:
             results[k] = run_verdict(integrate(points[i], settings, s), s, plan, k)
@@ -142,19 +139,10 @@ def _run_lanes(
         streams = max(1, min(numba.get_num_threads(), -(-len(ks) // kernels.LANES)))
         shared = (per, N, settings.transient_periods, settings.record_periods, DIVERGENCE_BOUND,
                   settings.adaptive, streams, *lle_tolerances(settings))  # fmt: skip
-        laws = [law(points[i]) for i in members.tolist()]
-        if name == "cubic":
-            a = np.array([lw.a for lw in laws])[inverse]
-            c = np.array([lw.c for lw in laws])[inverse]
-            out = kernels.run_batch(a, c, mu, x0, v0, *tabled, *shared)
-        else:
-            alpha = np.array([lw.alpha for lw in laws])[inverse]
-            kc, nk = padded_terms([f[0] for f in packed])
-            fc, nf = padded_terms([f[2] for f in packed])
-            fm = np.array([f[1] for f in packed])
-            out = kernels.run_kink_batch(
-                alpha, mu, x0, v0, *tabled, kc, nk, fm, fc, nf, *shared
-            )  # fmt: skip
+        lanes_of = LAWS[name].lanes
+        assert lanes_of is not None
+        out = lanes_of([law(points[i]) for i in members.tolist()], inverse, packed, mu, x0, v0,
+                       tabled, shared)  # fmt: skip
         verdicts = lane_verdicts(out, per)
         strobes = last_strobes(out, list(range(len(ks))))
         for j, k in enumerate(ks):
@@ -168,16 +156,6 @@ def lle_tolerances(settings: SimulationSettings) -> tuple[float, float]:
     if not settings.adaptive:
         return 0.0, 0.0
     return settings.lle_stderr_rel, settings.lle_stderr_abs
-
-
-def padded_terms(terms: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Forcing coefficients of shape (3, n_i) of M points as one array (M, 3, max n_i), zero
-    padded, and the counts n_i, shape (M,)."""
-    count = np.array([t.shape[1] for t in terms], dtype=np.int64)
-    padded = np.zeros((len(terms), 3, max(1, int(count.max(initial=0)))))
-    for m, t in enumerate(terms):
-        padded[m, :, : t.shape[1]] = t
-    return padded, count
 
 
 def simulate_batch(

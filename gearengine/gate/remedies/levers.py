@@ -20,16 +20,12 @@ def iso1328_class(design: Design, amplitude: float) -> int | None:
     of both gears bound the mesh-frequency transmission-error harmonic at or below ``amplitude``
     [m] (``iso1328.mesh_error_bound``); None when no class does or the standard does not apply
     (no geometry, or outside its range)."""
-    gears = (design.driver, design.driven)
-    if any(g.module is None or g.face_width is None for g in gears):
-        return None
     for grade in range(11, 0, -1):
         try:
-            profile = [iso1328.tolerances(grade, g.teeth, g.module * 1e3, g.face_width * 1e3)
-                       .F_alpha for g in gears]  # type: ignore[operator]  # fmt: skip
+            bound = iso1328.pair_te_bound(grade, design.driver, design.driven)
         except ValueError:
             return None
-        if iso1328.mesh_error_bound(*profile) * 1e-6 <= amplitude:
+        if bound <= amplitude:
             return grade
     return None
 

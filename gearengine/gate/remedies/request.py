@@ -13,7 +13,7 @@ from pydantic import (
     field_validator,
     model_validator,
 )
-from pydantic_core import InitErrorDetails, PydanticCustomError
+from pydantic_core import InitErrorDetails
 
 from gearengine.gate.envelope import (
     ENVELOPE_SETTINGS,
@@ -25,6 +25,7 @@ from gearengine.gate.envelope import (
 )
 from gearengine.jsonio import message
 from gearengine.model.design import EXAMPLE_DESIGN, Design
+from gearengine.model.errors import Problems
 from gearengine.model.params import request_config
 from gearengine.model.units import display_unit, in_display_unit
 from gearengine.numerics.settings import SimulationSettings
@@ -218,11 +219,8 @@ def _current(design: Design, path: str) -> float:
 
 def request_errors(request: RemediesRequest) -> list[InitErrorDetails]:
     """The envelope and every user lever checked before any compute, as pydantic errors."""
-    errors: list[InitErrorDetails] = []
-
-    def add(loc: tuple[str | int, ...], message: str, value: object) -> None:
-        errors.append({"type": PydanticCustomError("remedies", message), "loc": loc,
-                       "input": value})  # fmt: skip
+    problems = Problems("remedies")
+    add, errors = problems.add, problems.details
 
     env = request.envelope
     for name in ENVELOPE_AXES:

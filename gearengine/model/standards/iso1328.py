@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 from gearengine.model.errors import InputError
 
@@ -152,3 +153,38 @@ def mesh_error_bound(profile_driver_um: float, profile_driven_um: float) -> floa
     inspection is anywhere: the amplitude is drawn uniformly on [0, e_max].
     """
     return math.hypot(profile_driver_um, profile_driven_um) / 2.0
+
+
+MM_PER_M = 1e3
+"""The standard's formulas take lengths in mm; a design holds them in m."""
+M_PER_UM = 1e-6
+"""The standard's tolerances are in µm; the engine's transmission error is in m."""
+
+
+class GearData(Protocol):
+    """A gear of a design: teeth, module and face width [m]."""
+
+    teeth: int
+    module: float | None
+    face_width: float | None
+
+
+def pair_tolerances(
+    tolerance_class: int, driver: GearData, driven: GearData
+) -> tuple[FlankTolerances, FlankTolerances]:
+    """The flank tolerances [µm] of both gears of a pair at one class; InputError (at the
+    gear's field) when a gear has no module or face width or lies outside the standard."""
+    out = []
+    for role, gear in (("driver", driver), ("driven", driven)):
+        if gear.module is None or gear.face_width is None:
+            raise InputError(f"design.{role}", "ISO 1328 needs the module and the face width")
+        out.append(tolerances(tolerance_class, gear.teeth, gear.module * MM_PER_M,
+                              gear.face_width * MM_PER_M, role))  # fmt: skip
+    return out[0], out[1]
+
+
+def pair_te_bound(tolerance_class: int, driver: GearData, driven: GearData) -> float:
+    """The bound [m] of the mesh-frequency transmission-error amplitude of a pair at one class
+    (``mesh_error_bound`` of both gears' total profile tolerances F_alpha)."""
+    a, b = pair_tolerances(tolerance_class, driver, driven)
+    return mesh_error_bound(a.F_alpha, b.F_alpha) * M_PER_UM

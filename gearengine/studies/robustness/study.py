@@ -23,11 +23,12 @@ import math
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, Field, ValidationError
-from pydantic_core import PydanticCustomError
+from pydantic import BaseModel, Field
+from pydantic_core import InitErrorDetails
 
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.model.design import Design
+from gearengine.model.errors import InputError, Problems
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
 from gearengine.model.units import Scales, in_display_unit, response_values
@@ -36,7 +37,6 @@ from gearengine.numerics.settings import SimulationSettings, work
 from gearengine.studies import jobs
 from gearengine.studies.robustness import sensitivity
 from gearengine.studies.robustness.tolerances import (
-    ToleranceError,
     Variable,
     base_design,
     probability,
@@ -112,40 +112,36 @@ class RobustnessRequest(BaseModel):
         ]
 
 
-def request_errors(request: RobustnessRequest) -> list[Any]:
+def request_errors(request: RobustnessRequest) -> list[InitErrorDetails]:
     """Checks needing the design: every tolerance (naming its field), every axis, N a power
     of 2 (the Sobol sequence's balance)."""
-    errors: list[Any] = []
+    problems = Problems("robustness")
     try:
         request.variables()
-    except ToleranceError as exc:
-        errors.append(exc.details())
+    except InputError as exc:
+        problems.add_error(exc, exc.loc[-1] if exc.loc else None)
     if request.samples & (request.samples - 1):
-        errors.append(_error(("samples",), "give a power of 2 (the Sobol points' balance)", 0))
+        problems.add(("samples",), "give a power of 2 (the Sobol points' balance)", 0)
     for i, axis in enumerate(request.axes):
         if is_dimensionless(axis.parameter):
-            errors.append(_error(("axes", i, "parameter"), "a physical field of the design", 0))
+            problems.add(("axes", i, "parameter"), "a physical field of the design", 0)
             continue
         problem = axis_problem(convert_design(request.design).params, request.design,
                                axis.parameter, axis.start, axis.stop, {})  # fmt: skip
         if problem is not None:
-            errors.append(_error(("axes", i, problem[0]), problem[1], axis.parameter))
-    return errors
-
-
-def _error(loc: tuple, message: str, value: object) -> Any:
-    return {"type": PydanticCustomError("robustness", message), "loc": loc, "input": value}
+            problems.add(("axes", i, problem[0]), problem[1], axis.parameter)
+    return problems.details
 
 
 def checked(request: RobustnessRequest, max_points: int | None = None) -> RobustnessRequest:
     """``request`` if its tolerances and axes are sound; else ``ValidationError`` naming each
     field (what the API and the CLI share)."""
-    errors = request_errors(request)
+    problems = Problems("robustness")
+    problems.details += request_errors(request)
     n = math.prod(a.num for a in request.axes)
-    if not errors and max_points is not None and n > max_points:
-        errors.append(_error(("axes",), f"{n} points, the limit is {max_points}", n))
-    if errors:
-        raise ValidationError.from_exception_data("RobustnessRequest", errors)
+    if not problems.details and max_points is not None and n > max_points:
+        problems.add(("axes",), f"{n} points, the limit is {max_points}", n)
+    problems.raise_if_any("RobustnessRequest")
     return request
 
 

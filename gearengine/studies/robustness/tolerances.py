@@ -23,7 +23,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from pydantic import ValidationError
-from pydantic_core import InitErrorDetails, PydanticCustomError
 from scipy import stats
 from scipy.stats import qmc
 
@@ -62,20 +61,10 @@ class Variable:
         return self.label or self.path
 
 
-class ToleranceError(ValueError):
-    """Bad tolerance input: ``field`` is the path inside ``design.tolerances``."""
-
-    def __init__(self, field: str, message: str) -> None:
-        super().__init__(f"design.tolerances{'.' if field else ''}{field}: {message}")
-        self.field, self.message = field, message
-
-    def details(self) -> InitErrorDetails:
-        """As a pydantic error detail (loc design.tolerances.<field>)."""
-        return {
-            "type": PydanticCustomError("tolerance", self.message),
-            "loc": ("design", "tolerances", self.field) if self.field else ("design", "tolerances"),
-            "input": self.field,
-        }
+def tolerance_error(field: str, message: str) -> InputError:
+    """A refused tolerance: the field is the path inside ``design.tolerances``."""
+    path = f"design.tolerances{'.' if field else ''}{field}"
+    return InputError(path, message, ("design", "tolerances", field) if field else None)
 
 
 def base_design(design: Design) -> Design:
@@ -95,10 +84,10 @@ def _value(design: Design, path: str, value: object, what: str) -> float:
     try:
         return si_value(design, path, value)
     except (KeyError, IndexError, TypeError):
-        raise ToleranceError(path, "the design has no such field") from None
+        raise tolerance_error(path, "the design has no such field") from None
     except ValidationError as exc:
         reason = "; ".join(e["msg"] for e in exc.errors(include_url=False))
-        raise ToleranceError(
+        raise tolerance_error(
             path, f"{what} {value!r} is outside the field's range: {reason}"
         ) from None
 
@@ -108,27 +97,27 @@ def _variable(design: Design, path: str, dist: Distribution) -> Variable:
     if isinstance(dist, Uniform):
         lo, hi = (_value(design, path, v, "the bound") for v in dist.uniform)
         if not lo < hi:
-            raise ToleranceError(path, "uniform: give [low, high] with low < high")
+            raise tolerance_error(path, "uniform: give [low, high] with low < high")
         return Variable(path, f"uniform on [{lo:.6g}, {hi:.6g}]", stats.uniform(lo, hi - lo).ppf)
     if isinstance(dist, Triangular):
         lo, mode, hi = (_value(design, path, v, "the value") for v in dist.triangular)
         if not lo <= mode <= hi or not lo < hi:
-            raise ToleranceError(path, "triangular: give [low, mode, high], low <= mode <= high")
+            raise tolerance_error(path, "triangular: give [low, mode, high], low <= mode <= high")
         shape = stats.triang((mode - lo) / (hi - lo), loc=lo, scale=hi - lo)
         return Variable(path, f"triangular [{lo:.6g}, {mode:.6g}, {hi:.6g}]", shape.ppf)
     assert isinstance(dist, Normal)
     mean = _value(design, path, dist.normal.mean, "the mean")
     if not lo_b <= mean <= hi_b:
-        raise ToleranceError(path, f"the mean {mean:g} is outside the physical bounds")
+        raise tolerance_error(path, f"the mean {mean:g} is outside the physical bounds")
     sd_given = dist.normal.sd
     if isinstance(sd_given, (int, float)) and sd_given <= 0:
-        raise ToleranceError(path, "normal: the sd must be > 0")
+        raise tolerance_error(path, "normal: the sd must be > 0")
     try:
         sd = si_value(design, path, sd_given)
     except (ValidationError, KeyError, IndexError, TypeError):
-        raise ToleranceError(path, f"normal: the sd {sd_given!r} must be a value > 0") from None
+        raise tolerance_error(path, f"normal: the sd {sd_given!r} must be a value > 0") from None
     if not sd > 0:
-        raise ToleranceError(path, "normal: the sd must be > 0")
+        raise tolerance_error(path, "normal: the sd must be > 0")
     shape = stats.truncnorm((lo_b - mean) / sd, (hi_b - mean) / sd, loc=mean, scale=sd)
     for end in shape.ppf([1e-9, 1 - 1e-9]):  # the far ends of what is drawn must be designs
         _value(design, path, float(end), "the distribution reaches")
@@ -139,23 +128,19 @@ def _variable(design: Design, path: str, dist: Distribution) -> Variable:
 def variables(design: Design) -> list[Variable]:
     """The toleranced fields of ``design`` in order: accuracy, backlash, then by path.
 
-    Raises ``ToleranceError`` (naming the field) for an unknown path, a distribution outside
+    Raises ``InputError`` (naming the field) for an unknown path, a distribution outside
     the field's physical bounds, sd <= 0, or an ISO 1328 input outside its range.
     """
     tol = design.tolerances
     if tol is None:
-        raise ToleranceError("", "the design has no tolerances")
+        raise tolerance_error("", "the design has no tolerances")
     base, out = base_design(design), []
     if tol.accuracy is not None:
-        grade, profile = tol.accuracy.tolerance_class, []
-        for gear in (design.driver, design.driven):
-            assert gear.module is not None and gear.face_width is not None
-            try:
-                t = iso1328.tolerances(grade, gear.teeth, gear.module * 1e3, gear.face_width * 1e3)
-            except InputError as exc:
-                raise ToleranceError("accuracy", exc.message) from None
-            profile.append(t.F_alpha)
-        e_max = iso1328.mesh_error_bound(*profile) * 1e-6
+        grade = tol.accuracy.tolerance_class
+        try:
+            e_max = iso1328.pair_te_bound(grade, design.driver, design.driven)
+        except InputError as exc:
+            raise tolerance_error("accuracy", exc.message) from None
         out.append(Variable(ACCURACY_FIELD, f"ISO 1328 class {grade}: mesh-frequency TE "
                             f"uniform on [0, {e_max * 1e6:.3g} um]",
                             stats.uniform(0.0, e_max).ppf,
@@ -171,7 +156,7 @@ def variables(design: Design) -> list[Variable]:
     for path, dist in tol.fields().items():
         out.append(_variable(base, path, dist))
     if not out:
-        raise ToleranceError("", "give at least one tolerance")
+        raise tolerance_error("", "give at least one tolerance")
     return out
 
 

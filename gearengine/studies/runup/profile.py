@@ -23,8 +23,9 @@ from typing import Literal
 
 import numpy as np
 from pydantic import ValidationError
-from pydantic_core import InitErrorDetails, PydanticCustomError
+from pydantic_core import InitErrorDetails
 
+from gearengine.model.errors import Problems
 from gearengine.model.params import GearParams
 from gearengine.model.units import RPM, in_si
 from gearengine.studies.runup.request import MAX_RUNUP_STEPS, RunupRequest, request_errors
@@ -198,10 +199,8 @@ def mid_speeds_rpm(seg: Segment) -> np.ndarray:
 def budget_errors(request: RunupRequest) -> list[InitErrorDetails]:
     """The work budget (``MAX_RUNUP_STEPS``) of a request whose fields ``request_errors``
     passed, as pydantic error details naming the field that sets the length."""
-    errors: list[InitErrorDetails] = []
-
-    def add(loc: tuple[str | int, ...], message: str, value: object) -> None:
-        errors.append({"type": PydanticCustomError("runup", message), "loc": loc, "input": value})
+    problems = Problems("runup")
+    add, errors = problems.add, problems.details
 
     try:
         steps = runup_plan(request).work(request.ensemble.size)

@@ -20,9 +20,10 @@ import math
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, BeforeValidator, Field, WithJsonSchema
-from pydantic_core import InitErrorDetails, PydanticCustomError
+from pydantic_core import InitErrorDetails
 
 from gearengine.model.design import EXAMPLE_DESIGN
+from gearengine.model.errors import Problems
 from gearengine.model.params import request_config
 from gearengine.model.reduction import ParamsOrDesign
 from gearengine.model.units import (
@@ -182,10 +183,8 @@ def request_errors(request: RunupRequest) -> list[InitErrorDetails]:
     """Checks across fields, as pydantic error details naming each field: a design with the
     piecewise law, one profile (points, or from/to with rate or duration), ordered speeds and
     times (the work budget is ``profile.checked``'s), all before any compute."""
-    errors: list[InitErrorDetails] = []
-
-    def add(loc: tuple[str | int, ...], message: str, value: object) -> None:
-        errors.append({"type": PydanticCustomError("runup", message), "loc": loc, "input": value})
+    problems = Problems("runup")
+    add, errors = problems.add, problems.details
 
     design = request.design
     if design is None:

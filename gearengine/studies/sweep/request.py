@@ -19,9 +19,10 @@ from typing import Annotated, Literal
 
 import numpy as np
 from pydantic import BaseModel, Field, PlainValidator, ValidationError, WithJsonSchema
-from pydantic_core import InitErrorDetails, PydanticCustomError
+from pydantic_core import InitErrorDetails
 
 from gearengine.model.design import Design
+from gearengine.model.errors import Problems
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, WholeNumber, request_config
 from gearengine.model.reduction import ParamsOrDesign
@@ -189,10 +190,8 @@ def request_errors(request: SweepRequest, max_points: int | None = None) -> list
     the point count under ``max_points``, and every corner of the grid a valid design (the
     admissible set of each alias is an interval, so the corners decide).
     """
-    errors: list[InitErrorDetails] = []
-
-    def add(loc: tuple[str | int, ...], message: str, value: object) -> None:
-        errors.append({"type": PydanticCustomError("sweep", message), "loc": loc, "input": value})
+    problems = Problems("sweep")
+    add, errors = problems.add, problems.details
 
     for i, axis in enumerate(request.axes):
         if axis.num > 1 and axis.stop == axis.start:

@@ -13,57 +13,12 @@ Poincare period T0 = 2 pi / Omega_0 so stroboscopic samples fall on step boundar
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
-from gearengine.model.backlash import LAWS
 from gearengine.model.frequencies import incommensurate_reason, poincare_frequency
-from gearengine.model.params import CubicBacklash, GearParams
+from gearengine.model.params import GearParams
 from gearengine.systems.base import StepPlan
-
-
-@dataclass(frozen=True)
-class ForcingCoefficients:
-    """Flat arrays of the cosine terms of K(t) and F(t) (Eq. 9), each of shape (n_terms,)."""
-
-    k_amp: np.ndarray
-    k_omega: np.ndarray
-    k_phase: np.ndarray
-    mean_force: float
-    f_amp: np.ndarray
-    f_omega: np.ndarray
-    f_phase: np.ndarray
-
-
-@dataclass(frozen=True)
-class Law:
-    """Backlash law f_h as kernel arguments: its name and code in ``model.backlash.LAWS``, the
-    cubic's (a, c) and the piecewise law's alpha (the unused ones are 0)."""
-
-    name: str
-    code: int
-    a: float
-    c: float
-    alpha: float
-
-
-def forcing_coefficients(params: GearParams) -> ForcingCoefficients:
-    """Cosine terms of K(t) and F(t) of Eq. (9) for every harmonic with nonzero amplitude."""
-    kc, fm, fc = packed_forcing(params)
-    return ForcingCoefficients(
-        k_amp=kc[0], k_omega=kc[1], k_phase=kc[2], mean_force=fm,
-        f_amp=fc[0], f_omega=fc[1], f_phase=fc[2],
-    )  # fmt: skip
-
-
-def law(params: GearParams) -> Law:
-    """Kernel arguments of the backlash law f_h."""
-    b = params.backlash
-    code = LAWS[b.model].kernel_code
-    if isinstance(b, CubicBacklash):
-        return Law(b.model, code, float(b.a), float(b.c), 0.0)
-    return Law(b.model, code, 0.0, 0.0, float(b.alpha))
 
 
 def packed_forcing(params: GearParams) -> tuple[np.ndarray, float, np.ndarray]:

@@ -2,49 +2,23 @@
 
     x' = v,    v' = -2 mu v - K(t) f_h(x) + F(t)                       (Eq. 9)
 
-Its integrator is chosen per backlash law from ``INTEGRATORS`` (the smooth RK4 for the cubic
-law, the kink-splitting RK4 for the piecewise law of Eq. 8); its stroboscopic flow and 2 x 2
-monodromy matrix come from ``kernels.monodromy`` (both laws, the same RK4 arithmetic).
+Its integrator is its backlash law's, from ``laws.LAWS`` (the smooth RK4 for the cubic law, the
+kink-splitting RK4 for the piecewise law of Eq. 8); its stroboscopic flow and 2 x 2 monodromy
+matrix come from ``kernels.monodromy`` (both laws, the same RK4 arithmetic).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from gearengine.model.params import GearParams
-from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.systems.base import Run, StepPlan, System
 from gearengine.systems.spur_pair import kernels
-from gearengine.systems.spur_pair.forcing import Law, law, packed_forcing, step_plan
-
-Kernel = Callable[..., tuple]
-"""A kernel call: (law, mu, start, forcing, plan, n_trans, n_rec, stride) -> kernel outputs."""
-
-
-def _smooth(lw: Law, mu: float, start: Sequence[float], forcing: tuple, plan: StepPlan,
-            n_trans: int, n_rec: int, stride: int) -> tuple:  # fmt: skip
-    return kernels.run_rk4(
-        lw.code, lw.a, lw.c, lw.alpha, mu, start[0], start[1], *forcing, plan.omega0 is not None,
-        plan.period, plan.steps, n_trans, n_rec, stride, DIVERGENCE_BOUND,
-    )  # fmt: skip
-
-
-def _kink(lw: Law, mu: float, start: Sequence[float], forcing: tuple, plan: StepPlan,
-          n_trans: int, n_rec: int, stride: int) -> tuple:  # fmt: skip
-    return kernels.run_kink(
-        lw.alpha, mu, start[0], start[1], *forcing, plan.period, plan.steps, n_trans, n_rec,
-        stride, DIVERGENCE_BOUND, plan.omega0 is not None,
-    )  # fmt: skip
-
-
-INTEGRATORS: dict[str, tuple[Kernel, str]] = {
-    "cubic": (_smooth, "rk4"),
-    "piecewise": (_kink, "rk4 split at the kinks |x| = 1 (Illinois regula falsi)"),
-}
-"""Integrator of each backlash law (``model.backlash.LAWS`` names) and its description."""
+from gearengine.systems.spur_pair.forcing import packed_forcing, step_plan
+from gearengine.systems.spur_pair.laws import LAWS, Law, law
 
 
 @dataclass(frozen=True)
@@ -93,9 +67,8 @@ class SpurPair(System):
         self, plan: StepPlan, start: Sequence[float], n_trans: int, n_rec: int, stride: int
     ) -> Run:
         lw = law(self.params)
-        kernel = INTEGRATORS[lw.name][0]
-        out = kernel(lw, self.params.damping, start, packed_forcing(self.params), plan, n_trans,
-                     n_rec, stride)  # fmt: skip
+        out = LAWS[lw.name].run(lw, self.params.damping, start, packed_forcing(self.params),
+                                plan, n_trans, n_rec, stride)  # fmt: skip
         xs, vs, logs, hx, hv, xmin, xmax, done, xf, vf, fmin, fmax = out
         return Run(
             xs, vs, logs, hx, hv, xmin, xmax, done, (xf, vf), done < n_trans + n_rec,
@@ -113,4 +86,4 @@ class SpurPair(System):
     def method(self, plan: StepPlan) -> str:
         name = self.params.backlash.model
         table = plan.omega0 is not None
-        return INTEGRATORS[name][1] + (", forcing table" if table else ", forcing at abs. time")
+        return LAWS[name].method + (", forcing table" if table else ", forcing at abs. time")

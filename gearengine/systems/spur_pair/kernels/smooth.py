@@ -71,7 +71,7 @@ def law_force(
     law: int, a: float, c: float, alpha: float, x: float
 ) -> tuple[float, float]:  # pragma: no cover - compiled
     """f_h(x) and f_h'(x): cubic -a x + c x^3 (law 0) or Eq. (8) (law 1); codes from
-    ``gearengine.model.backlash.LAWS``."""
+    ``gearengine.systems.spur_pair.laws.LAWS``."""
     if law == 0:
         x2 = x * x
         return x * (c * x2 - a), 3.0 * c * x2 - a
