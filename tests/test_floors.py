@@ -127,3 +127,10 @@ def test_no_engine_module_over_the_line_limit() -> None:
         if (n := len(p.read_text().splitlines())) > MAX_LINES and m not in LONG_KERNELS
     }  # fmt: skip
     assert long == {}
+
+
+def test_the_architecture_doc_names_every_module() -> None:
+    doc = (ROOT / "docs" / "architecture.md").read_text()
+    missing = [str(p.relative_to(ROOT)) for p in engine_modules().values()
+               if f"`{p.relative_to(ROOT)}`" not in doc]  # fmt: skip
+    assert missing == []
