@@ -134,23 +134,14 @@ class BranchCoefficients(BaseModel):
 def homoclinic_orbit(
     t: np.ndarray | float, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
 ) -> tuple:
-    """(x_h, y_h) at dimensionless time t on the given loop: Eq. (15) for F_m = 0, else the
-    loaded loop x_s + u_s(t) of ``loops`` (u_s = s P / (cosh(k t) + cos theta_s))."""
-    s = BRANCH_SIGN[branch]
-    if fm == 0.0:
-        z = math.sqrt(a) * np.asarray(t, dtype=float)
-        e = np.exp(-np.abs(z))
-        sech = 2.0 * e / (1.0 + e * e)  # overflow-free sech(z)
-        x = s * math.sqrt(2.0 * a / c) * sech
-        y = -s * math.sqrt(2.0 / c) * a * sech * np.tanh(z)
-        return x, y
-    xs, alpha, p, cos_t, _ = loops.loop_shape(a, c, fm, s)
-    z = math.sqrt(alpha) * np.abs(np.asarray(t, dtype=float))
-    e = np.exp(-z)  # overflow-free: cosh z + cos = (1 + 2 cos e + e^2) / (2 e)
-    den = 1.0 + 2.0 * cos_t * e + e * e
-    u = s * p * 2.0 * e / den
-    du = -s * p * math.sqrt(alpha) * 2.0 * e * (1.0 - e * e) / den**2  # u' for t >= 0
-    return xs + u, np.sign(np.asarray(t, dtype=float)) * du
+    """(x_h, y_h) at dimensionless time t (array or scalar) on the given loop: Eq. (15) for
+    F_m = 0, else the loaded loop x_s + u_s(t) of ``loops`` (u_s = s P / (cosh(k t) +
+    cos theta_s)); compiled (``loops.orbit``)."""
+    times = np.asarray(t, dtype=float)
+    x, y = loops.orbit(times.ravel(), a, c, fm, BRANCH_SIGN[branch])
+    if times.ndim == 0:
+        return float(x[0]), float(y[0])
+    return x.reshape(times.shape), y.reshape(times.shape)
 
 
 # --- Closed form, corrected Eq. (19), compiled in ``kernels`` ------------------------------------
