@@ -33,6 +33,7 @@ Oscillations, Dynamical Systems, and Bifurcations of Vector Fields*, Springer 19
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -147,9 +148,13 @@ def homoclinic_orbit(
 # --- Closed form, corrected Eq. (19), compiled in ``kernels`` ------------------------------------
 
 
+@functools.lru_cache(maxsize=1024)
 def _system(a: float, c: float, fm: float = 0.0) -> np.ndarray:
-    """The unperturbed system (a, c, F_m) in the kernels' packed ``system`` form."""
-    return system_array(0.0, a, c, fm, 0.0, 1.0)
+    """The unperturbed system (a, c, F_m) in the kernels' packed ``system`` form, read-only and
+    kept: every coefficient of a verdict asks for the same one."""
+    system = system_array(0.0, a, c, fm, 0.0, 1.0)
+    system.flags.writeable = False
+    return system
 
 
 def damping_coefficient(

@@ -25,7 +25,14 @@ from gearengine.homoclinic.coefficients import (
     melnikov_coefficients,
     saddle_loop,
 )
-from gearengine.homoclinic.extrema import Interval, TrigSum, extrema, sublevel_interval
+from gearengine.homoclinic.extrema import (
+    Interval,
+    TrigSum,
+    extrema,
+    one_sinusoid,
+    one_sinusoid_interval,
+    sublevel_interval,
+)
 from gearengine.homoclinic.schemas import (
     BranchThreshold,
     ParameterThreshold,
@@ -137,17 +144,19 @@ def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum]
     if coef.damping_per_unit is None:
         raise ValueError("coefficients read back from JSON carry no per-unit values (they are "
                          "not serialised): compute them again from the parameters")  # fmt: skip
+    j = None
+    if parameter != "mu":
+        name = _TERM_OF[parameter]
+        j = next((i for i, t in enumerate(coef.terms) if t.excitation == name and t.r == 1), None)
+        if j is None:
+            return None
     m = coef.trig_sum()
     zeros = np.zeros_like(m.amplitudes)
-    if parameter == "mu":
+    if j is None:
         return (
             TrigSum(0.0, m.amplitudes, m.frequencies, m.phases),
             TrigSum(coef.damping_per_unit, zeros, m.frequencies, m.phases),
         )
-    name = _TERM_OF[parameter]
-    j = next((i for i, t in enumerate(coef.terms) if t.excitation == name and t.r == 1), None)
-    if j is None:
-        return None
     rest = m.amplitudes.copy()
     rest[j] = 0.0
     unit = zeros.copy()
@@ -160,6 +169,10 @@ def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum]
 
 def no_sign_change(m0: TrigSum, g: TrigSum) -> list[Interval]:
     """Intervals of p where m0 + p g keeps one sign: max <= 0 or min >= 0."""
+    if m0.amplitudes.size <= 1:  # the closed forms, on floats (-M: the same floats negated)
+        single = one_sinusoid(m0, g)
+        below = one_sinusoid_interval(*single)
+        return [s for s in (below, one_sinusoid_interval(*(-v for v in single))) if s is not None]
     sets = (sublevel_interval(m0, g), sublevel_interval(m0.negated(), g.negated()))
     return [s for s in sets if s is not None]
 
