@@ -165,35 +165,6 @@ def damping_coefficient(
     return float(kernels.damping_unit(_system(a, c, fm), BRANCH_SIGN[branch]))
 
 
-def stiffness_coefficient(omega: float, a: float, c: float, fm: float = 0.0) -> float:
-    """B per unit k_pr: pi Omega^2 (2a - Omega^2) / (3c) csch(pi Omega / (2 sqrt a)).
-
-    Corrected stiffness term of Eq. (19); the same for both branches when F_m = 0 (the loaded
-    loops' on plus, ``kernels.unit_coefficient``, otherwise).
-    """
-    return float(kernels.unit_coefficient(kernels.STIFFNESS, omega, _system(a, c, fm), 1.0))
-
-
-def torque_coefficient(
-    omega: float, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
-) -> float:
-    """B per unit F_pr: s sqrt(2/c) pi Omega sech(pi Omega / (2 sqrt a)) (Eq. 19)."""
-    s = BRANCH_SIGN[branch]
-    return float(kernels.unit_coefficient(kernels.TORQUE, omega, _system(a, c, fm), s))
-
-
-def transmission_error_coefficient(
-    omega: float, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
-) -> float:
-    """B per unit F_er: s sqrt(2/c) pi Omega^3 sech(pi Omega / (2 sqrt a)) (Eq. 19).
-
-    The forcing amplitude is Omega^2 F_er (Eq. 9), hence Omega^3.
-    """
-    s = BRANCH_SIGN[branch]
-    kind = kernels.TRANSMISSION_ERROR
-    return float(kernels.unit_coefficient(kind, omega, _system(a, c, fm), s))
-
-
 # --- Quadrature of Eq. (18), term by term -------------------------------------------------------
 
 
