@@ -8,17 +8,27 @@ Cases: the paper's section 4.1 design (one excitation), a design with stiffness,
 error and torque (commensurate 1 : 0.5 : 0.25), both with all thresholds and the default
 Omega_e scan; and the verdicts and margins of 10,000 one-excitation designs (the old engine has
 no batch: its per-design verdict and four parameter thresholds, timed on 500 designs).
+
+Served (issue 31): POST /v1/melnikov through a real ``gearengine serve`` of the working tree and
+one of commit 9b6ddae (before issue 31, ``git archive`` of gearengine and service), both warm,
+requests alternating between them (a shared machine loads both alike); every request a new
+design (no cache serves it), one excitation or three; and the same verdicts in process
+(``answer_melnikov`` and its JSON) in a worker of each tree, batches alternating.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import random
+import socket
 import subprocess
 import sys
+import tempfile
+import time
 from pathlib import Path
 
-from common import extracted  # benchmarks/common.py (the script's own folder)
+from common import extracted, min_median, served  # benchmarks/common.py (the script's folder)
 from report import write_section
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -26,6 +36,12 @@ BASELINE = "2216844"
 PREVIOUS = "8ba34c9"
 """Before the per-point verdicts ran compiled: the baseline of rows the old engine cannot run."""
 DESIGN = ROOT / "examples" / "design-direct.json"
+BEFORE = "9b6ddae"
+"""Before issue 31: the loops' largest speed and force sampled on all 4001 grid times, the API
+key check and every verdict in a worker thread."""
+ROUNDS, PER_ROUND = 12, 40
+"""Served and in-process timings: rounds (the trees alternate, first one then the other) of
+that many new designs each, per excitation count."""
 
 WORKER = r"""
 import json, random, sys, time
@@ -114,7 +130,186 @@ def measure_commit(commit: str) -> dict:
         return measure(tmp)
 
 
+def varied(kind: str, rng: random.Random) -> dict:
+    """A new /v1/melnikov request: one excitation (transmission error) or three (stiffness,
+    transmission error and torque at 1 : 0.5 : 0.25), amplitude, damping, load and speed drawn
+    afresh (loads below F_crit = 0.0642 of the paper's cubic: the loaded loops)."""
+    om = rng.uniform(0.4, 0.6)
+    params = {
+        "damping": rng.uniform(0.04, 0.09),
+        "mean_force": rng.uniform(0.0, 0.04),
+        "transmission_error": {
+            "frequency": om,
+            "harmonics": [{"amplitude": rng.uniform(0.05, 0.3)}],
+        },
+    }
+    if kind == "three":
+        params["stiffness"] = {"frequency": 2 * om, "harmonics": [{"amplitude": 0.1, "phase": 0.3}]}
+        params["torque"] = {"frequency": om / 2, "harmonics": [{"amplitude": 0.08, "phase": 1.1}]}
+    return {"params": params}
+
+
+class Plain:
+    """A blocking keep-alive HTTP/1.1 connection on a bare socket: the client adds microseconds,
+    not the fraction of a millisecond of httpx, to a served verdict."""
+
+    def __init__(self, port: int) -> None:
+        self.sock = socket.create_connection(("127.0.0.1", port))
+        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self.file = self.sock.makefile("rb")
+
+    def request(self, method: str, path: str, body: bytes = b"") -> tuple[int, bytes]:
+        """(status, body) of one request; the response must carry Content-Length."""
+        head = f"{method} {path} HTTP/1.1\r\nHost: 127.0.0.1\r\n"
+        if body:
+            head += f"Content-Type: application/json\r\nContent-Length: {len(body)}\r\n"
+        self.sock.sendall(head.encode() + b"\r\n" + body)
+        status = int(self.file.readline().split()[1])
+        length = 0
+        while (line := self.file.readline()) not in (b"\r\n", b""):
+            key, _, value = line.partition(b":")
+            if key.strip().lower() == b"content-length":
+                length = int(value)
+        return status, self.file.read(length)
+
+    def close(self) -> None:
+        self.file.close()
+        self.sock.close()
+
+
+def served_timings(ports: dict[str, int]) -> dict[tuple[str, str], list[float]]:
+    """Wall time per request [s], by (tree, what): POST /v1/melnikov of new designs ("one",
+    "three") and GET /v1/health ("health", the floor of any request), the trees alternating."""
+    clients = {label: Plain(port) for label, port in ports.items()}
+    times: dict[tuple[str, str], list[float]] = {}
+    try:
+        for warm in range(20):  # both servers' HTTP processes warm
+            for client in clients.values():
+                client.request(
+                    "POST", "/v1/melnikov", json.dumps(varied("one", random.Random(warm))).encode()
+                )
+        for k in range(ROUNDS):
+            order = list(clients) if k % 2 == 0 else list(clients)[::-1]
+            for what in ("one", "three", "health"):
+                for label in order:
+                    rng = random.Random(1000 * k + len(what))  # the same designs for both trees
+                    for _ in range(PER_ROUND):
+                        body = b"" if what == "health" else json.dumps(varied(what, rng)).encode()
+                        method, path = (
+                            ("GET", "/v1/health") if what == "health" else ("POST", "/v1/melnikov")
+                        )
+                        t = time.perf_counter()
+                        status, _ = clients[label].request(method, path, body)
+                        times.setdefault((label, what), []).append(time.perf_counter() - t)
+                        if status != 200:
+                            raise RuntimeError(f"{label} {what}: HTTP {status}")
+    finally:
+        for client in clients.values():
+            client.close()
+    return times
+
+
+VERDICTS = r"""
+import json, sys, time
+from gearengine.analysis import MelnikovRequest, answer_melnikov
+from gearengine.jsonio import dumps
+for line in sys.stdin:
+    reqs = [MelnikovRequest.model_validate(d) for d in json.loads(line)]
+    times = []
+    for r in reqs:
+        t = time.perf_counter()
+        dumps(answer_melnikov(r))
+        times.append(time.perf_counter() - t)
+    print(json.dumps(times), flush=True)
+"""
+
+
+def in_process_timings(trees: dict[str, Path]) -> dict[tuple[str, str], list[float]]:
+    """Wall time [s] of ``answer_melnikov`` and its JSON per new design, by (tree, "one" or
+    "three"), in one worker process per tree, batches alternating between them."""
+    workers = {
+        label: subprocess.Popen(
+            [sys.executable, "-c", VERDICTS],
+            env={**os.environ, "PYTHONPATH": str(tree)},
+            cwd=tree,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        for label, tree in trees.items()
+    }
+
+    def batch(label: str, docs: list[dict]) -> list[float]:
+        worker = workers[label]
+        worker.stdin.write(json.dumps(docs) + "\n")
+        worker.stdin.flush()
+        return json.loads(worker.stdout.readline())
+
+    times: dict[tuple[str, str], list[float]] = {}
+    try:
+        for k in range(-1, ROUNDS):  # round -1 warms the kernels and caches of fixed things
+            order = list(workers) if k % 2 == 0 else list(workers)[::-1]
+            for what in ("one", "three"):
+                rng = random.Random(7000 + k)
+                docs = [varied(what, rng) for _ in range(PER_ROUND)]
+                for label in order:
+                    got = batch(label, docs)
+                    if k >= 0:
+                        times.setdefault((label, what), []).extend(got)
+    finally:
+        for worker in workers.values():
+            worker.stdin.close()
+            worker.wait()
+    return times
+
+
+def served_section() -> list[str]:
+    """The served and in-process rows of issue 31, before (BEFORE) and now, as markdown."""
+    with extracted(BEFORE, ("gearengine", "service")) as old, tempfile.TemporaryDirectory() as d:
+        tmp = Path(d)
+        for label in ("before", "now"):
+            (tmp / label).mkdir()
+        with served(tmp / "before" / "data", {}, old) as a, served(tmp / "now" / "data", {}) as b:
+            ports = {"before": a.base_url.port, "now": b.base_url.port}
+            http = served_timings(ports)
+        local = in_process_timings({"before": old, "now": ROOT})
+    load = os.getloadavg()[0]
+    rows = [
+        ("served: POST /v1/melnikov, one excitation", http, "one"),
+        ("served: POST /v1/melnikov, three excitations", http, "three"),
+        ("served: GET /v1/health (the floor of any request)", http, "health"),
+        ("in process: `answer_melnikov` + JSON, one excitation", local, "one"),
+        ("in process: `answer_melnikov` + JSON, three excitations", local, "three"),
+    ]
+    lines = [
+        f"### Served (issue 31): before ({BEFORE}) and now",
+        "",
+        f"A real `gearengine serve` of each tree (its defaults: one HTTP process per core), warm; "
+        f"{ROUNDS} rounds of {PER_ROUND} requests per row, alternating between the trees, from "
+        "one blocking keep-alive client on a bare socket (wall time from the request written to "
+        "the response read); every verdict a new design (amplitude, damping, load below F_crit "
+        "and speed drawn afresh), so no response cache serves it. In process: the same kind "
+        "of designs in one worker per tree, batches alternating. Targets (issue 31): served at "
+        "or under 0.6 ms (one excitation) and 6 ms (three).",
+        "",
+        "| what | before, min / median ms | now, min / median ms | before / now (median) |",
+        "| --- | ---: | ---: | ---: |",
+    ]
+    for label, times, what in rows:
+        (b_min, b_med), (n_min, n_med) = (
+            min_median(times[(tree, what)]) for tree in ("before", "now")
+        )
+        lines.append(
+            f"| {label} | {1e3 * b_min:.3f} / {1e3 * b_med:.3f} | {1e3 * n_min:.3f} / "
+            f"{1e3 * n_med:.3f} | {b_med / n_med:.2f}x |"
+        )
+    lines += ["", f"Load average (1 min) at the end of the run: {load:.1f} on 2 cores."]
+    return lines
+
+
 def main() -> None:
+    issue31 = served_section()
+    print("\n".join(issue31), flush=True)
     old = measure_commit(BASELINE)
     previous = measure_commit(PREVIOUS)
     new = measure(ROOT)
@@ -159,6 +354,8 @@ def main() -> None:
         "",
         f"Designs with several excitations take the per-design path of `melnikov_batch`: "
         f"{new['batch_three']:.3f} ms per design (three excitations).",
+        "",
+        *issue31,
     ]
     markdown = "\n".join(lines)
     print(markdown)

@@ -60,34 +60,38 @@ def wait_ready(client: httpx.Client, seconds: float = 120.0) -> None:
 
 
 @contextmanager
-def extracted(commit: str) -> Iterator[Path]:
-    """A temporary directory holding the ``gearengine`` package of ``commit`` (``git archive``):
-    the previous implementation, run with ``PYTHONPATH`` set to it and the same dependencies."""
+def extracted(commit: str, packages: tuple[str, ...] = ("gearengine",)) -> Iterator[Path]:
+    """A temporary directory holding the ``packages`` of ``commit`` (``git archive``): the
+    previous implementation, run with ``PYTHONPATH`` set to it and the same dependencies."""
     with tempfile.TemporaryDirectory(prefix="gearchaos-baseline-") as tmp:
         archive = subprocess.run(
-            ["git", "archive", commit, "gearengine"], cwd=ROOT, capture_output=True, check=True
+            ["git", "archive", commit, *packages], cwd=ROOT, capture_output=True, check=True
         )
         subprocess.run(["tar", "-x", "-C", tmp], input=archive.stdout, check=True)
         yield Path(tmp)
 
 
 @contextmanager
-def served(data_dir: Path, env: dict[str, str]) -> Iterator[httpx.Client]:
-    """A real ``gearengine serve`` of the working tree on a free loopback port with ``env`` added
-    to this process's environment and its job store in ``data_dir``, ready (``wait_ready``);
-    yields a client of it and stops it afterwards (killed if it does not stop within 60 s)."""
+def served(data_dir: Path, env: dict[str, str], tree: Path = ROOT) -> Iterator[httpx.Client]:
+    """A real ``gearengine serve`` of the working tree (or of the source ``tree`` of an earlier
+    commit, ``extracted`` with gearengine and service: then on ``PYTHONPATH``) on a free loopback
+    port with ``env`` added to this process's environment and its job store in ``data_dir``,
+    ready (``wait_ready``); yields a client of it and stops it afterwards (killed if it does not
+    stop within 60 s)."""
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
     cmd = [sys.executable, "-m", "gearengine.cli", "serve", "--port", str(port),
            "--data-dir", str(data_dir)]  # fmt: skip
     with open(data_dir.parent / "server.log", "w") as log:
+        if tree != ROOT:
+            env = {**env, "PYTHONPATH": str(tree)}
         proc = subprocess.Popen(
-            cmd, cwd=ROOT, env={**os.environ, **env}, stdout=log, stderr=subprocess.STDOUT
+            cmd, cwd=tree, env={**os.environ, **env}, stdout=log, stderr=subprocess.STDOUT
         )
         try:
             with httpx.Client(base_url=f"http://127.0.0.1:{port}", timeout=600) as client:
-                wait_ready(client)
+                wait_ready(client, 900.0)  # a tree extracted afresh compiles its kernels
                 yield client
         finally:
             proc.terminate()

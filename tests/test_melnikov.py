@@ -128,13 +128,17 @@ def test_erratum_printed_stiffness_term_disagrees_with_quadrature() -> None:
         printed = printed_eq19_stiffness(omega, a, c)
         assert abs(printed - quad) > 0.5 * abs(quad), (omega, printed, quad)
     # at Omega = 1 the printed form even has the wrong sign
-    assert printed_eq19_stiffness(1.0, a, c) * mk.stiffness_coefficient(1.0, a, c) < 0.0
+    assert (
+        printed_eq19_stiffness(1.0, a, c)
+        * mk.closed_form_coefficient("stiffness", 1.0, a, c, "plus")
+        < 0.0
+    )
 
 
 def test_printed_stiffness_term_is_right_only_when_a_is_one() -> None:
     for omega in (0.5, 1.3):
         assert printed_eq19_stiffness(omega, 1.0, 0.7) == pytest.approx(
-            mk.stiffness_coefficient(omega, 1.0, 0.7), rel=1e-12
+            mk.closed_form_coefficient("stiffness", omega, 1.0, 0.7, "plus"), rel=1e-12
         )
 
 

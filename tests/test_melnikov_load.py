@@ -147,9 +147,9 @@ def test_zero_load_reproduces_todays_closed_form() -> None:
         for br, s in SIGN.items():
             i1, t2 = loops.loop_integrals(omega, A, C, 0.0, s)
             pairs = [
-                (omega * i1, mk.torque_coefficient(omega, A, C, br)),
-                (omega**3 * i1, mk.transmission_error_coefficient(omega, A, C, br)),
-                (omega * t2, mk.stiffness_coefficient(omega, A, C)),
+                (omega * i1, mk.closed_form_coefficient("torque", omega, A, C, br)),
+                (omega**3 * i1, mk.closed_form_coefficient("transmission_error", omega, A, C, br)),
+                (omega * t2, mk.closed_form_coefficient("stiffness", omega, A, C, br)),
             ]
             for new, old in pairs:
                 assert new == pytest.approx(old, rel=1e-8, abs=1e-14)

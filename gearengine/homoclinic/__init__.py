@@ -4,7 +4,8 @@ saddle intersect transversally?
 Data flow: ``loops`` (the saddle and the two homoclinic loops of x'' = a x - c x^3 + F_m, the
 mean load in the unperturbed system; none for |F_m| >= F_crit) -> ``coefficients`` (the
 sinusoids of M(tau0), Eq. 19, closed form or quadrature) -> ``extrema`` (min and max of M over
-tau0) -> ``thresholds`` (critical values of each control parameter and the design's margin) ->
+tau0) -> ``thresholds`` (critical values of each control parameter; ``margins``: their sets and the
+design's margin) ->
 ``verdict`` (``melnikov``: the whole answer, with ``perturbations``: how far first-order theory
 is stretched), with the request and result documents in ``schemas``; ``batch``
 (``melnikov_batch``) gives verdicts and margins of many designs at once, ``grid`` the chaos

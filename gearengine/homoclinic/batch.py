@@ -44,12 +44,9 @@ from gearengine.homoclinic.kernels import (
     damping_unit,
     unit_coefficient,
 )
+from gearengine.homoclinic.margins import signed_margin
 from gearengine.homoclinic.terms import packed_terms
-from gearengine.homoclinic.thresholds import (
-    CONTROL_PARAMETERS,
-    parameter_threshold,
-    signed_margin,
-)
+from gearengine.homoclinic.thresholds import CONTROL_PARAMETERS, parameter_threshold
 from gearengine.homoclinic.verdict import applicability
 from gearengine.model.aliases import get_alias
 from gearengine.model.examples import PAPER_SECTION_41
@@ -110,7 +107,7 @@ class MelnikovBatchResult(BaseModel):
 def _margin(
     parameter: str, value: float, critical: Sequence[float], no_chaos: Sequence[Sequence]
 ) -> Margin:
-    """``thresholds.signed_margin``: positive on the safe side (null without critical value)."""
+    """``margins.signed_margin``: positive on the safe side (null without critical value)."""
     _, margin, rel = signed_margin(parameter, value, critical, no_chaos)
     return {"margin": margin, "relative_margin": rel}
 

@@ -33,6 +33,7 @@ Oscillations, Dynamical Systems, and Bifurcations of Vector Fields*, Springer 19
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -134,31 +135,26 @@ class BranchCoefficients(BaseModel):
 def homoclinic_orbit(
     t: np.ndarray | float, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
 ) -> tuple:
-    """(x_h, y_h) at dimensionless time t on the given loop: Eq. (15) for F_m = 0, else the
-    loaded loop x_s + u_s(t) of ``loops`` (u_s = s P / (cosh(k t) + cos theta_s))."""
-    s = BRANCH_SIGN[branch]
-    if fm == 0.0:
-        z = math.sqrt(a) * np.asarray(t, dtype=float)
-        e = np.exp(-np.abs(z))
-        sech = 2.0 * e / (1.0 + e * e)  # overflow-free sech(z)
-        x = s * math.sqrt(2.0 * a / c) * sech
-        y = -s * math.sqrt(2.0 / c) * a * sech * np.tanh(z)
-        return x, y
-    xs, alpha, p, cos_t, _ = loops.loop_shape(a, c, fm, s)
-    z = math.sqrt(alpha) * np.abs(np.asarray(t, dtype=float))
-    e = np.exp(-z)  # overflow-free: cosh z + cos = (1 + 2 cos e + e^2) / (2 e)
-    den = 1.0 + 2.0 * cos_t * e + e * e
-    u = s * p * 2.0 * e / den
-    du = -s * p * math.sqrt(alpha) * 2.0 * e * (1.0 - e * e) / den**2  # u' for t >= 0
-    return xs + u, np.sign(np.asarray(t, dtype=float)) * du
+    """(x_h, y_h) at dimensionless time t (array or scalar) on the given loop: Eq. (15) for
+    F_m = 0, else the loaded loop x_s + u_s(t) of ``loops`` (u_s = s P / (cosh(k t) +
+    cos theta_s)); compiled (``loops.orbit``)."""
+    times = np.asarray(t, dtype=float)
+    x, y = loops.orbit(times.ravel(), a, c, fm, BRANCH_SIGN[branch])
+    if times.ndim == 0:
+        return float(x[0]), float(y[0])
+    return x.reshape(times.shape), y.reshape(times.shape)
 
 
 # --- Closed form, corrected Eq. (19), compiled in ``kernels`` ------------------------------------
 
 
+@functools.lru_cache(maxsize=1024)
 def _system(a: float, c: float, fm: float = 0.0) -> np.ndarray:
-    """The unperturbed system (a, c, F_m) in the kernels' packed ``system`` form."""
-    return system_array(0.0, a, c, fm, 0.0, 1.0)
+    """The unperturbed system (a, c, F_m) in the kernels' packed ``system`` form, read-only and
+    kept: every coefficient of a verdict asks for the same one."""
+    system = system_array(0.0, a, c, fm, 0.0, 1.0)
+    system.flags.writeable = False
+    return system
 
 
 def damping_coefficient(
@@ -167,35 +163,6 @@ def damping_coefficient(
     """dA/dmu = -(8/3) a^(3/2) / c, from -2 mu * integral of y_h^2 (Eq. 19, first term); on the
     given loaded loop for F_m != 0."""
     return float(kernels.damping_unit(_system(a, c, fm), BRANCH_SIGN[branch]))
-
-
-def stiffness_coefficient(omega: float, a: float, c: float, fm: float = 0.0) -> float:
-    """B per unit k_pr: pi Omega^2 (2a - Omega^2) / (3c) csch(pi Omega / (2 sqrt a)).
-
-    Corrected stiffness term of Eq. (19); the same for both branches when F_m = 0 (the loaded
-    loops' on plus, ``kernels.unit_coefficient``, otherwise).
-    """
-    return float(kernels.unit_coefficient(kernels.STIFFNESS, omega, _system(a, c, fm), 1.0))
-
-
-def torque_coefficient(
-    omega: float, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
-) -> float:
-    """B per unit F_pr: s sqrt(2/c) pi Omega sech(pi Omega / (2 sqrt a)) (Eq. 19)."""
-    s = BRANCH_SIGN[branch]
-    return float(kernels.unit_coefficient(kernels.TORQUE, omega, _system(a, c, fm), s))
-
-
-def transmission_error_coefficient(
-    omega: float, a: float, c: float, branch: HomoclinicBranch, fm: float = 0.0
-) -> float:
-    """B per unit F_er: s sqrt(2/c) pi Omega^3 sech(pi Omega / (2 sqrt a)) (Eq. 19).
-
-    The forcing amplitude is Omega^2 F_er (Eq. 9), hence Omega^3.
-    """
-    s = BRANCH_SIGN[branch]
-    kind = kernels.TRANSMISSION_ERROR
-    return float(kernels.unit_coefficient(kind, omega, _system(a, c, fm), s))
 
 
 # --- Quadrature of Eq. (18), term by term -------------------------------------------------------

@@ -167,7 +167,7 @@ def sublevel_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
     overflow.
     """
     if m0.amplitudes.size <= 1:
-        return _one_sinusoid_interval(m0, g)
+        return one_sinusoid_interval(*one_sinusoid(m0, g))
     m0, g = _flushed(m0), _flushed(g)
     freqs = m0.frequencies
     active = (m0.amplitudes != 0.0) | (g.amplitudes != 0.0)
@@ -206,16 +206,23 @@ def _flush(v: float) -> float:
     return 0.0 if abs(v) < NEGLIGIBLE else v
 
 
-def _one_sinusoid_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
-    """``sublevel_interval`` of sums with at most one sinusoid, on Python floats.
+def one_sinusoid(m0: TrigSum, g: TrigSum) -> tuple[float, float, float, float]:
+    """(m0.offset, g.offset, a, b) of sums with at most one sinusoid (a, b its amplitudes in
+    m0 and g, 0 when there is none) as Python floats, for ``one_sinusoid_interval``."""
+    a = float(m0.amplitudes[0]) if m0.amplitudes.size else 0.0
+    b = float(g.amplitudes[0]) if g.amplitudes.size else 0.0
+    return float(m0.offset), float(g.offset), a, b
 
-    phi(p) = (m0.offset + p g.offset) + |a + p b| is convex piecewise linear with one kink
-    k = -a / b (Eqs. 23-24 are its roots); the steps and roundings are those of
-    ``_supremum_interval`` for one term, without arrays.
+
+def one_sinusoid_interval(off0: float, offg: float, a: float, b: float) -> Interval | None:
+    """``sublevel_interval`` of sums with at most one sinusoid, on the Python floats of
+    ``one_sinusoid`` (negated, they give the set where the minimum stays >= 0).
+
+    phi(p) = (off0 + p offg) + |a + p b| is convex piecewise linear with one kink k = -a / b
+    (Eqs. 23-24 are its roots); the steps and roundings are those of ``_supremum_interval`` for
+    one term, without arrays.
     """
-    off0, offg = _flush(float(m0.offset)), _flush(float(g.offset))
-    a = _flush(float(m0.amplitudes[0])) if m0.amplitudes.size else 0.0
-    b = _flush(float(g.amplitudes[0])) if g.amplitudes.size else 0.0
+    off0, offg, a, b = _flush(off0), _flush(offg), _flush(a), _flush(b)
     if b == 0.0:
         return _affine_nonpositive(off0 + abs(a) if a != 0.0 else off0, offg)
     base = off0 + 0.0

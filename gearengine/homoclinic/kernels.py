@@ -26,7 +26,7 @@ import math
 import numba
 import numpy as np
 
-from gearengine.homoclinic.loops import loop_integrals
+from gearengine.homoclinic.loops import loop_shape, shape_integrals
 
 STIFFNESS, TRANSMISSION_ERROR, TORQUE = 0, 1, 2
 KIND = {"stiffness": STIFFNESS, "transmission_error": TRANSMISSION_ERROR, "torque": TORQUE}
@@ -64,13 +64,28 @@ def _csch(z: float) -> float:
 
 
 @jit
+def branch_shape(system, s: float):
+    """``loops.loop_shape`` of the system's loaded loop s (zeros for F_m = 0, where the closed
+    forms of Eq. 19 need none): computed once per branch, not once per coefficient."""
+    if system[FM] == 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0
+    return loop_shape(system[A], system[C], system[FM], s)
+
+
+@jit
 def damping_unit(system, s: float) -> float:
     """dA/dmu = -2 integral y_h^2 dt on branch s: -(8/3) a^(3/2) / c (Eq. 19, first term) of
     the system's cubic (a, c), both branches; -2 T_2(0) of ``loops.loop_integrals`` on the
     loaded loop s (F_m != 0: the loops differ)."""
+    return damping_on(system, s, branch_shape(system, s))
+
+
+@jit
+def damping_on(system, s: float, shape) -> float:
+    """``damping_unit`` with the branch's ``branch_shape`` given."""
     a, c, fm = system[A], system[C], system[FM]
     if fm != 0.0:
-        return -2.0 * loop_integrals(0.0, a, c, fm, s)[1]
+        return -2.0 * shape_integrals(0.0, c, s, shape)[1]
     return -8.0 / 3.0 * a**1.5 / c
 
 
@@ -85,9 +100,15 @@ def unit_coefficient(kind: int, omega: float, system, s: float) -> float:
     integrals (``loops.loop_integrals``): torque Omega I_1, transmission error Omega^3 I_1,
     stiffness Omega T_2 - 2 F_m Omega I_1 (Eq. 18 with a x - c x^3 = x'' - F_m on the loop).
     """
+    return unit_on(kind, omega, system, s, branch_shape(system, s))
+
+
+@jit
+def unit_on(kind: int, omega: float, system, s: float, shape) -> float:
+    """``unit_coefficient`` with the branch's ``branch_shape`` given."""
     a, c, fm = system[A], system[C], system[FM]
     if fm != 0.0:
-        i1, t2 = loop_integrals(omega, a, c, fm, s)
+        i1, t2 = shape_integrals(omega, c, s, shape)
         if kind == STIFFNESS:
             return omega * t2 - 2.0 * fm * omega * i1
         return omega * i1 if kind == TORQUE else omega**3 * i1
@@ -224,28 +245,41 @@ def scan_strength(om: float, value: float, terms, system) -> float:
     incommensurate). Returns FALLBACK (NaN) when a coefficient underflows to 0 and the active
     set (and so its period) is no longer the given one.
     """
+    return _strength(om, value, terms, system, _workspace(terms, system))
+
+
+@jit
+def _workspace(terms, system):
+    """What ``_strength`` reuses from one Omega_e of a scan to the next: both branches'
+    ``branch_shape`` (frequency-independent), and scratch arrays (frequencies, amplitudes, and
+    the grid of a single or incommensurate set, which needs none)."""
+    n = terms.shape[1]
+    shapes = ((1.0, branch_shape(system, 1.0)), (-1.0, branch_shape(system, -1.0)))
+    return shapes, np.empty(n), np.empty(n), np.zeros(2), np.zeros((2, n)), np.empty(2)
+
+
+@jit
+def _strength(om: float, value: float, terms, system, work) -> float:
+    """``scan_strength`` with the ``_workspace`` of its scan."""
+    shapes, freqs, amps, taus, table, values = work
     n = terms.shape[1]
     base, r, phase = terms[FUNDAMENTAL], terms[HARMONIC], terms[PHASE]
     gcd, lcm = system[GCD], system[LCM]
     factor = om / value
-    freqs = np.empty(n)
     for i in range(n):
         freqs[i] = r[i] * (base[i] * factor)
     exact = n >= 2 and gcd > 0.0
     period = 2.0 * math.pi / (freqs.max() * gcd / lcm) if exact else 0.0
     if exact:
         taus, table = grid_sines(freqs, phase, period)
-    else:
-        taus, table = np.zeros(2), np.zeros((2, n))
-    values = np.empty(taus.size)
+        values = np.empty(taus.size)
     best = -np.inf
-    amps = np.empty(n)
-    for s in (1.0, -1.0):
-        damping = damping_unit(system, s) * system[MU]
+    for s, shape in shapes:
+        damping = damping_on(system, s, shape) * system[MU]
         nact = 0
         for i in range(n):
             kind = int(terms[KIND_ROW, i])
-            amps[i] = unit_coefficient(kind, freqs[i], system, s) * terms[AMPLITUDE, i]
+            amps[i] = unit_on(kind, freqs[i], system, s, shape) * terms[AMPLITUDE, i]
             nact += amps[i] != 0.0
         if 2 <= nact < n:
             return FALLBACK
@@ -255,12 +289,12 @@ def scan_strength(om: float, value: float, terms, system) -> float:
 
 
 @jit
-def _brentq(value: float, terms, system, xa: float, xb: float, xtol: float) -> float:
+def _brentq(value: float, terms, system, work, xa: float, xb: float, xtol: float) -> float:
     """Root of ``scan_strength`` in [xa, xb]: scipy's brentq (Zeros/brentq.c), step for step."""
     xpre, xcur = xa, xb
     xblk, fblk, spre, scur = 0.0, 0.0, 0.0, 0.0
-    fpre = scan_strength(xpre, value, terms, system)
-    fcur = scan_strength(xcur, value, terms, system)
+    fpre = _strength(xpre, value, terms, system, work)
+    fcur = _strength(xcur, value, terms, system, work)
     if fpre == 0.0:
         return xpre
     if fcur == 0.0:
@@ -291,7 +325,7 @@ def _brentq(value: float, terms, system, xa: float, xb: float, xtol: float) -> f
             spre, scur = sbis, sbis
         xpre, fpre = xcur, fcur
         xcur += scur if abs(scur) > delta else (delta if sbis > 0 else -delta)
-        fcur = scan_strength(xcur, value, terms, system)
+        fcur = _strength(xcur, value, terms, system, work)
         if math.isnan(fcur):
             return np.nan
     return np.nan
@@ -304,16 +338,17 @@ def scan_roots(omegas, xtol: float, value: float, terms, system):
     Returns (critical, no_chaos, ok): ``no_chaos[j]`` says the strength is <= 0 in the middle of
     piece j of [start, *critical, stop]; ``ok`` is False when the scan met a FALLBACK point.
     """
+    work = _workspace(terms, system)
     m = omegas.size
     vals = np.empty(m)
     for k in range(m):
-        vals[k] = scan_strength(omegas[k], value, terms, system)
+        vals[k] = _strength(omegas[k], value, terms, system, work)
     critical = [0.0 for _ in range(0)]
     if np.isnan(vals).any():
         return np.empty(0), np.zeros(0, dtype=np.bool_), False
     for k in range(m - 1):
         if (vals[k] > 0.0) != (vals[k + 1] > 0.0):
-            root = _brentq(value, terms, system, omegas[k], omegas[k + 1], xtol)
+            root = _brentq(value, terms, system, work, omegas[k], omegas[k + 1], xtol)
             if math.isnan(root):
                 return np.empty(0), np.zeros(0, dtype=np.bool_), False
             critical.append(root)
@@ -323,7 +358,7 @@ def scan_roots(omegas, xtol: float, value: float, terms, system):
         edges[j + 1] = critical[j]
     no_chaos = np.zeros(edges.size - 1, dtype=np.bool_)
     for j in range(edges.size - 1):
-        mid = scan_strength(0.5 * (edges[j] + edges[j + 1]), value, terms, system)
+        mid = _strength(0.5 * (edges[j] + edges[j + 1]), value, terms, system, work)
         if math.isnan(mid):
             return np.empty(0), np.zeros(0, dtype=np.bool_), False
         no_chaos[j] = mid <= 0.0

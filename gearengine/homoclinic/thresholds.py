@@ -3,14 +3,14 @@
 For each control parameter p in (F_e1, mu, k_p1, F_p1) M is affine in p, M = m0 + p g, so the
 set of p where a branch does *not* change sign is a union of at most two closed intervals
 (max M <= 0 or min M >= 0); their finite ends are the critical values, found by root finding
-for every term and harmonic. Omega_e enters M non-linearly and is scanned.
+for every term and harmonic (the sets' algebra and the design's margin: ``margins``). Omega_e
+enters M non-linearly and is scanned.
 """
 
 from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Sequence
 
 import numpy as np
 
@@ -25,7 +25,15 @@ from gearengine.homoclinic.coefficients import (
     melnikov_coefficients,
     saddle_loop,
 )
-from gearengine.homoclinic.extrema import Interval, TrigSum, extrema, sublevel_interval
+from gearengine.homoclinic.extrema import (
+    Interval,
+    TrigSum,
+    extrema,
+    one_sinusoid,
+    one_sinusoid_interval,
+    sublevel_interval,
+)
+from gearengine.homoclinic.margins import intersect, interval_ends, threshold_document
 from gearengine.homoclinic.schemas import (
     BranchThreshold,
     ParameterThreshold,
@@ -115,39 +123,24 @@ def chaos_possible(params: GearParams, mean_load: MeanLoad = "unperturbed") -> b
     return None if math.isnan(strength) else strength > 0.0
 
 
-def verdict_flips(
-    params: GearParams, alias: str, lo: float, hi: float, num: int = 160
-) -> list[float]:
-    """Values of ``alias`` in [lo, hi] where the Melnikov verdict flips: brentq on the
-    sign-change strength from a scan of ``num`` values (flips closer than a step may be missed).
-    """
-    from scipy import optimize  # scipy loads in ~0.2 s; only root finding here needs it
-
-    grid = np.linspace(min(lo, hi), max(lo, hi), num)
-    s = [strength_at(params, {alias: float(v)}) for v in grid]
-    return [
-        float(optimize.brentq(lambda v: strength_at(params, {alias: v}), g0, g1, xtol=1e-10))
-        for g0, g1, s0, s1 in zip(grid, grid[1:], s, s[1:], strict=False)
-        if np.isfinite(s0) and np.isfinite(s1) and (s0 > 0.0) != (s1 > 0.0)
-    ]
-
-
 def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum] | None:
     """Split M = m0 + p g for the control parameter p (None if p's excitation is absent)."""
     if coef.damping_per_unit is None:
         raise ValueError("coefficients read back from JSON carry no per-unit values (they are "
                          "not serialised): compute them again from the parameters")  # fmt: skip
+    j = None
+    if parameter != "mu":
+        name = _TERM_OF[parameter]
+        j = next((i for i, t in enumerate(coef.terms) if t.excitation == name and t.r == 1), None)
+        if j is None:
+            return None
     m = coef.trig_sum()
     zeros = np.zeros_like(m.amplitudes)
-    if parameter == "mu":
+    if j is None:
         return (
             TrigSum(0.0, m.amplitudes, m.frequencies, m.phases),
             TrigSum(coef.damping_per_unit, zeros, m.frequencies, m.phases),
         )
-    name = _TERM_OF[parameter]
-    j = next((i for i, t in enumerate(coef.terms) if t.excitation == name and t.r == 1), None)
-    if j is None:
-        return None
     rest = m.amplitudes.copy()
     rest[j] = 0.0
     unit = zeros.copy()
@@ -160,75 +153,12 @@ def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum]
 
 def no_sign_change(m0: TrigSum, g: TrigSum) -> list[Interval]:
     """Intervals of p where m0 + p g keeps one sign: max <= 0 or min >= 0."""
+    if m0.amplitudes.size <= 1:  # the closed forms, on floats (-M: the same floats negated)
+        single = one_sinusoid(m0, g)
+        below = one_sinusoid_interval(*single)
+        return [s for s in (below, one_sinusoid_interval(*(-v for v in single))) if s is not None]
     sets = (sublevel_interval(m0, g), sublevel_interval(m0.negated(), g.negated()))
     return [s for s in sets if s is not None]
-
-
-def _intersect(xs: list[Interval], ys: list[Interval]) -> list[Interval]:
-    out = []
-    for x in xs:
-        for y in ys:
-            lo = _max_end(x.lo, y.lo)
-            hi = _min_end(x.hi, y.hi)
-            if lo is None or hi is None or lo <= hi:
-                out.append(Interval(lo, hi))
-    return sorted(out, key=lambda i: -np.inf if i.lo is None else i.lo)
-
-
-def _max_end(p: float | None, q: float | None) -> float | None:
-    return q if p is None else p if q is None else max(p, q)
-
-
-def _min_end(p: float | None, q: float | None) -> float | None:
-    return q if p is None else p if q is None else min(p, q)
-
-
-def _ends(intervals: list[Interval], domain: Interval) -> list[float]:
-    """Finite interval ends that are not ends of the parameter's domain."""
-    bounds = {domain.lo, domain.hi}
-    return sorted({e for i in intervals for e in (i.lo, i.hi) if e is not None and e not in bounds})
-
-
-AMPLITUDES = frozenset(_TERM_OF)
-"""Control parameters that are amplitudes: a negative amplitude is the same harmonic shifted by
-pi, so a design's amplitude reaches a critical value by growing or shrinking, not through 0."""
-
-
-def signed_margin(
-    parameter: str, value: float, critical: Sequence[float], no_chaos: Sequence[Sequence]
-) -> tuple[float | None, float | None, float | None]:
-    """(nearest, margin, relative_margin) of a design's value: the nearest critical value (for an
-    amplitude, the nearest of its own sign when there is one), the distance |value - nearest|
-    signed positive on the safe side (the value lies in a ``no_chaos`` interval [lo, hi], None
-    an open end) and negative inside the chaos-possible region, and margin / |nearest| (None if
-    nearest is 0). All None without a critical value."""
-    if not critical:
-        return None, None, None
-    pool = list(critical)
-    if parameter in AMPLITUDES and value != 0.0:
-        pool = [v for v in critical if (v > 0.0) == (value > 0.0)] or pool
-    nearest = min(pool, key=lambda v: abs(value - v))
-    safe = any((lo is None or value >= lo) and (hi is None or value <= hi) for lo, hi in no_chaos)
-    margin = abs(value - nearest) if safe else -abs(value - nearest)
-    return nearest, margin, margin / abs(nearest) if nearest != 0.0 else None
-
-
-def _threshold(
-    parameter: str, value: float | None, critical: list[float], no_chaos: list, **extra: object
-) -> ParameterThreshold:
-    """The threshold document: critical values and the design's margin (``signed_margin``)."""
-    nearest = margin = rel = None
-    if value is not None:
-        nearest, margin, rel = signed_margin(parameter, value, critical, no_chaos)
-    return ParameterThreshold(
-        value=value,
-        critical_values=critical,
-        nearest=nearest,
-        margin=margin,
-        relative_margin=rel,
-        no_chaos=no_chaos,
-        **extra,
-    )
 
 
 def unit_coefficients(
@@ -266,19 +196,19 @@ def parameter_threshold(
         family = _family(coefs[br], parameter)
         if family is None:
             exc = _TERM_OF[parameter]
-            return _threshold(
+            return threshold_document(
                 parameter, value, [], [], note=f"{exc} is not given: no frequency for {parameter}"
             )
-        sets[br] = _intersect(no_sign_change(*family), [domain])
+        sets[br] = intersect(no_sign_change(*family), [domain])
         branches[br] = BranchThreshold(
-            critical_values=_ends(sets[br], domain),
+            critical_values=interval_ends(sets[br], domain),
             no_sign_change=[(i.lo, i.hi) for i in sets[br]],
         )
-    overall = _intersect(sets["plus"], sets["minus"])
-    return _threshold(
+    overall = intersect(sets["plus"], sets["minus"])
+    return threshold_document(
         parameter,
         value,
-        _ends(overall, domain),
+        interval_ends(overall, domain),
         [(i.lo, i.hi) for i in overall],
         branches=branches,
     )
@@ -304,7 +234,7 @@ def frequency_threshold(
     """
     value = get_alias(params, "Omega_e")
     if value is None:
-        return _threshold(
+        return threshold_document(
             "Omega_e",
             None,
             [],
@@ -315,7 +245,7 @@ def frequency_threshold(
     fm = loop_load(params, mean_load)
     found = _scan_compiled(params, a, c, fm, scan, value) if method == "closed_form" else None
     critical, no_chaos = found or _scan_python(params, a, c, scan, value, method, mean_load)
-    return _threshold(
+    return threshold_document(
         "Omega_e",
         value,
         critical,

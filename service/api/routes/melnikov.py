@@ -39,7 +39,18 @@ async def post_melnikov(body: MelnikovRequest, request: Request) -> Response:
         "melnikov",
         body.model_dump_json(),
         lambda: (dumps(answer_melnikov(body)).encode(), JSON),
+        inline=one_sinusoid(body),
     )
+
+
+def one_sinusoid(body: MelnikovRequest) -> bool:
+    """True when the verdict is a fraction of a millisecond, shorter than a worker thread's hop:
+    closed-form coefficients, dimensionless params (a design adds the speed windows, hundreds of
+    verdicts) and at most one harmonic with an amplitude (M = A + B sin(Omega tau0 + phi): no
+    extrema grid along the Omega_e scan)."""
+    if body.design is not None or body.method != "closed_form":
+        return False
+    return sum(1 for _, exc in body.params.excitations() for _ in exc.active()) <= 1
 
 
 @router.post(
