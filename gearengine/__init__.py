@@ -12,7 +12,7 @@ The public facade, short verbs on a design (as ChaosTools.jl):
 Rooms (subpackages) follow the data flow, a diamond rather than a chain: ``model`` feeds both
 ``homoclinic`` (the Melnikov analysis of the homoclinic orbits) and ``numerics``, which know
 nothing of each other; ``numerics.attractors`` runs many starts of one design, ``analysis``
-and ``engineering`` join them, then ``sweeps`` -> ``plots`` -> ``cli``;
+and ``engineering`` join them, then ``studies.sweep`` -> ``plots`` -> ``cli``;
 ``docs/architecture.md`` draws it. The engine imports no web code.
 """
 

@@ -155,7 +155,7 @@ class Lever(BaseModel):
         return self.start + t * (self.end - self.start)
 
     def shown(self, si: float) -> float:
-        """``si`` in the lever's display unit (``sweeps.axes.display_unit``)."""
+        """``si`` in the lever's display unit (``studies.sweep.axes.display_unit``)."""
         return in_display_unit(self.path, si)
 
     @property

@@ -7,7 +7,7 @@ field's physical bounds, ``triang``). Samples are points of a scrambled Sobol se
 (scipy.stats.qmc, seeded: the same seed gives the same samples), or with sensitivity the
 Saltelli design of SALib built on it (``studies.robustness.sensitivity``), mapped through the
 inverse CDFs. Every sample is a full design, re-validated and converted as a single analysis of it
-would be (``sweeps.axes.design_with``), at every operating point of the request.
+would be (``studies.sweep.axes.design_with``), at every operating point of the request.
 
 A probability is k of n samples with the Clopper-Pearson 95 % interval
 (``scipy.stats.binomtest(...).proportion_ci(method="exact")``): exact for independent samples and

@@ -1,7 +1,7 @@
 """Computing a run-up as a job: one chunk per ensemble member (the whole profile, kink-accurate
 RK4 on the integrated driver angle, ``systems.spur_pair.kernels.ramp``), and the two lines of the
-quasi-static continuation sweep (up and down, ``sweeps.compute``, on the bin centres); the
-assembly reads them into bins, jumps and lags (``runup.reading``).
+quasi-static continuation sweep (up and down, ``studies.sweep.compute``, on the bin centres); the
+assembly reads them into bins, jumps and lags (``studies.runup.reading``).
 
 Member m starts from the state of the settling (``settle_periods`` mesh periods at the start
 speed from the static contact x = 1 + F~_m, v = 0), member 0 as it is, the others perturbed by

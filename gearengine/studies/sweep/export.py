@@ -65,7 +65,7 @@ def result_json(
     """The JSON text of a ``SweepResult`` from the chunks' outputs (``chunk_json``, in chunk
     order): the points streamed as they are, the lines' bifurcations gathered at the end.
     ``partial``: some chunks are missing (a job that did not succeed); ``windows``: the speed
-    windows (``sweeps.windows``) of a sweep over the driver speed."""
+    windows (``studies.sweep.windows``) of a sweep over the driver speed."""
     yield '{"axes":[' + ",".join(a.model_dump_json() for a in axes) + '],"points":['
     first = True
     located: list[dict[str, object]] | None = None

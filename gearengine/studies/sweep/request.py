@@ -171,13 +171,13 @@ class SweepRequest(ParamsOrDesign):
         return [a.values(self.design) for a in self.axes]
 
     def point(self, values: dict[str, float]) -> GearParams:
-        """The dimensionless parameters at one grid point (``sweeps.axes.point_params``)."""
+        """The dimensionless parameters at one grid point (``studies.sweep.axes.point_params``)."""
         assert self.params is not None
         return point_params(self.params, self.design, values)
 
     def scaled_point(self, values: dict[str, float]) -> tuple[GearParams, Scales | None]:
         """The parameters at one grid point and, for a design, its scales
-        (``sweeps.axes.scaled_point``)."""
+        (``studies.sweep.axes.scaled_point``)."""
         assert self.params is not None
         scales = None if self.conversion is None else self.conversion.scales
         return scaled_point(self.params, self.design, scales, values)

@@ -70,7 +70,7 @@ def to_csv(
 
 def to_pandas(result: SweepResult) -> Any:
     """A ``pandas.DataFrame``, one row per point and branch, with exactly the columns of the
-    sweep's CSV (``sweeps.export.csv_rows``: axes in SI, a design's axes in display units as
+    sweep's CSV (``studies.sweep.export.csv_rows``: axes in SI, a design's axes in display units as
     ``speed [rpm]``, ``dte [um]``, ``dynamic_factor``, the verdicts); ``poincare_x`` holds a list
     of floats per row (units of b)."""
     try:
