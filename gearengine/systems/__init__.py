@@ -1,0 +1,1 @@
+"""Dynamical systems of the engine (the lead reconciles the System interface here)."""

@@ -1,0 +1,10 @@
+"""The gear train: motor, input shaft, pinion, gear, output shaft, load and bearings around the
+mesh of Eq. (2) (``docs/gear-trains.md``).
+
+* ``model``: the train's matrices in physical and dimensionless coordinates (``TrainModel``).
+* ``modes``: natural frequencies, damping ratios, mode shapes and mesh strain-energy shares.
+* ``campbell``: natural frequencies against driver speed with the order lines and crossings.
+* ``kernel``: the n-dimensional RK4 with its tangent equation (numba).
+* ``response``: period, LLE, contact regime, DTE and dynamic factor of a train.
+* ``reduction``: the Melnikov verdict of the mesh-mode reduction.
+"""
