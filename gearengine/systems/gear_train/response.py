@@ -73,8 +73,10 @@ class TrainSystem:
         need = math.ceil(plan.period * self.omega_max / H_OMEGA)
         if need <= plan.steps:
             return plan
-        note = (f"the train's fastest mode (omega = {self.omega_max:.4g} omega_n) needs "
-                f"{need} RK4 steps per T0 (h omega <= {H_OMEGA}); {plan.steps} were asked")  # fmt: skip
+        note = (
+            f"the train's fastest mode (omega = {self.omega_max:.4g} omega_n) needs {need} RK4 "
+            f"steps per T0 (h omega <= {H_OMEGA}); {plan.steps} were asked"
+        )
         return StepPlan(plan.omega0, plan.period, need, plan.omega_ref, (*plan.notes, note))
 
     def start(self, x0: float, v0: float) -> tuple[np.ndarray, np.ndarray]:
