@@ -62,6 +62,8 @@ class TrainSystem:
     ec: np.ndarray
     tc: np.ndarray
     omega_max: float
+    torque_ratio: float
+    """T_p / (r_p b k_m) per unit of the pair's F~_p: I_a / (m_e r_a^2)."""
 
     @property
     def conversion(self) -> DesignConversion:
@@ -110,6 +112,7 @@ def train_system(model: TrainModel, pair: DesignConversion) -> TrainSystem:
         AK=inv @ form.stiffness, AC=inv @ form.damping, g=inv @ w, w=w,
         f=inv @ form.mean_force, p=inv @ form.torque_direction,
         kc=kc, ec=ec, tc=tc, omega_max=float(np.sqrt(np.max(np.abs(linear)))),
+        torque_ratio=scale,
     )  # fmt: skip
 
 
