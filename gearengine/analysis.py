@@ -177,6 +177,10 @@ def analyze(
         request = AnalysisRequest(**{key: request}, settings=settings or SimulationSettings())
     elif settings is not None:
         raise TypeError("analyze: an AnalysisRequest carries its settings; give one or the other")
+    if request.design is not None and request.design.train is not None:
+        from gearengine.systems.gear_train.analysis import analyze_train  # imports this module
+
+        return analyze_train(request)
     mel = melnikov(request.params)
     num = simulate(request.params, request.settings)
     conv = request.conversion

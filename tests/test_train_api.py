@@ -118,3 +118,14 @@ def test_pair_without_train_is_unchanged(client: TestClient) -> None:
     assert pair.status_code == 200 and "train" not in pair.text
     with_train = client.post("/v1/conversions/design", json={"design": TRAIN_DESIGN})
     assert with_train.json()["conversion"]["params"] == pair.json()["conversion"]["params"]
+
+
+def test_analysis_of_a_train(client: TestClient) -> None:
+    """POST /v1/analyses with a train: its modes in the engineering block, Melnikov's reason."""
+    settings = {"transient_periods": 50, "record_periods": 20}
+    r = client.post("/v1/analyses", json={"design": TRAIN_DESIGN, "settings": settings})
+    assert r.status_code == 200, r.text
+    body = r.json()
+    assert body["engineering"]["modes"]["mesh_mode"] == 4
+    assert body["melnikov"]["applicable"] is False
+    assert "strain energy" in body["melnikov"]["notes"][0]

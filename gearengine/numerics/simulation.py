@@ -16,7 +16,7 @@ Chaotic Systems* (Springer 1989), ch. 6.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Protocol
 
 from gearengine.model.params import GearParams
 from gearengine.numerics.batch import simulate_batch
@@ -44,8 +44,22 @@ from gearengine.numerics.runs import (
 from gearengine.numerics.settings import SimulationSettings, check_work
 
 
-def simulate(params: GearParams, settings: SimulationSettings | None = None) -> NumericsResult:
+class System(Protocol):
+    """A dynamical system other than Eq. (9) whose mesh deflection plays x (a gear train,
+    ``systems.gear_train``): its step plan and one run from a start (x0, v0)."""
+
+    def plan(self, steps_per_period: int) -> StepPlan: ...
+
+    def integrate(self, settings: SimulationSettings, start: tuple[float, float]) -> Run: ...
+
+
+def simulate(
+    params: GearParams, settings: SimulationSettings | None = None, system: System | None = None
+) -> NumericsResult:
     """Integrate Eq. (9) from every start of ``settings`` and return the numerical verdict.
+
+    With ``system`` its runs replace those of Eq. (9) (``params`` give its forcing and law);
+    Floquet multipliers are then not computed (``floquet_note`` says so).
 
     The detailed fields (LLE statistics, spectrum, Poincare points, time history, nolds) describe
     the worst start; ``starts`` holds a summary per start. A periodic worst start under
@@ -54,13 +68,21 @@ def simulate(params: GearParams, settings: SimulationSettings | None = None) -> 
     says why there are none.
     """
     settings = settings or SimulationSettings()
-    plan = step_plan(params, settings.steps_per_period)
+    plan = (
+        step_plan(params, settings.steps_per_period)
+        if system is None
+        else system.plan(settings.steps_per_period)
+    )
     check_work(settings, plan.steps)
     commensurate = plan.omega0 is not None
     notes = list(plan.notes)
     runs: list[tuple[Run, StartVerdict]] = []
     for start in settings.starts():
-        run = integrate(params, settings, start)
+        run = (
+            integrate(params, settings, start)
+            if system is None
+            else system.integrate(settings, start)
+        )
         runs.append((run, start_verdict(run, start, plan.period, commensurate)))
     worst, wv = max(runs, key=lambda rv: severity(rv[1].classification, rv[1].period))
     base: dict[str, Any] = {
@@ -77,6 +99,9 @@ def simulate(params: GearParams, settings: SimulationSettings | None = None) -> 
         result = _diverged(base, worst, plan, notes)
     else:
         result = _detailed(base, worst, wv, plan, settings, notes)
+    if system is not None:
+        why = "Floquet multipliers are computed for the pair of Eq. (9) only, not yet for a train"
+        return result.model_copy(update={"floquet": None, "floquet_note": why})
     orbit, why = floquet_of(params, settings, result)
     return result.model_copy(update={"floquet": orbit, "floquet_note": why})
 

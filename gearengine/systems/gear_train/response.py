@@ -81,6 +81,10 @@ class TrainSystem:
         )
         return StepPlan(plan.omega0, plan.period, need, plan.omega_ref, (*plan.notes, note))
 
+    def integrate(self, settings: SimulationSettings, start: tuple[float, float]) -> Run:
+        """One run from (delta, delta') = ``start`` (``numerics.simulation.System``)."""
+        return integrate_train(self, settings, start)
+
     def start(self, x0: float, v0: float) -> tuple[np.ndarray, np.ndarray]:
         """(u, v) at tau = 0: delta = x0, delta' = v0, shafts and bearings at their static
         deflection under the mean load (the train linearised in contact), at rest."""
