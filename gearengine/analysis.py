@@ -35,6 +35,7 @@ class AnalysisRequest(ParamsOrDesign):
     """``{"params": {...}, "settings": {...}}``: analyse one design."""
 
     model_config = request_config({"params": PAPER_SECTION_41, "settings": {}})
+    TRAINS = True  # systems.gear_train answers for it
 
     settings: RequestSettings = Field(
         default_factory=SimulationSettings,
@@ -212,6 +213,7 @@ class DesignRequest(ParamsOrDesign):
     """``{"design": {...}}``: the design's conversion and its engineering block."""
 
     model_config = request_config({"design": EXAMPLE_DESIGN})
+    TRAINS = True  # the pair's conversion; a train's own answers are in analyses
 
     ONE_OF = ("design",)  # a conversion needs a design: its schema asks for one
 

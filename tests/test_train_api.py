@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import copy
 import json
+import subprocess
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -129,3 +131,28 @@ def test_analysis_of_a_train(client: TestClient) -> None:
     assert body["engineering"]["modes"]["mesh_mode"] == 4
     assert body["melnikov"]["applicable"] is False
     assert "strain energy" in body["melnikov"]["notes"][0]
+
+
+def test_cli_json_is_the_api_body(client: TestClient, tmp_path: Path) -> None:
+    """``gearengine campbell FILE --json`` prints the body of POST /v1/analyses/campbell; the
+    default range reaches past the mesh resonance."""
+    design = {k: v for k, v in TRAIN_DESIGN.items() if k != "speed_range"}
+    path = tmp_path / "train.json"
+    path.write_text(json.dumps({"design": design}))
+    out = subprocess.run(
+        [sys.executable, "-m", "gearengine.cli", "campbell", str(path), "--json"],
+        capture_output=True, text=True, timeout=300, cwd=ROOT,
+    )  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    body = client.post("/v1/analyses/campbell", json={"design": design}).text
+    assert out.stdout.strip() == body
+    result = json.loads(body)
+    assert result["speed_range_rpm"][1] >= 1.2 * result["mesh_resonance_rpm"] - 1e-6
+
+
+@pytest.mark.parametrize("route", ["/v1/melnikov", "/v1/thresholds"])
+def test_requests_without_a_train_model_refuse_one(client: TestClient, route: str) -> None:
+    """A request that would answer for the pair alone refuses a train, naming design.train."""
+    r = client.post(route, json={"design": TRAIN_DESIGN})
+    assert r.status_code == 422, r.text
+    assert [e["path"] for e in r.json()["errors"]] == ["design.train"]

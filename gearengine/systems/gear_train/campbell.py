@@ -23,12 +23,16 @@ from gearengine.model.units import RPM, shown
 from gearengine.systems.gear_train.model import train_of
 from gearengine.systems.gear_train.modes import Modes, modes
 
+RESONANCE_MARGIN = 1.2
+"""Without a ``speed_range`` the diagram reaches at least this factor past the mesh resonance."""
+
 
 class CampbellRequest(ParamsOrDesign):
     """``{"design": {... "train": {...}}}``: the Campbell diagram of a train over the design's
-    ``speed_range`` (default 10 rpm to 3x the speed)."""
+    ``speed_range`` (default 10 rpm to 3x the speed, or to 1.2x the mesh resonance)."""
 
     model_config = request_config({"design": {**EXAMPLE_DESIGN, "train": EXAMPLE_TRAIN}})
+    TRAINS = True  # systems.gear_train answers for it
 
     ONE_OF = ("design",)
 
@@ -96,7 +100,11 @@ def campbell(request: CampbellRequest) -> Campbell:
         )
     model, pair = train_of(design)
     found = modes(model, pair.natural_frequency_hz)
+    mesh_hz = found.modes[found.mesh_mode].frequency_hz
+    resonance = 60.0 * mesh_hz / design.driver.teeth
     lo, hi = request.speed_rpm_range()
+    if design.speed_range is None:  # the default range reaches past the mesh resonance
+        hi = max(hi, RESONANCE_MARGIN * resonance)
     lines = order_lines(design)
     crossings = []
     for k, mode in enumerate(found.modes):
@@ -113,12 +121,11 @@ def campbell(request: CampbellRequest) -> Campbell:
                     )
                 )
     crossings.sort(key=lambda c: c.speed_rpm)
-    mesh_hz = found.modes[found.mesh_mode].frequency_hz
     return Campbell(
         modes=found,
         lines=lines,
         crossings=crossings,
         speed_range_rpm=(shown(lo), shown(hi)),
         speed_rpm=shown(design.speed / RPM),
-        mesh_resonance_rpm=shown(60.0 * mesh_hz / design.driver.teeth),
+        mesh_resonance_rpm=shown(resonance),
     )
