@@ -120,6 +120,7 @@ _SUBMODULES = frozenset(
         "plots",
         "runup",
         "sweeps",
+        "systems",
     }
 )
 """The package's own modules: ``gearengine.numerics`` after a bare ``import gearengine`` still
