@@ -19,11 +19,18 @@ equal components and is renormalised every interval T; the log of its norm is re
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 from numba import njit
 
+from gearengine.jitcache import drop_stale
+from gearengine.numerics.kernels import smooth
 from gearengine.numerics.kernels.smooth import JIT_OPTIONS, law_force
+
+_HERE = Path(__file__).parent
+drop_stale("kernel", [Path(__file__), Path(smooth.__file__)], _HERE / "__pycache__")
+"""Before any kernel runs: numba watches only this file, and ``law_force`` lives in smooth."""
 
 
 @njit(**JIT_OPTIONS)
