@@ -156,3 +156,15 @@ def test_requests_without_a_train_model_refuse_one(client: TestClient, route: st
     r = client.post(route, json={"design": TRAIN_DESIGN})
     assert r.status_code == 422, r.text
     assert [e["path"] for e in r.json()["errors"]] == ["design.train"]
+
+
+def test_stiff_train_over_the_budget_is_refused_before_compute(client: TestClient) -> None:
+    """Stiff bearings raise the train's steps per period (RK4 must resolve them): the budget
+    counts them and refuses before any compute."""
+    settings = {"transient_periods": 50, "record_periods": 20}
+    stiff = _with("train.bearings.driver.stiffness", "1e12 N/m")
+    r = client.post("/v1/analyses", json={"design": stiff, "settings": settings})
+    assert r.status_code == 422, r.text
+    assert "synchronous compute budget" in r.json()["detail"]
+    soft = client.post("/v1/analyses", json={"design": TRAIN_DESIGN, "settings": settings})
+    assert soft.status_code == 200

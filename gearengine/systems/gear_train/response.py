@@ -30,7 +30,7 @@ from gearengine.numerics.classify import DIVERGENCE_BOUND, severity
 from gearengine.numerics.diagnostics import ImpactRegime, impact_regime
 from gearengine.numerics.forcing import StepPlan, law, packed_forcing, step_plan
 from gearengine.numerics.runs import Run, history_stride, start_verdict
-from gearengine.numerics.settings import MAX_TOTAL_STEPS, SimulationSettings
+from gearengine.numerics.settings import MAX_TOTAL_STEPS, SimulationSettings, run_steps
 from gearengine.systems.gear_train.kernel import run_train, train_forcing
 from gearengine.systems.gear_train.model import (
     RELATIVE,
@@ -39,6 +39,10 @@ from gearengine.systems.gear_train.model import (
     dimensionless,
     train_of,
 )
+
+TRAIN_STEP_COST = 3
+"""A train's RK4 step in steps of the pair's analysis, for compute budgets: the median ratio of a
+train's analysis to the pair's at the same steps (``benchmarks/bench_train.py``: 3.18)."""
 
 H_OMEGA = 0.5
 """Largest h omega_max of the RK4 step against the train's fastest mode (RK4's stability limit
@@ -220,3 +224,11 @@ def respond(system: TrainSystem, settings: SimulationSettings) -> TrainResponse:
         sampling_interval=plan.period,
         notes=list(plan.notes),
     )
+
+
+def train_work(design: Design, settings: SimulationSettings) -> int:
+    """The compute budget of analysing a train (``numerics.settings.work``'s unit: the pair's RK4
+    steps): its steps (raised for stiff shafts and bearings) times ``TRAIN_STEP_COST``."""
+    model, pair = train_of(design)
+    steps = train_system(model, pair).plan(settings.steps_per_period).steps
+    return TRAIN_STEP_COST * run_steps(settings, steps)

@@ -16,6 +16,7 @@ from gearengine.numerics import work
 from gearengine.numerics.settings import BasinSettings
 from gearengine.plots import MEDIA_TYPES, analysis_figure, basins_figure, campbell_figure
 from gearengine.systems.gear_train.campbell import Campbell, CampbellRequest, campbell
+from gearengine.systems.gear_train.response import train_work
 from service.api.deps import AppLimits, AppMetrics, cached_compute, require_key
 from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
 from service.limits import BASINS_HINT, Limits
@@ -26,8 +27,11 @@ router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 
 def check_analysis_budget(limits: Limits, body: AnalysisRequest) -> None:
     """422 before any compute when the analysis (its starts and basin starts) is over the
-    synchronous budget; names settings.basins.starts when basins are asked for."""
-    if body.settings.basins is None:
+    synchronous budget; names settings.basins.starts when basins are asked for. A train counts
+    its own steps (raised for stiff shafts and bearings) at their cost (``train_work``)."""
+    if body.design is not None and body.design.train is not None:
+        limits.check_budget(train_work(body.design, body.settings))
+    elif body.settings.basins is None:
         limits.check_budget(work(body.params, body.settings))
     else:
         steps = work(body.params, body.settings)
