@@ -119,6 +119,7 @@ _SUBMODULES = frozenset(
         "gate",
         "signals",
         "studies",
+        "systems",
     }
 )
 """The package's own modules: ``gearengine.numerics`` after a bare ``import gearengine`` still

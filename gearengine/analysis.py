@@ -16,8 +16,10 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.engineering import IMPACT_WORDS, Engineering, engineering
+from gearengine.engineering import summary as engineering_summary
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
-from gearengine.homoclinic.verdict import melnikov
+from gearengine.homoclinic.train_reduction import train_melnikov
+from gearengine.homoclinic.verdict import melnikov, not_applicable
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
@@ -27,6 +29,10 @@ from gearengine.numerics.attractors import attractors, coexistence, headline
 from gearengine.numerics.results import NumericsResult
 from gearengine.numerics.settings import RequestSettings, SimulationSettings
 from gearengine.numerics.simulation import simulate
+from gearengine.systems.gear_train.model import train_of
+from gearengine.systems.gear_train.modes import modes
+from gearengine.systems.gear_train.system import train_system
+from gearengine.systems.spur_pair.laws import melnikov_cubic
 
 Agreement = Literal["both_chaotic", "both_regular", "melnikov_only", "numerics_only", "undecided"]
 
@@ -35,6 +41,7 @@ class AnalysisRequest(ParamsOrDesign):
     """``{"params": {...}, "settings": {...}}``: analyse one design."""
 
     model_config = request_config({"params": PAPER_SECTION_41, "settings": {}})
+    TRAINS = True  # systems.gear_train answers for it
 
     settings: RequestSettings = Field(
         default_factory=SimulationSettings,
@@ -177,6 +184,8 @@ def analyze(
         request = AnalysisRequest(**{key: request}, settings=settings or SimulationSettings())
     elif settings is not None:
         raise TypeError("analyze: an AnalysisRequest carries its settings; give one or the other")
+    if request.design is not None and request.design.train is not None:
+        return analyze_train(request)
     mel = melnikov(request.params)
     num = simulate(request.params, request.settings)
     conv = request.conversion
@@ -208,6 +217,7 @@ class DesignRequest(ParamsOrDesign):
     """``{"design": {...}}``: the design's conversion and its engineering block."""
 
     model_config = request_config({"design": EXAMPLE_DESIGN})
+    TRAINS = True  # the pair's conversion; a train's own answers are in analyses
 
     ONE_OF = ("design",)  # a conversion needs a design: its schema asks for one
 
@@ -230,4 +240,58 @@ def convert(request: DesignRequest) -> DesignReport:
     mel = melnikov(conv.params)
     return DesignReport(
         conversion=conv, engineering=engineering(conv, request.speed_rpm_range(), mel)
+    )
+
+
+def analyze_train(request: AnalysisRequest) -> AnalysisResult:
+    """``analyze`` for a design with a ``train``: the numerical verdict from the train's kernel
+    (``systems.gear_train``), the Melnikov verdict of its mesh-mode reduction (or not applicable
+    with the reason, ``homoclinic.train_reduction``), and the engineering block on the scales of
+    its equivalent pair (``model.equivalent_design``). The Melnikov speed windows are those of
+    the reduction (its frequencies scale with the speed like the pair's); without a reduction
+    there are none, and the note says why."""
+
+    design = request.design
+    assert design is not None and design.train is not None
+    if request.settings.basins is not None:
+        raise InputError(
+            "settings.basins",
+            "basins of a gear train are not built yet; remove settings.basins (the train's "
+            "verdict is over the settings' starts)",
+        )
+    model, pair = train_of(design)
+    system = train_system(model, pair)
+    num = simulate(system, request.settings)
+    reduced = train_melnikov(system)
+    if reduced.applicable:
+        assert reduced.melnikov is not None and reduced.params is not None
+        mel = reduced.melnikov.model_copy(
+            update={"notes": [reduced.reason, reduced.reduction, *reduced.melnikov.notes]}
+        )
+        conv = pair.model_copy(update={"params": reduced.params})
+    else:
+        a, c, _ = melnikov_cubic(system.params.backlash)
+        mel = not_applicable(a, c, "closed_form", [reduced.reason])
+        conv = pair
+    eng = engineering(conv, request.speed_rpm_range(), mel, num)
+    if not reduced.applicable:
+        lo, hi = eng.speed_range_rpm
+        eng = eng.model_copy(
+            update={
+                "speed_windows_rpm": [],
+                "speed_windows_note": "no Melnikov reduction: " + reduced.reason,
+                "summary": engineering_summary(conv, mel, [], (lo, hi), eng.response, num),
+            }
+        )
+    notes = [f"gear train: {model.size} coordinates; numerics of the train, scales of its "
+             "equivalent pair (I_a = I_m + I_p, I_b = I_g + I_l)"]  # fmt: skip
+    found = modes(model, pair.natural_frequency_hz)
+    eng = eng.model_copy(update={"notes": [*eng.notes, *notes], "modes": found})
+    return AnalysisResult(
+        melnikov=mel,
+        numerics=num,
+        settings=request.settings,
+        verdict=verdict(mel, num),
+        params=system.params,
+        engineering=eng,
     )

@@ -49,6 +49,7 @@ from gearengine.model.units import (
     to_physical,
 )
 from gearengine.numerics.results import NumericsResult
+from gearengine.systems.gear_train.modes import Modes
 
 WINDOW_SCAN = 240
 """Speeds sampled in the Melnikov window scan before brentq refines each edge."""
@@ -131,6 +132,11 @@ class Engineering(_Doc):
     response: Response | None = Field(None, description="For analyses: the response.")
     summary: str = Field(description="Plain sentences for a design review.")
     notes: list[str]
+    modes: Modes | None = Field(
+        None,
+        exclude_if=lambda modes: modes is None,  # a pair's JSON stays the pair's
+        description="With a train: its modes linearised in contact (docs/gear-trains.md).",
+    )
 
 
 def _speed_path(params: GearParams, speed_rpm: float):

@@ -10,6 +10,7 @@
     gearengine runup FILE --from 500 --to 6000 --rate 1000 [--direction up|down|up_down]
         [--bin 50] [--json OUT] [--plot OUT.png]
     gearengine basins FILE [--starts N] [--json] [--plot FILE]
+    gearengine campbell FILE [--json] [--plot FILE]
     gearengine convert FILE [--json]
 
 FILE holds ``{"params": {...}}`` or ``{"design": {...}}`` (physical units), and ``"settings"``
@@ -178,6 +179,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--samples", type=int, default=64, help="with --max-probability (default 64)")
     p.add_argument("--seed", type=int, default=0, help="with --max-probability (default 0)")
     p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
+
+    p = sub.add_parser("campbell", help="modes and Campbell diagram of a gear train")
+    p.add_argument("file", help='JSON file holding {"design": {... "train": {...}}}, or -')
+    p.add_argument("--json", action="store_true", help="print the API's JSON response")
+    p.add_argument("--plot", metavar="FILE", help="write the diagram (.png or .svg)")
+    p.set_defaults(func=lazy("gearengine.cli.campbell", "cmd_campbell"))
 
     p = sub.add_parser("basins", help="coexisting attractors of a design and their basins")
     p.add_argument("file", help='JSON file holding {"params" or "design": {...}, "settings": '

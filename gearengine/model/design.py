@@ -37,6 +37,7 @@ from gearengine.model.params import (
     request_config,
 )
 from gearengine.model.tolerances import Tolerances
+from gearengine.model.train import Train
 from gearengine.model.units import (
     Angle,
     Bore,
@@ -228,6 +229,12 @@ class Design(StrictModel):
         None,
         description="Manufacturing tolerances (distributions of fields by path, ISO 1328 "
         "accuracy, backlash band): read by robustness jobs; the analyses use the nominal design.",
+    )
+    train: Train | None = Field(
+        None,
+        exclude_if=lambda train: train is None,  # a pair's JSON stays the pair's
+        description="Motor, shafts, load and bearings around the mesh (docs/gear-trains.md); "
+        "without it the pair of rigid discs of Eq. (2).",
     )
 
     _readings: list[str] = PrivateAttr(default_factory=list)

@@ -333,6 +333,12 @@ class ParamsOrDesign(BaseModel):
     def _convert(self) -> ParamsOrDesign:
         if self.design is None:
             return self
+        if self.design.train is not None and not self.TRAINS:
+            raise InputError(
+                "design.train",
+                "this request does not model a gear train yet: analyse it with /v1/analyses "
+                "(gearengine analyze) or its modes with /v1/analyses/campbell, or remove train",
+            )
         conversion = convert_design(self.design)
         # a stored request (a sweep job) carries both: params must be the design's conversion
         if self.params is not None and not self.params.same_parameters(conversion.params):
@@ -350,6 +356,10 @@ class ParamsOrDesign(BaseModel):
         schema = handler.resolve_ref_schema(handler(core_schema))
         schema["oneOf"] = [given(name) for name in cls.ONE_OF]
         return schema
+
+    TRAINS: ClassVar[bool] = False
+    """Whether this request answers for a design's ``train`` (``systems.gear_train``); the
+    others refuse one, naming ``design.train``, rather than answer for the pair alone."""
 
     ONE_OF: ClassVar[tuple[str, ...]] = ("params", "design")
     """The fields of which a request gives exactly one (in its schema's ``oneOf``)."""

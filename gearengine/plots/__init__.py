@@ -19,6 +19,7 @@ from gearengine.lazyload import lazy_names
 if TYPE_CHECKING:
     from gearengine.plots.analysis import analysis_figure, threshold_figure
     from gearengine.plots.basins import basins_figure
+    from gearengine.plots.campbell import campbell_figure
     from gearengine.plots.runup import runup_figure
     from gearengine.plots.style import MEDIA_TYPES, ImageFormat
     from gearengine.plots.sweep import sweep_figure
@@ -28,6 +29,7 @@ __all__ = [
     "ImageFormat",
     "analysis_figure",
     "basins_figure",
+    "campbell_figure",
     "runup_figure",
     "sweep_figure",
     "threshold_figure",
@@ -38,6 +40,7 @@ _HOMES = {
     "ImageFormat": ("gearengine.plots.style", "ImageFormat"),
     "analysis_figure": ("gearengine.plots.analysis", "analysis_figure"),
     "basins_figure": ("gearengine.plots.basins", "basins_figure"),
+    "campbell_figure": ("gearengine.plots.campbell", "campbell_figure"),
     "runup_figure": ("gearengine.plots.runup", "runup_figure"),
     "sweep_figure": ("gearengine.plots.sweep", "sweep_figure"),
     "threshold_figure": ("gearengine.plots.analysis", "threshold_figure"),

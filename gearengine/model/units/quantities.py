@@ -123,6 +123,20 @@ QUANTITIES: dict[str, QuantityKind] = {
         "1000 rpm/s",
     ),
     "duration": QuantityKind("duration", "s", 1e-3, 3600.0, ("ms", "min"), "5 s"),
+    "torsional_stiffness": QuantityKind(
+        "torsional stiffness",
+        "N*m/rad",
+        10.0,
+        1e9,
+        ("kN*m/rad", "MN*m/rad"),
+        "3e4 N*m/rad",
+        {f"{t}/rad": f"{m}/rad" for t, m in TORQUE_SPELLINGS.items()},
+    ),
+    "bearing_stiffness": QuantityKind(
+        "bearing stiffness", "N/m", 1e5, 1e12, ("N/um", "N/mm"), "2e8 N/m"
+    ),
+    "mass": QuantityKind("mass", "kg", 1e-3, 1e5, ("g", "t"), "1.2 kg"),
+    "shear_modulus": QuantityKind("shear modulus", "Pa", 1e9, 5e11, ("GPa", "MPa"), "79.3 GPa"),
 }
 """Kinds of quantity by key; ``low``/``high`` bound plausible magnitudes in SI units."""
 
@@ -272,3 +286,7 @@ Damping = quantity_type("damping", allow_zero=True)
 Angle = quantity_type("angle")
 Duration = quantity_type("duration")
 Time = quantity_type("duration", allow_zero=True)
+TorsionalStiffness = quantity_type("torsional_stiffness")
+BearingStiffness = quantity_type("bearing_stiffness")
+Mass = quantity_type("mass")
+ShearModulus = quantity_type("shear_modulus")

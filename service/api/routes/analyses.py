@@ -1,5 +1,7 @@
 """POST /v1/analyses, /v1/analyses/plot and /v1/analyses/basins/plot: the numerical verdict
-next to the Melnikov verdict, its figure, and the basin picture of its attractors."""
+next to the Melnikov verdict, its figure, and the basin picture of its attractors;
+/v1/analyses/campbell and /v1/analyses/campbell/plot: a gear train's modes and Campbell
+diagram."""
 
 from __future__ import annotations
 
@@ -12,7 +14,9 @@ from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.jsonio import dumps
 from gearengine.numerics import work
 from gearengine.numerics.settings import BasinSettings
-from gearengine.plots import MEDIA_TYPES, analysis_figure, basins_figure
+from gearengine.numerics.trains import train_work
+from gearengine.plots import MEDIA_TYPES, analysis_figure, basins_figure, campbell_figure
+from gearengine.systems.gear_train.campbell import Campbell, CampbellRequest, campbell
 from service.api.deps import AppLimits, AppMetrics, cached_compute, require_key
 from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
 from service.limits import BASINS_HINT, Limits
@@ -23,8 +27,11 @@ router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 
 def check_analysis_budget(limits: Limits, body: AnalysisRequest) -> None:
     """422 before any compute when the analysis (its starts and basin starts) is over the
-    synchronous budget; names settings.basins.starts when basins are asked for."""
-    if body.settings.basins is None:
+    synchronous budget; names settings.basins.starts when basins are asked for. A train counts
+    its own steps (raised for stiff shafts and bearings) at their cost (``train_work``)."""
+    if body.design is not None and body.design.train is not None:
+        limits.check_budget(train_work(body.design, body.settings))
+    elif body.settings.basins is None:
         limits.check_budget(work(body.params, body.settings))
     else:
         steps = work(body.params, body.settings)
@@ -119,3 +126,41 @@ async def post_basins_plot(
     fmt = image_format(request, format)
     return await _figure(request, body, limits, metrics, fmt, "analyses/basins/plot",
                          basins_figure)  # fmt: skip
+
+
+@router.post(
+    "/analyses/campbell",
+    response_model=Campbell,
+    responses=CACHED,
+    summary="Modes and Campbell diagram of a gear train (a design with `train`)",
+)
+async def post_campbell(body: CampbellRequest, request: Request) -> Response:
+    """Natural frequencies, damping ratios, mode shapes and mesh strain-energy shares of the
+    train linearised in contact, the excitation order lines (mesh, shafts, torque fluctuation)
+    and their crossings with the modes in rpm over the design's `speed_range`."""
+    return await cached_compute(
+        request,
+        "analyses/campbell",
+        body.model_dump_json(),
+        lambda: (dumps(campbell(body)).encode(), JSON),
+    )
+
+
+@router.post(
+    "/analyses/campbell/plot",
+    response_class=Response,
+    responses=IMAGE_RESPONSES,
+    summary="Campbell diagram of a gear train as PNG or SVG",
+)
+async def post_campbell_plot(
+    body: CampbellRequest, request: Request, format: Literal["png", "svg"] | None = FormatQuery
+) -> Response:
+    """Natural frequencies against driver speed, the order lines, and the crossings marked in
+    rpm (the mesh mode bold, the design speed and the mesh resonance as vertical lines)."""
+    fmt = image_format(request, format)
+    return await cached_compute(
+        request,
+        f"analyses/campbell/plot.{fmt}",
+        body.model_dump_json(),
+        lambda: (campbell_figure(campbell(body), fmt), MEDIA_TYPES[fmt]),
+    )

@@ -1,0 +1,240 @@
+"""Fixed-step RK4 of the dimensionless train with its tangent equation (numba).
+
+In relative coordinates u (n of them, ``model.Dimensionless``) with A^-1 applied once:
+
+    u'' = f + p T(tau) - AK u - AC v - g W,      v = u'
+    W = K(tau) f_h(delta) + 2 mu delta',          delta = w . u - e(tau),  delta' = w . v - e'(tau)
+    du'' = -AK du - AC dv - g (K(tau) f_h'(delta) w . du + 2 mu w . dv)       (tangent equation)
+
+AK = A^-1 K~, AC = A^-1 C~, g = A^-1 w~, f = A^-1 f~, p = A^-1 p~ (docs/gear-trains.md).
+K(tau) = 1 + sum kc0 cos(kc1 tau + kc2) as the pair's kernels (``systems.spur_pair.forcing``);
+e(tau) = sum ec0 cos(ec1 tau + ec2) the transmission error in units of b, and
+T(tau) = sum tc0 cos(tc1 tau + tc2) the torque fluctuation T_p / (r_p b k_m).
+
+The backlash law is the pair's ``law_force`` (``systems.spur_pair.kernels.smooth``: cubic, or Eq. 8
+stepped straight across its kinks). Benettin: the 2n-dimensional tangent vector starts with
+equal components and is renormalised every interval T; the log of its norm is recorded.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from numba import njit
+
+from gearengine.jitcache import drop_stale
+from gearengine.systems.spur_pair.kernels import smooth
+from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, law_force
+
+_HERE = Path(__file__).parent
+drop_stale("kernel", [Path(__file__), Path(smooth.__file__)], _HERE / "__pycache__")
+"""Before any kernel runs: numba watches only this file, and ``law_force`` lives in smooth."""
+
+
+@njit(**JIT_OPTIONS)
+def train_forcing(
+    t: float, kc: np.ndarray, ec: np.ndarray, tc: np.ndarray
+) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
+    """K(t), e(t), e'(t) and T(t) at dimensionless time t (module docstring)."""
+    K = 1.0
+    for i in range(kc.shape[1]):
+        K += kc[0, i] * math.cos(kc[1, i] * t + kc[2, i])
+    e = 0.0
+    ed = 0.0
+    for i in range(ec.shape[1]):
+        arg = ec[1, i] * t + ec[2, i]
+        e += ec[0, i] * math.cos(arg)
+        ed -= ec[0, i] * ec[1, i] * math.sin(arg)
+    T = 0.0
+    for i in range(tc.shape[1]):
+        T += tc[0, i] * math.cos(tc[1, i] * t + tc[2, i])
+    return K, e, ed, T
+
+
+@njit(**JIT_OPTIONS)
+def _field(
+    law: int,
+    a: float,
+    c: float,
+    alpha: float,
+    twomu: float,
+    AK: np.ndarray,
+    AC: np.ndarray,
+    g: np.ndarray,
+    w: np.ndarray,
+    f: np.ndarray,
+    p: np.ndarray,
+    K: float,
+    e: float,
+    ed: float,
+    T: float,
+    s: np.ndarray,
+    k: np.ndarray,
+    stage: int,
+) -> None:  # pragma: no cover - compiled
+    """The train's field and its tangent at the state s = (u, v, du, dv), shape (4, n), into
+    k[stage] (indices, not row views: a view costs reference counting every call)."""  # fmt: skip
+    n = s.shape[1]
+    delta = -e
+    deltad = -ed
+    wdu = 0.0
+    wdv = 0.0
+    for i in range(n):
+        delta += w[i] * s[0, i]
+        deltad += w[i] * s[1, i]
+        wdu += w[i] * s[2, i]
+        wdv += w[i] * s[3, i]
+    fh, dfh = law_force(law, a, c, alpha, delta)
+    W = K * fh + twomu * deltad
+    dW = K * dfh * wdu + twomu * wdv
+    for i in range(n):
+        acc = f[i] + p[i] * T - g[i] * W
+        dacc = -g[i] * dW
+        for j in range(n):
+            acc -= AK[i, j] * s[0, j] + AC[i, j] * s[1, j]
+            dacc -= AK[i, j] * s[2, j] + AC[i, j] * s[3, j]
+        k[stage, 0, i] = s[1, i]
+        k[stage, 1, i] = acc
+        k[stage, 2, i] = s[3, i]
+        k[stage, 3, i] = dacc
+
+
+@njit(**JIT_OPTIONS)
+def run_train(
+    law: int,
+    a: float,
+    c: float,
+    alpha: float,
+    mu: float,
+    AK: np.ndarray,
+    AC: np.ndarray,
+    g: np.ndarray,
+    w: np.ndarray,
+    f: np.ndarray,
+    p: np.ndarray,
+    kc: np.ndarray,
+    ec: np.ndarray,
+    tc: np.ndarray,
+    u0: np.ndarray,
+    v0: np.ndarray,
+    use_table: bool,
+    T: float,
+    N: int,
+    n_trans: int,
+    n_rec: int,
+    stride: int,
+    bound: float,
+):  # pragma: no cover - compiled
+    """Classical RK4 of the train + tangent over n_trans + n_rec intervals T of N steps.
+
+    Args:
+        law, a, c, alpha: backlash law (0 cubic, 1 piecewise Eq. 8); mu: mesh damping mu~.
+        AK, AC (n, n), g, w, f, p (n,): the train (module docstring).
+        kc, ec, tc: forcing terms, shape (3, terms): amplitude, omega, phase.
+        u0, v0: initial state (n,) at tau = 0.
+        use_table: the forcing is T-periodic: tabulate it at the 2N+1 stage times of a period.
+        T, N: sampling interval and steps per interval; n_trans, n_rec: intervals.
+        stride: record delta, delta' every ``stride`` recorded steps.
+        bound: divergence bound on every |u_i|, |v_i|.
+
+    Returns:
+        xs, vs: delta, delta' at the end of each recorded interval, shape (n_rec,);
+        logs: log of the tangent norm before each renormalisation, (n_rec,);
+        hx, hv: delta, delta' every ``stride`` recorded steps, (n_rec N // stride,);
+        xmin, xmax: extremes of delta over the recorded steps; done: intervals completed;
+        u, v: final state; fmin, fmax: extremes of the mesh force W at the recorded step ends.
+    """  # fmt: skip
+    n = u0.size
+    h = T / N
+    h2 = 0.5 * h
+    h6 = h / 6.0
+    twomu = 2.0 * mu
+    if use_table:
+        table = np.empty((2 * N + 1, 4))
+        for s in range(2 * N + 1):
+            table[s, 0], table[s, 1], table[s, 2], table[s, 3] = train_forcing(s * h2, kc, ec, tc)
+    else:
+        table = np.empty((0, 4))
+    y = np.empty((4, n))  # u, v, du, dv
+    start = 1.0 / math.sqrt(2.0 * n)
+    for i in range(n):
+        y[0, i], y[1, i], y[2, i], y[3, i] = u0[i], v0[i], start, start
+    k = np.empty((4, 4, n))  # stage, (u, v, du, dv), component
+    s = np.empty((4, n))
+    xs = np.zeros(n_rec)
+    vs = np.zeros(n_rec)
+    logs = np.zeros(n_rec)
+    hx = np.zeros(n_rec * N // stride)
+    hv = np.zeros(n_rec * N // stride)
+    xmin, xmax = np.inf, -np.inf
+    fmin, fmax = np.inf, -np.inf
+    forcing = np.empty((3, 4))
+    done = 0
+    count = 0
+    ih = 0
+    delta = 0.0
+    deltad = 0.0
+    for it in range(n_trans + n_rec):
+        rec = it >= n_trans
+        tn = it * T
+        for j in range(N):
+            for q in range(3):
+                if use_table:
+                    for r in range(4):
+                        forcing[q, r] = table[2 * j + q, r]
+                else:
+                    forcing[q, 0], forcing[q, 1], forcing[q, 2], forcing[q, 3] = train_forcing(
+                        tn + j * h + q * h2, kc, ec, tc
+                    )
+            for stage in range(4):
+                step = 0.0 if stage == 0 else (h if stage == 3 else h2)
+                for r in range(4):
+                    for i in range(n):
+                        s[r, i] = y[r, i] + step * k[stage - 1, r, i] if stage else y[r, i]
+                q = 0 if stage == 0 else (2 if stage == 3 else 1)
+                _field(
+                    law, a, c, alpha, twomu, AK, AC, g, w, f, p,
+                    forcing[q, 0], forcing[q, 1], forcing[q, 2], forcing[q, 3], s, k, stage,
+                )  # fmt: skip
+            delta = -forcing[2, 1]
+            deltad = -forcing[2, 2]
+            for r in range(4):
+                for i in range(n):
+                    y[r, i] += h6 * (k[0, r, i] + 2.0 * (k[1, r, i] + k[2, r, i]) + k[3, r, i])
+            for i in range(n):
+                delta += w[i] * y[0, i]
+                deltad += w[i] * y[1, i]
+            xmin = min(xmin, delta)
+            xmax = max(xmax, delta)
+            force = forcing[2, 0] * law_force(law, a, c, alpha, delta)[0] + twomu * deltad
+            fmin = min(fmin, force)
+            fmax = max(fmax, force)
+            count += 1
+            if count == stride:
+                count = 0
+                hx[ih] = delta
+                hv[ih] = deltad
+                ih = ih + 1 if rec else 0
+        nrm = 0.0
+        big = 0.0
+        for i in range(n):
+            nrm += y[2, i] * y[2, i] + y[3, i] * y[3, i]
+            big = max(big, abs(y[0, i]), abs(y[1, i]))
+        nrm = math.sqrt(nrm)
+        for i in range(n):
+            y[2, i] /= nrm
+            y[3, i] /= nrm
+        if not big < bound:
+            break
+        if rec:
+            r = it - n_trans
+            logs[r] = math.log(nrm)
+            xs[r] = delta
+            vs[r] = deltad
+        elif it + 1 == n_trans:
+            xmin, xmax, count, ih = np.inf, -np.inf, 0, 0
+            fmin, fmax = np.inf, -np.inf
+        done = it + 1
+    return xs, vs, logs, hx, hv, xmin, xmax, done, y[0].copy(), y[1].copy(), fmin, fmax

@@ -1,0 +1,184 @@
+"""A gear train as a ``System``: the kernel's arguments, its step plan and one run.
+
+The train is integrated in the dimensionless form of ``model.Dimensionless`` on the scales of
+its equivalent pair (the stiff limit, ``model.equivalent_design``): the same Poincare period,
+forcing terms (``systems.spur_pair.forcing``), backlash law and mesh damping mu~ as that pair. A
+start (x0, v0) of the settings sets the mesh deflection delta and its rate; the shafts and bearings
+start at their static deflection under the mean load, at rest. The verdict of each start is the
+pair's (``numerics.runs.start_verdict``: strobes of (delta, delta'), Benettin on the
+2n-dimensional tangent, ``signals.classify``); the worst start is reported.
+
+RK4 is explicit: the step must resolve the train's fastest mode, h omega_max <= ``H_OMEGA``, so
+the steps per period are raised above ``settings.steps_per_period`` when the shafts or bearings
+are stiff (a note says so).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from gearengine.model.params import GearParams
+from gearengine.model.reduction import DesignConversion
+from gearengine.signals.classify import DIVERGENCE_BOUND
+from gearengine.systems.base import Run, StepPlan, StroboscopicFlow, System
+from gearengine.systems.gear_train.kernel import run_train, train_forcing
+from gearengine.systems.gear_train.model import (
+    RELATIVE,
+    Dimensionless,
+    TrainModel,
+    dimensionless,
+)
+from gearengine.systems.spur_pair.forcing import packed_forcing, step_plan
+from gearengine.systems.spur_pair.laws import law
+
+TRAIN_STEP_COST = 3
+"""A train's RK4 step in steps of the pair's analysis, for compute budgets: the median ratio of a
+train's analysis to the pair's at the same steps (``benchmarks/bench_train.py``: 3.18)."""
+
+H_OMEGA = 0.5
+"""Largest h omega_max of the RK4 step against the train's fastest mode (RK4's stability limit
+is 2.83; 0.5 keeps a fast mode's phase error per step near 1e-4)."""
+
+
+@dataclass(frozen=True)
+class TrainSystem(System):
+    """The kernel's arguments of one train (``kernel.run_train``) and its scales."""
+
+    model: TrainModel
+    form: Dimensionless
+    params: GearParams
+    AK: np.ndarray
+    AC: np.ndarray
+    g: np.ndarray
+    w: np.ndarray
+    f: np.ndarray
+    p: np.ndarray
+    kc: np.ndarray
+    ec: np.ndarray
+    tc: np.ndarray
+    omega_max: float
+    torque_ratio: float
+    """T_p / (r_p b k_m) per unit of the pair's F~_p: I_a / (m_e r_a^2)."""
+
+    @property
+    def conversion(self) -> DesignConversion:
+        return self.form.conversion
+
+    def plan(self, steps_per_period: int) -> StepPlan:
+        """The pair's step plan, with at least T0 omega_max / ``H_OMEGA`` steps per T0."""
+        plan = step_plan(self.params, steps_per_period)
+        need = math.ceil(plan.period * self.omega_max / H_OMEGA)
+        if need <= plan.steps:
+            return plan
+        note = (
+            f"the train's fastest mode (omega = {self.omega_max:.4g} omega_n) needs {need} RK4 "
+            f"steps per T0 (h omega <= {H_OMEGA}); {plan.steps} were asked"
+        )
+        return StepPlan(plan.omega0, plan.period, need, plan.omega_ref, (*plan.notes, note))
+
+    name = "gear_train"
+
+    @property
+    def n(self) -> int:  # type: ignore[override]
+        """State dimension: every relative coordinate and its rate."""
+        return 2 * len(self.w)
+
+    @property
+    def coordinates(self) -> tuple[str, ...]:  # type: ignore[override]
+        return (*RELATIVE, *(f"{c}_rate" for c in RELATIVE))
+
+    def start_state(self, x: float, v: float) -> tuple[float, ...]:
+        """The full state of ``start`` (delta = x, delta' = v): (u, v) flattened."""
+        u0, v0 = self.start(x, v)
+        return tuple(float(q) for q in np.concatenate([u0, v0]))
+
+    def integrate(
+        self, plan: StepPlan, start: Sequence[float], n_trans: int, n_rec: int, stride: int
+    ) -> Run:
+        """One run from the full state ``start`` (``start_state``), delta for x."""
+        half = len(start) // 2
+        u0 = np.array(start[:half], dtype=np.float64)
+        v0 = np.array(start[half:], dtype=np.float64)
+        return integrate_train(self, plan, u0, v0, n_trans, n_rec, stride)
+
+    def stroboscopic_flow(self, steps_per_period: int) -> StroboscopicFlow:
+        raise ValueError(
+            "Floquet multipliers are computed for the pair of Eq. (9) only, not yet for a train "
+            "(no monodromy kernel of the train)"
+        )
+
+    def method(self, plan: StepPlan) -> str:
+        return f"rk4 of the gear train ({self.n} states), forcing at abs. time"
+
+    def start(self, x0: float, v0: float) -> tuple[np.ndarray, np.ndarray]:
+        """(u, v) at tau = 0: delta = x0, delta' = v0, shafts and bearings at their static
+        deflection under the mean load (the train linearised in contact), at rest."""
+        form = self.form
+        w = form.mesh_direction
+        static = np.linalg.solve(form.stiffness + np.outer(w, w), form.mean_force)
+        _, e, ed, _ = train_forcing(0.0, self.kc, self.ec, self.tc)
+        mesh = RELATIVE.index("mesh_rotation")
+        u = static.copy()
+        u[mesh] += x0 + e - w @ static
+        v = np.zeros_like(u)
+        v[mesh] = v0 + ed
+        return u, v
+
+
+def train_system(model: TrainModel, pair: DesignConversion) -> TrainSystem:
+    """The kernel's arrays of ``model`` on the scales of its equivalent pair ``pair``."""
+    form = dimensionless(model, pair)
+    params = pair.params
+    inv = np.linalg.inv(form.mass)
+    w = form.mesh_direction
+    kc, _, _ = packed_forcing(params)
+    scale = (model.mass[0, 0] + model.mass[1, 1]) / (pair.equivalent_mass_kg * model.radii[0] ** 2)
+    ec = _terms(params.transmission_error, 1.0)  # e_r / b
+    tc = _terms(params.torque, scale)  # F~_pr = m r_a T_pr / (I_a b k_m) -> T_pr / (r_p b k_m)
+    linear = np.linalg.eigvals(inv @ (form.stiffness + np.outer(w, w)))
+    return TrainSystem(
+        model=model, form=form, params=params,
+        AK=inv @ form.stiffness, AC=inv @ form.damping, g=inv @ w, w=w,
+        f=inv @ form.mean_force, p=inv @ form.torque_direction,
+        kc=kc, ec=ec, tc=tc, omega_max=float(np.sqrt(np.max(np.abs(linear)))),
+        torque_ratio=scale,
+    )  # fmt: skip
+
+
+def _terms(excitation, factor: float) -> np.ndarray:
+    """(3, terms): amplitude x factor, r Omega, phase of the active harmonics."""
+    rows = []
+    if excitation is not None:
+        omega = excitation.frequency
+        rows = [(h.amplitude * factor, r * omega, h.phase) for r, h in excitation.active()]
+    return np.ascontiguousarray(np.array(rows, dtype=np.float64).reshape(-1, 3).T)
+
+
+def integrate_train(
+    system: TrainSystem,
+    plan: StepPlan,
+    u0: np.ndarray,
+    v0: np.ndarray,
+    n_trans: int,
+    n_rec: int,
+    stride: int,
+) -> Run:
+    """One run of the train from (u0, v0) (``systems.base.Run`` with delta for x)."""
+    lw = law(system.params)
+    out = run_train(
+        lw.code, lw.a, lw.c, lw.alpha, system.params.damping,
+        system.AK, system.AC, system.g, system.w, system.f, system.p,
+        system.kc, system.ec, system.tc, u0, v0,
+        plan.omega0 is not None, plan.period, plan.steps, n_trans, n_rec,
+        stride, DIVERGENCE_BOUND,
+    )  # fmt: skip
+    xs, vs, logs, hx, hv, xmin, xmax, done, _, _, fmin, fmax = out
+    final = (float(hx[-1]), float(hv[-1])) if hx.size else (math.nan, math.nan)
+    return Run(
+        xs, vs, logs, hx, hv, xmin, xmax, done, final, done < n_trans + n_rec,
+        max(0, done - n_trans), fmin, fmax,
+    )  # fmt: skip

@@ -1,0 +1,54 @@
+"""``gearengine.analyze`` of a design with a ``train`` (issue 32): the train's numerical verdict,
+the Melnikov answer of its reduction, its modes in the engineering block."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from pydantic import ValidationError
+
+import gearengine
+from gearengine.analysis import AnalysisRequest
+from gearengine.model.design import Design
+from gearengine.model.errors import InputError
+from gearengine.model.train import EXAMPLE_TRAIN
+from gearengine.numerics.settings import SimulationSettings
+from gearengine.numerics.trains import simulate_train
+
+ROOT = Path(__file__).resolve().parents[1]
+PAIR = json.loads((ROOT / "examples" / "design-direct.json").read_text())["design"]
+SETTINGS = SimulationSettings(transient_periods=200, record_periods=60)
+
+
+def test_analysis_of_a_train_is_the_trains() -> None:
+    design = Design.model_validate({**PAIR, "train": EXAMPLE_TRAIN})
+    result = gearengine.analyze(design, SETTINGS)
+    train = simulate_train(design, SETTINGS)
+    num, eng = result.numerics, result.engineering
+    assert num.classification == train.classification == "periodic"
+    assert num.period == train.period and num.lle == train.lle
+    assert eng.response.dte_peak_to_peak_um == train.dte_um
+    assert eng.response.dynamic_factor == train.dynamic_factor
+    assert num.floquet is None and "train" in num.floquet_note
+    assert not result.melnikov.applicable and "56.5%" in result.melnikov.notes[0]
+    assert result.verdict.agreement == "undecided"
+    assert [round(m.frequency_hz, 1) for m in eng.modes.modes][-1] == 2799.9
+    assert eng.speed_windows_rpm == [] and "no Melnikov reduction" in eng.speed_windows_note
+    # the pair alone: no train's answer in its JSON
+    pair = gearengine.analyze(Design.model_validate(PAIR), SETTINGS)
+    text = pair.model_dump_json()
+    assert '"modes"' not in text and '"train"' not in text
+    assert pair.numerics.lle != num.lle
+
+
+def test_train_basins_refused() -> None:
+    with pytest.raises((InputError, ValidationError)) as err:
+        gearengine.analyze(
+            AnalysisRequest(
+                design={**PAIR, "train": EXAMPLE_TRAIN},
+                settings={"basins": {"starts": 4}, "record_periods": 10},
+            )
+        )
+    assert "basins" in str(err.value)
