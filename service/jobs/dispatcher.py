@@ -100,7 +100,7 @@ class Dispatcher:
 
     def start(self) -> None:
         """Run the loop in a daemon thread."""
-        self._thread = threading.Thread(target=self.run, name="sweep-dispatcher", daemon=True)
+        self._thread = threading.Thread(target=self.run, name="job-dispatcher", daemon=True)
         self._thread.start()
 
     def request_stop(self, grace: float = 5.0) -> None:

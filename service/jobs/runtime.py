@@ -13,14 +13,14 @@ from service.jobs.store import JobStore
 
 
 @dataclass
-class SweepJobs:
+class JobQueue:
     """The store of the data directory and this process's dispatcher (None: store only)."""
 
     store: JobStore
     dispatcher: Dispatcher | None
 
     @classmethod
-    def open(cls, settings: Settings) -> SweepJobs:
+    def open(cls, settings: Settings) -> JobQueue:
         """Open the store of the data directory; no dispatcher until ``start_dispatcher``
         (``service.warmup`` starts it once the kernels are compiled)."""
         return cls(JobStore.in_dir(Path(settings.data_dir)), None)
