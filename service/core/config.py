@@ -46,6 +46,15 @@ class Settings(BaseSettings):
     )
     insecure: bool = Field(False, description="Allow a non-loopback bind without API keys.")
     dask_scheduler: str | None = Field(None, description="Dask scheduler address for sweeps.")
+    database_url: str | None = Field(
+        None,
+        description="PostgreSQL job store shared by every replica "
+        "(``postgresql://user:password@host:5432/gearchaos``); unset, the job store is the SQLite "
+        "file jobs.sqlite3 in data_dir, for one machine (docs/scale-out.md).",
+    )
+    database_pool_size: int = Field(
+        8, ge=2, le=100, description="Most PostgreSQL connections of one process (a pool)."
+    )
 
     keep_alive_seconds: float = Field(
         30.0,
