@@ -11,9 +11,11 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
+import psycopg
 import pytest
 
 from service.jobs.store import DB_FILE, JobStore, QueueFullError
+from tests._polling import poll
 
 LEASE = 60.0
 
@@ -302,3 +304,29 @@ def test_the_queue_cap_holds_under_concurrent_submissions(store: JobStore) -> No
     for t in threads:
         t.join()
     assert results.count("full") == 7 and store.list(None, None, 100, 0)[1] == 5
+
+
+def test_a_postgres_store_cut_off_is_not_ready_and_recovers(database_url: str) -> None:
+    """The database refuses connections and drops the pool's: the readiness check says so
+    (within its timeout, not the pool's 30 s) and answers again once connections are back."""
+    store = JobStore.open(database_url)
+    name = database_url.rsplit("/", 1)[1]
+    admin = psycopg.connect(database_url.rsplit("/", 1)[0] + "/postgres", autocommit=True)
+
+    def allow(yes: bool) -> None:
+        admin.execute(f"ALTER DATABASE {name} ALLOW_CONNECTIONS {str(yes).lower()}")
+
+    try:
+        assert store.ping()
+        allow(False)
+        admin.execute(
+            "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s", (name,)
+        )
+        assert not store.ping()
+        allow(True)
+        assert poll(store.ping, bool, timeout=30)
+        assert submit(store) and store.ping()
+    finally:
+        allow(True)
+        admin.close()
+        store.shutdown()

@@ -87,8 +87,9 @@ class Database(Protocol):
     def transaction(self) -> AbstractContextManager[Tx]:
         """A write transaction: committed when the block ends, rolled back on an exception."""
 
-    def reading(self) -> AbstractContextManager[Tx]:
-        """A connection for reads (each statement sees the latest committed state)."""
+    def reading(self, timeout: float | None = None) -> AbstractContextManager[Tx]:
+        """A connection for reads (each statement sees the latest committed state); waiting
+        at most ``timeout`` seconds for one where connections are pooled."""
 
     def now(self, tx: Tx) -> float:
         """The store's clock, POSIX seconds (PostgreSQL: the server's, one clock for every

@@ -165,6 +165,7 @@ class PostgresDatabase:
             min_size=1,
             max_size=pool_size,
             kwargs={"autocommit": True, "row_factory": rows},
+            check=ConnectionPool.check_connection,  # a connection broken by a restart is replaced
             name="gearchaos-jobs",
             open=True,
         )
@@ -175,8 +176,8 @@ class PostgresDatabase:
             yield PgTx(conn)
 
     @contextmanager
-    def reading(self) -> Iterator[Tx]:
-        with self.pool.connection() as conn:
+    def reading(self, timeout: float | None = None) -> Iterator[Tx]:
+        with self.pool.connection(timeout) as conn:
             yield PgTx(conn)
 
     def now(self, tx: Tx) -> float:

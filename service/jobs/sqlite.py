@@ -130,7 +130,7 @@ class SqliteDatabase:
         db.execute("COMMIT")
 
     @contextmanager
-    def reading(self) -> Iterator[sqlite3.Connection]:
+    def reading(self, timeout: float | None = None) -> Iterator[sqlite3.Connection]:
         yield self._db()
 
     def now(self, tx: Tx) -> float:

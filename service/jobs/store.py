@@ -77,6 +77,8 @@ class Claim:
         return (self.job_id, self.index)
 
 
+PING_SECONDS = 2.0
+"""Longest wait of the readiness check for a pooled connection (PostgreSQL down: not ready)."""
 RETRIES = 5
 """Runs of a transaction that the database aborted to break a deadlock (``Database.retryable``)."""
 
@@ -157,7 +159,7 @@ class JobStore:
     def ping(self) -> bool:
         """The database answers a query."""
         try:
-            with self.db.reading() as db:
+            with self.db.reading(timeout=PING_SECONDS) as db:
                 db.execute("SELECT 1 FROM jobs LIMIT 1").fetchall()
         except self.db.errors:
             return False
