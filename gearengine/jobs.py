@@ -54,6 +54,7 @@ KINDS: dict[str, str] = {
     "remedies": "gearengine.ensembles.remedies:REMEDIES_JOB",
     "runup": "gearengine.runup.compute:RUNUP_JOB",
     "robustness": "gearengine.ensembles.robustness:ROBUSTNESS_JOB",
+    "basins": "gearengine.basins:BASINS_JOB",
 }
 """Kind name -> ``module:attribute`` of its ``JobKind``."""
 

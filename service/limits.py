@@ -15,10 +15,10 @@ from service.errors import FieldError, ProblemError
 SWEEP_HINT = "submit it as a sweep job: POST /v1/sweeps"
 """Where an analysis over the synchronous budget can run."""
 BASINS_HINT = (
-    "use fewer basin starts or periods, or run it where no budget applies: "
-    "gearengine basins FILE --plot OUT.png"
+    "submit it as a job, POST /v1/basins (the same request; its /plot is the basin picture), "
+    "or use fewer basin starts or periods"
 )
-"""Where one design's basins over the synchronous budget can run (no job kind runs them)."""
+"""Where one design's basins over the synchronous budget can run: the job kind ``basins``."""
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ from service import errors
 from service.api.deps import load_key_hashes
 from service.api.routes import (
     analyses,
+    basins,
     conversions,
     explorer,
     health,
@@ -101,6 +102,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(remedies.router, tags=["remedies"])
     app.include_router(runups.router, tags=["runups"])
     app.include_router(robustness.router, tags=["robustness"])
+    app.include_router(basins.router, tags=["basins"])
     app.include_router(explorer.router)
     app.add_middleware(
         BodyLimit,

@@ -322,7 +322,13 @@ class JobRoutes:
 
             def assemble() -> bytes:
                 request = kind.request.model_validate_json(jobs.store.request_json(job_id))
-                document = kind.assemble(request, list(jobs.store.chunk_results(job_id)))
+                try:
+                    document = kind.assemble(request, list(jobs.store.chunk_results(job_id)))
+                except ValueError as exc:  # a kind with no partial result before its chunks
+                    raise ProblemError(
+                        409, "no-result", "No result", f"{routes.noun} {job_id}: {exc}",
+                        headers=poll_headers(job),
+                    ) from None  # fmt: skip
                 return document.model_dump_json().encode()
 
             body = await run_in_threadpool(assemble)
