@@ -107,6 +107,7 @@ numba, scipy, pint and nolds in ~0.7 s."""
 _SUBMODULES = frozenset(
     {
         "analysis",
+        "basins",
         "cli",
         "engineering",
         "ensembles",
