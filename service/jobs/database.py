@@ -1,9 +1,9 @@
 """What the job store needs of a SQL database, and the versioned migrations of its schema.
 
 ``service.jobs.store.JobStore`` holds the queue's logic once, written in SQL that SQLite and
-PostgreSQL both run (``?`` placeholders, ``IS ?`` for a comparison that matches NULL, row values
-in ``IN``). A ``Database`` carries what differs: how a connection and a transaction are had, the
-clock, the row-locking clauses, which errors mean "run the transaction again", and the schema.
+PostgreSQL both run (``?`` placeholders, row values in ``IN``). A ``Database`` carries what
+differs: how a connection and a transaction are had, the clock, the row-locking clauses, which
+errors mean "run the transaction again", and the schema.
 
 Migrations are numbered; ``migrate`` applies, in one transaction, those a database has not yet
 recorded in its ``schema_migrations`` table, so replicas that start together migrate once.

@@ -12,7 +12,6 @@ store runs it again (``retryable``). The clock of leases is the server's
 
 from __future__ import annotations
 
-import re
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from functools import lru_cache
@@ -96,9 +95,8 @@ MIGRATIONS = (Migration(1, "jobs, chunks, commits, job events and kinds", statem
 
 @lru_cache(maxsize=256)
 def to_pyformat(sql: str) -> str:
-    """The store's SQL for psycopg: ``IS ?`` (matches NULL) as ``IS NOT DISTINCT FROM``, ``?``
-    placeholders as ``%s``."""
-    return re.sub(r"\bIS \?", "IS NOT DISTINCT FROM ?", sql).replace("?", "%s")
+    """The store's SQL for psycopg: ``?`` placeholders as ``%s``."""
+    return sql.replace("?", "%s")
 
 
 class Row(tuple):

@@ -200,7 +200,7 @@ class JobStore:
     def get(self, job_id: str, owner: str | None, kind: str | None = None) -> Job | None:
         """The job if it exists, belongs to ``owner`` (None: auth off) and, when ``kind`` is
         given, is of that kind."""
-        where, args = _of("j.id = ? AND j.owner IS ?", [job_id, owner], kind)
+        where, args = _of("j.id = ?", [job_id], owner, kind)
         with self.db.reading() as db:
             row = db.execute(f"{_JOB_SELECT} WHERE {where}", args).fetchone()
         return None if row is None else _job(row)
@@ -217,7 +217,7 @@ class JobStore:
     ) -> tuple[list[Job], int]:  # fmt: skip
         """A page of ``owner``'s jobs (of ``kind`` when given), newest first, and the number
         matching."""
-        where, args = _of("j.owner IS ?", [owner], kind)
+        where, args = _of("TRUE", [], owner, kind)
         if status is not None:
             where += " AND j.status = ?"
             args.append(status)
@@ -232,7 +232,7 @@ class JobStore:
     @retried
     def cancel(self, job_id: str, owner: str | None, kind: str | None = None) -> Job | None:
         """Cancel an unfinished job: no new chunk starts. Finished jobs are left as they are."""
-        where, args = _of("id = ? AND owner IS ?", [job_id, owner], kind, column="kind")
+        where, args = _of("id = ?", [job_id], owner, kind, table="")
         with self._tx() as db:
             self._lock_job(db, job_id)
             hit = db.execute(
@@ -459,10 +459,16 @@ _JOB_SELECT = (
 
 
 def _of(
-    where: str, args: list[object], kind: str | None, column: str = "j.kind"
+    where: str, args: list[object], owner: str | None, kind: str | None, table: str = "j."
 ) -> tuple[str, list[object]]:
-    """``where`` narrowed to jobs of ``kind`` (None: every kind)."""
-    return (where, args) if kind is None else (f"{where} AND {column} = ?", [*args, kind])
+    """``where`` narrowed to the jobs of ``owner`` (None: those stored without one, auth off)
+    and of ``kind`` (None: every kind); ``table``: the prefix of the jobs table's columns.
+    ``IS NULL`` or ``=``, never ``IS ?``: PostgreSQL's ``IS NOT DISTINCT FROM`` uses no index."""
+    if owner is None:
+        where += f" AND {table}owner IS NULL"
+    else:
+        where, args = f"{where} AND {table}owner = ?", [*args, owner]
+    return (where, args) if kind is None else (f"{where} AND {table}kind = ?", [*args, kind])
 
 
 def _job(row: Any) -> Job:
