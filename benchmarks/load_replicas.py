@@ -43,6 +43,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 from tests._postgres import PostgresCluster, binaries  # noqa: E402 (the tests' throwaway server)
 
+CONFIGS = (("sqlite, 1 replica", 1, False), ("postgres, 1 replica", 1, True),
+           ("postgres, 2 replicas", 2, True))  # fmt: skip
+"""The rows: (label, replicas, on PostgreSQL)."""
 OPS = {"sweeps": "sweep", "melnikov": "melnikov"}
 """Mix of ``load.MIXES`` -> the operation it times."""
 
@@ -109,6 +112,10 @@ def main() -> None:
     parser.add_argument("--clients", type=int, default=32)
     parser.add_argument("--seconds", type=float, default=20.0)
     parser.add_argument("--database-url", default=None)
+    parser.add_argument(
+        "--only", type=lambda s: s.split(";"), default=None,
+        help="run only these rows (;-separated labels); the README is not rewritten",
+    )  # fmt: skip
     args = parser.parse_args()
     cluster = None
     if args.database_url is None:
@@ -118,9 +125,9 @@ def main() -> None:
     try:
         with tempfile.TemporaryDirectory(prefix="gearchaos-replicas-") as name:
             tmp = Path(name)
-            for label, n, pg in (("sqlite, 1 replica", 1, False),
-                                 ("postgres, 1 replica", 1, True),
-                                 ("postgres, 2 replicas", 2, True)):  # fmt: skip
+            for label, n, pg in CONFIGS:
+                if args.only and label not in args.only:
+                    continue
                 url = None
                 if pg:
                     url = cluster.new_database() if cluster else args.database_url
@@ -135,7 +142,8 @@ def main() -> None:
     finally:
         if cluster is not None:
             cluster.stop()
-    write_section("replicas", report(rows, args))
+    if not args.only:
+        write_section("replicas", report(rows, args))
 
 
 def report(rows: list[tuple[str, str, dict, int]], args: argparse.Namespace) -> str:

@@ -138,9 +138,7 @@ class JobStore:
         ``job_events``) are logged once it has committed."""
         with self.db.transaction() as db:
             yield db
-            events = db.execute("SELECT * FROM job_events").fetchall()
-            if events:
-                db.execute("DELETE FROM job_events")
+            events = db.execute("DELETE FROM job_events RETURNING *").fetchall()
         for event in events:
             log_transition(event)
 
@@ -176,13 +174,6 @@ class JobStore:
         ``max_unfinished`` jobs (of every kind)."""
         job_id = uuid.uuid4().hex
         with self._tx() as db:
-            if self.db.serialize_submits:
-                db.execute(self.db.serialize_submits)
-            (n,) = db.execute(
-                "SELECT COUNT(*) FROM jobs WHERE status IN ('queued', 'running')"
-            ).fetchone()
-            if n >= max_unfinished:
-                raise QueueFullError(f"{n} unfinished jobs, the limit is {max_unfinished}")
             db.execute(
                 "INSERT INTO jobs (id, kind, owner, status, request_json, chunk_points, "
                 "total_chunks, total_points, created_at) VALUES (?, ?, ?, 'queued', ?, ?, ?, ?, ?)",
@@ -193,6 +184,15 @@ class JobStore:
                 "INSERT INTO chunks (job_id, idx, n_points, status) VALUES (?, ?, ?, 'pending')",
                 [(job_id, i, n) for i, n in enumerate(chunk_counts)],
             )
+            # counted after the inserts (this job included), so that concurrent submissions
+            # take turns (serialize_submits) only for the count and the commit
+            if self.db.serialize_submits:
+                db.execute(self.db.serialize_submits)
+            (n,) = db.execute(
+                "SELECT COUNT(*) FROM jobs WHERE status IN ('queued', 'running')"
+            ).fetchone()
+            if n > max_unfinished:
+                raise QueueFullError(f"{n - 1} unfinished jobs, the limit is {max_unfinished}")
         job = self.get(job_id, owner)
         assert job is not None
         return job
