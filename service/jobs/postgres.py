@@ -24,6 +24,11 @@ from psycopg_pool import ConnectionPool
 
 from service.jobs.database import Migration, Tx, statements
 
+IDLE_IN_TRANSACTION_MS = 10_000
+"""A session idle inside a transaction this long is ended by the server, its row locks freed: a
+process frozen mid-transaction (SIGSTOP, a paused VM, a stalled pod) would otherwise hold its
+job's row and stall every dispatcher's claims and commits of that job. The store's own
+transactions never wait for anything but the database."""
 LOCK_KEY = 0x6765_6172
 """Advisory lock namespace of gearchaos ("gear"); the second key picks the lock."""
 
@@ -162,7 +167,11 @@ class PostgresDatabase:
             url,
             min_size=1,
             max_size=pool_size,
-            kwargs={"autocommit": True, "row_factory": rows},
+            kwargs={
+                "autocommit": True,
+                "row_factory": rows,
+                "options": f"-c idle_in_transaction_session_timeout={IDLE_IN_TRANSACTION_MS}",
+            },
             check=ConnectionPool.check_connection,  # a connection broken by a restart is replaced
             name="gearchaos-jobs",
             open=True,
