@@ -7,11 +7,13 @@ ENV PYTHONDONTWRITEBYTECODE=1 PYTHONUNBUFFERED=1 \
 
 RUN useradd --create-home --uid 10001 gearchaos && mkdir /data && chown gearchaos /data
 WORKDIR /app
+# extras to install beside the package, e.g. --build-arg EXTRAS="[dask]" for Dask workers
+ARG EXTRAS=""
 COPY pyproject.toml README.md ./
 COPY gearengine ./gearengine
 COPY service ./service
 RUN python -m pip install --no-cache-dir --upgrade pip \
-    && python -m pip install --no-cache-dir .
+    && python -m pip install --no-cache-dir ".${EXTRAS}"
 
 USER gearchaos
 VOLUME ["/data"]

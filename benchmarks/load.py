@@ -57,8 +57,9 @@ def request_for(op: str, rng: random.Random) -> tuple[str, dict]:
     return "/v1/sweeps", {"params": PARAMS, "settings": SHORT, "axes": [axis]}
 
 
-MIXES = {"mixed": [6, 3, 1], "melnikov": [1, 0, 0]}
-"""Weights of (melnikov, analysis, sweep) per mix: mixed, or Melnikov verdicts only."""
+MIXES = {"mixed": [6, 3, 1], "melnikov": [1, 0, 0], "sweeps": [0, 0, 1]}
+"""Weights of (melnikov, analysis, sweep) per mix: mixed, Melnikov verdicts only, or sweep
+submissions only (benchmarks/load_replicas.py)."""
 
 
 class Connection:

@@ -45,6 +45,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         "workers": args.workers,
         "http_processes": args.http_processes,
         "dask_scheduler": args.dask,
+        "database_url": args.database_url,
         "insecure": args.insecure or None,
     }
     settings = Settings(**{k: v for k, v in flags.items() if v is not None})
@@ -90,8 +91,18 @@ def cmd_worker(args: argparse.Namespace) -> int:
     from service.core.config import Settings
     from service.jobs.worker import run_worker
 
-    flags = {"data_dir": args.data_dir, "workers": args.workers, "dask_scheduler": args.dask}
+    flags = {
+        "data_dir": args.data_dir,
+        "workers": args.workers,
+        "dask_scheduler": args.dask,
+        "database_url": args.database_url,
+    }
     return run_worker(Settings(**{k: v for k, v in flags.items() if v is not None}))
+
+
+DATABASE_URL_HELP = (
+    "PostgreSQL job store shared by replicas (postgresql://...; default: SQLite in the data dir)"
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -108,6 +119,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="HTTP server processes on the one port (default: cores)",
     )
     p.add_argument("--dask", default=None, metavar="ADDRESS", help="Dask scheduler for sweeps")
+    p.add_argument("--database-url", default=None, metavar="URL", help=DATABASE_URL_HELP)
     p.add_argument(
         "--insecure", action="store_true", help="allow a non-loopback bind without API keys"
     )
@@ -117,4 +129,5 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--data-dir", default=None, help="directory holding the job store")
     p.add_argument("--workers", type=int, default=None, help="worker processes (default: cores)")
     p.add_argument("--dask", default=None, metavar="ADDRESS", help="Dask scheduler to run on")
+    p.add_argument("--database-url", default=None, metavar="URL", help=DATABASE_URL_HELP)
     p.set_defaults(func=cmd_worker)

@@ -15,10 +15,10 @@ from service.errors import FieldError, ProblemError
 SWEEP_HINT = "submit it as a sweep job: POST /v1/sweeps"
 """Where an analysis over the synchronous budget can run."""
 BASINS_HINT = (
-    "use fewer basin starts or periods, or run it where no budget applies: "
-    "gearengine basins FILE --plot OUT.png"
+    "submit it as a job, POST /v1/basins (the same request; its /plot is the basin picture), "
+    "or use fewer basin starts or periods"
 )
-"""Where one design's basins over the synchronous budget can run (no job kind runs them)."""
+"""Where one design's basins over the synchronous budget can run: the job kind ``basins``."""
 
 
 @dataclass(frozen=True)
@@ -30,12 +30,12 @@ class Limits:
     def document(self, spec: dict[str, Any]) -> None:
         """Write the limits that bound one field into the OpenAPI document, so that its schema
         refuses what these checks refuse: the ``num`` of a threshold curve (max_curve_points)
-        and of a sweep axis (max_sweep_points: one axis can hold no more); under a cap below
+        and of a sweep axis (max_job_points: one axis can hold no more); under a cap below
         its default, num is required."""
         schemas = spec.get("components", {}).get("schemas", {})
         caps = {
             "ThresholdsRequest": self.settings.max_curve_points,
-            "SweepAxis": self.settings.max_sweep_points,
+            "SweepAxis": self.settings.max_job_points,
         }
         for name, cap in caps.items():
             schema = schemas.get(name, {})
@@ -66,14 +66,14 @@ class Limits:
 
     def check_job(self, kind: str, body: BaseModel, noun: str, path: str = "axes") -> None:
         """Refuse a job whose total work (its kind's ``work``, in RK4 steps) is over the per-job
-        budget (max_sweep_steps, for jobs of every kind); ``path`` is the field to shrink."""
+        budget (max_job_steps, for jobs of every kind); ``path`` is the field to shrink."""
         steps = jobs.kind(kind).work(body)
-        cap = self.settings.max_sweep_steps
+        cap = self.settings.max_job_steps
         if steps > cap:
             raise over_limit(
                 path,
                 f"this {noun} needs {steps} RK4 steps, over the budget of {cap} steps per "
-                f"{noun} (max_sweep_steps); use fewer points, periods or steps per period",
+                f"{noun} (max_job_steps); use fewer points, periods or steps per period",
                 kind="over-budget",
             )
 

@@ -16,6 +16,7 @@ from service import errors
 from service.api.deps import load_key_hashes
 from service.api.routes import (
     analyses,
+    basins,
     conversions,
     explorer,
     health,
@@ -28,7 +29,7 @@ from service.api.routes import (
 )
 from service.cache import ResponseCache
 from service.core.config import Settings
-from service.jobs.runtime import SweepJobs
+from service.jobs.runtime import JobQueue
 from service.limits import Limits
 from service.metrics import Metrics
 from service.middleware import AccessLog, BodyLimit
@@ -62,7 +63,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
 
     @asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
-        jobs = app.state.sweep_jobs = await run_in_threadpool(SweepJobs.open, settings)
+        jobs = app.state.jobs = await run_in_threadpool(JobQueue.open, settings)
         ready_checks["job_store"] = jobs.ready
         warming = app.state.warm_up = KernelWarmUp(jobs, settings)  # after the ready line
         ready_checks["kernels"] = warming.done.is_set
@@ -101,6 +102,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(remedies.router, tags=["remedies"])
     app.include_router(runups.router, tags=["runups"])
     app.include_router(robustness.router, tags=["robustness"])
+    app.include_router(basins.router, tags=["basins"])
     app.include_router(explorer.router)
     app.add_middleware(
         BodyLimit,

@@ -14,7 +14,7 @@ import threading
 import time
 
 from service.core.config import Settings
-from service.jobs.runtime import SweepJobs
+from service.jobs.runtime import JobQueue
 
 log = logging.getLogger("gearchaos.startup")
 
@@ -32,7 +32,7 @@ class KernelWarmUp:
     """A daemon thread: ``warm_up_kernels``, then the sweep dispatcher of ``jobs``; ``done``
     is set when both happened (the ``kernels`` readiness check)."""
 
-    def __init__(self, jobs: SweepJobs, settings: Settings) -> None:
+    def __init__(self, jobs: JobQueue, settings: Settings) -> None:
         self.jobs = jobs
         self.settings = settings
         self.done = threading.Event()

@@ -22,6 +22,7 @@ from hypothesis import settings
 from gearengine.model.examples import PAPER_SECTION_41
 from service.core.config import Settings
 from service.main import create_app
+from tests._postgres import PostgresCluster, binaries, unavailable
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -134,3 +135,25 @@ def server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Server]:
     srv = Server(tmp_path_factory.mktemp("srv") / "data")
     yield srv
     srv.stop()
+
+
+@pytest.fixture(scope="session")
+def postgres() -> Iterator[PostgresCluster]:
+    """A throwaway PostgreSQL server for the session (``tests._postgres``); skips, saying why,
+    where the binaries are absent (fails when GEARCHAOS_POSTGRES_TESTS=required)."""
+    bin_dir = binaries()
+    if bin_dir is None:
+        unavailable("no PostgreSQL server binaries (initdb, pg_ctl) under /usr/lib/postgresql")
+    try:
+        cluster = PostgresCluster(bin_dir, free_port())
+    except (subprocess.CalledProcessError, KeyError, OSError) as exc:
+        detail = getattr(exc, "stderr", b"") or b""
+        unavailable(f"PostgreSQL did not start: {exc} {detail.decode(errors='replace')[-500:]}")
+    yield cluster
+    cluster.stop()
+
+
+@pytest.fixture
+def database_url(postgres: PostgresCluster) -> str:
+    """A fresh database on the session's PostgreSQL server."""
+    return postgres.new_database()

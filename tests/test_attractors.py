@@ -188,8 +188,8 @@ def test_the_service_refuses_too_many_basin_starts_before_compute(client: TestCl
     assert r.status_code == 422, r.text
     problem = r.json()
     assert problem["errors"][0]["path"] == "settings.basins.starts"
-    assert "max_sync_steps" in problem["detail"] and "gearengine basins" in problem["detail"]
-    assert "/v1/sweeps" not in problem["detail"]  # no job kind runs one design's basins
+    assert "max_sync_steps" in problem["detail"] and "POST /v1/basins" in problem["detail"]
+    assert "/v1/sweeps" not in problem["detail"]  # the basins job kind runs them, not a sweep
     bad = {"params": {"damping": 0.07}, "settings": {"basins": {"box": [[3, -3], [-3, 3]]}}}
     r = client.post("/v1/analyses", json=bad)
     assert r.status_code == 422

@@ -18,7 +18,7 @@ def test_base_image_and_user() -> None:
 
 def test_installs_the_project_like_the_makefile() -> None:
     assert re.search(r"pip install --quiet (--no-compile )?-e \.", MAKEFILE)
-    assert "pip install --no-cache-dir ." in DOCKERFILE
+    assert re.search(r"pip install --no-cache-dir \"?\.(\$\{EXTRAS\})?\"?$", DOCKERFILE, re.M)
     for path in ("pyproject.toml", "gearengine", "service"):
         assert path in DOCKERFILE
 

@@ -1,4 +1,5 @@
-"""The SQLite job store: ownership, the queue cap, leases, commits, retries, cancellation."""
+"""The job store on each of its databases (SQLite, and PostgreSQL on a throwaway server):
+ownership, the queue cap, leases, commits, retries, cancellation; the same tests for both."""
 
 from __future__ import annotations
 
@@ -7,18 +8,32 @@ import multiprocessing
 import sqlite3
 import threading
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
+import psycopg
 import pytest
 
-from service.jobs.store import JobStore, QueueFullError
+from service.jobs.store import DB_FILE, JobStore, QueueFullError
+from tests._polling import poll
 
 LEASE = 60.0
 
 
+@pytest.fixture(params=["sqlite", "postgres"])
+def location(request: pytest.FixtureRequest, tmp_path: Path) -> str:
+    """Where the store is: the SQLite file of a data directory, or a fresh PostgreSQL
+    database."""
+    if request.param == "postgres":
+        return request.getfixturevalue("database_url")
+    return str(tmp_path / DB_FILE)
+
+
 @pytest.fixture
-def store(tmp_path: Path) -> JobStore:
-    return JobStore.in_dir(tmp_path)
+def store(location: str) -> Iterator[JobStore]:
+    s = JobStore.open(location)
+    yield s
+    s.shutdown()
 
 
 def submit(store: JobStore, owner: str | None = None, chunks: int = 3, cap: int = 10) -> str:
@@ -130,19 +145,20 @@ def test_release_gives_chunks_back_without_counting_the_attempt(store: JobStore)
     assert c.attempt == 1 and store.attempts(job) == [1]
 
 
-def _claim_all(path: str, owner: str, out: multiprocessing.Queue) -> None:
-    store = JobStore(Path(path))
+def _claim_all(location: str, owner: str, out: multiprocessing.Queue) -> None:
+    store = JobStore.open(location)
     got = []
     while claims := store.claim(owner, LEASE, 3, 1):
         got += [c.key for c in claims]
     out.put(got)
+    store.shutdown()
 
 
-def test_concurrent_dispatchers_never_claim_a_chunk_twice(store: JobStore) -> None:
+def test_concurrent_dispatchers_never_claim_a_chunk_twice(store: JobStore, location: str) -> None:
     job = submit(store, chunks=60, cap=10)
     ctx = multiprocessing.get_context("spawn")
     out = ctx.Queue()
-    procs = [ctx.Process(target=_claim_all, args=(str(store.path), f"p{i}", out)) for i in range(4)]
+    procs = [ctx.Process(target=_claim_all, args=(location, f"p{i}", out)) for i in range(4)]
     for p in procs:
         p.start()
     claimed = [key for _ in procs for key in out.get(timeout=60)]
@@ -170,8 +186,9 @@ def test_every_job_transition_is_one_structured_log_line(
     assert json.loads(caplog.records[-1].message)["status"] == "cancelled"
 
 
-def test_a_locked_database_makes_writers_wait_not_fail(store: JobStore, tmp_path: Path) -> None:
+def test_a_locked_database_makes_writers_wait_not_fail(tmp_path: Path) -> None:
     """Another process holding the write lock (concurrent writer): the submit waits for it."""
+    store = JobStore.in_dir(tmp_path)
     submit(store)
     holder = sqlite3.connect(
         tmp_path / "jobs.sqlite3", isolation_level=None, check_same_thread=False
@@ -200,9 +217,10 @@ def test_a_store_from_before_job_kinds_gains_the_kind_column(tmp_path: Path) -> 
     )
     old.close()
     store = JobStore.in_dir(tmp_path)
-    store._db().execute(
-        "INSERT INTO chunks (job_id, idx, n_points, status) VALUES ('old', 0, 2, 'pending')"
-    )
+    with store.db.transaction() as db:
+        db.execute(
+            "INSERT INTO chunks (job_id, idx, n_points, status) VALUES ('old', 0, 2, 'pending')"
+        )
     other = store.submit(None, '{"doc": 2}', [1], 1, 10, kind="robustness").id
     assert (
         store.get("old", None, "sweep") is not None and store.get("old", None, "robustness") is None
@@ -214,3 +232,101 @@ def test_a_store_from_before_job_kinds_gains_the_kind_column(tmp_path: Path) -> 
         ("old", "sweep"),
         (other, "robustness"),
     ]
+
+
+def _open_and_report(location: str, out: multiprocessing.Queue) -> None:
+    store = JobStore.open(location)
+    with store.db.reading() as db:
+        out.put(sorted(r[0] for r in db.execute("SELECT version FROM schema_migrations")))
+    store.shutdown()
+
+
+def test_migrations_are_versioned_and_applied_once_by_stores_opened_together(
+    location: str,
+) -> None:
+    """Four processes open a new store at the same moment (replicas starting together): each
+    sees every version recorded once, and none fails on a half-made schema."""
+    ctx = multiprocessing.get_context("spawn")
+    out = ctx.Queue()
+    procs = [ctx.Process(target=_open_and_report, args=(location, out)) for _ in range(4)]
+    for p in procs:
+        p.start()
+    seen = [out.get(timeout=60) for _ in procs]
+    for p in procs:
+        p.join()
+    store = JobStore.open(location)
+    expected = sorted(m.version for m in store.db.migrations)
+    assert seen == [expected] * 4
+    assert store.list(None, None, 1, 0) == ([], 0)
+    store.shutdown()
+
+
+def _commit_together(store: JobStore, commits: list[tuple[str, str, int]]) -> list[bool]:
+    """Run ``store.commit(owner, job, idx, ...)`` for each entry in its own thread, released at
+    the same instant; returns whether each was committed."""
+    start, done = threading.Barrier(len(commits)), [False] * len(commits)
+
+    def one(i: int, owner: str, job: str, idx: int) -> None:
+        start.wait()
+        done[i] = store.commit(owner, job, idx, f"[{idx}]")
+
+    threads = [threading.Thread(target=one, args=(i, *c)) for i, c in enumerate(commits)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    return done
+
+
+def test_the_last_two_chunks_committed_at_once_finish_the_job(store: JobStore) -> None:
+    """Two dispatchers commit a job's last two chunks in the same instant: whichever commits
+    second sees the other's chunk done and finishes the job (every time)."""
+    jobs = [submit(store, chunks=2, cap=100) for _ in range(15)]
+    for job in jobs:
+        claims = store.claim("a", LEASE, 3, 1) + store.claim("b", LEASE, 3, 1)
+        assert [c.job_id for c in claims] == [job, job]
+        assert _commit_together(store, [("a", job, 0), ("b", job, 1)]) == [True, True]
+    assert {store.get(job, None).status for job in jobs} == {"succeeded"}
+
+
+def test_the_queue_cap_holds_under_concurrent_submissions(store: JobStore) -> None:
+    results: list[str] = []
+
+    def one() -> None:
+        try:
+            results.append(submit(store, cap=5))
+        except QueueFullError:
+            results.append("full")
+
+    threads = [threading.Thread(target=one) for _ in range(12)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert results.count("full") == 7 and store.list(None, None, 100, 0)[1] == 5
+
+
+def test_a_postgres_store_cut_off_is_not_ready_and_recovers(database_url: str) -> None:
+    """The database refuses connections and drops the pool's: the readiness check says so
+    (within its timeout, not the pool's 30 s) and answers again once connections are back."""
+    store = JobStore.open(database_url)
+    name = database_url.rsplit("/", 1)[1]
+    admin = psycopg.connect(database_url.rsplit("/", 1)[0] + "/postgres", autocommit=True)
+
+    def allow(yes: bool) -> None:
+        admin.execute(f"ALTER DATABASE {name} ALLOW_CONNECTIONS {str(yes).lower()}")
+
+    try:
+        assert store.ping()
+        allow(False)
+        admin.execute(
+            "SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = %s", (name,)
+        )
+        assert not store.ping()
+        allow(True)
+        assert poll(store.ping, bool, timeout=30)
+        assert submit(store) and store.ping()
+    finally:
+        allow(True)
+        admin.close()
+        store.shutdown()

@@ -228,7 +228,7 @@ def test_a_cancelled_study_gives_a_partial_result_of_its_finished_chunks(tmp_pat
     app = create_app(Settings(data_dir=tmp_path, workers=0))
     with TestClient(app) as c:
         job = c.post("/v1/robustness", json=doc(samples=64)).json()
-        url, store = f"/v1/robustness/{job['id']}", app.state.sweep_jobs.store
+        url, store = f"/v1/robustness/{job['id']}", app.state.jobs.store
         assert c.get(url + "/result").status_code == 409
         claims = store.claim("test-worker", 60.0, 3, 4)
         assert [(cl.index, cl.kind) for cl in claims] == [(i, "robustness") for i in range(4)]

@@ -12,7 +12,7 @@ import httpx
 import pytest
 
 from service.core.config import Settings
-from service.jobs.runtime import SweepJobs
+from service.jobs.runtime import JobQueue
 from service.main import create_app
 from service.warmup import KernelWarmUp
 from tests.conftest import Server, free_port, started
@@ -96,14 +96,14 @@ def test_the_ready_line_does_not_wait_for_the_kernels(tmp_path: Path) -> None:
     in the background (``service.warmup``); ``kernels`` turns true once both happened."""
     app = create_app(Settings(data_dir=tmp_path, workers=1))
     with started(app) as c:
-        assert app.state.sweep_jobs.dispatcher is not None
+        assert app.state.jobs.dispatcher is not None
         assert c.get("/v1/ready").json()["checks"] == {"job_store": True, "kernels": True}
 
 
 def test_no_dispatcher_starts_once_the_service_stops(tmp_path: Path) -> None:
     """A service stopped while its kernels warm up never starts its pool workers."""
     settings = Settings(data_dir=tmp_path, workers=1)
-    jobs = SweepJobs.open(settings)
+    jobs = JobQueue.open(settings)
     warming = KernelWarmUp(jobs, settings)
     warming.stop()
     warming.start()

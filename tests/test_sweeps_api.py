@@ -108,13 +108,24 @@ def test_invalid_sweeps_are_422_naming_the_field(
 
 
 def test_sweep_over_the_compute_budget_is_refused_before_it_is_stored(tmp_path: Path) -> None:
-    app = create_app(Settings(data_dir=tmp_path, workers=0, max_sweep_steps=1_000_000))
+    app = create_app(Settings(data_dir=tmp_path, workers=0, max_job_steps=1_000_000))
     with TestClient(app) as c:
         r = c.post("/v1/sweeps", json=body(num=200))  # 200 points x 100 periods x 64 steps
         assert r.status_code == 422
-        assert "max_sweep_steps" in r.json()["detail"] and "1280000" in r.json()["detail"]
+        assert "max_job_steps" in r.json()["detail"] and "1280000" in r.json()["detail"]
         assert c.get("/v1/sweeps").json()["total"] == 0
         assert c.post("/v1/sweeps", json=body(num=100)).status_code == 202
+
+
+@pytest.mark.parametrize("variable", ["GEARCHAOS_MAX_JOB_POINTS", "GEARCHAOS_MAX_SWEEP_POINTS"])
+def test_the_job_point_cap_is_read_from_its_variable_or_its_old_alias(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, variable: str
+) -> None:
+    monkeypatch.setenv(variable, "150")
+    with TestClient(create_app(Settings(data_dir=tmp_path, workers=0))) as c:
+        r = c.post("/v1/sweeps", json=body(num=200))
+        assert r.status_code == 422 and "150" in r.json()["detail"], r.json()
+        assert c.post("/v1/sweeps", json=body(num=150)).status_code == 202
 
 
 def test_queue_cap_answers_429_with_retry_after(tmp_path: Path) -> None:
@@ -211,7 +222,7 @@ def test_a_cancelled_jobs_finished_chunks_are_a_partial_result(tmp_path: Path) -
     app = create_app(Settings(data_dir=tmp_path, workers=0, sweep_chunk_points=4))
     with TestClient(app) as c:
         job = c.post("/v1/sweeps", json=body(num=301)).json()
-        store = app.state.sweep_jobs.store
+        store = app.state.jobs.store
         url = f"/v1/sweeps/{job['id']}"
         assert c.get(url + "/result", params={"partial": True}).json()["points"] == []
         # a worker leases chunks 0..51 and finishes only chunk 51; then the job is cancelled
@@ -277,5 +288,5 @@ def test_a_sweep_is_chunked_for_its_workers_unless_the_size_is_set(
     app = create_app(Settings(data_dir=tmp_path, workers=0, sweep_chunk_points=setting))
     with TestClient(app) as c:
         assert c.post("/v1/sweeps", json=body(num=4000)).status_code == 202
-        claims = app.state.sweep_jobs.store.claim("test-worker", 60.0, 3, 10_000)
+        claims = app.state.jobs.store.claim("test-worker", 60.0, 3, 10_000)
     assert {cl.chunk_points for cl in claims} == {stored} and len(claims) == 4000 // stored

@@ -54,6 +54,7 @@ KINDS: dict[str, str] = {
     "remedies": "gearengine.gate.remedies.compute:REMEDIES_JOB",
     "runup": "gearengine.studies.runup.compute:RUNUP_JOB",
     "robustness": "gearengine.studies.robustness.study:ROBUSTNESS_JOB",
+    "basins": "gearengine.studies.basins:BASINS_JOB",
 }
 """Kind name -> ``module:attribute`` of its ``JobKind``."""
 

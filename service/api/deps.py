@@ -20,7 +20,7 @@ from gearengine.model.errors import InputError
 from service.cache import ResponseCache, etag_for
 from service.core.config import Settings
 from service.errors import FieldError, ProblemError
-from service.jobs.runtime import SweepJobs
+from service.jobs.runtime import JobQueue
 from service.limits import Limits
 from service.metrics import Metrics
 
@@ -98,9 +98,9 @@ def app_settings(request: Request) -> Settings:
     return request.app.state.settings
 
 
-def sweep_jobs(request: Request) -> SweepJobs:
+def job_queue(request: Request) -> JobQueue:
     """The app's job store and dispatcher."""
-    return request.app.state.sweep_jobs
+    return request.app.state.jobs
 
 
 def app_limits(request: Request) -> Limits:
@@ -124,7 +124,7 @@ def ready_checks(request: Request) -> dict[str, Callable[[], bool]]:
 
 
 AppSettings = Annotated[Settings, Depends(app_settings)]
-Jobs = Annotated[SweepJobs, Depends(sweep_jobs)]
+Jobs = Annotated[JobQueue, Depends(job_queue)]
 AppLimits = Annotated[Limits, Depends(app_limits)]
 AppMetrics = Annotated[Metrics, Depends(app_metrics)]
 ReadyChecks = Annotated[dict[str, Callable[[], bool]], Depends(ready_checks)]

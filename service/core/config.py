@@ -10,14 +10,22 @@ import os
 from functools import cached_property
 from pathlib import Path
 
-from pydantic import Field
+from pydantic import AliasChoices, Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
+
+
+def _job_alias(what: str) -> AliasChoices:
+    """The environment variables of the ``max_job_<what>`` setting: its own and its name from
+    before jobs had kinds (still read, an alias). Keywords and flags use the field name."""
+    return AliasChoices(f"GEARCHAOS_MAX_JOB_{what.upper()}", f"GEARCHAOS_MAX_SWEEP_{what.upper()}")
 
 
 class Settings(BaseSettings):
     """Service settings; field names are the environment variables without ``GEARCHAOS_``."""
 
-    model_config = SettingsConfigDict(env_prefix="GEARCHAOS_", extra="ignore", frozen=True)
+    model_config = SettingsConfigDict(
+        env_prefix="GEARCHAOS_", extra="ignore", frozen=True, populate_by_name=True
+    )
 
     host: str = Field("127.0.0.1", description="Address the API binds to.")
     port: int = Field(8000, ge=0, le=65535, description="TCP port of the API.")
@@ -38,6 +46,15 @@ class Settings(BaseSettings):
     )
     insecure: bool = Field(False, description="Allow a non-loopback bind without API keys.")
     dask_scheduler: str | None = Field(None, description="Dask scheduler address for sweeps.")
+    database_url: str | None = Field(
+        None,
+        description="PostgreSQL job store shared by every replica "
+        "(``postgresql://user:password@host:5432/gearchaos``); unset, the job store is the SQLite "
+        "file jobs.sqlite3 in data_dir, for one machine (docs/scale-out.md).",
+    )
+    database_pool_size: int = Field(
+        8, ge=2, le=100, description="Most PostgreSQL connections of one process (a pool)."
+    )
 
     keep_alive_seconds: float = Field(
         30.0,
@@ -59,14 +76,20 @@ class Settings(BaseSettings):
     max_curve_points: int = Field(2000, ge=2, description="Most frequencies in a threshold curve.")
     cache_entries: int = Field(512, ge=0, description="Responses kept in the in-memory LRU.")
 
-    max_sweep_points: int = Field(
-        40_000, ge=1, description="Most points of one sweep (every axis and branch counted)."
+    max_job_points: int = Field(
+        40_000,
+        ge=1,
+        validation_alias=_job_alias("points"),
+        description="Most points of one job (every axis and branch counted). Environment: "
+        "GEARCHAOS_MAX_JOB_POINTS, or its old name GEARCHAOS_MAX_SWEEP_POINTS (an alias).",
     )
-    max_sweep_steps: int = Field(
+    max_job_steps: int = Field(
         20_000_000_000,
         ge=1000,
-        description="Compute budget of one sweep in RK4 steps (points x periods x steps x "
-        "starts); the default is about a minute on two cores.",
+        validation_alias=_job_alias("steps"),
+        description="Compute budget of one job in RK4 steps (points x periods x steps x "
+        "starts); the default is about a minute on two cores. Environment: "
+        "GEARCHAOS_MAX_JOB_STEPS, or its old name GEARCHAOS_MAX_SWEEP_STEPS (an alias).",
     )
     max_queued_jobs: int = Field(
         64, ge=1, description="Most unfinished (queued or running) sweep jobs; then 429."

@@ -1,2 +1,2 @@
-"""The durable job queue of every kind of ``gearengine.studies.jobs.KINDS``: SQLite store,
-dispatcher (process pool or Dask), worker command."""
+"""The durable job queue of every kind of ``gearengine.studies.jobs.KINDS``: the store (SQLite,
+or PostgreSQL shared by replicas), dispatcher (process pool or Dask), worker command."""

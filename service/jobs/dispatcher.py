@@ -100,7 +100,7 @@ class Dispatcher:
 
     def start(self) -> None:
         """Run the loop in a daemon thread."""
-        self._thread = threading.Thread(target=self.run, name="sweep-dispatcher", daemon=True)
+        self._thread = threading.Thread(target=self.run, name="job-dispatcher", daemon=True)
         self._thread.start()
 
     def request_stop(self, grace: float = 5.0) -> None:
@@ -190,6 +190,8 @@ class Dispatcher:
             return
         if self.store.commit(self.owner, c.job_id, c.index, result):
             log.info("job %s chunk %d committed", c.job_id, c.index)
+        else:  # fenced: another dispatcher holds (or committed) the chunk, or it was cancelled
+            log.info("job %s chunk %d not committed: lease lost", c.job_id, c.index)
 
     def _lost(self, c: Claim, exc: Exception) -> None:
         """An attempt failed for a reason outside the computation: retry (bounded)."""

@@ -4,7 +4,6 @@ dispatcher."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 from service.core.config import Settings
 from service.jobs.backends import make_backend
@@ -13,17 +12,18 @@ from service.jobs.store import JobStore
 
 
 @dataclass
-class SweepJobs:
-    """The store of the data directory and this process's dispatcher (None: store only)."""
+class JobQueue:
+    """The job store (PostgreSQL at ``database_url``, else the data directory's SQLite file)
+    and this process's dispatcher (None: store only)."""
 
     store: JobStore
     dispatcher: Dispatcher | None
 
     @classmethod
-    def open(cls, settings: Settings) -> SweepJobs:
-        """Open the store of the data directory; no dispatcher until ``start_dispatcher``
+    def open(cls, settings: Settings) -> JobQueue:
+        """Open the configured store; no dispatcher until ``start_dispatcher``
         (``service.warmup`` starts it once the kernels are compiled)."""
-        return cls(JobStore.in_dir(Path(settings.data_dir)), None)
+        return cls(JobStore.configured(settings), None)
 
     def start_dispatcher(self, settings: Settings) -> None:
         """Start a dispatcher on Dask (``dask_scheduler``) or on a pool of ``workers``
@@ -45,7 +45,7 @@ class SweepJobs:
         return self.store.ping()
 
     def close(self, grace: float = 5.0) -> None:
-        """Stop the dispatcher gracefully and close this thread's connection."""
+        """Stop the dispatcher gracefully and close the store's connections."""
         if self.dispatcher is not None:
             self.dispatcher.stop(grace)
-        self.store.close()
+        self.store.shutdown()

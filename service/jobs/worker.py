@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import logging
 import signal
-from pathlib import Path
 from types import FrameType
 
 from service.core.config import Settings
@@ -14,11 +13,12 @@ from service.jobs.store import JobStore
 
 
 def run_worker(settings: Settings) -> int:
-    """Run a dispatcher on the data directory's store until SIGTERM or SIGINT (graceful)."""
+    """Run a dispatcher on the configured store (``database_url``, else the data directory's)
+    until SIGTERM or SIGINT (graceful)."""
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(message)s")
     backend = make_backend(max(1, settings.workers), settings.dask_scheduler)
     assert backend is not None
-    store = JobStore.in_dir(Path(settings.data_dir))
+    store = JobStore.configured(settings)
     dispatcher = Dispatcher(store, backend, settings.lease_seconds, settings.max_retries)
 
     def on_signal(signum: int, _: FrameType | None) -> None:
@@ -28,4 +28,5 @@ def run_worker(settings: Settings) -> int:
     signal.signal(signal.SIGTERM, on_signal)
     signal.signal(signal.SIGINT, on_signal)
     dispatcher.run()
+    store.shutdown()
     return 0

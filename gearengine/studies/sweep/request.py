@@ -39,7 +39,7 @@ from gearengine.studies.sweep.axes import (
 )
 
 MAX_AXIS_POINTS = 100_000
-"""Upper cap of ``num`` of one axis (the service caps the product lower, max_sweep_points)."""
+"""Upper cap of ``num`` of one axis (the service caps the product lower, max_job_points)."""
 
 
 def _axis_value(value: object) -> float | str:
@@ -204,7 +204,7 @@ def request_errors(request: SweepRequest, max_points: int | None = None) -> list
         add(
             ("axes",),
             f"{request.n_points()} points, over the limit of {max_points} per sweep "
-            "(max_sweep_points)",
+            "(max_job_points)",
             [a.num for a in request.axes],
         )
     if errors:

@@ -33,7 +33,9 @@ async def health(request: Request) -> Health:
     summary="Readiness: kernels warmed and job store reachable",
     responses={503: {"description": "Not ready yet."}},
 )
-async def ready(request: Request, ready_checks: ReadyChecks) -> Health:
+def ready(request: Request, ready_checks: ReadyChecks) -> Health:
+    # a plain def: FastAPI runs it in its thread pool, so a store that is slow to answer (a
+    # PostgreSQL outage) holds up this probe, never the event loop of every other request
     checks = {name: bool(check()) for name, check in ready_checks.items()}
     if not all(checks.values()):
         failing = ", ".join(k for k, v in checks.items() if not v)

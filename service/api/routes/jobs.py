@@ -27,7 +27,7 @@ from service.api.responses import JSON, PNG, PROBLEMS, RETRY_AFTER_HEADER, SVG, 
 from service.core.config import Settings
 from service.errors import ProblemError
 from service.jobs.models import UNFINISHED, Job, JobPage, JobStatus
-from service.jobs.runtime import SweepJobs
+from service.jobs.runtime import JobQueue
 from service.jobs.store import QueueFullError
 
 RETRY_AFTER = {"queued": "5", "running": "2"}
@@ -95,7 +95,7 @@ class JobRoutes:
         submit_summary, submit_doc: the POST route's summary and description.
         result_model, result_summary, result_doc: the result route's model and texts.
         check: ``(body, request, settings)``: refusals beyond the model (422 problems), before
-            the work budget (the kind's ``work`` against max_sweep_steps) is checked.
+            the work budget (the kind's ``work`` against max_job_steps) is checked.
         chunk_size: ``(request, settings) -> units of work per chunk`` (default: the kind's).
         budget_path: the field a refusal over the work budget names.
     """
@@ -113,14 +113,14 @@ class JobRoutes:
     chunk_size: Callable[[Any, Settings], int] | None = None
     budget_path: str = "axes"
 
-    def job_or_404(self, jobs: SweepJobs, job_id: str, owner: str | None) -> Job:
+    def job_or_404(self, jobs: JobQueue, job_id: str, owner: str | None) -> Job:
         """The caller's job of this kind, else 404."""
         job = jobs.store.get(job_id, owner, self.kind)
         if job is None:
             raise ProblemError(404, "not-found", "Not found", f"no {self.noun} job {job_id}")
         return job
 
-    def succeeded(self, jobs: SweepJobs, job_id: str, owner: str | None) -> Job:
+    def succeeded(self, jobs: JobQueue, job_id: str, owner: str | None) -> Job:
         """The caller's succeeded job, else 404 or 409 (with Retry-After while unfinished)."""
         job = self.job_or_404(jobs, job_id, owner)
         if job.status != "succeeded":
@@ -136,7 +136,7 @@ class JobRoutes:
 
     def submit(
         self, body: BaseModel, request: Request, response: Response, owner: str | None,
-        settings: Settings, jobs: SweepJobs,
+        settings: Settings, jobs: JobQueue,
     ) -> Job:  # fmt: skip
         """Check, plan and store a job; 429 when the queue is full."""
         self.check(body, request, settings)
@@ -274,7 +274,7 @@ class JobRoutes:
         router: APIRouter,
         summary: str,
         description: str,
-        draw: Callable[[SweepJobs, str, Literal["png", "svg"]], bytes],
+        draw: Callable[[JobQueue, str, Literal["png", "svg"]], bytes],
     ) -> None:
         """Add ``GET /{job_id}/plot`` to ``router``: the figure ``draw(jobs, job_id, fmt)`` of a
         succeeded job of the kind (409 before), PNG or SVG by ``?format`` or ``Accept``."""
@@ -322,7 +322,13 @@ class JobRoutes:
 
             def assemble() -> bytes:
                 request = kind.request.model_validate_json(jobs.store.request_json(job_id))
-                document = kind.assemble(request, list(jobs.store.chunk_results(job_id)))
+                try:
+                    document = kind.assemble(request, list(jobs.store.chunk_results(job_id)))
+                except ValueError as exc:  # a kind with no partial result before its chunks
+                    raise ProblemError(
+                        409, "no-result", "No result", f"{routes.noun} {job_id}: {exc}",
+                        headers=poll_headers(job),
+                    ) from None  # fmt: skip
                 return document.model_dump_json().encode()
 
             body = await run_in_threadpool(assemble)

@@ -11,7 +11,7 @@ from service.core.config import Settings
 
 
 def _check(body: RobustnessRequest, request: Request, settings: Settings) -> None:
-    checked(body, settings.max_sweep_points)
+    checked(body, settings.max_job_points)
 
 
 ROBUSTNESS = JobRoutes(

@@ -20,7 +20,7 @@ from gearengine.studies.runup.request import RunupRequest
 from gearengine.studies.runup.results import RunupResult
 from service.api.routes.jobs import JobRoutes
 from service.core.config import Settings
-from service.jobs.runtime import SweepJobs
+from service.jobs.runtime import JobQueue
 
 
 def _check(body: RunupRequest, request: Request, settings: Settings) -> None:
@@ -44,7 +44,7 @@ RUNUPS = JobRoutes(
 router = RUNUPS.router()
 
 
-def _draw(jobs: SweepJobs, job_id: str, fmt: Literal["png", "svg"]) -> bytes:
+def _draw(jobs: JobQueue, job_id: str, fmt: Literal["png", "svg"]) -> bytes:
     kind = job_kinds.kind("runup")
     body = kind.request.model_validate_json(jobs.store.request_json(job_id))
     result = kind.assemble(body, list(jobs.store.chunk_results(job_id)))

@@ -38,11 +38,11 @@ from service.api.routes.jobs import (
     poll_headers,
 )
 from service.core.config import Settings
-from service.jobs.runtime import SweepJobs
+from service.jobs.runtime import JobQueue
 
 
 def _check(body: SweepRequest, request: Request, settings: Settings) -> None:
-    checked(body, settings.max_sweep_points)
+    checked(body, settings.max_job_points)
 
 
 def _chunk_points(body: SweepRequest, settings: Settings) -> int:
@@ -72,7 +72,7 @@ router = SWEEPS.router(result=False)
 CSV = "text/csv"
 
 
-def _windows(jobs: SweepJobs, job_id: str, sweep: SweepRequest) -> list[SpeedWindows] | None:
+def _windows(jobs: JobQueue, job_id: str, sweep: SweepRequest) -> list[SpeedWindows] | None:
     """The speed windows of a sweep over the driver speed; None, without reading a point,
     for other sweeps (a map's result streams chunk by chunk)."""
     if SPEED not in [a.parameter for a in sweep.axes]:
@@ -80,7 +80,7 @@ def _windows(jobs: SweepJobs, job_id: str, sweep: SweepRequest) -> list[SpeedWin
     return speed_windows(sweep, list(_points(jobs, job_id)))
 
 
-def _stored_points(jobs: SweepJobs, job_id: str) -> Iterator[dict[str, object]]:
+def _stored_points(jobs: JobQueue, job_id: str) -> Iterator[dict[str, object]]:
     """The stored points as their JSON objects (the workers wrote them from valid points; no
     model is built: ``csv_rows`` reads the fields by name), one chunk in memory at a time: the
     CSV of a million-point map streams at the speed of its writer."""
@@ -88,7 +88,7 @@ def _stored_points(jobs: SweepJobs, job_id: str) -> Iterator[dict[str, object]]:
         yield from points_of_chunk(array)
 
 
-def _points(jobs: SweepJobs, job_id: str) -> Iterator[SweepPoint]:
+def _points(jobs: JobQueue, job_id: str) -> Iterator[SweepPoint]:
     for array in jobs.store.chunk_results(job_id):
         for item in points_of_chunk(array):
             yield SweepPoint.model_validate(item)
@@ -156,7 +156,7 @@ def get_result(
     )
 
 
-def _draw(jobs: SweepJobs, job_id: str, fmt: Literal["png", "svg"]) -> bytes:
+def _draw(jobs: JobQueue, job_id: str, fmt: Literal["png", "svg"]) -> bytes:
     sweep = SweepRequest.model_validate_json(jobs.store.request_json(job_id))
     located = chunk_bifurcations(jobs.store.chunk_results(job_id))
     return plots.sweep_figure(sweep, list(_points(jobs, job_id)), fmt, located)

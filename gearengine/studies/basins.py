@@ -1,0 +1,61 @@
+"""Basins as a durable job (kind ``basins``): one design's coexisting attractors and the basin
+fractions of its starts, the answer of ``gearengine basins FILE --json``, for requests too big
+for the synchronous budget of ``POST /v1/analyses``.
+
+The request is an analysis request; without ``settings.basins`` the default basin settings
+(16 starts) are used, as ``POST /v1/analyses/basins/plot`` does. The whole analysis is one
+chunk (progress counts its starts): the attractors are found by clustering the orbits of all
+starts together (``numerics.attractors``), so the chunk is the analysis ``analyze`` computes,
+and its result is the CLI's document byte for byte.
+"""
+
+from __future__ import annotations
+
+from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
+from gearengine.jsonio import dumps
+from gearengine.numerics.settings import BasinSettings, work
+from gearengine.studies.jobs import JobKind
+
+
+def with_basins(request: AnalysisRequest) -> AnalysisRequest:
+    """``request`` with its basin settings, the defaults when it has none."""
+    if request.settings.basins is not None:
+        return request
+    settings = request.settings.model_copy(update={"basins": BasinSettings()})
+    return request.model_copy(update={"settings": settings})
+
+
+def basin_starts(request: AnalysisRequest, chunk_points: int) -> list[int]:
+    """One chunk, counting the request's basin starts."""
+    basins = with_basins(request).settings.basins
+    assert basins is not None
+    return [basins.starts]
+
+
+def basins_work(request: AnalysisRequest) -> int:
+    """RK4 steps of the analysis with its basin starts (``numerics.settings.work``)."""
+    full = with_basins(request)
+    return work(full.params, full.settings)
+
+
+def basins_chunk(request: AnalysisRequest, index: int, chunk_points: int) -> str:
+    """The analysis with basins as JSON text (``gearengine basins --json``'s document)."""
+    return dumps(analyze(with_basins(request)))
+
+
+def basins_result(request: AnalysisRequest, chunks: list[str]) -> AnalysisResult:
+    """The job's result: its one chunk's analysis (ValueError while it has none)."""
+    if not chunks:
+        raise ValueError("the basins job has no finished chunk yet")
+    return AnalysisResult.model_validate_json(chunks[0])
+
+
+BASINS_JOB = JobKind(
+    name="basins",
+    request=AnalysisRequest,
+    chunk_points=1,
+    chunk_counts=basin_starts,
+    work=basins_work,
+    compute_chunk=basins_chunk,
+    assemble=basins_result,
+)
