@@ -123,6 +123,7 @@ QUANTITIES: dict[str, QuantityKind] = {
         "1000 rpm/s",
     ),
     "duration": QuantityKind("duration", "s", 1e-3, 3600.0, ("ms", "min"), "5 s"),
+    "sample_rate": QuantityKind("sample rate", "Hz", 1e-3, 1e8, ("kHz", "MHz"), "20 kHz"),
 }
 """Kinds of quantity by key; ``low``/``high`` bound plausible magnitudes in SI units."""
 
@@ -272,6 +273,7 @@ Damping = quantity_type("damping", allow_zero=True)
 Angle = quantity_type("angle")
 Duration = quantity_type("duration")
 Time = quantity_type("duration", allow_zero=True)
+SampleRate = quantity_type("sample_rate")
 
 RPM = 2.0 * math.pi / 60.0
 """One revolution per minute in rad/s."""
