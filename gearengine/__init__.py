@@ -40,6 +40,8 @@ if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDE
     )
     from gearengine.runup import RunupRequest, RunupResult
     from gearengine.runup import run_local as run_runup
+    from gearengine.signals import SignalRequest, SignalResult
+    from gearengine.signals.reading import signal
     from gearengine.sweeps import SweepRequest, SweepResult
     from gearengine.sweeps import run_local as run_sweep
 
@@ -54,6 +56,8 @@ __all__ = [
     "RemediesResult",
     "RunupRequest",
     "RunupResult",
+    "SignalRequest",
+    "SignalResult",
     "SimulationSettings",
     "SweepRequest",
     "SweepResult",
@@ -66,6 +70,7 @@ __all__ = [
     "remedies",
     "run_runup",
     "run_sweep",
+    "signal",
     "simulate",
     "simulate_batch",
     "threshold_curve",
@@ -83,6 +88,8 @@ _HOMES: dict[str, tuple[str, str]] = {
     "RemediesResult": ("gearengine.ensembles.remedies", "RemediesResult"),
     "RunupRequest": ("gearengine.runup", "RunupRequest"),
     "RunupResult": ("gearengine.runup", "RunupResult"),
+    "SignalRequest": ("gearengine.signals", "SignalRequest"),
+    "SignalResult": ("gearengine.signals", "SignalResult"),
     "SimulationSettings": ("gearengine.numerics", "SimulationSettings"),
     "SweepRequest": ("gearengine.sweeps", "SweepRequest"),
     "SweepResult": ("gearengine.sweeps", "SweepResult"),
@@ -95,6 +102,7 @@ _HOMES: dict[str, tuple[str, str]] = {
     "remedies": ("gearengine.ensembles.remedies", "remedies"),
     "run_runup": ("gearengine.runup", "run_local"),
     "run_sweep": ("gearengine.sweeps", "run_local"),
+    "signal": ("gearengine.signals.reading", "signal"),
     "simulate": ("gearengine.numerics", "simulate"),
     "simulate_batch": ("gearengine.numerics", "simulate_batch"),
     "threshold_curve": ("gearengine.homoclinic", "threshold_curve"),
@@ -119,6 +127,7 @@ _SUBMODULES = frozenset(
         "numerics",
         "plots",
         "runup",
+        "signals",
         "sweeps",
     }
 )

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     from gearengine.plots.analysis import analysis_figure, threshold_figure
     from gearengine.plots.basins import basins_figure
     from gearengine.plots.runup import runup_figure
+    from gearengine.plots.signal import signal_figure
     from gearengine.plots.style import MEDIA_TYPES, ImageFormat
     from gearengine.plots.sweep import sweep_figure
 
@@ -29,6 +30,7 @@ __all__ = [
     "analysis_figure",
     "basins_figure",
     "runup_figure",
+    "signal_figure",
     "sweep_figure",
     "threshold_figure",
 ]
@@ -39,6 +41,7 @@ _HOMES = {
     "analysis_figure": ("gearengine.plots.analysis", "analysis_figure"),
     "basins_figure": ("gearengine.plots.basins", "basins_figure"),
     "runup_figure": ("gearengine.plots.runup", "runup_figure"),
+    "signal_figure": ("gearengine.plots.signal", "signal_figure"),
     "sweep_figure": ("gearengine.plots.sweep", "sweep_figure"),
     "threshold_figure": ("gearengine.plots.analysis", "threshold_figure"),
 }

@@ -28,12 +28,14 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from gearengine.signals import orders
-from gearengine.signals.embedding import delay_by_mutual_information, embed
+from gearengine.signals.embedding import delay_by_mutual_information, delay_vectors, embed
 from gearengine.signals.rosenstein import MAX_POINTS, largest_exponent
 from gearengine.signals.schema import (
     EmbeddingReport,
@@ -63,6 +65,7 @@ PATH_POINTS = 2000
 STROBES_SHOWN = 512
 CORR_DIM_POINTS = 2000
 LINES_SHOWN = 8
+ATTRACTOR_POINTS = 2000
 
 
 @dataclass(frozen=True)
@@ -234,6 +237,7 @@ def read(request: SignalRequest) -> SignalResult:
         delay_samples=emb.delay, delay_s=emb.delay * dz, dimension=emb.dimension,
         delay_rule=emb.delay_rule, decimation=q, sample_interval_s=dz,
         mutual_information=emb.mutual_information, false_neighbours=emb.false_neighbours,
+        attractor=delay_vectors(z, 3, emb.delay)[-ATTRACTOR_POINTS:].tolist(),
     )  # fmt: skip
     if ang.per_cycle is not None:
         series = orders.strobes(ang.y, ang.per_cycle)
@@ -266,14 +270,46 @@ def read(request: SignalRequest) -> SignalResult:
     cycle = None if ang.per_cycle is None else max(1, round(ang.per_cycle / q))
     lyapunov = _lyapunov(z, dz, emb.dimension, emb.delay, cycle, ref, notes)
     verdict, evidence = decide(ang, periodicity, zero_one, surrogates, lyapunov)
+    model = None
+    if request.design is not None:
+        from gearengine.signals.rig import model_beside  # the simulation room, only then
+
+        model = model_beside(request, verdict)
     return SignalResult(
         verdict=verdict, summary=summary(verdict, evidence), evidence=evidence, record=record,
         reference=ref, spectrum=ang.spectrum, periodicity=periodicity,
         strobes=[] if ang.per_cycle is None else series[-STROBES_SHOWN:].tolist(),
         embedding=embedding, zero_one=zero_one, lyapunov=lyapunov,
         correlation_dimension=_corr_dim(z, emb.dimension, emb.delay),
-        surrogates=surrogates, notes=notes,
+        surrogates=surrogates, model=model, notes=notes,
     )  # fmt: skip
+
+
+def signal(
+    values: Sequence[float] | np.ndarray,
+    sample_rate: float | str,
+    *,
+    speed: float | str | None = None,
+    teeth: int | None = None,
+    tach: dict[str, Any] | None = None,
+    quantity: str = "other",
+    unit: str = "1",
+    design: dict[str, Any] | None = None,
+    seed: int = 0,
+) -> SignalResult:
+    """Read a recorded series: ``gearengine.signal(x, "20 kHz", speed="1500 rpm", teeth=18)``.
+
+    Arguments as the fields of ``SignalRequest`` (quantities as strings with units or SI
+    numbers); raises pydantic's ValidationError naming the field for bad input."""
+    body: dict[str, Any] = {
+        "signal": {"values": np.asarray(values, dtype=float).tolist(),
+                   "sample_rate": sample_rate, "quantity": quantity, "unit": unit},
+        "seed": seed,
+    }  # fmt: skip
+    for key, value in (("speed", speed), ("teeth", teeth), ("tach", tach), ("design", design)):
+        if value is not None:
+            body[key] = value
+    return read(SignalRequest.model_validate(body))
 
 
 def _lyapunov(

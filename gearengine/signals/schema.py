@@ -85,6 +85,10 @@ class EmbeddingReport(_Result):
     sample_interval_s: float = Field(description="Spacing of the analysed series.")
     mutual_information: list[float] = Field(description="I(T), nats, T = 0, 1, ... samples.")
     false_neighbours: list[float] = Field(description="False fraction, d = 1, 2, ...")
+    attractor: list[list[float]] = Field(
+        description="The last <= 2000 delay vectors (x_i, x_i+tau, x_i+2 tau), unit of the "
+        "values: the reconstructed attractor."
+    )
 
 
 class ZeroOneReport(_Result):
@@ -142,7 +146,10 @@ class ModelReport(_Result):
     lle_per_second: float | None
     agrees: bool | None = Field(description="Same verdict family (periodic / chaotic) as the "
                                 "signal's; null when the signal's is undetermined.")  # fmt: skip
-    lines: list[SpectrumLine] = Field(description="The model's spectrum lines, in orders.")
+    lines: list[SpectrumLine] = Field(
+        description="The model's spectrum lines in orders, amplitudes in µm of relative "
+        "displacement (ratio_db 0: the model has no noise floor)."
+    )
     summary: str
 
 

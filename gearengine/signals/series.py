@@ -17,6 +17,7 @@ below twice the mesh frequency, a tach that is not increasing or covers fewer th
 from __future__ import annotations
 
 import math
+import re
 from functools import cached_property
 from typing import Annotated, Literal
 
@@ -197,3 +198,36 @@ class SignalRequest(StrictModel):
         if self.design is not None:
             return self.design.speed / (2.0 * math.pi)
         return None
+
+
+_SPLIT = re.compile(r"[,;\s]+")
+
+
+def read_table(text: str) -> tuple[np.ndarray, float | None]:
+    """(values, sample rate [Hz] from a time column, or None) of a text or CSV table: one value
+    per line, or columns split by commas, semicolons or blanks (the last column is read; with
+    two or more, a first column that increases is the time in seconds). Lines before the
+    numbers that are not numbers (a header) are skipped; raises InputError("signal.values")."""
+    rows = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        fields = [f for f in _SPLIT.split(line.strip()) if f]
+        if not fields:
+            continue
+        try:
+            rows.append([float(f) for f in fields])
+        except ValueError:
+            if rows:  # a header comes first; text after the numbers is an error
+                raise InputError("signal.values", f"line {number}: not a number: "
+                                 f"{line.strip()[:60]!r}") from None  # fmt: skip
+    if not rows:
+        raise InputError("signal.values", "no numbers found")
+    width = len(rows[0])
+    if any(len(r) != width for r in rows):
+        raise InputError("signal.values", "rows have different numbers of columns")
+    table = np.asarray(rows, dtype=float)
+    rate = None
+    if width >= 2:
+        step = np.diff(table[:, 0])
+        if step.size and np.all(step > 0.0):
+            rate = 1.0 / float(np.median(step))
+    return table[:, -1], rate

@@ -1,0 +1,64 @@
+"""Model against rig: the design's simulated verdict at the signal's speed, beside the signal's.
+
+The design (``SignalRequest.design``) is analysed (``gearengine.analysis.analyze``, default
+settings) at the signal's shaft speed (its speed, the tach's mean, else the design's own) and
+the design's torque. Its spectrum lines (angular frequencies in tau units, ``omega``) are put
+in shaft orders through the design's time scale, f = omega / (2 pi t_s), order = f / f_shaft,
+so that they overlay the signal's order spectrum, amplitudes in µm of relative displacement
+(x times the half backlash); its LLE per tau becomes per second as
+lambda / t_s. "Agrees" compares the families: periodic with periodic, chaotic with chaotic,
+quasi-periodic with quasi-periodic (null when the signal's verdict is undetermined or
+stochastic, which the deterministic model cannot give).
+"""
+
+from __future__ import annotations
+
+import math
+
+from gearengine.analysis import AnalysisRequest, analyze
+from gearengine.model.design import Design
+from gearengine.signals.schema import ModelReport, SpectrumLine
+from gearengine.signals.series import SignalRequest
+
+COMPARABLE = frozenset({"periodic", "quasi_periodic", "chaotic"})
+
+
+def at_speed(design: Design, speed: float) -> Design:
+    """The design at driver speed ``speed`` [rad/s] (validated again: derived data follow)."""
+    data = design.model_dump(exclude_none=True)
+    data["speed"] = speed
+    return Design.model_validate(data)
+
+
+def model_beside(request: SignalRequest, verdict: str) -> ModelReport:
+    """The model's verdict for ``request.design`` at the signal's speed."""
+    assert request.design is not None and request.shaft_hz is not None
+    shaft = request.shaft_hz
+    design = at_speed(request.design, 2.0 * math.pi * shaft)
+    result = analyze(AnalysisRequest.model_validate({"design": design}))
+    eng = result.engineering
+    assert eng is not None
+    num = result.numerics
+    t_s = eng.time_scale_s
+    teeth = design.driver.teeth
+    lines = []
+    for peak in num.spectrum_peaks:
+        hz = peak.frequency / (2.0 * math.pi * t_s)
+        order = hz / shaft
+        k = order / teeth
+        label = f"mesh harmonic {round(k)}" if abs(k - round(k)) < 0.01 else f"order {order:.4g}"
+        amplitude = peak.amplitude * eng.half_backlash_um
+        lines.append(SpectrumLine(frequency_hz=hz, order=order, amplitude=amplitude,
+                                  ratio_db=0.0, label=label))  # fmt: skip
+    model = num.classification
+    agrees = (model == verdict) if verdict in COMPARABLE else None
+    lle = None if num.lle is None else num.lle / t_s
+    said = {True: "agrees with the signal", False: f"disagrees with the signal ({verdict})",
+            None: f"cannot be compared with a {verdict} signal"}[agrees]  # fmt: skip
+    period = f" (period {num.period} forcing periods)" if num.period else ""
+    return ModelReport(
+        speed_rpm=shaft * 60.0, torque_nm=design.torque, classification=model,
+        period=num.period, lle_per_second=lle, agrees=agrees, lines=lines,
+        summary=f"The model at {shaft * 60.0:.6g} rpm and {design.torque:.6g} N m is "
+        f"{model.replace('_', '-')}{period}: it {said}.",
+    )  # fmt: skip
