@@ -44,7 +44,7 @@ ACF_POINTS = 4096
 MAX_DIMENSION = 10
 R_TOL = 15.0
 A_TOL = 2.0
-FNN_FRACTION = 0.05
+FNN_FRACTION = 0.01
 
 
 @dataclass(frozen=True)
@@ -112,7 +112,8 @@ def delay_vectors(x: np.ndarray, dimension: int, delay: int) -> np.ndarray:
 
 
 def false_neighbour_fractions(x: np.ndarray, delay: int, max_dimension: int) -> list[float]:
-    """Kennel's false fraction for d = 1..max_dimension (criteria 1 and 2 above)."""
+    """Kennel's false fraction for d = 1..max_dimension (criteria 1 and 2 above), up to the
+    first d below ``FNN_FRACTION``."""
     x = np.ascontiguousarray(x, dtype=float)
     r_a = float(np.std(x))
     out = []
@@ -134,6 +135,8 @@ def false_neighbour_fractions(x: np.ndarray, delay: int, max_dimension: int) -> 
         r_next = np.sqrt(r_d**2 + extra**2)
         false = (extra / r_d > R_TOL) | (r_next / r_a > A_TOL)
         out.append(float(np.mean(false)) if false.size else 1.0)
+        if out[-1] < FNN_FRACTION:  # embedded: higher dimensions are not needed
+            break
     return out
 
 

@@ -46,6 +46,8 @@ LINE_RATIO = 10.0
 """A line stands 10 x (20 dB) above its local floor."""
 FLOOR_BINS = 32
 MAX_LINES = 12
+CANDIDATES = 20 * MAX_LINES
+"""Local maxima whose floor is measured (the strongest)."""
 MAX_HARMONIC = 8
 """The lowest line of a periodic series is at most this harmonic of its fundamental."""
 HARMONIC_TOLERANCE = 0.25
@@ -75,6 +77,8 @@ def lines(amp: np.ndarray, bin_width: float) -> list[Line]:
         return []
     inner = np.flatnonzero((amp[1:-1] >= amp[:-2]) & (amp[1:-1] > amp[2:])) + 1
     inner = inner[inner >= 2]
+    # the floors of the strongest maxima only: lines are among them (a median each)
+    inner = inner[np.argsort(amp[inner])[::-1][:CANDIDATES]]
     if not inner.size:
         return []
     lo = np.maximum(inner - FLOOR_BINS, 1)

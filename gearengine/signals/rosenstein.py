@@ -38,7 +38,7 @@ from gearengine.signals.embedding import delay_vectors
 NOLDS_MAX_POINTS = 3000
 """Largest series given to nolds.lyap_r: its distance matrix is then <= 72 MB (twice that while
 it is built)."""
-MAX_POINTS = 20000
+MAX_POINTS = 10000
 """Largest series followed with the KD tree (the last points of a longer one)."""
 PLATEAU_RISE = 0.9
 """The fit ends before y(k) has risen 90 % of its way to the plateau."""
