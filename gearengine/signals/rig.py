@@ -55,7 +55,8 @@ def model_beside(request: SignalRequest, verdict: str) -> ModelReport:
     lle = None if num.lle is None else num.lle / t_s
     said = {True: "agrees with the signal", False: f"disagrees with the signal ({verdict})",
             None: f"cannot be compared with a {verdict} signal"}[agrees]  # fmt: skip
-    period = f" (period {num.period} forcing periods)" if num.period else ""
+    plural = "s" if num.period and num.period > 1 else ""
+    period = f" (period {num.period} forcing period{plural})" if num.period else ""
     return ModelReport(
         speed_rpm=shaft * 60.0, torque_nm=design.torque, classification=model,
         period=num.period, lle_per_second=lle, agrees=agrees, lines=lines,
