@@ -141,3 +141,27 @@ def test_plot_route_and_cli_plot_draw_the_reading(client: TestClient, tmp_path: 
     svg = tmp_path / "reading.svg"
     assert main(["signal", str(column), "--rate", "20kHz", "--plot", str(svg)]) == 0
     assert svg.read_text().lstrip().startswith("<?xml")
+
+
+def test_with_a_design_the_models_verdict_stands_beside_the_signals(client: TestClient) -> None:
+    from gearengine.model.design import EXAMPLE_DESIGN
+
+    doc = body(mesh_tones())
+    del doc["teeth"]  # the design's driver has 18 teeth
+    r = client.post("/v1/signals", json={**doc, "design": EXAMPLE_DESIGN})
+    assert r.status_code == 200, r.text
+    model = r.json()["model"]
+    assert model["speed_rpm"] == pytest.approx(1500.0) and model["torque_nm"] == 40.0
+    assert model["classification"] == "periodic" and model["agrees"] is True
+    mesh = [ln for ln in model["lines"] if ln["label"] == "mesh harmonic 1"]
+    assert mesh and mesh[0]["order"] == pytest.approx(18.0, abs=1e-3)
+    assert r.json()["reference"]["teeth"] == 18
+
+
+def test_tach_and_teeth_are_checked(client: TestClient) -> None:
+    doc = body(mesh_tones())
+    del doc["speed"]
+    doc["tach"] = {"times": [0.0, 0.04, 0.03, 0.08], "per_revolution": 1}
+    assert errors(client.post("/v1/signals", json=doc))[0][0] == "tach.times[2]"
+    del doc["tach"]
+    assert errors(client.post("/v1/signals", json=doc))[0][0] == "teeth"
