@@ -71,3 +71,22 @@ def test_chaotic_gear_response_is_chaotic_with_the_simulations_exponent(
     assert ly.per_second == pytest.approx(lle, rel=0.30)
     assert ly.per_mesh_period == pytest.approx(ly.per_second / mesh_hz)
     assert ly.per_revolution == pytest.approx(ly.per_second * TEETH / mesh_hz)
+
+
+def test_a_model_that_disagrees_with_the_rig_is_swept_over_its_uncertain_quantities() -> None:
+    """The README's design (periodic at this speed) beside the chaotic recording: the model
+    disagrees, and each uncertain quantity is tried halved and doubled."""
+    from gearengine.model.design import EXAMPLE_DESIGN
+
+    x, mesh_hz, _, _ = recording(0.25, None)
+    r = signal(x, RATE, speed=2.0 * math.pi * mesh_hz / TEETH, design=EXAMPLE_DESIGN)
+    assert r.verdict == "chaotic" and r.model is not None
+    assert r.model.classification == "periodic" and r.model.agrees is False
+    tried = {(t.quantity, t.factor): t for t in r.model.sweep}
+    assert set(tried) == {(q, f) for q in ("damping", "half_backlash", "transmission_error")
+                          for f in (0.5, 2.0)}  # fmt: skip
+    assert tried[("damping", 0.5)].value == "0.025"
+    assert tried[("half_backlash", 2.0)].value == "100 um"
+    assert tried[("transmission_error", 0.5)].value == "2.5 um"
+    assert all(t.matches_signal == (t.classification == "chaotic") for t in r.model.sweep)
+    assert "disagrees with the signal (chaotic)" in r.model.summary

@@ -9,18 +9,73 @@ so that they overlay the signal's order spectrum, amplitudes in µm of relative 
 lambda / t_s. "Agrees" compares the families: periodic with periodic, chaotic with chaotic,
 quasi-periodic with quasi-periodic (null when the signal's verdict is undetermined or
 stochastic, which the deterministic model cannot give).
+
+When they disagree, a short sweep asks which uncertain quantity of the design moves the model
+towards the rig: the mesh damping, the half backlash and the transmission-error amplitudes,
+each halved and doubled (``LEVERS`` x ``FACTORS``, one analysis each), with the model's verdict
+for every trial.
 """
 
 from __future__ import annotations
 
+import copy
 import math
+from collections.abc import Callable
+from typing import Any
 
 from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.model.design import Design
-from gearengine.signals.schema import ModelReport, SpectrumLine
+from gearengine.signals.schema import LeverTrial, ModelReport, SpectrumLine
 from gearengine.signals.series import SignalRequest
 
 COMPARABLE = frozenset({"periodic", "quasi_periodic", "chaotic"})
+FACTORS = (0.5, 2.0)
+
+
+def _damping(data: dict[str, Any], factor: float) -> str:
+    mesh = data["mesh"]
+    key = "damping_ratio" if "damping_ratio" in mesh else "damping"
+    mesh[key] *= factor
+    return f"{mesh[key]:.4g}" + ("" if key == "damping_ratio" else " N s/m")
+
+
+def _half_backlash(data: dict[str, Any], factor: float) -> str:
+    data["mesh"]["half_backlash"] *= factor
+    return f"{data['mesh']['half_backlash'] * 1e6:.4g} um"
+
+
+def _transmission_error(data: dict[str, Any], factor: float) -> str:
+    harmonics = (data.get("transmission_error") or {}).get("harmonics", [])
+    for h in harmonics:
+        h["amplitude"] *= factor
+    return ", ".join(f"{h['amplitude'] * 1e6:.4g} um" for h in harmonics) or "none"
+
+
+LEVERS: dict[str, Callable[[dict[str, Any], float], str]] = {
+    "damping": _damping,
+    "half_backlash": _half_backlash,
+    "transmission_error": _transmission_error,
+}
+"""The design's uncertain quantities: each scales its field of a design document (SI units)
+and says the value tried."""
+
+
+def short_sweep(design: Design, signal_verdict: str) -> list[LeverTrial]:
+    """The model's verdict with each lever halved and doubled (design already at speed)."""
+    trials = []
+    for name, scale in LEVERS.items():
+        for factor in FACTORS:
+            data = copy.deepcopy(design.model_dump(exclude_none=True))
+            value = scale(data, factor)
+            try:
+                result = analyze(AnalysisRequest.model_validate({"design": data}))
+                verdict: str | None = result.numerics.classification
+            except ValueError:  # out of the design's plausible ranges: refused
+                verdict = None
+            trials.append(LeverTrial(quantity=name, factor=factor, value=value,
+                                     classification=verdict,
+                                     matches_signal=verdict == signal_verdict))  # fmt: skip
+    return trials
 
 
 def at_speed(design: Design, speed: float) -> Design:
@@ -55,11 +110,17 @@ def model_beside(request: SignalRequest, verdict: str) -> ModelReport:
     lle = None if num.lle is None else num.lle / t_s
     said = {True: "agrees with the signal", False: f"disagrees with the signal ({verdict})",
             None: f"cannot be compared with a {verdict} signal"}[agrees]  # fmt: skip
+    sweep = short_sweep(design, verdict) if agrees is False else []
+    moves = [f"{t.quantity} x {t.factor:g} ({t.value})" for t in sweep if t.matches_signal]
+    if agrees is False:
+        said += (f"; the model reads {verdict.replace('_', '-')} with " + ", ".join(moves)
+                 if moves else "; halving or doubling the damping, the half backlash or the "
+                 "transmission error alone does not make it so")  # fmt: skip
     plural = "s" if num.period and num.period > 1 else ""
     period = f" (period {num.period} forcing period{plural})" if num.period else ""
     return ModelReport(
         speed_rpm=shaft * 60.0, torque_nm=design.torque, classification=model,
-        period=num.period, lle_per_second=lle, agrees=agrees, lines=lines,
+        period=num.period, lle_per_second=lle, agrees=agrees, lines=lines, sweep=sweep,
         summary=f"The model at {shaft * 60.0:.6g} rpm and {design.torque:.6g} N m is "
         f"{model.replace('_', '-')}{period}: it {said}.",
     )  # fmt: skip

@@ -136,6 +136,16 @@ class SurrogateReport(_Result):
     method: str
 
 
+class LeverTrial(_Result):
+    """The model with one uncertain quantity of the design scaled."""
+
+    quantity: str = Field(description="damping | half_backlash | transmission_error.")
+    factor: float = Field(description="Multiplies the design's value.")
+    value: str = Field(description="The value tried, with its unit.")
+    classification: str | None = Field(description="The model's verdict then (null: refused).")
+    matches_signal: bool
+
+
 class ModelReport(_Result):
     """The model's verdict for the design at the signal's speed."""
 
@@ -149,6 +159,10 @@ class ModelReport(_Result):
     lines: list[SpectrumLine] = Field(
         description="The model's spectrum lines in orders, amplitudes in µm of relative "
         "displacement (ratio_db 0: the model has no noise floor)."
+    )
+    sweep: list[LeverTrial] = Field(
+        default_factory=list,
+        description="When the verdicts disagree: each uncertain quantity halved and doubled.",
     )
     summary: str
 
