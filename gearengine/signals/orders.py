@@ -2,7 +2,7 @@
 the period found by synchronous averaging.
 
 Angle domain (order tracking): with a shaft speed (constant) or a tachometer (pulse times,
-``per_revolution`` pulses a turn: the shaft angle is interpolated linearly between pulses), the
+``per_revolution`` pulses a turn: the time of each angle a cubic spline through the pulses), the
 series is interpolated (cubic spline) at ``samples_per_rev`` equal angle steps, a whole number of
 samples per mesh period when the teeth are known, so that every ``per_cycle``-th sample is one
 strobe (one per mesh period, or per revolution without teeth). Without speed or tach the
@@ -22,8 +22,9 @@ P whole periods), the average waveform explains the periodic part; the unexplain
 
 (the factor removes the 1/M of noise that the average keeps) is ~ the noise's share of the
 variance for a periodic series, and stays large for a chaotic, quasi-periodic or random one.
-The period is the smallest n <= ``MAX_PERIOD`` with u_n <= ``PERIODIC_FRACTION``, within the
-noise of the best n (``period_of``), and at least ``MIN_AVERAGES`` periods in the record.
+The period is the smallest n <= ``MAX_PERIOD`` with u_n <= ``PERIODIC_FRACTION``, no more than
+the record's white noise (``noise_share``) leaves, within the noise of the best n
+(``period_of``), and at least ``MIN_AVERAGES`` periods in the record.
 """
 
 from __future__ import annotations
@@ -40,6 +41,10 @@ MIN_AVERAGES = 8
 """Fewest whole periods a synchronous average needs."""
 PERIODIC_FRACTION = 0.05
 """Largest unexplained variance of a periodic series (signal-to-noise ratio >= 13 dB)."""
+NOISE_FACTOR = 1.5
+NOISE_FLOOR = 1e-3
+"""Unexplained share accepted of a periodic record without white noise (30 dB): the angle
+resampling, speed jitter between tach pulses, rounding."""
 NOISE_MARGIN = 0.002
 """A period's average may leave this much more variance than the best one (``period_of``)."""
 LINE_RATIO = 10.0
@@ -123,8 +128,10 @@ def angle_resample(
     """x (shape (n,), fs samples per second) at ``samples_per_rev`` equal angle steps.
 
     Constant speed: revolution r at time r / shaft_hz. Tach: ``tach_revs`` = (pulse times
-    [s], revolutions at those times), the angle linear between pulses; only the span between
-    the first and the last pulse inside the record is kept."""
+    [s], revolutions at those times), the time of an angle a cubic spline through the pulses
+    (a speed ramp makes the angle quadratic in time: linear interpolation between once-a-turn
+    pulses would jitter the mesh phase); only the span between the first and the last pulse
+    inside the record is kept."""
     t = np.arange(x.size) / fs
     if tach_revs is None:
         assert shaft_hz is not None
@@ -141,7 +148,7 @@ def angle_resample(
         first = math.ceil(pulse_r[0] * samples_per_rev)
         last = math.floor(pulse_r[-1] * samples_per_rev)
         angles = np.arange(first, last + 1) / samples_per_rev
-        times = np.interp(angles, pulse_r, pulse_t)
+        times = CubicSpline(pulse_r, pulse_t)(angles)
     return CubicSpline(t, x)(times)
 
 
@@ -161,18 +168,40 @@ def synchronous_residuals(y: np.ndarray, per_cycle: int, max_period: int) -> lis
     return out
 
 
-def period_of(residuals: list[float]) -> int | None:
-    """Smallest n with u_n <= PERIODIC_FRACTION and within the noise of the best average,
-    u_n <= max(2 u_min, u_min + NOISE_MARGIN), else None: a 4T orbit just past its period
-    doubling is nearly 2T (u_2 ~ 1 %), and only the 4-cycle average leaves the noise alone."""
+def noise_share(y: np.ndarray) -> float:
+    """The share of var(y) that is white measurement noise, estimated from the upper half of
+    the band (above a quarter of the sample rate, where a gear's response has died out): the
+    periodogram |Y_k|^2 / n of white noise of variance s^2 is exponential with mean s^2, so
+    s^2 = median / ln 2 there."""
+    power = np.abs(np.fft.rfft(y - y.mean())) ** 2 / y.size
+    upper = power[power.size // 2 : -1]
+    if not upper.size:
+        return 1.0
+    return float(min(1.0, np.median(upper) / math.log(2.0) / max(float(np.var(y)), 1e-300)))
+
+
+def period_of(residuals: list[float], noise: float) -> int | None:
+    """Smallest n whose average leaves no more than noise: u_n <= PERIODIC_FRACTION, u_n <=
+    max(NOISE_FACTOR x the noise's share, NOISE_FLOOR) (``noise_share``: a chaotic band that
+    hugs a 4T orbit leaves 0.1-1 % of the variance, a periodic record only its noise), and
+    u_n <= max(2 u_min, u_min + NOISE_MARGIN) (a 4T orbit just past its period doubling is
+    nearly 2T, u_2 ~ 1 %, and only the 4-cycle average leaves the noise alone); else None."""
     if not residuals:
         return None
     floor = min(residuals)
-    bound = min(PERIODIC_FRACTION, max(2.0 * floor, floor + NOISE_MARGIN))
+    bound = min(PERIODIC_FRACTION, max(NOISE_FACTOR * noise, NOISE_FLOOR),
+                max(2.0 * floor, floor + NOISE_MARGIN))  # fmt: skip
     for n, u in enumerate(residuals, start=1):
         if u <= bound:
             return n
     return None
+
+
+def less_average(s: np.ndarray, n: int) -> np.ndarray:
+    """The last whole n-periods of s less their n-periodic average (shape (m n,))."""
+    m = s.size // n
+    block = s[s.size - m * n :].reshape(m, n)
+    return np.ascontiguousarray((block - block.mean(axis=0)).ravel())
 
 
 def strobes(y: np.ndarray, per_cycle: int) -> np.ndarray:

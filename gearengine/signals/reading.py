@@ -10,12 +10,13 @@ Order of the reading (docs/signals.md):
    else the verdict is ``undetermined`` and says which speed the strongest line implies.
 2. Period: the smallest n <= 64 cycles whose synchronous average leaves at most 5 % of the
    variance (``orders.period_of``): ``periodic``.
-3. Otherwise the 0-1 test (``zero_one``) on one sample per cycle (the strobes), or without a
-   cycle on the series taken every embedding delay: K <= ``K_REGULAR``: ``quasi_periodic``
-   (bounded, not periodic); K >= ``K_DIFFUSIVE``: the strobes diffuse, and the IAAFT surrogate
-   test (``surrogates``) tells deterministic chaos (rejected, p <= 0.05, and a positive
-   Rosenstein exponent: ``chaotic``) from linear noise (not rejected: ``stochastic``);
-   between the two: ``undetermined``.
+3. Otherwise the 0-1 test (``zero_one``) on one sample per cycle (the strobes, less their
+   average over the n cycles that explain most: a chaotic band hugging a 4T orbit reads as
+   its 4-cycle hops otherwise), or without a cycle on the series taken every embedding delay:
+   K <= ``K_REGULAR``: ``quasi_periodic`` (bounded, not periodic); K >= ``K_DIFFUSIVE``: the
+   strobes diffuse, and the IAAFT surrogate test (``surrogates``) tells deterministic chaos
+   (rejected, p <= 0.05, and a positive Rosenstein exponent: ``chaotic``) from linear noise
+   (not rejected: ``stochastic``); between the two: ``undetermined``.
 
 The largest Lyapunov exponent (``rosenstein``), the embedding (``embedding``) and the
 correlation dimension (nolds.corr_dim) are reported whatever the verdict. Work is bounded
@@ -54,6 +55,9 @@ from gearengine.signals.series import SignalRequest
 from gearengine.signals.surrogates import ALPHA, surrogate_test
 from gearengine.signals.zero_one import MIN_POINTS, zero_one_test
 
+BAND_FRACTION = 0.5
+"""The strobes are read less their n-cycle average when that average explains at least half
+of the variance (a chaotic band around a periodic orbit), as they are otherwise."""
 K_REGULAR = 0.3
 K_DIFFUSIVE = 0.7
 DELAY_SAMPLES = 4
@@ -215,13 +219,14 @@ def read(request: SignalRequest) -> SignalResult:
     periodicity = None
     if ang.per_cycle is not None:
         u = orders.synchronous_residuals(ang.y, ang.per_cycle, orders.MAX_PERIOD)
-        n = orders.period_of(u)
+        noise = orders.noise_share(ang.y)
+        n = orders.period_of(u, noise)
         cycle_s = 1.0 / ref.cycle_hz if ref.cycle_hz else None
         per_rev = (ref.teeth or 1) if ref.shaft_hz else None
         periodicity = Periodicity(
             cycles=n, seconds=None if n is None or cycle_s is None else n * cycle_s,
             revolutions=None if n is None or per_rev is None else n / per_rev,
-            unexplained=u, threshold=orders.PERIODIC_FRACTION,
+            unexplained=u, threshold=orders.PERIODIC_FRACTION, noise_share=noise,
         )  # fmt: skip
     # embedding on the series decimated to ~DELAY_SAMPLES samples per delay; a delay of at
     # most a quarter cycle (the mutual information of a chaotic gear response has its first
@@ -239,10 +244,19 @@ def read(request: SignalRequest) -> SignalResult:
         mutual_information=emb.mutual_information, false_neighbours=emb.false_neighbours,
         attractor=delay_vectors(z, 3, emb.delay)[-ATTRACTOR_POINTS:].tolist(),
     )  # fmt: skip
+    strobes = np.empty(0)
     if ang.per_cycle is not None:
-        series = orders.strobes(ang.y, ang.per_cycle)
+        series = strobes = orders.strobes(ang.y, ang.per_cycle)
         spacing = ang.per_cycle * ang.dt
         what = f"one sample per {(ref.cycle or 'cycle').replace('_', ' ')}"
+        u = [] if periodicity is None or periodicity.cycles else periodicity.unexplained
+        if u and min(u) <= BAND_FRACTION:  # a chaotic band around an n-cycle orbit
+            best = int(np.argmin(u)) + 1
+            series = orders.less_average(strobes, best)
+            plural = "s" if best > 1 else ""
+            what += f", less its average over {best} {ref.cycle or 'cycle'}{plural}".replace(
+                "_", " "
+            )
     else:
         series = z[:: emb.delay]
         spacing = emb.delay * dz
@@ -278,7 +292,7 @@ def read(request: SignalRequest) -> SignalResult:
     return SignalResult(
         verdict=verdict, summary=summary(verdict, evidence), evidence=evidence, record=record,
         reference=ref, spectrum=ang.spectrum, periodicity=periodicity,
-        strobes=[] if ang.per_cycle is None else series[-STROBES_SHOWN:].tolist(),
+        strobes=strobes[-STROBES_SHOWN:].tolist(),
         embedding=embedding, zero_one=zero_one, lyapunov=lyapunov,
         correlation_dimension=_corr_dim(z, emb.dimension, emb.delay),
         surrogates=surrogates, model=model, notes=notes,
@@ -382,7 +396,8 @@ def decide(
     if periodicity is not None and periodicity.unexplained:
         evidence.append(f"no period up to {len(periodicity.unexplained)} {cycle}s: the "
                         f"synchronous averages leave at least "
-                        f"{100 * min(periodicity.unexplained):.2g} % of the variance")  # fmt: skip
+                        f"{100 * min(periodicity.unexplained):.2g} % of the variance, the "
+                        f"noise {100 * periodicity.noise_share:.2g} %")  # fmt: skip
     elif periodicity is None:
         evidence.append("no speed, tach or harmonic line spectrum: no cycle to average over")
     if zero_one is None:

@@ -72,6 +72,9 @@ class Periodicity(_Result):
         description="u_n, n = 1, 2, ...: variance the n-cycle synchronous average leaves."
     )
     threshold: float
+    noise_share: float = Field(
+        description="Share of the variance that is white noise (from the upper half band)."
+    )
 
 
 class EmbeddingReport(_Result):
