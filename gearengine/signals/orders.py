@@ -180,17 +180,19 @@ def noise_share(y: np.ndarray) -> float:
     return float(min(1.0, np.median(upper) / math.log(2.0) / max(float(np.var(y)), 1e-300)))
 
 
-def period_of(residuals: list[float], noise: float) -> int | None:
-    """Smallest n whose average leaves no more than noise: u_n <= PERIODIC_FRACTION, u_n <=
+def periodic_bound(residuals: list[float], noise: float) -> float:
+    """The most a periodic record's average may leave: PERIODIC_FRACTION, no more than
     max(NOISE_FACTOR x the noise's share, NOISE_FLOOR) (``noise_share``: a chaotic band that
     hugs a 4T orbit leaves 0.1-1 % of the variance, a periodic record only its noise), and
-    u_n <= max(2 u_min, u_min + NOISE_MARGIN) (a 4T orbit just past its period doubling is
-    nearly 2T, u_2 ~ 1 %, and only the 4-cycle average leaves the noise alone); else None."""
-    if not residuals:
-        return None
-    floor = min(residuals)
-    bound = min(PERIODIC_FRACTION, max(NOISE_FACTOR * noise, NOISE_FLOOR),
-                max(2.0 * floor, floor + NOISE_MARGIN))  # fmt: skip
+    max(2 u_min, u_min + NOISE_MARGIN) (a 4T orbit just past its period doubling is nearly 2T,
+    u_2 ~ 1 %, and only the 4-cycle average leaves the noise alone)."""
+    floor = min(residuals) if residuals else 0.0
+    return min(PERIODIC_FRACTION, max(NOISE_FACTOR * noise, NOISE_FLOOR),
+               max(2.0 * floor, floor + NOISE_MARGIN))  # fmt: skip
+
+
+def period_of(residuals: list[float], bound: float) -> int | None:
+    """Smallest n with u_n <= bound (``periodic_bound``), else None."""
     for n, u in enumerate(residuals, start=1):
         if u <= bound:
             return n

@@ -220,13 +220,14 @@ def read(request: SignalRequest) -> SignalResult:
     if ang.per_cycle is not None:
         u = orders.synchronous_residuals(ang.y, ang.per_cycle, orders.MAX_PERIOD)
         noise = orders.noise_share(ang.y)
-        n = orders.period_of(u, noise)
+        bound = orders.periodic_bound(u, noise)
+        n = orders.period_of(u, bound)
         cycle_s = 1.0 / ref.cycle_hz if ref.cycle_hz else None
         per_rev = (ref.teeth or 1) if ref.shaft_hz else None
         periodicity = Periodicity(
             cycles=n, seconds=None if n is None or cycle_s is None else n * cycle_s,
             revolutions=None if n is None or per_rev is None else n / per_rev,
-            unexplained=u, threshold=orders.PERIODIC_FRACTION, noise_share=noise,
+            unexplained=u, threshold=bound, noise_share=noise,
         )  # fmt: skip
     # embedding on the series decimated to ~DELAY_SAMPLES samples per delay; a delay of at
     # most a quarter cycle (the mutual information of a chaotic gear response has its first
@@ -391,7 +392,8 @@ def decide(
         n, u = periodicity.cycles, periodicity.unexplained[periodicity.cycles - 1]
         plural = "s" if n > 1 else ""
         evidence.append(f"the average over {n} {cycle}{plural} leaves {100 * u:.2g} % of the "
-                        f"variance (periodic at <= {100 * periodicity.threshold:g} %)")  # fmt: skip
+                        f"variance (periodic at <= {100 * periodicity.threshold:.2g} %; white "
+                        f"noise {100 * periodicity.noise_share:.2g} %)")  # fmt: skip
         return "periodic", evidence
     if periodicity is not None and periodicity.unexplained:
         evidence.append(f"no period up to {len(periodicity.unexplained)} {cycle}s: the "

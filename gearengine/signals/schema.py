@@ -71,7 +71,9 @@ class Periodicity(_Result):
     unexplained: list[float] = Field(
         description="u_n, n = 1, 2, ...: variance the n-cycle synchronous average leaves."
     )
-    threshold: float
+    threshold: float = Field(
+        description="The most a periodic record's average may leave (orders.periodic_bound)."
+    )
     noise_share: float = Field(
         description="Share of the variance that is white noise (from the upper half band)."
     )
