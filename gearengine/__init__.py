@@ -38,6 +38,9 @@ if TYPE_CHECKING:  # what the names below load lazily, for type checkers and IDE
         warm_up,
     )
     from gearengine.numerics.attractors import of_design as attractors
+    from gearengine.rig import signal
+    from gearengine.signals.schema import SignalResult
+    from gearengine.signals.series import SignalRequest
     from gearengine.studies.runup import RunupRequest, RunupResult
     from gearengine.studies.runup import run_local as run_runup
     from gearengine.studies.sweep import SweepRequest, SweepResult
@@ -54,6 +57,8 @@ __all__ = [
     "RemediesResult",
     "RunupRequest",
     "RunupResult",
+    "SignalRequest",
+    "SignalResult",
     "SimulationSettings",
     "SweepRequest",
     "SweepResult",
@@ -66,6 +71,7 @@ __all__ = [
     "remedies",
     "run_runup",
     "run_sweep",
+    "signal",
     "simulate",
     "simulate_batch",
     "threshold_curve",
@@ -83,6 +89,8 @@ _HOMES: dict[str, tuple[str, str]] = {
     "RemediesResult": ("gearengine.gate.remedies", "RemediesResult"),
     "RunupRequest": ("gearengine.studies.runup", "RunupRequest"),
     "RunupResult": ("gearengine.studies.runup", "RunupResult"),
+    "SignalRequest": ("gearengine.signals.series", "SignalRequest"),
+    "SignalResult": ("gearengine.signals.schema", "SignalResult"),
     "SimulationSettings": ("gearengine.numerics", "SimulationSettings"),
     "SweepRequest": ("gearengine.studies.sweep", "SweepRequest"),
     "SweepResult": ("gearengine.studies.sweep", "SweepResult"),
@@ -95,6 +103,7 @@ _HOMES: dict[str, tuple[str, str]] = {
     "remedies": ("gearengine.gate.remedies", "remedies"),
     "run_runup": ("gearengine.studies.runup", "run_local"),
     "run_sweep": ("gearengine.studies.sweep", "run_local"),
+    "signal": ("gearengine.rig", "signal"),
     "simulate": ("gearengine.numerics", "simulate"),
     "simulate_batch": ("gearengine.numerics", "simulate_batch"),
     "threshold_curve": ("gearengine.homoclinic", "threshold_curve"),
@@ -116,6 +125,7 @@ _SUBMODULES = frozenset(
         "model",
         "numerics",
         "plots",
+        "rig",
         "gate",
         "signals",
         "studies",

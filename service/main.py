@@ -24,6 +24,7 @@ from service.api.routes import (
     remedies,
     robustness,
     runups,
+    signals,
     sweeps,
     thresholds,
 )
@@ -48,6 +49,8 @@ torque fluctuation and transmission error (Farshidianfar & Saghafi 2014, Eq. 9).
 * **Figures** as PNG or SVG (`/v1/analyses/plot`, `/v1/thresholds/plot`).
 * **Sweeps**: bifurcation diagrams (one axis) and 2-D chaos maps (two axes) as durable jobs
   (`POST /v1/sweeps`, then poll, fetch `/result` as JSON or CSV and `/plot`).
+* **Signals**: a recorded series (transmission error, accelerometer) read as periodic,
+  quasi-periodic, chaotic or stochastic, with the model beside it (`POST /v1/signals`).
 * **Robustness**: probabilities of chaos and rattle over a design's manufacturing tolerances
   (ISO 1328 class, backlash band, distributions), with Sobol indices (`POST /v1/robustness`).
 
@@ -103,11 +106,15 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(runups.router, tags=["runups"])
     app.include_router(robustness.router, tags=["robustness"])
     app.include_router(basins.router, tags=["basins"])
+    app.include_router(signals.router, tags=["signals"])
     app.include_router(explorer.router)
     app.add_middleware(
         BodyLimit,
         limit=settings.max_body_bytes,
-        per_path={"/v1/melnikov/batch": settings.max_batch_body_bytes},
+        per_path={
+            "/v1/melnikov/batch": settings.max_batch_body_bytes,
+            **dict.fromkeys(signals.PATHS, settings.max_batch_body_bytes),
+        },
     )
     app.add_middleware(AccessLog, metrics=app.state.metrics)
     logging.getLogger("gearchaos").setLevel(logging.INFO)

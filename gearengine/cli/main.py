@@ -12,6 +12,7 @@
     gearengine basins FILE [--starts N] [--json] [--plot FILE]
     gearengine campbell FILE [--json] [--plot FILE]
     gearengine convert FILE [--json]
+    gearengine signal FILE --rate 20kHz [--speed 1500rpm --teeth 18] [--json OUT] [--plot OUT]
 
 FILE holds ``{"params": {...}}`` or ``{"design": {...}}`` (physical units), and ``"settings"``
 for analyze/check; ``-`` reads standard input. ``--json`` prints exactly the body the HTTP API
@@ -250,6 +251,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help='JSON file holding {"design": {...}}, or - for stdin')
     p.add_argument("--json", action="store_true", help="print the API's JSON response")
     p.set_defaults(func=lazy("gearengine.cli.convert", "cmd_convert"))
+
+    p = sub.add_parser("signal", help="a recorded series: periodic, quasi-periodic, chaotic or "
+                       "noise?")  # fmt: skip
+    p.add_argument("file", help="JSON request (as POST /v1/signals), or the samples as text or "
+                   "CSV (last column; a first column of times sets the rate), or -")  # fmt: skip
+    p.add_argument("--rate", metavar="RATE", help="sample rate: Hz, or with units (20kHz)")
+    p.add_argument("--speed", metavar="SPEED", help="shaft speed: rpm, or with units")
+    p.add_argument("--teeth", type=int, default=None, help="teeth on that shaft (mesh orders)")
+    p.add_argument("--quantity", choices=["transmission_error", "acceleration", "displacement",
+                   "velocity", "other"], default=None)  # fmt: skip
+    p.add_argument("--unit", default=None, help="unit of the values (um, m/s^2, g)")
+    p.add_argument("--design", metavar="FILE", help='JSON file holding {"design": {...}}: the '
+                   "model's verdict beside the signal's")  # fmt: skip
+    p.add_argument("--seed", type=int, default=None, help="seed of the 0-1 test and surrogates")
+    p.add_argument("--json", metavar="OUT", help="write the API's response body")
+    p.add_argument("--plot", metavar="OUT", help="write the figure (.png or .svg)")
+    p.set_defaults(func=lazy("gearengine.cli.signal", "cmd_signal"))
 
     for plugin in entry_points(group=PLUGIN_GROUP):
         try:

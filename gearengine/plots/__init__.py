@@ -21,6 +21,7 @@ if TYPE_CHECKING:
     from gearengine.plots.basins import basins_figure
     from gearengine.plots.campbell import campbell_figure
     from gearengine.plots.runup import runup_figure
+    from gearengine.plots.signal import signal_figure
     from gearengine.plots.style import MEDIA_TYPES, ImageFormat
     from gearengine.plots.sweep import sweep_figure
 
@@ -31,6 +32,7 @@ __all__ = [
     "basins_figure",
     "campbell_figure",
     "runup_figure",
+    "signal_figure",
     "sweep_figure",
     "threshold_figure",
 ]
@@ -42,6 +44,7 @@ _HOMES = {
     "basins_figure": ("gearengine.plots.basins", "basins_figure"),
     "campbell_figure": ("gearengine.plots.campbell", "campbell_figure"),
     "runup_figure": ("gearengine.plots.runup", "runup_figure"),
+    "signal_figure": ("gearengine.plots.signal", "signal_figure"),
     "sweep_figure": ("gearengine.plots.sweep", "sweep_figure"),
     "threshold_figure": ("gearengine.plots.analysis", "threshold_figure"),
 }

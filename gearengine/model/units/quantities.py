@@ -137,6 +137,7 @@ QUANTITIES: dict[str, QuantityKind] = {
     ),
     "mass": QuantityKind("mass", "kg", 1e-3, 1e5, ("g", "t"), "1.2 kg"),
     "shear_modulus": QuantityKind("shear modulus", "Pa", 1e9, 5e11, ("GPa", "MPa"), "79.3 GPa"),
+    "sample_rate": QuantityKind("sample rate", "Hz", 1e-3, 1e8, ("kHz", "MHz"), "20 kHz"),
 }
 """Kinds of quantity by key; ``low``/``high`` bound plausible magnitudes in SI units."""
 
@@ -290,3 +291,4 @@ TorsionalStiffness = quantity_type("torsional_stiffness")
 BearingStiffness = quantity_type("bearing_stiffness")
 Mass = quantity_type("mass")
 ShearModulus = quantity_type("shear_modulus")
+SampleRate = quantity_type("sample_rate")
