@@ -48,6 +48,7 @@ from gearengine.model.units import (
     response_values,
     to_physical,
 )
+from gearengine.numerics.attractors import Headline
 from gearengine.numerics.results import NumericsResult
 
 WINDOW_SCAN = 240
@@ -301,8 +302,12 @@ def summary(
     rng: tuple[float, float],
     resp: Response | None,
     num: NumericsResult | None,
+    decided: Headline | None = None,
 ) -> str:
-    """Two or three sentences an engineer can paste into a design review."""
+    """Two or three sentences an engineer can paste into a design review; with basins the
+    response named is the worst attractor's above the basin threshold (``decided``, with its
+    fraction), and the contact, DTE and dynamic factor those of the recorded run, said so when
+    that run settled elsewhere."""
     t_crit = critical_torque(conv, mel)
     if over_critical(conv, mel) and t_crit is not None and mel.critical_mean_force:
         words = load_words(conv, mel.critical_mean_force, t_crit)
@@ -326,7 +331,15 @@ def summary(
             text += f" It applies below the critical torque {t_crit:,.3g} N*m."
     if num is not None and resp is not None:
         kind = f"periodic ({num.period}T)" if num.period else num.classification.replace("_", "-")
-        text += f" The simulated response is {kind}"
+        if decided is None:
+            text += f" The simulated response is {kind}"
+        elif decided.kind == kind:
+            text += f" The simulated response is {kind} ({decided.decided_by})"
+        else:
+            text += (
+                f" The simulated response is {decided.kind} ({decided.decided_by}, the worst "
+                f"attractor); the recorded run from the settings' start is {kind}"
+            )
         if resp.contact is not None:
             text += f" with {IMPACT_WORDS.get(resp.contact.regime or '', 'no verdict on impacts')}"
             if resp.contact.separation_fraction > 0.0:
@@ -344,8 +357,10 @@ def engineering(
     rpm_range: tuple[float, float],
     mel: MelnikovResult,
     num: NumericsResult | None = None,
+    decided: Headline | None = None,
 ) -> Engineering:
-    """The engineering block of a design's Melnikov verdict (and analysis, given ``num``)."""
+    """The engineering block of a design's Melnikov verdict (and analysis, given ``num``;
+    ``decided`` the worst attractor of its basins, ``numerics.attractors.headline``)."""
     params = conv.params
     t_crit = critical_torque(conv, mel)
     note = None
@@ -385,6 +400,6 @@ def engineering(
         critical=crit,
         derived=conv.derived,
         response=resp,
-        summary=summary(conv, mel, windows, (lo, hi), resp, num),
+        summary=summary(conv, mel, windows, (lo, hi), resp, num, decided),
         notes=conv.notes,
     )
