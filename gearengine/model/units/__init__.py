@@ -40,6 +40,7 @@ from gearengine.model.units.quantities import (
     parse_quantity,
     readings,
     registry,
+    si_numbers,
 )
 
 __all__ = [
@@ -74,5 +75,6 @@ __all__ = [
     "registry",
     "response_values",
     "shown",
+    "si_numbers",
     "to_physical",
 ]
