@@ -88,6 +88,16 @@ def micrometres(text: str) -> float:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def samples_count(text: str) -> int | str:
+    """``--samples`` of the probability gate: a whole number, or ``auto``."""
+    if text == "auto":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("give a whole number (a power of 2) or auto") from None
+
+
 def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -> None:
     """The gate's rules and envelope options, shared by ``check`` and ``remedies``."""
     p.add_argument(
@@ -175,7 +185,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-probability", action="append", metavar="NAME=P",
                    help="fail where the 95 %% upper bound of P(NAME) over the design's "
                    "tolerances exceeds P (chaotic, impacts, back_flank; repeatable)")  # fmt: skip
-    p.add_argument("--samples", type=int, default=64, help="with --max-probability (default 64)")
+    p.add_argument("--samples", type=samples_count, default=64,
+                   help="with --max-probability: N, a power of 2 (64), refused when too few "
+                   "to prove a limit; or auto: double until every point is decided")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="with --max-probability (default 0)")
     p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
 
