@@ -18,6 +18,7 @@ from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
     InvalidInputError,
+    points_of,
     read_document,
     validated_input,
 )
@@ -25,6 +26,7 @@ from gearengine.cli.envelope import axis
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import ENVELOPE_SETTINGS
 from gearengine.model.units import display_unit
+from gearengine.studies import jobs
 from gearengine.studies.robustness.study import (
     RobustnessRequest,
     RobustnessResult,
@@ -57,7 +59,17 @@ def robustness_request(args: argparse.Namespace) -> RobustnessRequest:
             "samples": args.samples, "seed": args.seed}  # fmt: skip
     if getattr(args, "sensitivity", False):
         body["sensitivity"] = True
-    return validated_input(lambda d: checked(RobustnessRequest.model_validate(d)), body, args.file)
+    n = points_of(body["axes"])
+    if n > jobs.MAX_JOB_POINTS:  # before the study's checks cost each point's design
+        raise InvalidInputError([f"this robustness study has {n} points, the limit is "
+                                 f"{jobs.MAX_JOB_POINTS} (max_sweep_points)"])  # fmt: skip
+    request = validated_input(
+        lambda d: checked(RobustnessRequest.model_validate(d)), body, args.file
+    )
+    why = jobs.over_budget("robustness", request, n, "robustness study")
+    if why is not None:
+        raise InvalidInputError([why])
+    return request
 
 
 def study(args: argparse.Namespace) -> tuple[RobustnessRequest, RobustnessResult]:

@@ -48,6 +48,7 @@ from gearengine.model.units import (
     Inertia,
     Length,
     MeshStiffness,
+    Module,
     Speed,
     StiffnessVariation,
     Torque,
@@ -72,7 +73,7 @@ class Gear(StrictModel):
     teeth: WholeNumber = Field(ge=5, le=1000, description="Number of teeth z.", examples=[18])
     base_radius: Length | None = Field(None, description="Base-circle radius r_b.")
     inertia: Inertia | None = Field(None, description="Mass moment of inertia about the axis.")
-    module: Length | None = Field(None, description="Normal module m (geometry form).")
+    module: Module | None = Field(None, description="Normal module m (geometry form).")
     face_width: Length | None = Field(None, description="Face width b (geometry form).")
     pressure_angle: Angle = Field(math.radians(20.0), description="Pressure angle (20 deg).")
     profile_shift: float = Field(

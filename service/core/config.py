@@ -13,6 +13,8 @@ from pathlib import Path
 from pydantic import Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
+from gearengine.studies.jobs import MAX_JOB_POINTS, MAX_JOB_STEPS
+
 
 class Settings(BaseSettings):
     """Service settings; field names are the environment variables without ``GEARCHAOS_``."""
@@ -60,10 +62,12 @@ class Settings(BaseSettings):
     cache_entries: int = Field(512, ge=0, description="Responses kept in the in-memory LRU.")
 
     max_sweep_points: int = Field(
-        40_000, ge=1, description="Most points of one sweep (every axis and branch counted)."
+        MAX_JOB_POINTS,
+        ge=1,
+        description="Most points of one sweep (every axis and branch counted).",
     )
     max_sweep_steps: int = Field(
-        20_000_000_000,
+        MAX_JOB_STEPS,
         ge=1000,
         description="Compute budget of one sweep in RK4 steps (points x periods x steps x "
         "starts); the default is about a minute on two cores.",

@@ -113,6 +113,7 @@ def _respelled(text: str, kind: QuantityKind) -> str:
 
 QUANTITIES: dict[str, QuantityKind] = {
     "length": QuantityKind("length", "m", 1e-9, 10.0, ("um", "mm"), "30 mm"),
+    "module": QuantityKind("module", "m", 1e-5, 0.1, ("mm",), "3 mm"),
     "half_backlash": QuantityKind("half backlash", "m", 1e-7, 5e-3, ("um", "mm"), "50 um"),
     "error": QuantityKind("transmission error", "m", 0.0, 1e-3, ("um", "mm"), "5 um"),
     "speed": QuantityKind(
@@ -141,7 +142,9 @@ QUANTITIES: dict[str, QuantityKind] = {
 """Kinds of quantity by key; ``low``/``high`` bound plausible magnitudes in SI units."""
 
 # Lengths of gear bodies (radius, module, face width, bore) may be zero only for a bore.
-POSITIVE_KINDS = frozenset({"length", "half_backlash", "speed", "stiffness", "inertia", "angle"})
+POSITIVE_KINDS = frozenset(
+    {"length", "module", "half_backlash", "speed", "stiffness", "inertia", "angle"}
+)
 
 
 def parse_quantity(
@@ -223,6 +226,9 @@ def _plausible(si: float, given: object, kind: QuantityKind, allow_zero: bool) -
         return si
     ureg = registry()
     shown = given if isinstance(given, str) else kind.describe(si)
+    if si < 0.0 and kind.low > 0.0:  # no slip of the unit makes it positive
+        raise ValueError(f"{shown} is negative; a {kind.name} is a positive magnitude, e.g. "
+                         f"{kind.example!r}")  # fmt: skip
     message = (
         f"{shown} is outside the plausible range of a {kind.name}, "
         f"{kind.describe(kind.low)} to {kind.describe(kind.high)}"
@@ -309,6 +315,7 @@ def quantity_type(key: str, allow_zero: bool = False, keyword: str | None = None
 
 
 Length = quantity_type("length")
+Module = quantity_type("module")
 Bore = quantity_type("length", allow_zero=True)
 HalfBacklash = quantity_type("half_backlash")
 ErrorAmplitude = quantity_type("error", allow_zero=True)
