@@ -2,7 +2,7 @@
 
     gearengine melnikov FILE [--json] [--method closed_form|quadrature] [--mean-load ...]
     gearengine analyze FILE [--json]
-    gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov|impacts|separation]
+    gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov|back_flank|separation]
         [--max-lle V] [--max-dte E] [--max-dynamic-factor F]
         [--min-stability-margin X]
     gearengine remedies FILE --speed A:B [--torque A:B] [check's rules] [--lever PATH=LO:HI]
@@ -103,7 +103,15 @@ def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -
     p.add_argument(
         "--fail-on",
         action="append",
-        choices=["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"],
+        choices=[
+            "chaotic",
+            "quasi_periodic",
+            "diverged",
+            "melnikov",
+            "back_flank",
+            "impacts",
+            "separation",
+        ],
         help="repeatable",
     )
     p.add_argument("--speed", metavar="LOW:HIGH", required=speed_required,
@@ -157,7 +165,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="CI gate: exit 1 when the design fails (0 pass, 2 invalid input)",
         description="--fail-on X fails on X or anything worse "
         "(periodic < quasi_periodic < chaotic < diverged); melnikov fails when a transverse "
-        "homoclinic tangle is possible; impacts on back-flank contact; separation when the "
+        "homoclinic tangle is possible; back_flank (or impacts) on back-flank impacts; "
+        "separation when the "
         "teeth separate (drive-flank impacts, or impacts on both flanks). Default: --fail-on "
         "chaotic; the limits (--max-lle, --max-dte, --max-dynamic-factor, --min-stability-margin) "
         "add to it. With "
@@ -182,9 +191,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="fail when the response is periodic and its Floquet stability margin "
         "1 - max |lambda| is below X (or unavailable); one design only, not an envelope",
     )
-    p.add_argument("--max-probability", action="append", metavar="NAME=P",
-                   help="fail where the 95 %% upper bound of P(NAME) over the design's "
-                   "tolerances exceeds P (chaotic, impacts, back_flank; repeatable)")  # fmt: skip
+    p.add_argument(
+        "--max-probability",
+        action="append",
+        metavar="NAME=P",
+        help="fail where the 95 %% upper bound of P(NAME) over the design's "
+        "tolerances exceeds P (chaotic, separation, back_flank; repeatable)",
+    )
     p.add_argument("--samples", type=samples_count, default=64,
                    help="with --max-probability: N, a power of 2 (64), refused when too few "
                    "to prove a limit; or auto: double until every point is decided")  # fmt: skip

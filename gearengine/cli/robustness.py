@@ -35,7 +35,7 @@ from gearengine.studies.robustness.study import (
 )
 from gearengine.studies.robustness.tolerances import samples_to_prove
 
-GATED = ("chaotic", "quasi_periodic", "diverged", "impacts", "back_flank",
+GATED = ("chaotic", "quasi_periodic", "diverged", "separation", "impacts", "back_flank",
          "dynamic_factor_above_limit", "melnikov_chaos_possible")  # fmt: skip
 """Probabilities a gate may limit."""
 
@@ -134,7 +134,7 @@ def cmd_robustness(args: argparse.Namespace) -> int:
         pr = p.probabilities
         words = ", ".join(
             f"{k} {pr[k].value:.3f} [{pr[k].interval[0]:.3f}, {pr[k].interval[1]:.3f}]"
-            for k in ("chaotic", "impacts", "back_flank")
+            for k in ("chaotic", "separation", "back_flank")
         )
         print(f"{point_name(p.shown)}: {words} ({p.samples} samples)")
         for line in p.ranking or []:
