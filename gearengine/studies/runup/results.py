@@ -39,7 +39,10 @@ class RunupBin(_Result):
         description="Ensemble-averaged finite-time Lyapunov exponent over the bin, per unit "
         "tau (x 1/time_scale_s for 1/s); null where a member diverged."
     )
-    lle_stderr: float | None = Field(description="Its standard error over the ensemble.")
+    lle_stderr: float | None = Field(
+        description="Its standard error: of the rates of every member's blocks in the bin "
+        "(members settled on one orbit agree exactly, so the ensemble's spread alone is 0)."
+    )
     chaotic: bool | None = Field(
         description="lle > 1e-3 and > 3 lle_stderr (signals.classify's rule)."
     )
