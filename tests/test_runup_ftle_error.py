@@ -16,3 +16,16 @@ def test_ftle_standard_error_is_positive_where_the_members_agree() -> None:
     assert bins and all(b.lle is not None and b.lle < 0 for b in bins)  # a periodic response
     assert all(b.lle_stderr is not None and b.lle_stderr > 0 for b in bins)
     assert not any(b.chaotic for b in bins)
+
+
+def test_ftle_is_read_from_500_rpm_on() -> None:
+    """The 23/67 pair settled 100 mesh periods at 500 rpm (~1e4 tau in one block): the tangent
+    underflowed to 0 and every bin's FTLE was null; it is the damping's contraction, ~ -mu."""
+    from tests.test_robustness import DESIGN
+
+    r = validated({"design": DESIGN, "from_speed": "500 rpm", "to_speed": "700 rpm",
+                   "rate": "4000 rpm/s", "direction": "up", "ensemble": {"size": 2}})  # fmt: skip
+    bins = run_local(r).up.bins  # type: ignore[union-attr]
+    assert bins and all(b.lle is not None for b in bins)
+    mu = r.params.damping
+    assert all(abs(b.lle + mu) < 0.1 * mu for b in bins)
