@@ -137,7 +137,7 @@ def _bins(request: RunupRequest, tables: list[np.ndarray], branch: Branch, lo: f
         if ok:
             sep = float(mine[:, SEP].sum() / steps)
             back = float(mine[:, BACK].sum() / steps)
-            contact = "both_flanks" if back > 0 else ("no_contact" if sep > 0 else "drive_flank")
+            contact = "both_flanks" if back > 0 else ("separation" if sep > 0 else "drive_flank")
         factor = None
         if ok and (mine[:, FM] > 0).all():  # each block at its own mean force (a torque ramp)
             blocks = zip(mine[:, FMAX].tolist(), mine[:, FM].tolist(), strict=True)

@@ -28,8 +28,9 @@ class RunupBin(_Result):
     )
     back_flank_fraction: float | None = Field(description="Share of the time on the back flank.")
     contact: str | None = Field(
-        description="drive_flank (always in contact), no_contact (loses contact at times), "
-        "both_flanks (reaches the back flank)."
+        description="drive_flank (always in contact), separation (the teeth separate at times, "
+        "separation_fraction says how long; the gate's --fail-on separation), both_flanks "
+        "(reaches the back flank: back_flank). Was no_contact, which read as never touching."
     )
     back_flank_impacts: int | None = Field(description="Entries onto the back flank.")
     drive_flank_impacts: int | None = Field(
