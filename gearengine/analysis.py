@@ -25,7 +25,7 @@ from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
-from gearengine.numerics.attractors import attractors, coexistence, headline
+from gearengine.numerics.attractors import Headline, attractors, coexistence, headline
 from gearengine.numerics.results import NumericsResult
 from gearengine.numerics.settings import RequestSettings, SimulationSettings
 from gearengine.numerics.simulation import simulate
@@ -94,7 +94,10 @@ class AnalysisResult(BaseModel):
         """The verdicts in one line: response, LLE, contact, Melnikov, and with a design the
         DTE, dynamic factor and Melnikov speed windows (the gate's PASS or FAIL line)."""
         num = self.numerics
-        kind = f"periodic {num.period}T" if num.period else num.classification
+        decided = decision(num, self.settings) or num  # with basins the worst attractor's
+        kind = f"periodic {decided.period}T" if decided.period else decided.classification
+        if decided is not num:
+            kind += f" ({decided.decided_by})"
         lle = "LLE n/a" if num.lle is None else f"LLE {num.lle:+.4g} ± {num.lle_stderr or 0:.2g}"
         contact = IMPACT_WORDS.get(num.impact_regime or "", "no verdict on impacts")
         mel = {True: "chaos possible", False: "chaos not possible"}.get(
@@ -170,6 +173,14 @@ def verdict(mel: MelnikovResult, num: NumericsResult, min_fraction: float = 0.0)
     )
 
 
+def decision(num: NumericsResult, settings: SimulationSettings) -> Headline | None:
+    """The worst attractor above ``settings.basins.min_fraction`` that decides the verdict
+    (``numerics.attractors.headline``); None without basins."""
+    if num.attractors is None or num.basins is None or settings.basins is None:
+        return None
+    return headline(num.attractors, num.basins, settings.basins.min_fraction)
+
+
 def analyze(
     request: AnalysisRequest | Design | GearParams, settings: SimulationSettings | None = None
 ) -> AnalysisResult:
@@ -199,7 +210,7 @@ def analyze(
                             verdict=verdict(mel, num, min_fraction))  # fmt: skip
     if conv is None:
         return result
-    eng = engineering(conv, request.speed_rpm_range(), mel, num)
+    eng = engineering(conv, request.speed_rpm_range(), mel, num, decision(num, request.settings))
     return result.model_copy(update={"params": conv.params, "engineering": eng})
 
 

@@ -46,10 +46,13 @@ from gearengine.model.units import (
     display_label,
     in_si,
     response_values,
+    shown,
     to_physical,
 )
+from gearengine.numerics.attractors import Headline
 from gearengine.numerics.results import NumericsResult
 from gearengine.systems.gear_train.modes import Modes
+from gearengine.systems.spur_pair.forcing import contact_force_of, static_error
 
 WINDOW_SCAN = 240
 """Speeds sampled in the Melnikov window scan before brentq refines each edge."""
@@ -88,9 +91,32 @@ class Contact(_Doc):
 class Response(_Doc):
     """The numerical response in physical units (last recorded periods)."""
 
-    dte_peak_to_peak_um: float | None = Field(description="Dynamic transmission error p-p [µm].")
-    dynamic_mesh_force_max_n: float | None = Field(description="Largest mesh force [N].")
-    dynamic_mesh_force_min_n: float | None = Field(description="Smallest mesh force [N].")
+    dte_peak_to_peak_um: float | None = Field(
+        description="Dynamic transmission error p-p [µm]: x = r_a theta_a - r_b theta_b - e(t) "
+        "(Eq. 7), the static transmission error e(t) excluded, over every step of the record."
+    )
+    te_with_static_peak_to_peak_um: float | None = Field(
+        None,
+        description="Transmission error with the static TE, p-p [µm]: r_a theta_a - r_b theta_b "
+        "= x + e(t), what a pair of shaft encoders measures; from the recorded time history.",
+    )
+    dynamic_mesh_force_max_n: float | None = Field(
+        description="Largest mesh force of the model [N]: k_m (K(t) f_h(x) + 2 mu x'), whose "
+        "damping term acts in the clearance too (nonzero while the teeth are apart)."
+    )
+    dynamic_mesh_force_min_n: float | None = Field(
+        description="Smallest mesh force of the model [N] (negative: back-flank contact, or the "
+        "damping term while apart)."
+    )
+    contact_force_max_n: float | None = Field(
+        None,
+        description="Largest tooth contact force [N]: the model's force where a flank touches "
+        "(|x| > 1; drive flank >= 0, back flank <= 0), zero while the teeth are apart; from "
+        "the recorded time history.",
+    )
+    contact_force_min_n: float | None = Field(
+        None, description="Smallest tooth contact force [N] (negative: back-flank contact)."
+    )
     static_force_n: float = Field(description="Mean mesh force F^_m [N].")
     dynamic_factor: float | None = Field(description="max force / static force.")
     contact: Contact | None
@@ -267,8 +293,15 @@ def response(params: GearParams, num: NumericsResult, conv: DesignConversion) ->
     forces = [None if f is None else to_physical("mesh_force", f, scales)
               for f in (num.force_max, num.force_min)]  # fmt: skip
     values = response_values(num.x_peak_to_peak, num.force_max, scales)
+    te, touching = None, [None, None]
     if hist is not None and hist.x:
         x = np.asarray(hist.x)
+        t, v = np.asarray(hist.t), np.asarray(hist.v)
+        te = shown(to_physical("dte", float(np.ptp(x + static_error(params, t))), scales))
+        force = contact_force_of(params, t, x, v)
+        touching = [
+            shown(to_physical("mesh_force", float(f), scales)) for f in (force.max(), force.min())
+        ]
         contact = Contact(
             regime=num.impact_regime,
             separation_fraction=float(np.mean(np.abs(x) <= 1.0)),
@@ -283,6 +316,9 @@ def response(params: GearParams, num: NumericsResult, conv: DesignConversion) ->
         dte_peak_to_peak_um=values["dte"],
         dynamic_mesh_force_max_n=forces[0],
         dynamic_mesh_force_min_n=forces[1],
+        te_with_static_peak_to_peak_um=te,
+        contact_force_max_n=touching[0],
+        contact_force_min_n=touching[1],
         static_force_n=scales.static_force,
         dynamic_factor=values["dynamic_factor"],
         contact=contact,
@@ -307,8 +343,12 @@ def summary(
     rng: tuple[float, float],
     resp: Response | None,
     num: NumericsResult | None,
+    decided: Headline | None = None,
 ) -> str:
-    """Two or three sentences an engineer can paste into a design review."""
+    """Two or three sentences an engineer can paste into a design review; with basins the
+    response named is the worst attractor's above the basin threshold (``decided``, with its
+    fraction), and the contact, DTE and dynamic factor those of the recorded run, said so when
+    that run settled elsewhere."""
     t_crit = critical_torque(conv, mel)
     if over_critical(conv, mel) and t_crit is not None and mel.critical_mean_force:
         words = load_words(conv, mel.critical_mean_force, t_crit)
@@ -332,7 +372,15 @@ def summary(
             text += f" It applies below the critical torque {t_crit:,.3g} N*m."
     if num is not None and resp is not None:
         kind = f"periodic ({num.period}T)" if num.period else num.classification.replace("_", "-")
-        text += f" The simulated response is {kind}"
+        if decided is None:
+            text += f" The simulated response is {kind}"
+        elif decided.kind == kind:
+            text += f" The simulated response is {kind} ({decided.decided_by})"
+        else:
+            text += (
+                f" The simulated response is {decided.kind} ({decided.decided_by}, the worst "
+                f"attractor); the recorded run from the settings' start is {kind}"
+            )
         if resp.contact is not None:
             text += f" with {IMPACT_WORDS.get(resp.contact.regime or '', 'no verdict on impacts')}"
             if resp.contact.separation_fraction > 0.0:
@@ -350,8 +398,10 @@ def engineering(
     rpm_range: tuple[float, float],
     mel: MelnikovResult,
     num: NumericsResult | None = None,
+    decided: Headline | None = None,
 ) -> Engineering:
-    """The engineering block of a design's Melnikov verdict (and analysis, given ``num``)."""
+    """The engineering block of a design's Melnikov verdict (and analysis, given ``num``;
+    ``decided`` the worst attractor of its basins, ``numerics.attractors.headline``)."""
     params = conv.params
     t_crit = critical_torque(conv, mel)
     note = None
@@ -391,6 +441,6 @@ def engineering(
         critical=crit,
         derived=conv.derived,
         response=resp,
-        summary=summary(conv, mel, windows, (lo, hi), resp, num),
+        summary=summary(conv, mel, windows, (lo, hi), resp, num, decided),
         notes=conv.notes,
     )

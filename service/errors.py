@@ -17,6 +17,7 @@ from pydantic import BaseModel, Field, ValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from gearengine.jsonio import field_path, located
+from gearengine.model.errors import InputError
 
 PROBLEM_JSON = "application/problem+json"
 TYPE_BASE = "https://gearchaos.dev/problems/"
@@ -121,6 +122,16 @@ _TITLES = {
 }
 
 
+def engine_refusal(exc: ValueError) -> ProblemError:
+    """422 for a ValueError of the engine; an ``InputError`` names its field (typed, never
+    read from the message's text)."""
+    errors = []
+    if isinstance(exc, InputError) and exc.path:
+        pointer = "/" + exc.path.replace(".", "/")
+        errors = [FieldError(path=exc.path, pointer=pointer, message=exc.message)]
+    return ProblemError(422, "refused", "Refused by the engine", str(exc), errors)
+
+
 def install(app: FastAPI) -> None:
     """Register the handlers that turn every error into problem+json."""
 
@@ -140,6 +151,12 @@ def install(app: FastAPI) -> None:
     async def _engine_invalid(_: Request, exc: ValidationError) -> JSONResponse:
         errors = field_errors(list(exc.errors(include_url=False)), strip_body=False)
         return problem_response(validation_problem(errors).problem)
+
+    @app.exception_handler(InputError)
+    async def _refused(_: Request, exc: InputError) -> JSONResponse:
+        """An engine refusal found after validation (a design's radii while costing a job's
+        work, say): 422 naming the field, never 500."""
+        return problem_response(engine_refusal(exc).problem)
 
     @app.exception_handler(StarletteHTTPException)
     async def _http(_: Request, exc: StarletteHTTPException) -> JSONResponse:

@@ -41,12 +41,53 @@ def test_the_gate_fails_on_the_upper_bound_and_names_the_points(
 ) -> None:
     junit = design_file.with_name("junit.xml")
     base = ["check", str(design_file), "--speed", "2000:5000", "--speed-points", "2"]
-    # 8 samples: even with no impact the upper bound is 0.31, above 0.01
-    assert main([*base, "--samples", "8", "--max-probability", "back_flank=0.01",
+    # 8 samples prove 0.4 (0 events: upper bound 0.369); 7 of 8 impact at 5000 rpm
+    assert main([*base, "--samples", "8", "--max-probability", "impacts=0.4",
                  "--junit", str(junit)]) == 1  # fmt: skip
     cases = ElementTree.parse(junit).getroot().findall("testcase")
     assert [c.get("name") for c in cases] == ["speed 2000 rpm", "speed 5000 rpm"]
-    assert all(c.find("failure") is not None for c in cases)
+    assert [c.find("failure") is not None for c in cases] == [False, True]
     assert "upper bound" in capsys.readouterr().out
     assert main([*base, "--samples", "8", "--max-probability", "back_flank=0.5"]) == 0
     assert main([*base, "--max-probability", "nonsense=0.1"]) == 2
+
+
+def test_samples_to_prove_is_where_the_clopper_pearson_bound_of_no_event_meets_the_limit() -> None:
+    """Checked against scipy's exact interval (``binomtest(0, n).proportion_ci``)."""
+    from scipy.stats import binomtest
+
+    from gearengine.studies.robustness.tolerances import samples_to_prove
+
+    def upper(n: int) -> float:
+        return binomtest(0, n).proportion_ci(0.95, method="exact").high
+
+    for limit in (0.01, 0.05, 0.1, 0.369):
+        n = samples_to_prove(limit)
+        assert upper(n) <= limit < upper(n - 1)
+    assert samples_to_prove(0.01) == 368
+    assert samples_to_prove(0.0) is None
+
+
+def test_a_gate_that_cannot_pass_is_refused_before_computing(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """256 samples cannot prove 1 % even with no event (upper bound 0.0143): exit 2 at once,
+    naming the count needed; a zero limit no count proves."""
+    base = ["check", str(design_file), "--speed", "2000:5000", "--speed-points", "2"]
+    assert main([*base, "--samples", "256", "--max-probability", "chaotic=0.01"]) == 2
+    err = capsys.readouterr().err
+    assert "--samples 256 cannot prove P(chaotic) <= 0.01" in err
+    assert "upper bound of 0.0143" in err and "it takes 368 samples with 0 events" in err
+    assert "--samples 512" in err
+    assert main([*base, "--max-probability", "chaotic=0"]) == 2
+    assert "no number of samples can prove a probability of 0" in capsys.readouterr().err
+
+
+def test_samples_auto_samples_until_every_point_is_decided(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    base = ["check", str(design_file), "--speed", "2000:5000", "--speed-points", "2"]
+    assert main([*base, "--samples", "auto", "--max-probability", "impacts=0.4"]) == 1
+    captured = capsys.readouterr()
+    assert "--samples auto: decided at 64 samples" in captured.err
+    assert "PASS: speed 2000 rpm" in captured.out and "FAIL: speed 5000 rpm" in captured.out

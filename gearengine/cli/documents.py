@@ -58,3 +58,13 @@ def validated_input(validate: Callable[[object], R], data: object, path: str) ->
 def read_request(path: str, model: type[R]) -> R:
     """Read and validate a request document from a file or ``-`` (stdin)."""
     return validated_input(model.model_validate, read_document(path), path)
+
+
+def points_of(axes: object) -> int:
+    """The operating points of a request's ``axes`` (their ``num`` multiplied; 1 without
+    axes), counted before validation so that a count over the limit is refused at once."""
+    n = 1
+    for a in axes if isinstance(axes, list) else []:
+        num = a.get("num", 1) if isinstance(a, dict) else 1
+        n *= num if isinstance(num, int) and num > 0 else 1
+    return n

@@ -28,6 +28,7 @@ from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
     InvalidInputError,
+    points_of,
     read_document,
     validated_input,
 )
@@ -46,6 +47,7 @@ from gearengine.gate.envelope import (
 )
 from gearengine.jsonio import dumps
 from gearengine.numerics.settings import SimulationSettings
+from gearengine.studies import jobs
 from gearengine.studies.sweep.points import SpeedWindows
 from gearengine.studies.sweep.request import SweepRequest, validated
 from gearengine.studies.sweep.results import SweepResult
@@ -83,7 +85,15 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
         axes,
         f"envelope check of {Path(args.file).name}",
     )
-    return validated_input(validated, sweep, args.file)
+    n = points_of(axes)
+    if n > jobs.MAX_JOB_POINTS:  # before the sweep's checks build its grids
+        raise InvalidInputError([f"this envelope check has {n} points, the limit is "
+                                 f"{jobs.MAX_JOB_POINTS} (max_job_points)"])  # fmt: skip
+    request = validated_input(validated, sweep, args.file)
+    why = jobs.over_budget("sweep", request, n, "envelope check")
+    if why is not None:
+        raise InvalidInputError([f"{why}, or run it on a server (--server URL)"])
+    return request
 
 
 def _here(design: dict, name: str) -> str:

@@ -2,7 +2,7 @@
 
     gearengine melnikov FILE [--json] [--method closed_form|quadrature] [--mean-load ...]
     gearengine analyze FILE [--json]
-    gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov|impacts|separation]
+    gearengine check FILE [--fail-on chaotic|quasi_periodic|diverged|melnikov|back_flank|separation]
         [--max-lle V] [--max-dte E] [--max-dynamic-factor F]
         [--min-stability-margin X]
     gearengine remedies FILE --speed A:B [--torque A:B] [check's rules] [--lever PATH=LO:HI]
@@ -90,12 +90,30 @@ def micrometres(text: str) -> float:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def samples_count(text: str) -> int | str:
+    """``--samples`` of the probability gate: a whole number, or ``auto``."""
+    if text == "auto":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("give a whole number (a power of 2) or auto") from None
+
+
 def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -> None:
     """The gate's rules and envelope options, shared by ``check`` and ``remedies``."""
     p.add_argument(
         "--fail-on",
         action="append",
-        choices=["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"],
+        choices=[
+            "chaotic",
+            "quasi_periodic",
+            "diverged",
+            "melnikov",
+            "back_flank",
+            "impacts",
+            "separation",
+        ],
         help="repeatable",
     )
     p.add_argument("--speed", metavar="LOW:HIGH", required=speed_required,
@@ -149,7 +167,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="CI gate: exit 1 when the design fails (0 pass, 2 invalid input)",
         description="--fail-on X fails on X or anything worse "
         "(periodic < quasi_periodic < chaotic < diverged); melnikov fails when a transverse "
-        "homoclinic tangle is possible; impacts on back-flank contact; separation when the "
+        "homoclinic tangle is possible; back_flank (or impacts) on back-flank impacts; "
+        "separation when the "
         "teeth separate (drive-flank impacts, or impacts on both flanks). Default: --fail-on "
         "chaotic; the limits (--max-lle, --max-dte, --max-dynamic-factor, --min-stability-margin) "
         "add to it. With "
@@ -174,10 +193,16 @@ def build_parser() -> argparse.ArgumentParser:
         help="fail when the response is periodic and its Floquet stability margin "
         "1 - max |lambda| is below X (or unavailable); one design only, not an envelope",
     )
-    p.add_argument("--max-probability", action="append", metavar="NAME=P",
-                   help="fail where the 95 %% upper bound of P(NAME) over the design's "
-                   "tolerances exceeds P (chaotic, impacts, back_flank; repeatable)")  # fmt: skip
-    p.add_argument("--samples", type=int, default=64, help="with --max-probability (default 64)")
+    p.add_argument(
+        "--max-probability",
+        action="append",
+        metavar="NAME=P",
+        help="fail where the 95 %% upper bound of P(NAME) over the design's "
+        "tolerances exceeds P (chaotic, separation, back_flank; repeatable)",
+    )
+    p.add_argument("--samples", type=samples_count, default=64,
+                   help="with --max-probability: N, a power of 2 (64), refused when too few "
+                   "to prove a limit; or auto: double until every point is decided")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="with --max-probability (default 0)")
     p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
 

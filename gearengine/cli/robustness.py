@@ -18,6 +18,7 @@ from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
     InvalidInputError,
+    points_of,
     read_document,
     validated_input,
 )
@@ -25,14 +26,16 @@ from gearengine.cli.envelope import axis
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import ENVELOPE_SETTINGS
 from gearengine.model.units import display_unit
+from gearengine.studies import jobs
 from gearengine.studies.robustness.study import (
     RobustnessRequest,
     RobustnessResult,
     checked,
     run_local,
 )
+from gearengine.studies.robustness.tolerances import samples_to_prove
 
-GATED = ("chaotic", "quasi_periodic", "diverged", "impacts", "back_flank",
+GATED = ("chaotic", "quasi_periodic", "diverged", "separation", "impacts", "back_flank",
          "dynamic_factor_above_limit", "melnikov_chaos_possible")  # fmt: skip
 """Probabilities a gate may limit."""
 
@@ -56,7 +59,17 @@ def robustness_request(args: argparse.Namespace) -> RobustnessRequest:
             "samples": args.samples, "seed": args.seed}  # fmt: skip
     if getattr(args, "sensitivity", False):
         body["sensitivity"] = True
-    return validated_input(lambda d: checked(RobustnessRequest.model_validate(d)), body, args.file)
+    n = points_of(body["axes"])
+    if n > jobs.MAX_JOB_POINTS:  # before the study's checks cost each point's design
+        raise InvalidInputError([f"this robustness study has {n} points, the limit is "
+                                 f"{jobs.MAX_JOB_POINTS} (max_job_points)"])  # fmt: skip
+    request = validated_input(
+        lambda d: checked(RobustnessRequest.model_validate(d)), body, args.file
+    )
+    why = jobs.over_budget("robustness", request, n, "robustness study")
+    if why is not None:
+        raise InvalidInputError([why])
+    return request
 
 
 def study(args: argparse.Namespace) -> tuple[RobustnessRequest, RobustnessResult]:
@@ -121,7 +134,7 @@ def cmd_robustness(args: argparse.Namespace) -> int:
         pr = p.probabilities
         words = ", ".join(
             f"{k} {pr[k].value:.3f} [{pr[k].interval[0]:.3f}, {pr[k].interval[1]:.3f}]"
-            for k in ("chaotic", "impacts", "back_flank")
+            for k in ("chaotic", "separation", "back_flank")
         )
         print(f"{point_name(p.shown)}: {words} ({p.samples} samples)")
         for line in p.ranking or []:
@@ -135,10 +148,80 @@ def cmd_robustness(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+AUTO_SAMPLES = 4096
+"""The most samples ``--samples auto`` draws before it stops undecided."""
+
+
+def samples_needed(limits: dict[str, float], samples: int | str) -> int:
+    """The fewest samples (a power of 2, as the Sobol points need) that can prove every limit
+    (``samples_to_prove``): refused before computing when ``samples`` (a count) is fewer or a
+    limit is 0, which no count proves."""
+    need = {name: samples_to_prove(limit) for name, limit in limits.items()}
+    for name, n in need.items():
+        if n is None:
+            raise InvalidInputError(
+                [
+                    f"--max-probability {name}=0: no number of samples can "
+                    "prove a probability of 0 (with 0 events the 95 % upper "
+                    "bound is 1 - 0.025^(1/n) > 0); give a limit above 0"
+                ]
+            )
+    for name, n in need.items():
+        if samples != "auto" and int(samples) < n:  # type: ignore[operator]
+            upper = 1.0 - 0.025 ** (1.0 / int(samples))
+            raise InvalidInputError([
+                f"--samples {samples} cannot prove P({name}) <= {limits[name]:g}: even 0 of "
+                f"{samples} samples leave a 95 % Clopper-Pearson upper bound of {upper:.3g}; it "
+                f"takes {n} samples with 0 events (--samples {_power_of_two(n)}, a power of 2, "
+                "or --samples auto to sample until every point is decided)"
+            ])  # fmt: skip
+    return _power_of_two(max(need.values(), default=1))
+
+
+def _power_of_two(n: int) -> int:
+    return 1 << max(0, (int(n) - 1).bit_length())
+
+
+def decided(result: RobustnessResult, limits: dict[str, float]) -> bool:
+    """Every point proven under every limit (upper bound at or below it) or over one (a lower
+    bound above it)."""
+    for p in result.points:
+        probs = [(p.probabilities[name].interval, limit) for name, limit in limits.items()]
+        if any(ci is None for ci, _ in probs):
+            return False
+        if not any(ci[0] > limit for ci, limit in probs) and any(
+            ci[1] > limit for ci, limit in probs
+        ):
+            return False
+    return True
+
+
+def sequential_study(
+    args: argparse.Namespace, limits: dict[str, float], least: int
+) -> RobustnessResult:
+    """``--samples auto``: from the fewest samples that can prove the limits, doubled (the
+    seeded Sobol points of 2N begin with those of N) until every point is decided or
+    ``AUTO_SAMPLES`` is reached."""
+    n = max(least, 64)
+    while True:
+        args.samples = n
+        _, result = study(args)
+        if decided(result, limits) or n >= AUTO_SAMPLES:
+            state = "decided" if decided(result, limits) else "still undecided"
+            print(f"--samples auto: {state} at {n} samples", file=sys.stderr)
+            return result
+        n *= 2
+
+
 def cmd_probability_gate(args: argparse.Namespace) -> int:
-    """``check --max-probability``: exit 1 where an upper bound exceeds its limit."""
+    """``check --max-probability``: exit 1 where an upper bound exceeds its limit; a sample
+    count that cannot prove a limit is refused before computing (``samples_needed``)."""
     limits = limits_of(args.max_probability)
-    _, result = study(args)
+    least = samples_needed(limits, args.samples)
+    if args.samples == "auto":
+        result = sequential_study(args, limits, least)
+    else:
+        _, result = study(args)
     why = failures(result, limits)
     for p, reasons in zip(result.points, why, strict=True):
         verdict = "FAIL" if reasons else "PASS"

@@ -60,24 +60,27 @@ def _number(value: float | None, fmt: str) -> str:
 
 
 def branch_table(name: str, branch: RunupBranch, result: RunupResult) -> list[str]:
-    """One line per bin: speed, DTE (and the quasi-static one), factor, contact, FTLE."""
+    """One line per bin: speed, DTE (and the quasi-static one), factor, contact (shares of time
+    apart and on the back flank, entries onto the drive and the back flank), FTLE."""
     quasi = {round(p.speed_rpm, 6): p for p in getattr(result.quasi_static, name).points}
     lines = [
         f"run-{name}:",
         "  speed [rpm]    time [s]   DTE [µm]  QS DTE  dyn.f.  contact       sep   back  "
-        "impacts  FTLE/tau",
+        "impacts drive/back  FTLE/tau",
     ]
     for b in branch.bins:
         lo, hi = b.speed_rpm
         q = quasi.get(round(0.5 * (lo + hi), 6))
-        impacts = "-" if b.back_flank_impacts is None else str(b.back_flank_impacts)
+        impacts = "/".join(  # entries onto each flank, as the JSON's two counts
+            "-" if n is None else str(n) for n in (b.drive_flank_impacts, b.back_flank_impacts)
+        )
         lines.append(
             f"  {lo:6.0f}-{hi:<6.0f} {b.time_s[0]:6.2f}-{b.time_s[1]:<5.2f} "
             f"{_number(b.dte_peak_to_peak_um, '8.2f')} "
             f"{_number(None if q is None else q.dte_peak_to_peak_um, '7.2f')} "
             f"{_number(b.dynamic_factor, '6.2f')}  {b.contact or '-':12s} "
             f"{_number(b.separation_fraction, '5.2f')} {_number(b.back_flank_fraction, '5.2f')} "
-            f"{impacts:>7s}  {_number(b.lle, '+8.4f')}{' chaotic' if b.chaotic else ''}"
+            f"{impacts:>18s}  {_number(b.lle, '+8.4f')}{' chaotic' if b.chaotic else ''}"
         )
     for j in branch.jumps:
         lag = ""

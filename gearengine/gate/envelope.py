@@ -4,8 +4,10 @@ that GitHub, GitLab and Jenkins show.
 
 Rules (``Rules``): ``fail_on`` classes (``chaotic`` fails chaotic and diverged points, ordered
 periodic < quasi_periodic < chaotic < diverged as in ``signals.classify.SEVERITY``),
-``melnikov`` (the criterion allows chaos), ``impacts`` (back-flank contact), ``separation`` (the
-teeth separate: drive-flank impacts, or impacts on both flanks); and numeric limits,
+``melnikov`` (the criterion allows chaos), ``back_flank`` (back-flank impacts; ``impacts``, its
+older name, means the same), ``separation`` (the teeth separate: drive-flank impacts, or impacts
+on both flanks) - the words of the robustness probabilities P(separation), P(back_flank); and
+numeric limits,
 which add to the classes instead of replacing them: ``max_lle`` (per unit tau), ``max_dte_um``
 (dynamic transmission error peak to peak, µm), ``max_dynamic_factor`` (largest mesh force over
 the static force F~_m). With basins (``settings.basins``) every attractor of a point whose
@@ -31,7 +33,11 @@ from gearengine.studies.sweep.request import SweepRequest
 from gearengine.studies.sweep.results import SweepResult
 from gearengine.studies.sweep.windows import SPEED, runs
 
-FailOn = Literal["chaotic", "quasi_periodic", "diverged", "melnikov", "impacts", "separation"]
+FailOn = Literal[
+    "chaotic", "quasi_periodic", "diverged", "melnikov", "back_flank", "impacts", "separation"
+]
+BACK_FLANK = ("back_flank", "impacts")
+"""The rule names of back-flank impacts (``impacts`` the older one, kept: the same rule)."""
 
 
 class Rules(BaseModel):
@@ -41,8 +47,9 @@ class Rules(BaseModel):
 
     fail_on: list[FailOn] = Field(
         default_factory=lambda: ["chaotic"],
-        description="Classes that fail (and anything worse), melnikov, impacts (back-flank "
-        "contact), separation (the teeth separate: drive-flank or back-flank impacts).",
+        description="Classes that fail (and anything worse), melnikov, back_flank (back-flank "
+        "impacts; impacts is its older name, the same rule), separation (the teeth separate: "
+        "drive-flank or back-flank impacts), as the robustness probabilities name them.",
     )
     max_lle: float | None = Field(None, description="Largest LLE allowed, per unit tau.")
     max_dte_um: float | None = Field(None, description="Largest DTE peak to peak [µm].")
@@ -71,7 +78,7 @@ def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
             break
     if "melnikov" in rules.fail_on and p.melnikov_chaos_possible:
         out.append("Melnikov: chaos possible")
-    if "impacts" in rules.fail_on and p.impact_regime == "double_sided":
+    if any(r in rules.fail_on for r in BACK_FLANK) and p.impact_regime == "double_sided":
         out.append("back-flank impacts")
     if "separation" in rules.fail_on and p.impact_regime in SEPARATING:
         out.append("tooth separation")

@@ -4,16 +4,16 @@ through the envelope's speed range at each torque level, failing on the envelope
 Rules on the bins of each branch (``gate.envelope.Rules``): ``chaotic`` in ``fail_on`` fails a
 run of chaotic bins (ensemble FTLE clearly positive, or above ``max_lle`` when given) that lasts
 longer than ``chaos_seconds``: a ramp crossing a chaotic window quickly may pass, one lingering
-in it fails. ``impacts`` fails back-flank impacts, ``separation`` any loss of contact,
-``max_dte_um`` and ``max_dynamic_factor`` their limits, each bin by itself. Failures name the
-branch and the speeds.
+in it fails. ``back_flank`` (or ``impacts``) fails back-flank impacts, ``separation`` any loss
+of contact, ``max_dte_um`` and ``max_dynamic_factor`` their limits, each bin by itself.
+Failures name the branch and the speeds.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
-from gearengine.gate.envelope import EnvelopeReport, FailingWindow, Rules
+from gearengine.gate.envelope import BACK_FLANK, EnvelopeReport, FailingWindow, Rules
 from gearengine.model.units import RPM
 from gearengine.studies.runup.compute import run_local
 from gearengine.studies.runup.profile import validated
@@ -31,7 +31,7 @@ GATE_ENSEMBLE = 4
 def bin_failures(b: RunupBin, rules: Rules) -> list[str]:
     """The per-bin rules a bin breaks (chaos is judged over runs, see ``runup_failures``)."""
     out = []
-    if "impacts" in rules.fail_on and (b.back_flank_impacts or 0) > 0:
+    if any(r in rules.fail_on for r in BACK_FLANK) and (b.back_flank_impacts or 0) > 0:
         out.append("back-flank impacts")
     if "separation" in rules.fail_on and (b.separation_fraction or 0) > 0:
         out.append("tooth separation")

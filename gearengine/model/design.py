@@ -17,6 +17,7 @@ frequency unless an ``order`` (multiple of the driver speed) is given; the torqu
 from __future__ import annotations
 
 import math
+import re
 from typing import Annotated, Any, Literal
 
 from pydantic import (
@@ -39,6 +40,7 @@ from gearengine.model.params import (
 from gearengine.model.tolerances import Tolerances
 from gearengine.model.train import Train
 from gearengine.model.units import (
+    QUANTITIES,
     Angle,
     Bore,
     Damping,
@@ -47,9 +49,11 @@ from gearengine.model.units import (
     Inertia,
     Length,
     MeshStiffness,
+    Module,
     Speed,
     StiffnessVariation,
     Torque,
+    parse_quantity,
     readings,
 )
 
@@ -70,7 +74,7 @@ class Gear(StrictModel):
     teeth: WholeNumber = Field(ge=5, le=1000, description="Number of teeth z.", examples=[18])
     base_radius: Length | None = Field(None, description="Base-circle radius r_b.")
     inertia: Inertia | None = Field(None, description="Mass moment of inertia about the axis.")
-    module: Length | None = Field(None, description="Normal module m (geometry form).")
+    module: Module | None = Field(None, description="Normal module m (geometry form).")
     face_width: Length | None = Field(None, description="Face width b (geometry form).")
     pressure_angle: Angle = Field(math.radians(20.0), description="Pressure angle (20 deg).")
     profile_shift: float = Field(
@@ -127,7 +131,10 @@ class ErrorHarmonic(StrictModel):
 class TorqueFluctuationHarmonic(StrictModel):
     """Harmonic r of the driver-torque fluctuation (Eq. 3)."""
 
-    amplitude: Torque = Field(description="T_pr.", examples=["4 N*m"])
+    amplitude: Torque = Field(
+        description="T_pr; or a share of the mean torque, '3 %' (scales with the torque).",
+        examples=["4 N*m"],
+    )
     phase: Phase = Field(0.0, description="Phase, rad.")
 
 
@@ -239,14 +246,25 @@ class Design(StrictModel):
 
     _readings: list[str] = PrivateAttr(default_factory=list)
 
+    _ripple_shares: dict[int, float] = PrivateAttr(default_factory=dict)
+
     @model_validator(mode="wrap")
     @classmethod
     def _with_readings(cls, data: Any, handler: ModelWrapValidatorHandler[Design]) -> Design:
-        """Validate, keeping what was understood from engineers' unit spellings ("40 Nm")."""
+        """Validate, keeping what was understood from engineers' unit spellings ("40 Nm"),
+        bare numbers and torque fluctuation amplitudes in % of the mean torque."""
         with readings() as found:
+            data, shares = ripple_of_mean_torque(data, found)
             design = handler(data)
         design._readings = found
+        design._ripple_shares = shares
         return design
+
+    @property
+    def ripple_shares(self) -> dict[int, float]:
+        """Torque fluctuation harmonics given in % of the mean torque: {index: percent}, so
+        that a design with another torque (a sweep's point) scales them."""
+        return dict(self._ripple_shares)
 
     @property
     def readings(self) -> list[str]:
@@ -281,6 +299,41 @@ class Design(StrictModel):
         if tol is not None and tol.backlash is not None and BACKLASH_FIELD in tol.fields():
             raise InputError("tolerances.backlash", f"already sets {BACKLASH_FIELD}")
         return self
+
+
+SHARE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*%\s*")
+"""A share in percent, "3 %"."""
+
+
+def ripple_of_mean_torque(data: Any, notes: list[str]) -> tuple[Any, dict[int, float]]:
+    """``data`` with each torque fluctuation amplitude given in % ("3 %") written as that share
+    of the mean torque in N*m (Eq. 3's T_pr = 0.03 T_m), with a note each, and the shares by
+    harmonic index. Elsewhere a "%" is refused (``model.units.parse_quantity``); a torque
+    that cannot be read is left to its own field's error."""
+    harmonics = data.get("torque_fluctuation") if isinstance(data, dict) else None
+    harmonics = harmonics.get("harmonics") if isinstance(harmonics, dict) else None
+    if not isinstance(harmonics, list):
+        return data, {}
+    shares = {k: float(m.group(1)) for k, h in enumerate(harmonics)
+              if isinstance(h, dict) and isinstance(h.get("amplitude"), str)
+              and (m := SHARE.fullmatch(h["amplitude"]))}  # fmt: skip
+    if not shares:
+        return data, {}
+    try:
+        with readings():  # the torque's own reading is noted by its field
+            mean = parse_quantity(data.get("torque"), QUANTITIES["torque"], allow_zero=True)
+    except ValueError:
+        return data, {}
+    written = [dict(h) if isinstance(h, dict) else h for h in harmonics]
+    for k, share in shares.items():
+        amplitude = share / 100.0 * abs(mean)
+        written[k]["amplitude"] = f"{amplitude!r} N*m"
+        notes.append(
+            f"torque_fluctuation.harmonics.{k}.amplitude {share:g} % read as {amplitude:.6g} "
+            f"N*m, {share:g} % of the mean torque {mean:.6g} N*m"
+        )
+    fluctuation = {**data["torque_fluctuation"], "harmonics": written}
+    return {**data, "torque_fluctuation": fluctuation}, shares
 
 
 ACCURACY_FIELD = "transmission_error.harmonics.0.amplitude"

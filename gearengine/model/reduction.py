@@ -269,8 +269,15 @@ def convert_design(design: Design) -> DesignConversion:
         ("driver", data.base_radius_a, data.inertia_a),
         ("driven", data.base_radius_b, data.inertia_b),
     ):
-        derived.setdefault(f"base_radius_{role}", Derived(value=r, unit="m", source="given"))
-        derived.setdefault(f"inertia_{role}", Derived(value=inertia, unit="kg*m^2", source="given"))
+        gear = getattr(design, role)
+        for name, value, unit in (("base_radius", r, "m"), ("inertia", inertia, "kg*m^2")):
+            key = f"{name}_{role}"
+            if key in derived and getattr(gear, name) is not None:  # given beside the geometry
+                notes.append(f"{role}.{name}: the given {value:.6g} {unit} is used, not the "
+                             f"{float(derived[key].value):.6g} {unit} the geometry gives "  # type: ignore[arg-type]
+                             f"({derived[key].source})")  # fmt: skip
+                derived[key] = Derived(value=value, unit=unit, source="given")
+            derived.setdefault(key, Derived(value=value, unit=unit, source="given"))
     derived["equivalent_mass"] = Derived(
         value=m, unit="kg", source="m = I_a I_b / (I_b r_a^2 + I_a r_b^2) (Eq. 7)"
     )

@@ -310,6 +310,17 @@ class Headline:
     period: int | None
     decided_by: str
     """Which member decided it: 'chaotic, double-sided impacts from 41 % of starts'."""
+    fraction: float
+    """Its basin fraction (of diverged starts for 'diverged')."""
+    attractor: Attractor | None = None
+    """The deciding attractor (None for divergence): its LLE and impact regime."""
+
+    @property
+    def kind(self) -> str:
+        """'periodic (1T)', 'chaotic', 'quasi-periodic', 'diverged'."""
+        if self.period:
+            return f"{self.classification} ({self.period}T)"
+        return self.classification.replace("_", "-")
 
 
 def percent(fraction: float) -> str:
@@ -322,11 +333,11 @@ def headline(found: list[Attractor], counts: BasinCounts, min_fraction: float) -
     None when no start qualifies (every basin at or below it)."""
     diverged = counts.diverged / counts.starts
     if counts.diverged and diverged > min_fraction:
-        return Headline("diverged", None, f"diverged from {percent(diverged)} of starts")
+        return Headline("diverged", None, f"diverged from {percent(diverged)} of starts", diverged)
     for a in found:  # worst first
         if a.fraction > min_fraction:
-            return Headline(a.classification, a.period,
-                            f"{a.label} from {percent(a.fraction)} of starts")  # fmt: skip
+            text = f"{a.label} from {percent(a.fraction)} of starts"
+            return Headline(a.classification, a.period, text, a.fraction, a)
     return None
 
 

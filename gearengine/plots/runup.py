@@ -15,11 +15,11 @@ from gearengine.studies.runup.results import RunupBranch, RunupResult
 
 COLOURS = {"up": "#1f77b4", "down": "#d62728"}
 """Line colour of each branch."""
-CONTACT_COLOURS = {"drive_flank": "#c7e9c0", "no_contact": "#fdae6b", "both_flanks": "#a50f15"}
+CONTACT_COLOURS = {"drive_flank": "#c7e9c0", "separation": "#fdae6b", "both_flanks": "#a50f15"}
 """Band colour of each contact status."""
 CONTACT_WORDS = {
     "drive_flank": "drive flank (always in contact)",
-    "no_contact": "loses contact (tooth separation)",
+    "separation": "loses contact at times (tooth separation)",
     "both_flanks": "both flanks (back-flank impacts)",
 }
 

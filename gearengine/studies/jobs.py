@@ -49,6 +49,28 @@ class JobKind:
     assemble: Callable[[Any, list[str]], BaseModel]
 
 
+MAX_JOB_POINTS = 40_000
+"""Most operating points of one job (the service's default ``max_job_points``, every door)."""
+MAX_JOB_STEPS = 20_000_000_000
+"""Compute budget of one job in RK4 steps (the service's default ``max_job_steps``): about a
+minute on two cores."""
+
+
+def over_budget(name: str, request: BaseModel, points: int, noun: str) -> str | None:
+    """Why a job of kind ``name`` with ``points`` operating points is over the default limits
+    (``MAX_JOB_POINTS``, then its work against ``MAX_JOB_STEPS``), else None: the CLI refuses
+    what the API refuses, before computing (the points first, so no work is costed for them)."""
+    if points > MAX_JOB_POINTS:
+        return f"this {noun} has {points} points, the limit is {MAX_JOB_POINTS} (max_job_points)"
+    steps = kind(name).work(request)
+    if steps > MAX_JOB_STEPS:
+        return (
+            f"this {noun} needs {steps} RK4 steps, over the budget of {MAX_JOB_STEPS} steps "
+            f"per {noun} (max_job_steps); use fewer points, periods or steps per period"
+        )
+    return None
+
+
 KINDS: dict[str, str] = {
     "sweep": "gearengine.studies.sweep.compute:SWEEP_JOB",
     "remedies": "gearengine.gate.remedies.compute:REMEDIES_JOB",

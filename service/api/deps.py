@@ -16,10 +16,9 @@ from fastapi import Depends, Request, Response
 from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
-from gearengine.model.errors import InputError
 from service.cache import ResponseCache, etag_for
 from service.core.config import Settings
-from service.errors import FieldError, ProblemError
+from service.errors import ProblemError, engine_refusal
 from service.jobs.runtime import JobQueue
 from service.limits import Limits
 from service.metrics import Metrics
@@ -167,16 +166,6 @@ async def cached_compute(
         on_fresh(body)
     headers |= {"X-Cache": "miss", "Server-Timing": f"compute;dur={elapsed:.3f}"}
     return Response(body, media_type=media_type, headers=headers)
-
-
-def engine_refusal(exc: ValueError) -> ProblemError:
-    """422 for a ValueError of the engine; an ``InputError`` names its field (typed, never
-    read from the message's text)."""
-    errors = []
-    if isinstance(exc, InputError) and exc.path:
-        pointer = "/" + exc.path.replace(".", "/")
-        errors = [FieldError(path=exc.path, pointer=pointer, message=exc.message)]
-    return ProblemError(422, "refused", "Refused by the engine", str(exc), errors)
 
 
 def _if_none_match(request: Request) -> set[str]:

@@ -13,6 +13,8 @@ from pathlib import Path
 from pydantic import AliasChoices, Field
 from pydantic_settings import BaseSettings, SettingsConfigDict
 
+from gearengine.studies.jobs import MAX_JOB_POINTS, MAX_JOB_STEPS
+
 
 def _job_alias(what: str) -> AliasChoices:
     """The environment variables of the ``max_job_<what>`` setting: its own and its name from
@@ -77,14 +79,14 @@ class Settings(BaseSettings):
     cache_entries: int = Field(512, ge=0, description="Responses kept in the in-memory LRU.")
 
     max_job_points: int = Field(
-        40_000,
+        MAX_JOB_POINTS,
         ge=1,
         validation_alias=_job_alias("points"),
         description="Most points of one job (every axis and branch counted). Environment: "
         "GEARCHAOS_MAX_JOB_POINTS, or its old name GEARCHAOS_MAX_SWEEP_POINTS (an alias).",
     )
     max_job_steps: int = Field(
-        20_000_000_000,
+        MAX_JOB_STEPS,
         ge=1000,
         validation_alias=_job_alias("steps"),
         description="Compute budget of one job in RK4 steps (points x periods x steps x "

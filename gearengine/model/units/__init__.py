@@ -35,6 +35,7 @@ from gearengine.model.units.quantities import (
     Length,
     Mass,
     MeshStiffness,
+    Module,
     SampleRate,
     ShearModulus,
     Speed,
@@ -45,6 +46,7 @@ from gearengine.model.units.quantities import (
     parse_quantity,
     readings,
     registry,
+    si_numbers,
 )
 
 __all__ = [
@@ -65,6 +67,7 @@ __all__ = [
     "Length",
     "Mass",
     "MeshStiffness",
+    "Module",
     "SampleRate",
     "Scales",
     "ShearModulus",
@@ -84,5 +87,6 @@ __all__ = [
     "registry",
     "response_values",
     "shown",
+    "si_numbers",
     "to_physical",
 ]

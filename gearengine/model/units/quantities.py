@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from functools import cache
 from typing import TYPE_CHECKING, Annotated, Any
 
-from pydantic import BeforeValidator
+from pydantic import BeforeValidator, ValidationInfo
 
 if TYPE_CHECKING:
     import pint
@@ -81,6 +81,20 @@ def readings() -> Iterator[list[str]]:
         _READINGS.reset(token)
 
 
+_SI_NUMBERS: ContextVar[bool] = ContextVar("si_numbers", default=False)
+
+
+@contextmanager
+def si_numbers() -> Iterator[None]:
+    """Inside this block bare numbers are the engine's own SI values (a validated design
+    dumped and read again with a field changed), read without a note."""
+    token = _SI_NUMBERS.set(True)
+    try:
+        yield
+    finally:
+        _SI_NUMBERS.reset(token)
+
+
 _NUMBER_AND_UNIT = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)\s*")
 
 
@@ -99,6 +113,7 @@ def _respelled(text: str, kind: QuantityKind) -> str:
 
 QUANTITIES: dict[str, QuantityKind] = {
     "length": QuantityKind("length", "m", 1e-9, 10.0, ("um", "mm"), "30 mm"),
+    "module": QuantityKind("module", "m", 1e-5, 0.1, ("mm",), "3 mm"),
     "half_backlash": QuantityKind("half backlash", "m", 1e-7, 5e-3, ("um", "mm"), "50 um"),
     "error": QuantityKind("transmission error", "m", 0.0, 1e-3, ("um", "mm"), "5 um"),
     "speed": QuantityKind(
@@ -142,14 +157,19 @@ QUANTITIES: dict[str, QuantityKind] = {
 """Kinds of quantity by key; ``low``/``high`` bound plausible magnitudes in SI units."""
 
 # Lengths of gear bodies (radius, module, face width, bore) may be zero only for a bore.
-POSITIVE_KINDS = frozenset({"length", "half_backlash", "speed", "stiffness", "inertia", "angle"})
+POSITIVE_KINDS = frozenset(
+    {"length", "module", "half_backlash", "speed", "stiffness", "inertia", "angle"}
+)
 
 
-def parse_quantity(value: object, kind: QuantityKind, allow_zero: bool = False) -> float:
+def parse_quantity(
+    value: object, kind: QuantityKind, allow_zero: bool = False, field: str | None = None
+) -> float:
     """``value`` (a string with a unit, or a number in SI units) in the kind's SI unit.
 
     Raises ValueError naming the unit given and the dimension expected, or the plausible range
-    with a guess at the intended unit.
+    with a guess at the intended unit. A bare number is read in SI units with a note naming
+    ``field`` (``_bare``).
     """
     ureg = registry()
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
@@ -162,9 +182,18 @@ def parse_quantity(value: object, kind: QuantityKind, allow_zero: bool = False) 
         except Exception as exc:
             raise ValueError(f"cannot read {value!r} as a quantity ({exc}); write e.g. "
                              f"{kind.example!r}") from None  # fmt: skip
-        if not isinstance(quantity, ureg.Quantity):
-            quantity = ureg.Quantity(float(quantity), kind.unit)
-        elif quantity.dimensionless and kind.unit not in ("rad",):
+        if isinstance(quantity, ureg.Quantity) and str(quantity.units) in SHARES:
+            raise ValueError(
+                f"{value!r} is a share, not a {kind.name}: give a unit of dimension "
+                f"{kind.dimensionality}, e.g. {kind.example!r} (a share of a nominal value is "
+                "read only where one is meant: a torque fluctuation amplitude in % of the mean "
+                "torque)"
+            )
+        if not isinstance(quantity, ureg.Quantity) or str(quantity.units) == "dimensionless":
+            return _bare(
+                float(getattr(quantity, "magnitude", quantity)), value, kind, allow_zero, field
+            )
+        if quantity.dimensionless and kind.unit not in ("rad",):
             quantity = ureg.Quantity(quantity.magnitude, kind.unit)
         if quantity.dimensionality != kind.dimensionality:
             raise ValueError(
@@ -174,8 +203,32 @@ def parse_quantity(value: object, kind: QuantityKind, allow_zero: bool = False) 
             )
         si = float(quantity.to(kind.unit).magnitude)
     else:
-        si = float(value)
+        return _bare(float(value), value, kind, allow_zero, field)
     return _plausible(si, value, kind, allow_zero)
+
+
+SHARES = frozenset({"percent", "permille", "ppm"})
+"""Dimensionless units of a share: refused in a dimensional field (pint would read "3 %" as
+0.03, and a dimensionless magnitude here as the SI unit)."""
+
+
+def _bare(
+    si: float, given: object, kind: QuantityKind, allow_zero: bool, field: str | None
+) -> float:
+    """A bare number (no unit) read in the kind's SI unit, noted in the current ``readings``
+    with the value in the example's unit ("shaft speed: the bare number 6000 read as 6000
+    rad/s = 57,295.8 rpm; write '6000 rpm' if rpm was meant"), the same reading as every other
+    door (API, library; the CLI's options name their unit)."""
+    si = _plausible(si, given, kind, allow_zero)
+    found = _READINGS.get()
+    if found is not None and si != 0.0 and not _SI_NUMBERS.get():
+        shown = kind.example.split(maxsplit=1)[-1]
+        text = f"{field or kind.name}: the bare number {si:g} read as {kind.describe(si)}"
+        if shown != kind.unit:
+            other = float(registry().Quantity(si, kind.unit).to(shown).magnitude)
+            text += f" = {other:,.6g} {shown}; write '{si:g} {shown}' if {shown} was meant"
+        found.append(text)
+    return si
 
 
 def _plausible(si: float, given: object, kind: QuantityKind, allow_zero: bool) -> float:
@@ -188,6 +241,9 @@ def _plausible(si: float, given: object, kind: QuantityKind, allow_zero: bool) -
         return si
     ureg = registry()
     shown = given if isinstance(given, str) else kind.describe(si)
+    if si < 0.0 and kind.low > 0.0:  # no slip of the unit makes it positive
+        raise ValueError(f"{shown} is negative; a {kind.name} is a positive magnitude, e.g. "
+                         f"{kind.example!r}")  # fmt: skip
     message = (
         f"{shown} is outside the plausible range of a {kind.name}, "
         f"{kind.describe(kind.low)} to {kind.describe(kind.high)}"
@@ -264,16 +320,17 @@ def quantity_type(key: str, allow_zero: bool = False, keyword: str | None = None
     ``keyword`` (such as "iso6336": derive it) passes through as the string itself."""
     kind = QUANTITIES[key]
 
-    def parse(value: object) -> float | str:
+    def parse(value: object, info: ValidationInfo) -> float | str:
         if keyword is not None and value == keyword:
             return keyword
-        return parse_quantity(value, kind, allow_zero)
+        return parse_quantity(value, kind, allow_zero, info.field_name)
 
     stored = float if keyword is None else float | str
     return Annotated[stored, BeforeValidator(parse), QuantitySchema(kind, allow_zero, keyword)]
 
 
 Length = quantity_type("length")
+Module = quantity_type("module")
 Bore = quantity_type("length", allow_zero=True)
 HalfBacklash = quantity_type("half_backlash")
 ErrorAmplitude = quantity_type("error", allow_zero=True)

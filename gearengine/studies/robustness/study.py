@@ -52,7 +52,13 @@ CLASSES = ("periodic", "quasi_periodic", "chaotic", "diverged")
 CONTACTS = ("no_impact", "single_sided", "double_sided")
 RUN_FIELDS = ("class", "contact", "melnikov", "dte_um", "dynamic_factor")
 """The entries of one stored run, in order."""
-EVENTS = ("impacts", "back_flank", "dynamic_factor_above_limit", "melnikov_chaos_possible")
+EVENTS = (
+    "separation",
+    "impacts",
+    "back_flank",
+    "dynamic_factor_above_limit",
+    "melnikov_chaos_possible",
+)
 OUTPUTS = ("chaotic", "impacts", "back_flank", "dte", "dynamic_factor")
 """The outputs whose Sobol indices are reported."""
 DEFAULT_CHUNK_ROWS = 16
@@ -211,7 +217,9 @@ class RobustnessPoint(BaseModel):
     samples: int = Field(description="Samples counted at this point.")
     probabilities: dict[str, Probability] = Field(
         description="Of each class (periodic, quasi_periodic, chaotic, diverged) and event "
-        "(impacts: any tooth separation; back_flank: back-flank impacts; "
+        "(separation: the teeth separate, drive-flank or back-flank impacts, as the gate's "
+        "--fail-on separation; impacts: its older name, the same count; back_flank: back-flank "
+        "impacts, as --fail-on back_flank; "
         "dynamic_factor_above_limit; melnikov_chaos_possible)."
     )
     dte_um: dict[str, float | None] = Field(description="DTE over the samples: mean, p5, p95.")
@@ -256,7 +264,8 @@ def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[
     base = [r for row, r in zip(rows, runs, strict=True) if counted is None or row in counted]
     n = len(base)
     probs = {c: probability(sum(r[0] == k for r in base), n) for k, c in enumerate(CLASSES)}
-    probs["impacts"] = probability(sum(r[1] in (1, 2) for r in base), n)
+    probs["separation"] = probability(sum(r[1] in (1, 2) for r in base), n)
+    probs["impacts"] = probs["separation"]  # its older name
     probs["back_flank"] = probability(sum(r[1] == 2 for r in base), n)
     limit = request.dynamic_factor_limit
     probs["dynamic_factor_above_limit"] = probability(

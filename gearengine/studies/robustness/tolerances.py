@@ -187,3 +187,19 @@ def probability(k: int, n: int) -> dict[str, object]:
         return {"value": None, "interval": None, "count": 0, "samples": 0}
     ci = stats.binomtest(k, n).proportion_ci(0.95, method="exact")
     return {"value": k / n, "interval": [float(ci.low), float(ci.high)], "count": k, "samples": n}
+
+
+def samples_to_prove(limit: float, confidence: float = 0.95) -> int | None:
+    """The fewest samples n that can show P <= ``limit``: with 0 events the two-sided
+    Clopper-Pearson upper bound is 1 - ((1 - confidence)/2)^(1/n) (``probability``), at or
+    below ``limit`` from n = ln((1 - confidence)/2) / ln(1 - limit) on (368 for 1 %, 74 for
+    5 %); None for a zero limit, which no count proves."""
+    if limit <= 0.0:
+        return None
+    if limit >= 1.0:
+        return 1
+    tail = (1.0 - confidence) / 2.0
+    n = max(1, math.ceil(math.log(tail) / math.log1p(-limit)))
+    while 1.0 - tail ** (1.0 / n) > limit:  # rounding of the logarithms
+        n += 1
+    return n

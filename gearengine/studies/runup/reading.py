@@ -8,7 +8,9 @@ tau, averaged over the ensemble of slightly perturbed starts: the ensemble-avera
 (instantaneous) Lyapunov exponent of systems under parameter drift (D. Janosi and T. Tel,
 "Characterizing chaos in systems subjected to parameter drift", Phys. Rev. E 105, L062202
 (2022); the ensemble view of their 2024 work that ChaosTools.jl PR #345 implements). The window
-is one speed bin (``bin_rpm`` / rate seconds on a ramp); its standard error is the ensemble's.
+is one speed bin (``bin_rpm`` / rate seconds on a ramp); its standard error is that of the
+rates of every member's blocks in the bin (batch means over members and blocks: members that
+settle on one orbit agree to the last bit, so their spread alone would read as exactly 0).
 
 Jumps: between neighbouring bins in the direction of travel, the DTE changes by at least
 ``JUMP_RATIO`` times and by at least ``JUMP_MIN_B`` half backlashes; the speed of a jump is the
@@ -124,15 +126,18 @@ def _bins(request: RunupRequest, tables: list[np.ndarray], branch: Branch, lo: f
         logs = np.array([t[block_ids, LOG].sum() for t in tables if len(t)])
         tau = float(((mine[:, T1] - mine[:, T0]).sum()) * scales.natural_frequency)
         if ok and len(logs) == len(tables) and np.isfinite(logs).all() and tau > 0:
-            rates = logs / tau
-            lle = float(rates.mean())
+            lle = float((logs / tau).mean())
+            # the spread of the rates of every member's blocks in the bin: members that settle
+            # on one orbit agree to the last bit, and their spread alone would read as 0
+            taus = (mine[:, T1] - mine[:, T0]) * scales.natural_frequency
+            rates = np.concatenate([t[block_ids, LOG] / taus for t in tables if len(t)])
             stderr = float(rates.std(ddof=1) / math.sqrt(len(rates))) if len(rates) > 1 else None
         sep = back = None
         contact = None
         if ok:
             sep = float(mine[:, SEP].sum() / steps)
             back = float(mine[:, BACK].sum() / steps)
-            contact = "both_flanks" if back > 0 else ("no_contact" if sep > 0 else "drive_flank")
+            contact = "both_flanks" if back > 0 else ("separation" if sep > 0 else "drive_flank")
         factor = None
         if ok and (mine[:, FM] > 0).all():  # each block at its own mean force (a torque ramp)
             blocks = zip(mine[:, FMAX].tolist(), mine[:, FM].tolist(), strict=True)

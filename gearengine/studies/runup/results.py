@@ -28,8 +28,9 @@ class RunupBin(_Result):
     )
     back_flank_fraction: float | None = Field(description="Share of the time on the back flank.")
     contact: str | None = Field(
-        description="drive_flank (always in contact), no_contact (loses contact at times), "
-        "both_flanks (reaches the back flank)."
+        description="drive_flank (always in contact), separation (the teeth separate at times, "
+        "separation_fraction says how long; the gate's --fail-on separation), both_flanks "
+        "(reaches the back flank: back_flank). Was no_contact, which read as never touching."
     )
     back_flank_impacts: int | None = Field(description="Entries onto the back flank.")
     drive_flank_impacts: int | None = Field(
@@ -39,7 +40,10 @@ class RunupBin(_Result):
         description="Ensemble-averaged finite-time Lyapunov exponent over the bin, per unit "
         "tau (x 1/time_scale_s for 1/s); null where a member diverged."
     )
-    lle_stderr: float | None = Field(description="Its standard error over the ensemble.")
+    lle_stderr: float | None = Field(
+        description="Its standard error: of the rates of every member's blocks in the bin "
+        "(members settled on one orbit agree exactly, so the ensemble's spread alone is 0)."
+    )
     chaotic: bool | None = Field(
         description="lle > 1e-3 and > 3 lle_stderr (signals.classify's rule)."
     )

@@ -23,7 +23,7 @@ from gearengine.model.aliases import ALIASES, with_aliases, with_speed_factor
 from gearengine.model.design import Design
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import convert_design
-from gearengine.model.units import Scales
+from gearengine.model.units import Scales, si_numbers
 from gearengine.systems.spur_pair.forcing import packed_forcing
 
 OMEGA = "Omega"
@@ -82,7 +82,12 @@ def design_with(design: Design, values: dict[str, object]) -> Design:
     tree = design.model_dump()
     for path, value in values.items():
         _set(tree, path, value)
-    return Design.model_validate(tree)
+    for k, share in design.ripple_shares.items():  # a ripple in % follows the mean torque
+        path = f"torque_fluctuation.harmonics.{k}.amplitude"
+        if path not in values:
+            _set(tree, path, f"{share!r} %")
+    with si_numbers():  # the dump's numbers are SI: no note on them
+        return Design.model_validate(tree)
 
 
 def si_value(design: Design, path: str, value: object) -> float:

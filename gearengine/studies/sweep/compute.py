@@ -12,10 +12,10 @@ from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
 from gearengine.model.units import OUTPUTS, Scales, display_unit, in_display_unit, response_values
-from gearengine.numerics.attractors import coexisting, points_attractors
+from gearengine.numerics.attractors import coexisting, headline, points_attractors
 from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
 from gearengine.numerics.bifurcations import PointResponse, locate_bifurcations
-from gearengine.numerics.results import BatchPoint
+from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies import jobs
 from gearengine.studies.sweep.axes import is_dimensionless
@@ -62,16 +62,20 @@ def _point(
 ) -> SweepPoint:
     """The sweep's point from the engine's verdict ``bp`` (typed and finite, built by
     ``numerics.batch``), so ``model_construct`` skips a second validation (~0.05 ms a point);
-    ``basins`` its attractors, basins and coexisting entries (empty without basins)."""
+    ``basins`` its attractors, basins and coexisting entries (empty without basins) and the
+    verdict of its worst attractor (``_decided``)."""
     possible = chaos_possible(params)
+    verdict = {
+        "classification": bp.classification,
+        "period": bp.period,
+        "lle": bp.lle,
+        "lle_stderr": bp.lle_stderr,
+        "impact_regime": bp.impact_regime,
+    }
     return SweepPoint.model_construct(
         values={name: float(v) for name, v in values.items()},
         branch=branch,
-        classification=bp.classification,
-        period=bp.period,
-        lle=bp.lle,
-        lle_stderr=bp.lle_stderr,
-        impact_regime=bp.impact_regime,
+        **{**verdict, **basins.pop("verdict", {})},
         melnikov_chaos_possible=None if possible is None else bool(possible),
         poincare_x=[s[0] for s in bp.poincare],
         x_peak_to_peak=bp.x_peak_to_peak,
@@ -134,11 +138,31 @@ def _basins(
         return [{} for _ in scaled]
     designs = [params for params, _ in scaled]
     found = points_attractors(designs, request.settings, [sc for _, sc in scaled])
-    out: list[dict[str, Any]] = [{"attractors": a, "basins": c} for a, c in found]
+    min_fraction = request.settings.basins.min_fraction
+    out: list[dict[str, Any]] = [
+        {"attractors": a, "basins": c, **_decided(a, c, min_fraction)} for a, c in found
+    ]
     if request.continuation:
         for entry, bp in zip(out, verdicts, strict=True):
             entry["coexisting"] = coexisting(bp, entry["attractors"], entry["basins"])
     return out
+
+
+def _decided(found: list[Attractor], counts: BasinCounts, min_fraction: float) -> dict[str, Any]:
+    """The point's verdict from its ensemble (docs/basins.md): the worst attractor (or the
+    divergence) whose basin fraction is above ``min_fraction`` (``numerics.attractors.headline``),
+    its classification, period, LLE and impacts, named with its fraction in ``decided_by``; empty
+    when no basin is above it (the settings' own starts decide)."""
+    head = headline(found, counts, min_fraction)
+    if head is None:
+        return {}
+    verdict: dict[str, Any] = {"classification": head.classification, "period": head.period}
+    a = head.attractor
+    if a is None:  # diverged: no LLE, no impact verdict
+        verdict.update(lle=None, lle_stderr=None, impact_regime=None)
+    else:
+        verdict.update(lle=a.lle, lle_stderr=a.lle_stderr, impact_regime=a.impact_regime)
+    return {"verdict": verdict, "decided_by": head.decided_by, "decided_fraction": head.fraction}
 
 
 def _line_bifurcations(

@@ -101,12 +101,18 @@ CSV_FIELDS = (
 )
 """The CSV's columns after the axes, the long Poincaré column last."""
 
+BASIN_COLUMNS = ("decided_by", "decided_fraction", "basin_starts", "attractors")
+"""The CSV's last columns with settings.basins: who decided the verdict columns (the worst
+attractor above basins.min_fraction) and its fraction, the starts run, and every attractor with
+its basin fraction, worst first ('chaotic, double-sided impacts: 0.3125; periodic 1T, ...')."""
+
 
 def csv_rows(
     axes: list[SweepAxis],
     points: Iterable[SweepPoint | PointFields],
     outputs: Sequence[str] | None = None,
     design: bool = False,
+    basins: bool = False,
 ) -> Iterator[str]:
     """CSV rows (header first): one column per axis, a design's field in SI units and titled
     with its unit (``speed [rad/s]``, ``torque [N*m]``); with a ``design`` (a sweep of a design
@@ -118,15 +124,39 @@ def csv_rows(
     to the 15 significant digits they were given with (``_grid_value``); every other number is
     written as the JSON result writes it (``_json_numbers``). With ``outputs``
     (``SweepRequest.outputs``) only the columns it names (and branch) are written. Rows are
-    yielded one by one, so a streamed response never holds the whole table."""
+    yielded one by one, so a streamed response never holds the whole table. With ``basins`` (a
+    sweep with settings.basins, whose verdict columns are the worst attractor's) the
+    ``BASIN_COLUMNS`` follow."""
     names = [a.parameter for a in axes]
     extra = _physical_columns(names, outputs) if design else []
     fields = [f for f in CSV_FIELDS if outputs is None or f == "branch" or f in outputs]
     header = [*map(_axis_title, names), *(title for _, title, _ in extra), *fields]
+    header += BASIN_COLUMNS if basins else ()
     yield ",".join(_text_cell(c) for c in header) + "\n"
     shown = [(key, axis) for key, _, axis in extra]
     for p in points:
-        yield ",".join(_row(p, names, shown, fields)) + "\n"
+        cells = _row(p, names, shown, fields)
+        if basins:
+            cells += _basin_cells(p.__dict__ if isinstance(p, SweepPoint) else p)
+        yield ",".join(cells) + "\n"
+
+
+def _basin_cells(p: PointFields) -> list[str]:
+    """The ``BASIN_COLUMNS`` cells of a point (empty where it has no basins)."""
+
+    def field(item: Any, key: str) -> Any:
+        return item[key] if isinstance(item, Mapping) else getattr(item, key)
+
+    found = p.get("attractors")
+    counts = p.get("basins")
+    fraction = p.get("decided_fraction")
+    listed = "; ".join(f"{field(a, 'label')}: {field(a, 'fraction'):.6g}" for a in found or [])
+    return [
+        "" if p.get("decided_by") is None else _text_cell(str(p["decided_by"])),
+        "" if fraction is None else _json_numbers([float(fraction)])[0],
+        "" if counts is None else str(field(counts, "starts")),
+        _text_cell(listed) if listed else "",
+    ]
 
 
 STREAM_BLOCK = 1 << 16

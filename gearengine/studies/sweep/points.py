@@ -20,7 +20,7 @@ class PhysicalValue(BaseModel):
     unit: str
 
 
-BASIN_FIELDS = ("attractors", "basins", "coexisting")
+BASIN_FIELDS = ("attractors", "basins", "coexisting", "decided_by", "decided_fraction")
 """Point fields that exist only with settings.basins (left out of a point without them)."""
 
 
@@ -37,7 +37,9 @@ class SweepPoint(BaseModel):
     )
     classification: str | None = Field(
         None,
-        description="periodic | chaotic | quasi_periodic | diverged. This and every field "
+        description="periodic | chaotic | quasi_periodic | diverged; with settings.basins the "
+        "worst attractor's above basins.min_fraction (decided_by names it; period, lle, "
+        "lle_stderr and impact_regime are its too). This and every field "
         "below are left out of the stored and returned points that a sweep's outputs do not "
         "name (null when read back into this model).",
     )
@@ -86,8 +88,10 @@ class SweepPoint(BaseModel):
     attractors: list[Attractor] | None = Field(
         None,
         description="With settings.basins: the attractors reached from the point's basin "
-        "starts, worst first (as numerics.attractors of an analysis); the fields above "
-        "describe the worst of settings' own starts.",
+        "starts, worst first (as numerics.attractors of an analysis). The verdict fields "
+        "(classification, period, lle, lle_stderr, impact_regime) are the worst attractor's "
+        "above basins.min_fraction; the record fields (poincare_x, x_peak_to_peak, forces, "
+        "physical) describe the worst of settings' own starts.",
     )
     basins: BasinCounts | None = Field(
         None, description="With settings.basins: how the point's basin starts ended."
@@ -96,6 +100,16 @@ class SweepPoint(BaseModel):
         None,
         description="Continuation with settings.basins: the attractors other than the followed "
         "branch's found at this point, as 'label from NN % of starts'; null otherwise.",
+    )
+
+    decided_by: str | None = Field(
+        None,
+        description="With settings.basins: the attractor (or divergence) that decided the "
+        "verdict fields, with its basin fraction: 'chaotic, double-sided impacts from 31 % of "
+        "starts'; null without basins (or when no basin is above basins.min_fraction).",
+    )
+    decided_fraction: float | None = Field(
+        None, description="With settings.basins: the basin fraction of decided_by's attractor."
     )
 
     @model_serializer(mode="wrap")

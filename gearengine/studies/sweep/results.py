@@ -64,8 +64,9 @@ class SweepResult(BaseModel):
 def to_csv(
     result: SweepResult, outputs: Sequence[str] | None = None, design: bool = False
 ) -> Iterator[str]:
-    """CSV rows of a result (see ``csv_rows``)."""
-    return csv_rows(result.axes, result.points, outputs, design)
+    """CSV rows of a result (see ``csv_rows``; the basin columns when its points have basins)."""
+    basins = any(p.attractors is not None for p in result.points)
+    return csv_rows(result.axes, result.points, outputs, design, basins)
 
 
 def to_pandas(result: SweepResult) -> Any:

@@ -19,6 +19,7 @@ import numpy as np
 from gearengine.model.frequencies import incommensurate_reason, poincare_frequency
 from gearengine.model.params import GearParams
 from gearengine.systems.base import StepPlan
+from gearengine.systems.spur_pair.laws import LAWS
 
 
 def packed_forcing(params: GearParams) -> tuple[np.ndarray, float, np.ndarray]:
@@ -43,6 +44,32 @@ def packed_forcing(params: GearParams) -> tuple[np.ndarray, float, np.ndarray]:
     kc = np.ascontiguousarray(np.array(k, dtype=np.float64).reshape(-1, 3).T)
     fc = np.ascontiguousarray(np.array(f, dtype=np.float64).reshape(-1, 3).T)
     return kc, float(params.mean_force), fc
+
+
+def static_error(params: GearParams, t: np.ndarray) -> np.ndarray:
+    """The static transmission error e(tau) = sum_r F~_er cos(r Omega_e tau + phi_r) in units
+    of b at the times ``t`` (shape (n,)): Eq. (7)'s x = r_a theta_a - r_b theta_b - e excludes
+    it, so r_a theta_a - r_b theta_b (what shaft encoders measure) is x + e."""
+    e = np.zeros_like(t, dtype=np.float64)
+    exc = params.transmission_error
+    if exc is not None:
+        for r, h in exc.active():
+            e += h.amplitude * np.cos(r * exc.frequency * t + h.phase)
+    return e
+
+
+def contact_force_of(params: GearParams, t: np.ndarray, x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The tooth contact force at samples (tau, x, x') of shape (n,), dimensionless (units of
+    k_m b): the model's mesh force K(tau) f_h(x) + 2 mu x' (Eq. 9) where a flank touches
+    (|x| > 1), clipped to that flank's sign (a flank pushes, never pulls), and 0 where the teeth
+    are apart (|x| <= 1), where the model's damping term still acts."""
+    kc, _, _ = packed_forcing(params)
+    stiffness = 1.0 + np.sum(kc[0][:, None] * np.cos(kc[1][:, None] * t + kc[2][:, None]), axis=0)
+    force = (
+        stiffness * LAWS[params.backlash.model].f_h(params.backlash, x) + 2.0 * params.damping * v
+    )
+    contact = np.where(x > 1.0, np.maximum(force, 0.0), 0.0)
+    return np.where(x < -1.0, np.minimum(force, 0.0), contact)
 
 
 def fastest_excitation(params: GearParams) -> float | None:

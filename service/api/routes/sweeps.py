@@ -138,9 +138,12 @@ def get_result(
     axes = sweep.axes
     if format == "csv":
         designed = sweep.design is not None
+        basins = sweep.settings.basins is not None
         name = f"sweep-{job_id}{'-partial' if missing else ''}.csv"
         return StreamingResponse(
-            text_blocks(csv_rows(axes, _stored_points(jobs, job_id), sweep.outputs, designed)),
+            text_blocks(
+                csv_rows(axes, _stored_points(jobs, job_id), sweep.outputs, designed, basins)
+            ),
             media_type=CSV,
             headers={"Content-Disposition": f'attachment; filename="{name}"', **headers},
         )

@@ -20,6 +20,11 @@ from gearengine.systems.spur_pair.kernels.kink import kink_step
 from gearengine.systems.spur_pair.kernels.phase import ramp_forcing_at
 from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, region, region_force
 
+TANGENT_FLOOR = 1e-200
+"""Squared tangent norm below which (or above whose inverse) a block renormalises the tangent
+within itself, keeping the log: else a block of ~1e4 tau at low speed contracts it to 0 and
+every later FTLE reads NaN."""
+
 BLOCK_COLUMNS = (
     "x_min", "x_max", "force_min", "force_max", "steps_separated", "steps_back_flank",
     "back_flank_impacts", "drive_flank_impacts", "log_growth",
@@ -62,11 +67,18 @@ def run_ramp(
     for n in range(n_blocks):
         xmin, xmax, fmin, fmax = np.inf, -np.inf, np.inf, -np.inf
         sep, back, back_in, drive_in = 0, 0, 0, 0
+        grown = 0.0  # log of the tangent's norm taken out within the block
         t0 = n * steps * h
         for j in range(steps):
             prev = reg
             x, v, dx, dv, reg = kink_step(reg, alpha, twomu, kc, ramp, fc, t0 + j * h, h, x, v,
                                           dx, dv)  # fmt: skip
+            squared = dx * dx + dv * dv
+            if squared < TANGENT_FLOOR or squared > 1.0 / TANGENT_FLOOR:  # a long block (the
+                scale = math.sqrt(squared)  # settling at low speed) would under- or overflow
+                grown += math.log(scale)
+                dx /= scale
+                dv /= scale
             K = ramp_forcing_at(t0 + (j + 1) * h, kc, ramp, fc)[0]
             force = K * region_force(reg, alpha, x)[0] + twomu * v
             xmin = min(xmin, x)
@@ -90,6 +102,6 @@ def run_ramp(
         row = out[n]
         row[0], row[1], row[2], row[3] = xmin, xmax, fmin, fmax
         row[4], row[5], row[6], row[7] = sep, back, back_in, drive_in
-        row[8] = math.log(nrm)
+        row[8] = grown + math.log(nrm)
     state[0], state[1], state[2], state[3] = x, v, dx, dv
     return out, n_blocks

@@ -1,0 +1,83 @@
+"""One vocabulary for contact (issue 30 item 6): separation (the teeth lose contact, on either
+flank's side) and back_flank (back-flank impacts) mean the same in the gate's rules and the
+robustness probabilities; the DTE without and with the static TE and the contact force (zero
+while apart) beside the model's force, each defined where it is reported."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gearengine.gate.envelope import Rules, point_failures
+from gearengine.model.params import GearParams, PiecewiseBacklash
+from gearengine.studies.robustness.study import RobustnessRequest, run_local
+from gearengine.studies.sweep.points import SweepPoint
+from gearengine.systems.spur_pair.forcing import contact_force_of, static_error
+from tests.test_robustness import DESIGN
+
+
+def _point(regime: str) -> SweepPoint:
+    return SweepPoint(values={}, branch=None, classification="periodic", period=1,
+                      impact_regime=regime)  # fmt: skip
+
+
+def test_back_flank_is_the_gate_rule_of_back_flank_impacts() -> None:
+    for word in ("back_flank", "impacts"):  # impacts: the older name of the same rule
+        rules = Rules(fail_on=[word])
+        assert point_failures(_point("double_sided"), rules) == ["back-flank impacts"]
+        assert point_failures(_point("single_sided"), rules) == []
+    rules = Rules(fail_on=["separation"])
+    assert point_failures(_point("single_sided"), rules) == ["tooth separation"]
+
+
+def test_robustness_names_separation_as_the_gate_does() -> None:
+    request = RobustnessRequest.model_validate(
+        {"design": DESIGN, "samples": 8,
+         "axes": [{"parameter": "speed", "start": "5000 rpm", "stop": "5000 rpm", "num": 1}],
+         "settings": {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}}
+    )  # fmt: skip
+    (point,) = run_local(request).points
+    probs = point.probabilities
+    assert probs["separation"].count > 0  # this point separates in 7 of 8 samples
+    assert probs["separation"] == probs["impacts"]
+    assert probs["back_flank"].count <= probs["separation"].count
+
+
+def test_static_error_is_the_te_harmonics() -> None:
+    params = GearParams.model_validate(
+        {"damping": 0.05, "mean_force": 0.1,
+         "transmission_error": {"frequency": 0.5, "harmonics": [
+             {"amplitude": 0.2, "phase": 0.3}, {"amplitude": 0.05, "phase": 0.0}]}}
+    )  # fmt: skip
+    t = np.linspace(0.0, 30.0, 301)
+    expected = 0.2 * np.cos(0.5 * t + 0.3) + 0.05 * np.cos(1.0 * t)
+    np.testing.assert_allclose(static_error(params, t), expected, atol=1e-15)
+
+
+def test_contact_force_is_zero_while_apart_and_a_flank_never_pulls() -> None:
+    params = GearParams(damping=0.1, mean_force=0.1, backlash=PiecewiseBacklash(alpha=0.0))
+    t = np.zeros(5)
+    x = np.array([0.5, 1.5, -1.5, 1.01, 0.0])
+    v = np.array([3.0, 0.0, 0.0, -1.0, -4.0])
+    force = contact_force_of(params, t, x, v)
+    # apart (|x| <= 1): 0 although the model's damping force 2 mu x' is 0.6 and -0.8
+    assert force[0] == 0.0 and force[4] == 0.0
+    assert force[1] == pytest.approx(0.5) and force[2] == pytest.approx(-0.5)  # f_h(+-1.5)
+    assert force[3] == 0.0  # 0.01 - 0.2 < 0 on the drive flank: released, not pulling
+
+
+def test_analysis_reports_both_transmission_errors_and_the_contact_force() -> None:
+    """examples/ci/design.json: always in contact, so the contact force follows the model's
+    force (to the decimation of the history); its static TE adds to the DTE an encoder sees."""
+    import json
+    from pathlib import Path
+
+    from gearengine.analysis import AnalysisRequest, analyze
+
+    doc = json.loads((Path(__file__).parents[1] / "examples/ci/design.json").read_text())
+    r = analyze(AnalysisRequest.model_validate(doc)).engineering.response
+    assert r.contact.separation_fraction == 0.0
+    assert r.te_with_static_peak_to_peak_um > r.dte_peak_to_peak_um
+    assert r.dynamic_mesh_force_min_n <= r.contact_force_min_n <= r.contact_force_max_n
+    assert r.contact_force_max_n <= r.dynamic_mesh_force_max_n
+    assert r.contact_force_max_n == pytest.approx(r.dynamic_mesh_force_max_n, rel=1e-3)

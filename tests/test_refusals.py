@@ -1,0 +1,86 @@
+"""Refusals that name the field at fault, before any compute (issue 30 item 7)."""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+
+import pytest
+from pydantic import ValidationError
+
+from gearengine.cli.main import main
+from gearengine.model.design import Design
+from tests.test_robustness import DESIGN
+
+GEOMETRY = {
+    "driver": {"teeth": 18, "module": "3 mm", "face_width": "25 mm"},
+    "driven": {"teeth": 30, "module": "3 mm", "face_width": "25 mm"},
+    "speed": "3000 rpm",
+    "torque": "60 N*m",
+    "mesh": {"stiffness": "iso6336", "damping_ratio": 0.04, "half_backlash": "50 um"},
+}
+
+
+def _errors(doc: dict) -> list[dict]:
+    with pytest.raises(ValidationError) as err:
+        Design.model_validate(doc)
+    return err.value.errors()
+
+
+def test_robustness_with_radii_off_the_tooth_ratio_is_422_naming_the_field(client) -> None:
+    design = copy.deepcopy(DESIGN)
+    design["driven"]["base_radius"] = "80 mm"
+    answer = client.post("/v1/robustness", json={"design": design, "samples": 8})
+    assert answer.status_code == 422
+    assert [e["path"] for e in answer.json()["errors"]] == ["design.driven.base_radius"]
+
+
+def test_a_bare_module_of_2_5_is_refused_as_a_module() -> None:
+    doc = copy.deepcopy(GEOMETRY)
+    doc["driver"]["module"] = 2.5
+    (error,) = _errors(doc)
+    assert error["loc"] == ("driver", "module")
+    assert "2.5 m is outside the plausible range of a module" in error["msg"]
+    assert "did you mean 2.5 mm?" in error["msg"]
+
+
+def test_a_negative_backlash_gets_no_unit_guess() -> None:
+    doc = copy.deepcopy(GEOMETRY)
+    doc["mesh"]["half_backlash"] = "-50 um"
+    (error,) = _errors(doc)
+    assert error["loc"] == ("mesh", "half_backlash")
+    assert "is negative; a half backlash is a positive magnitude" in error["msg"]
+    assert "did you mean" not in error["msg"]
+
+
+@pytest.fixture()
+def design_file(tmp_path: Path) -> Path:
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": DESIGN}))
+    return path
+
+
+def test_cli_check_refuses_1e8_points_before_computing(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    big = ["--speed", "1000:6000", "--speed-points", "10000",
+           "--torque", "5:60", "--torque-points", "10000"]  # fmt: skip
+    assert main(["check", str(design_file), *big]) == 2
+    assert "this envelope check has 100000000 points, the limit is 40000" in (
+        capsys.readouterr().err
+    )
+    gate = ["--max-probability", "chaotic=0.4", "--samples", "8"]
+    assert main(["check", str(design_file), *big, *gate]) == 2
+    assert "this robustness study has 100000000 points" in capsys.readouterr().err
+
+
+def test_cli_check_refuses_work_over_the_job_budget(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """40 000 points x 256 starts x (60 + 60) periods x 128 steps = 1.6e11 RK4 steps, over the
+    2e10 the API allows a job (the points alone are within its 40 000)."""
+    many = ["--speed", "1000:6000", "--speed-points", "200", "--torque", "5:60",
+            "--torque-points", "200", "--starts", "256"]  # fmt: skip
+    assert main(["check", str(design_file), *many]) == 2
+    assert "over the budget of 20000000000 steps per envelope check" in capsys.readouterr().err

@@ -1,0 +1,66 @@
+"""No quantity read in a unit the user did not write without a note (issue 30 item 2): "%" only
+where a share of a nominal value is meant (a torque ripple of the mean torque, scaling when the
+torque is swept), a bare number read in SI units with a note naming the field, and a given
+value beside the geometry form used and said so."""
+
+from __future__ import annotations
+
+import copy
+
+import pytest
+from pydantic import ValidationError
+
+from gearengine.model.design import EXAMPLE_DESIGN, Design
+from gearengine.model.reduction import convert_design
+from gearengine.studies.sweep.axes import design_with
+
+
+def _design(**changes: object) -> dict:
+    doc = copy.deepcopy(EXAMPLE_DESIGN)
+    doc.update(changes)
+    return doc
+
+
+def test_percent_is_refused_where_no_share_is_meant() -> None:
+    doc = _design()
+    doc["mesh"]["half_backlash"] = "3 %"
+    with pytest.raises(ValidationError) as err:
+        Design.model_validate(doc)
+    ((error,),) = [err.value.errors()]
+    assert error["loc"] == ("mesh", "half_backlash")
+    assert "'3 %' is a share, not a half backlash" in error["msg"]
+
+
+def test_torque_ripple_in_percent_is_a_share_of_the_mean_torque() -> None:
+    doc = _design(torque_fluctuation={"harmonics": [{"amplitude": "3 %"}]})
+    design = Design.model_validate(doc)
+    assert design.torque_fluctuation.harmonics[0].amplitude == pytest.approx(1.2)
+    notes = convert_design(design).notes
+    assert any("3 % read as 1.2 N*m, 3 % of the mean torque 40 N*m" in n for n in notes)
+    halved = design_with(design, {"torque": "20 N*m"})  # a torque axis' point
+    assert halved.torque_fluctuation.harmonics[0].amplitude == pytest.approx(0.6)
+
+
+def test_bare_speed_is_read_in_rad_per_s_with_a_note(client) -> None:
+    body = {"design": _design(speed=6000)}
+    answer = client.post("/v1/conversions/design", json=body)
+    assert answer.status_code == 200
+    notes = answer.json()["conversion"]["notes"]
+    assert any("speed: the bare number 6000 read as 6000 rad/s = 57,295.8 rpm" in n for n in notes)
+
+
+def test_unit_strings_leave_no_bare_number_note() -> None:
+    notes = convert_design(Design.model_validate(_design())).notes
+    assert not [n for n in notes if "bare number" in n]
+
+
+def test_given_inertia_beside_the_geometry_is_used_and_said() -> None:
+    gear = {"teeth": 18, "module": "3 mm", "face_width": "25 mm", "inertia": "2e-3 kg*m^2"}
+    other = {"teeth": 30, "module": "3 mm", "face_width": "25 mm"}
+    doc = _design(driver=gear, driven=other)
+    doc["mesh"] = {**doc["mesh"], "stiffness": "iso6336"}
+    doc.pop("torque_fluctuation")
+    conv = convert_design(Design.model_validate(doc))
+    assert conv.derived["inertia_driver"].value == pytest.approx(2e-3)
+    assert conv.derived["inertia_driver"].source == "given"
+    assert any(n.startswith("driver.inertia: the given 0.002 kg*m^2 is used") for n in conv.notes)
