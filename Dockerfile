@@ -12,6 +12,9 @@ ARG EXTRAS=""
 COPY pyproject.toml README.md ./
 COPY gearengine ./gearengine
 COPY service ./service
+# pyunicorn (the signals' IAAFT surrogates) has no wheel for 3.11: it compiles with Cython
+RUN apt-get update && apt-get install -y --no-install-recommends gcc g++ \
+    && rm -rf /var/lib/apt/lists/*
 RUN python -m pip install --no-cache-dir --upgrade pip \
     && python -m pip install --no-cache-dir ".${EXTRAS}"
 
