@@ -1,6 +1,7 @@
 """Gear geometry (gearengine.model.geometry): hand-worked values, independent re-derivations and
 cross-checks (ISO/TR 6336-30 worked example; ross-rotordynamics energy method when installed)."""
 
+import importlib
 import itertools
 import math
 
@@ -8,6 +9,7 @@ import numpy as np
 import pytest
 
 from gearengine.model import geometry as g
+from tests._ross import import_ross
 
 DEG20 = math.radians(20.0)
 
@@ -338,9 +340,9 @@ def test_harmonics_edge_cases():
 def test_mean_mesh_stiffness_against_ross_energy_method():
     """Potential-energy TVMS of ross-rotordynamics (GearElementTVMS/Mesh) vs ISO k_mean.
 
-    Skipped unless ross is importable (it lives in a separate venv, see NOTES.md)."""
-    ross_gear = pytest.importorskip("ross.gear_element")
-    import ross
+    Skipped unless ross is importable (``tests._ross``; it is in the test extra)."""
+    ross = import_ross()
+    ross_gear = importlib.import_module("ross.gear_element")
 
     steel = ross.Material(name="steel_iso", rho=7850.0, E=206e9, Poisson=0.3)
     kw = dict(material=steel, width=0.025, module=0.003, pr_angle=DEG20)

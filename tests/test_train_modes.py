@@ -15,6 +15,7 @@ from gearengine.model.design import Design
 from gearengine.model.train import EXAMPLE_TRAIN
 from gearengine.systems.gear_train.model import train_of
 from gearengine.systems.gear_train.modes import eigen, mesh_energy_shares, modes
+from tests._ross import import_ross
 
 ROOT = Path(__file__).resolve().parents[1]
 PAIR = json.loads((ROOT / "examples" / "design-direct.json").read_text())["design"]
@@ -87,32 +88,13 @@ def test_mesh_energy_shares_and_damping() -> None:
     assert all(0.0 < m.damping_ratio < 0.2 for m in modes(model, 1.0).modes)
 
 
-def _ross():
-    """ROSS, imported past its plotly theme: ross 2.3.0 registers a template with the
-    ``scattermapbox`` trace that plotly >= 6 no longer has, so ``import ross`` raises; the
-    template is built leniently (invalid entries skipped) for the import only."""
-    rs = pytest.importorskip("plotly.graph_objects")
-    layout = rs.layout
-    strict = layout.Template
-
-    class Lenient(strict):  # type: ignore[misc, valid-type]
-        def __init__(self, arg=None, **kwargs):
-            super().__init__(arg, skip_invalid=True, **kwargs)
-
-    layout.Template = Lenient
-    try:
-        return pytest.importorskip("ross")
-    finally:
-        layout.Template = strict
-
-
 def test_torsional_modes_agree_with_ross() -> None:
     """ROSS (ross-rotordynamics) MultiRotor of two rotors, each one ShaftElement (Timoshenko
     beam, density 1e-3 kg/m^3: its own mass negligible) between a DiskElement (motor / load)
     and a GearElement (pinion / gear), coupled by the mesh stiffness, every node on a
     BearingElement of 1e13 N/m (lateral motion rigid). Its torsional frequencies equal the
     torsional train's (no bearings) within 1 %."""
-    rs = _ross()
+    rs = import_ross()
     g = 79.3e9
     light = rs.Material(name="light_steel", rho=1e-3, E=2.6 * g, G_s=g)
 
