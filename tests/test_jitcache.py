@@ -58,13 +58,14 @@ def test_the_kernels_caches_are_stamped_with_their_current_sources() -> None:
     every file its group compiles in, so an edit of adaptive.py, periodicity.py or extrema.py
     drops the cached code that froze it on the next import."""
     numerics = Path(kernels.__file__).parent
+    signals = Path(gearengine.__file__).parent / "signals"
     homoclinic = Path(gearengine.homoclinic.__file__).parent
     groups = {
         numerics / "__pycache__" / (
             "adaptive+intervals+kink+kinklanes+lockstep+monodromy+phase+ramp+smooth"
         ): [
-            *numerics.glob("*.py"), numerics.parent / "periodicity.py",
-            numerics.parent / "lyapunov.py", numerics.parent / "classify.py",
+            *numerics.glob("*.py"), signals / "periodicity.py",
+            signals / "lyapunov.py", signals / "classify.py",
         ],
         homoclinic / "__pycache__" / "kernels+batch+loops": [
             homoclinic / name for name in ("kernels.py", "batch.py", "extrema.py", "loops.py")

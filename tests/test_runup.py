@@ -147,7 +147,7 @@ def test_runup_follows_an_independent_integration_of_eq7() -> None:
         sep = sum(min(t1, nxt) - t for (t, g), nxt in
                   zip(marks, [m[0] for m in marks[1:]] + [t1], strict=True) if g == 0)  # fmt: skip
         assert bn.separation_fraction == pytest.approx(sep / (t1 - t0), abs=0.01), k
-        assert (bn.contact == "no_contact") == (sep > 0)
+        assert (bn.contact == "separation") == (sep > 0)
         assert bn.back_flank_fraction == 0.0 and not any(g < 0 for _, g in events)
     assert min(b.separation_fraction for b in bins) > 0.2  # the separating branch
 
