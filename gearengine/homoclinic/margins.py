@@ -65,12 +65,22 @@ def signed_margin(
 
 
 def threshold_document(
-    parameter: str, value: float | None, critical: list[float], no_chaos: list, **extra: object
+    parameter: str,
+    value: float | None,
+    critical: list[float],
+    no_chaos: list,
+    force: float | None = None,
+    f_crit: float = 1.0,
+    **extra: object,
 ) -> ParameterThreshold:
-    """The threshold document: critical values and the design's margin (``signed_margin``)."""
+    """The threshold document: critical values and the design's margin (``signed_margin``);
+    with ``force``, the largest force along the loops per unit of the parameter, the margin in
+    the force scale ``f_crit`` too (margin * force / F_crit)."""
     nearest = margin = rel = None
     if value is not None:
         nearest, margin, rel = signed_margin(parameter, value, critical, no_chaos)
+    if margin is not None and force is not None:
+        extra["margin_in_force_scale"] = margin * force / f_crit
     return ParameterThreshold(
         value=value,
         critical_values=critical,

@@ -29,7 +29,6 @@ from gearengine.homoclinic.extrema import (
     Interval,
     TrigSum,
     extrema,
-    one_sinusoid,
     one_sinusoid_interval,
     sublevel_interval,
 )
@@ -123,8 +122,14 @@ def chaos_possible(params: GearParams, mean_load: MeanLoad = "unperturbed") -> b
     return None if math.isnan(strength) else strength > 0.0
 
 
-def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum] | None:
-    """Split M = m0 + p g for the control parameter p (None if p's excitation is absent)."""
+Family = tuple[TrigSum, TrigSum] | tuple[float, float, float, float]
+"""M = m0 + p g of one control parameter p: two trig sums sharing frequencies and phases, or for
+at most one sinusoid the floats (m0.offset, g.offset, a, b) of ``extrema.one_sinusoid``."""
+
+
+def _family(coef: BranchCoefficients, m: TrigSum, parameter: str) -> Family | None:
+    """Split M = m0 + p g for the control parameter p (None if p's excitation is absent);
+    ``m`` is ``coef.trig_sum()``, read once for every parameter."""
     if coef.damping_per_unit is None:
         raise ValueError("coefficients read back from JSON carry no per-unit values (they are "
                          "not serialised): compute them again from the parameters")  # fmt: skip
@@ -134,7 +139,11 @@ def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum]
         j = next((i for i, t in enumerate(coef.terms) if t.excitation == name and t.r == 1), None)
         if j is None:
             return None
-    m = coef.trig_sum()
+    if m.amplitudes.size <= 1:  # the floats of one_sinusoid, without arrays
+        only = float(m.amplitudes[0]) if m.amplitudes.size else 0.0
+        if j is None:
+            return 0.0, float(coef.damping_per_unit), only, 0.0
+        return float(m.offset), 0.0, 0.0, float(coef.terms[j].per_unit)
     zeros = np.zeros_like(m.amplitudes)
     if j is None:
         return (
@@ -151,12 +160,12 @@ def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum]
     )
 
 
-def no_sign_change(m0: TrigSum, g: TrigSum) -> list[Interval]:
+def no_sign_change(family: Family) -> list[Interval]:
     """Intervals of p where m0 + p g keeps one sign: max <= 0 or min >= 0."""
-    if m0.amplitudes.size <= 1:  # the closed forms, on floats (-M: the same floats negated)
-        single = one_sinusoid(m0, g)
-        below = one_sinusoid_interval(*single)
-        return [s for s in (below, one_sinusoid_interval(*(-v for v in single))) if s is not None]
+    if len(family) == 4:  # the closed forms, on floats (-M: the same floats negated)
+        below = one_sinusoid_interval(*family)
+        return [s for s in (below, one_sinusoid_interval(*(-v for v in family))) if s is not None]
+    m0, g = family
     sets = (sublevel_interval(m0, g), sublevel_interval(m0.negated(), g.negated()))
     return [s for s in sets if s is not None]
 
@@ -187,19 +196,47 @@ def parameter_threshold(
     ``coefs`` are the branches' ``unit_coefficients`` if already known (else computed with
     ``method`` and ``mean_load``).
     """
-    value = get_alias(params, parameter)
-    domain = DOMAIN.get(parameter, Interval(None, None))
     coefs = unit_coefficients(params, a, c, method, mean_load) if coefs is None else coefs
+    sums = {br: coefs[br].trig_sum() for br in BRANCH_SIGN}
+    return _threshold(parameter, get_alias(params, parameter), coefs, sums)
+
+
+def parameter_thresholds(
+    params: GearParams, coefs: Coefficients, forces: dict[str, float | None], f_crit: float
+) -> dict[str, ParameterThreshold]:
+    """``parameter_threshold`` of every control parameter (``CONTROL_PARAMETERS``), each
+    branch's sum of ``coefs`` (``unit_coefficients``) read once for all of them, with the margin
+    in the force scale ``f_crit``: ``forces`` is the largest force along the loops per unit of
+    each parameter (``perturbations.force_per_unit``; None: no such force)."""
+    sums = {br: coefs[br].trig_sum() for br in BRANCH_SIGN}
+    return {
+        p: _threshold(p, get_alias(params, p), coefs, sums, forces[p], f_crit)
+        for p in CONTROL_PARAMETERS
+    }
+
+
+def _threshold(
+    parameter: str,
+    value: float | None,
+    coefs: Coefficients,
+    sums: dict[HomoclinicBranch, TrigSum],
+    force: float | None = None,
+    f_crit: float = 1.0,
+) -> ParameterThreshold:
+    """``parameter_threshold`` of a design whose ``parameter`` is ``value``, from the branches'
+    ``unit_coefficients`` and their trig sums; with ``force`` (the largest force along the
+    loops per unit of the parameter) the margin also in the force scale ``f_crit``."""
+    domain = DOMAIN.get(parameter, Interval(None, None))
     branches: dict[HomoclinicBranch, BranchThreshold] = {}
     sets: dict[HomoclinicBranch, list[Interval]] = {}
     for br in BRANCH_SIGN:
-        family = _family(coefs[br], parameter)
+        family = _family(coefs[br], sums[br], parameter)
         if family is None:
             exc = _TERM_OF[parameter]
             return threshold_document(
                 parameter, value, [], [], note=f"{exc} is not given: no frequency for {parameter}"
             )
-        sets[br] = intersect(no_sign_change(*family), [domain])
+        sets[br] = intersect(no_sign_change(family), [domain])
         branches[br] = BranchThreshold(
             critical_values=interval_ends(sets[br], domain),
             no_sign_change=[(i.lo, i.hi) for i in sets[br]],
@@ -211,6 +248,8 @@ def parameter_threshold(
         interval_ends(overall, domain),
         [(i.lo, i.hi) for i in overall],
         branches=branches,
+        force=force,
+        f_crit=f_crit,
     )
 
 

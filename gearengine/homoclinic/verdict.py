@@ -26,13 +26,13 @@ from gearengine.homoclinic.perturbations import (
     loop_extremes,
     perturbation_sizes,
 )
-from gearengine.homoclinic.schemas import BranchVerdict, MelnikovResult, ParameterThreshold
+from gearengine.homoclinic.schemas import BranchVerdict, MelnikovResult
 from gearengine.homoclinic.thresholds import (
     CONTROL_PARAMETERS,
     OMEGA_SCAN,
     Coefficients,
     frequency_threshold,
-    parameter_threshold,
+    parameter_thresholds,
     unit_coefficients,
 )
 from gearengine.model.frequencies import poincare_period
@@ -110,20 +110,6 @@ def applicability(
     return a, c, notes, units
 
 
-def _in_force_scale(
-    params: GearParams,
-    parameter: str,
-    t: ParameterThreshold,
-    extremes: tuple[float, float],
-    f_crit: float,
-) -> ParameterThreshold:
-    """``t`` with its margin measured in the force scale F_crit (``perturbations``)."""
-    unit = force_per_unit(params, parameter, extremes)
-    if t.margin is None or unit is None:
-        return t
-    return t.model_copy(update={"margin_in_force_scale": t.margin * unit / f_crit})
-
-
 def melnikov(
     params: GearParams,
     method: Method = "closed_form",
@@ -179,11 +165,8 @@ def melnikov(
             f"method {method}: the verdict, the thresholds and the Omega_e scan all use "
             f"{method} coefficients"
         )
-    thresholds = {
-        p: _in_force_scale(params, p, parameter_threshold(params, p, a, c, method, units),
-                           extremes, f_crit)
-        for p in CONTROL_PARAMETERS
-    }  # fmt: skip
+    forces = {p: force_per_unit(params, p, extremes) for p in CONTROL_PARAMETERS}
+    thresholds = parameter_thresholds(params, units, forces, f_crit)
     thresholds["Omega_e"] = frequency_threshold(params, a, c, omega_scan, method, mean_load)
     return MelnikovResult(
         applicable=True,
