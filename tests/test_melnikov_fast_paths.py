@@ -162,8 +162,6 @@ def test_compiled_scan_equals_the_documents(excitations: tuple[str, ...]) -> Non
             value = p.transmission_error.frequency
             found = _scan_compiled(p, 0.1667, 0.1667, fm, OMEGA_SCAN, value)
             assert found is not None
-            python = _scan_python(
-                p, 0.1667, 0.1667, OMEGA_SCAN, value, "closed_form", "unperturbed"
-            )
+            python = _scan_python(p, 0.1667, 0.1667, OMEGA_SCAN, value, "closed_form", fm)
             assert found[0] == pytest.approx(python[0], rel=1e-9)
             assert np.array(found[1]) == pytest.approx(np.array(python[1]), rel=1e-9)

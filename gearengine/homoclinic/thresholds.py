@@ -65,19 +65,18 @@ def sign_change_strength(
     a: float,
     c: float,
     method: Method = "closed_form",
-    mean_load: MeanLoad = "unperturbed",
+    fm: float = 0.0,
 ) -> float:
     """max over branches of min(max M, -min M): > 0 iff some branch changes sign.
 
     Continuous in the parameters (for a fixed set of commensurate frequencies), so its roots
     are the critical values of any parameter. ``method`` names the coefficients (``METHODS``),
-    ``mean_load`` where F_m goes (``coefficients.MeanLoad``; the loops must exist,
+    ``fm`` the mean force the loops carry (``coefficients.loop_load``; the loops must exist,
     ``saddle_loop``).
     The closed form runs compiled (``kernels.scan_strength`` at the design's own speed, on the
     packed form of ``terms``); quadrature, and the rare design on which a coefficient underflows
     to 0, take the same algorithm on the pydantic documents.
     """
-    fm = loop_load(params, mean_load)
     if method == "closed_form":
         strength = packed_terms(params, a, c, fm).strength()
         if not math.isnan(strength):
@@ -107,9 +106,10 @@ def strength_at(
     mean load in the unperturbed system)."""
     design = with_aliases(params, values) if values else params
     a, c = _cubic(design.backlash)
-    if not saddle_loop(a, c, loop_load(design, mean_load)):
+    fm = loop_load(design, mean_load)
+    if not saddle_loop(a, c, fm):
         return math.nan
-    return sign_change_strength(design, a, c, mean_load=mean_load)
+    return sign_change_strength(design, a, c, fm=fm)
 
 
 def chaos_possible(params: GearParams, mean_load: MeanLoad = "unperturbed") -> bool | None:
@@ -202,17 +202,18 @@ def parameter_threshold(
 
 
 def parameter_thresholds(
-    params: GearParams, coefs: Coefficients, forces: dict[str, float | None], f_crit: float
+    coefs: Coefficients,
+    values: dict[str, float | None],
+    forces: dict[str, float | None],
+    f_crit: float,
 ) -> dict[str, ParameterThreshold]:
     """``parameter_threshold`` of every control parameter (``CONTROL_PARAMETERS``), each
-    branch's sum of ``coefs`` (``unit_coefficients``) read once for all of them, with the margin
-    in the force scale ``f_crit``: ``forces`` is the largest force along the loops per unit of
-    each parameter (``perturbations.force_per_unit``; None: no such force)."""
+    branch's sum of ``coefs`` (``unit_coefficients``) read once for all of them. ``values`` are
+    the design's values of the parameters (``get_alias``); with the margin in the force scale
+    ``f_crit``, ``forces`` being the largest force along the loops per unit of each parameter
+    (``perturbations.force_per_unit``; None: no such force)."""
     sums = {br: coefs[br].trig_sum() for br in BRANCH_SIGN}
-    return {
-        p: _threshold(p, get_alias(params, p), coefs, sums, forces[p], f_crit)
-        for p in CONTROL_PARAMETERS
-    }
+    return {p: _threshold(p, values[p], coefs, sums, forces[p], f_crit) for p in CONTROL_PARAMETERS}
 
 
 def _threshold(
@@ -255,11 +256,12 @@ def _threshold(
 
 def frequency_threshold(
     params: GearParams,
+    value: float | None,
     a: float,
     c: float,
+    fm: float,
     scan: tuple = OMEGA_SCAN,
     method: Method = "closed_form",
-    mean_load: MeanLoad = "unperturbed",
 ) -> ParameterThreshold:
     """Critical Omega_e in a scan: where the verdict flips, located by brentq.
 
@@ -270,8 +272,10 @@ def frequency_threshold(
     them, and the verdict would flip at isolated points.) The closed form runs compiled
     (``kernels.scan_roots``); quadrature, and the rare scan on which a coefficient underflows to
     0, take ``_scan_python``, the same algorithm on the pydantic documents.
+
+    ``value`` is the design's Omega_e (None: no transmission error given) and ``fm`` the mean
+    force its loops carry (``coefficients.loop_load``).
     """
-    value = get_alias(params, "Omega_e")
     if value is None:
         return threshold_document(
             "Omega_e",
@@ -281,9 +285,8 @@ def frequency_threshold(
             scan=scan,
             note="transmission_error is not given: no Omega_e to scan",
         )
-    fm = loop_load(params, mean_load)
     found = _scan_compiled(params, a, c, fm, scan, value) if method == "closed_form" else None
-    critical, no_chaos = found or _scan_python(params, a, c, scan, value, method, mean_load)
+    critical, no_chaos = found or _scan_python(params, a, c, scan, value, method, fm)
     return threshold_document(
         "Omega_e",
         value,
@@ -325,9 +328,10 @@ def _scan_python(
     scan: tuple,
     value: float,
     method: Method,
-    mean_load: MeanLoad,
+    fm: float,
 ) -> tuple[list[float], list[tuple[float, float]]]:
-    """The running-speed scan on the documents: ``sign_change_strength`` with ``method``."""
+    """The running-speed scan on the documents: ``sign_change_strength`` with ``method`` on
+    the loops carrying the mean force ``fm``."""
     start, stop, num = scan
 
     def strength(om: float) -> float:
@@ -336,7 +340,7 @@ def _scan_python(
             name: exc.model_copy(update={"frequency": exc.frequency * factor})
             for name, exc in params.excitations()
         }
-        return sign_change_strength(params.model_copy(update=moved), a, c, method, mean_load)
+        return sign_change_strength(params.model_copy(update=moved), a, c, method, fm)
 
     from scipy import optimize
 

@@ -16,6 +16,7 @@ from gearengine.homoclinic.coefficients import (
     active_only,
     critical_mean_force,
     loop_load,
+    melnikov_coefficients,
     saddle_loop,
 )
 from gearengine.homoclinic.extrema import Extrema, extrema
@@ -33,8 +34,8 @@ from gearengine.homoclinic.thresholds import (
     Coefficients,
     frequency_threshold,
     parameter_thresholds,
-    unit_coefficients,
 )
+from gearengine.model.aliases import get_alias
 from gearengine.model.frequencies import poincare_period
 from gearengine.model.params import GearParams
 from gearengine.systems.spur_pair.laws import melnikov_cubic
@@ -99,7 +100,10 @@ def applicability(
         )
         return a, c, notes, None
     # every per-unit coefficient the thresholds will use, inactive first harmonics included
-    units = unit_coefficients(params, a, c, method, mean_load)
+    units = {
+        br: melnikov_coefficients(params, a, c, br, method, include_inactive=True, fm=fm)
+        for br in BRANCH_SIGN
+    }
     scale = [units["plus"].damping_per_unit, *(t.per_unit for t in units["plus"].terms)]
     if not all(math.isfinite(v) and abs(v) < 1e150 for v in scale):
         notes.append(
@@ -126,12 +130,13 @@ def melnikov(
         mean_load: ``unperturbed`` (F_m in the unperturbed system, its saddle and loops) or
             ``perturbation`` (the paper's first-order treatment, F_m absent from M).
     """
+    period = poincare_period(params)  # the model room's answers first: T0 and the aliases
+    values = {p: get_alias(params, p) for p in (*CONTROL_PARAMETERS, "Omega_e")}
     a, c, notes, units = applicability(params, method, mean_load)
     if units is None:
         return not_applicable(a, c, method, notes, mean_load)
     fm, f_crit = loop_load(params, mean_load), critical_mean_force(a, c)
     coefs = {br: active_only(units[br], params) for br in BRANCH_SIGN}
-    period = poincare_period(params)
     branches = {br: branch_verdict(extrema(coefs[br].trig_sum(), period)) for br in BRANCH_SIGN}
     if any(b.extrema == "supremum" for b in branches.values()):
         notes.append(
@@ -166,8 +171,10 @@ def melnikov(
             f"{method} coefficients"
         )
     forces = {p: force_per_unit(params, p, extremes) for p in CONTROL_PARAMETERS}
-    thresholds = parameter_thresholds(params, units, forces, f_crit)
-    thresholds["Omega_e"] = frequency_threshold(params, a, c, omega_scan, method, mean_load)
+    thresholds = parameter_thresholds(units, values, forces, f_crit)
+    thresholds["Omega_e"] = frequency_threshold(
+        params, values["Omega_e"], a, c, fm, omega_scan, method
+    )
     return MelnikovResult(
         applicable=True,
         chaos_possible=any(b.sign_change for b in branches.values()),
