@@ -37,7 +37,7 @@ def numpy_orbit(t: np.ndarray, a: float, c: float, fm: float, s: float) -> tuple
         z = math.sqrt(a) * t
         sech = 1.0 / np.cosh(z)
         return s * math.sqrt(2.0 * a / c) * sech, -s * math.sqrt(2.0 / c) * a * sech * np.tanh(z)
-    xs, alpha, p, cos_t, _ = loops.loop_shape(a, c, fm, s)
+    xs, alpha, p, cos_t, *_ = loops.loop_shape(a, c, fm, s)
     k = math.sqrt(alpha)
     den = np.cosh(k * t) + cos_t
     return xs + s * p / den, -s * p * k * np.sinh(k * t) / den**2

@@ -68,7 +68,7 @@ def branch_shape(system, s: float):
     """``loops.loop_shape`` of the system's loaded loop s (zeros for F_m = 0, where the closed
     forms of Eq. 19 need none): computed once per branch, not once per coefficient."""
     if system[FM] == 0.0:
-        return 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     return loop_shape(system[A], system[C], system[FM], s)
 
 

@@ -34,7 +34,6 @@ from gearengine.homoclinic.extrema import (
 )
 from gearengine.homoclinic.margins import intersect, interval_ends, threshold_document
 from gearengine.homoclinic.schemas import (
-    BranchThreshold,
     ParameterThreshold,
     ThresholdCurve,
     ThresholdsRequest,
@@ -228,7 +227,7 @@ def _threshold(
     ``unit_coefficients`` and their trig sums; with ``force`` (the largest force along the
     loops per unit of the parameter) the margin also in the force scale ``f_crit``."""
     domain = DOMAIN.get(parameter, Interval(None, None))
-    branches: dict[HomoclinicBranch, BranchThreshold] = {}
+    branches: dict[HomoclinicBranch, dict] = {}
     sets: dict[HomoclinicBranch, list[Interval]] = {}
     for br in BRANCH_SIGN:
         family = _family(coefs[br], sums[br], parameter)
@@ -238,10 +237,10 @@ def _threshold(
                 parameter, value, [], [], note=f"{exc} is not given: no frequency for {parameter}"
             )
         sets[br] = intersect(no_sign_change(family), [domain])
-        branches[br] = BranchThreshold(
-            critical_values=interval_ends(sets[br], domain),
-            no_sign_change=[(i.lo, i.hi) for i in sets[br]],
-        )
+        branches[br] = {  # a BranchThreshold, validated with the document in one pass
+            "critical_values": interval_ends(sets[br], domain),
+            "no_sign_change": [(i.lo, i.hi) for i in sets[br]],
+        }
     overall = intersect(sets["plus"], sets["minus"])
     return threshold_document(
         parameter,

@@ -27,7 +27,7 @@ from gearengine.homoclinic.perturbations import (
     loop_extremes,
     perturbation_sizes,
 )
-from gearengine.homoclinic.schemas import BranchVerdict, MelnikovResult
+from gearengine.homoclinic.schemas import MelnikovResult
 from gearengine.homoclinic.thresholds import (
     CONTROL_PARAMETERS,
     OMEGA_SCAN,
@@ -41,16 +41,17 @@ from gearengine.model.params import GearParams
 from gearengine.systems.spur_pair.laws import melnikov_cubic
 
 
-def branch_verdict(ext: Extrema) -> BranchVerdict:
-    """Sign-change decision of one branch from its extrema."""
-    return BranchVerdict(
-        sign_change=ext.minimum.value < 0.0 < ext.maximum.value,
-        min=ext.minimum.value,
-        max=ext.maximum.value,
-        tau0_min=ext.minimum.tau0,
-        tau0_max=ext.maximum.tau0,
-        extrema=ext.method,
-    )
+def branch_verdict(ext: Extrema) -> dict:
+    """Sign-change decision of one branch from its extrema: a ``BranchVerdict``'s fields,
+    validated with the result in one pass."""
+    return {
+        "sign_change": ext.minimum.value < 0.0 < ext.maximum.value,
+        "min": ext.minimum.value,
+        "max": ext.maximum.value,
+        "tau0_min": ext.minimum.tau0,
+        "tau0_max": ext.maximum.tau0,
+        "extrema": ext.method,
+    }
 
 
 def not_applicable(
@@ -138,7 +139,7 @@ def melnikov(
     fm, f_crit = loop_load(params, mean_load), critical_mean_force(a, c)
     coefs = {br: active_only(units[br], params) for br in BRANCH_SIGN}
     branches = {br: branch_verdict(extrema(coefs[br].trig_sum(), period)) for br in BRANCH_SIGN}
-    if any(b.extrema == "supremum" for b in branches.values()):
+    if any(b["extrema"] == "supremum" for b in branches.values()):
         notes.append(
             "the active frequencies are incommensurate (no ratio p/q with q <= 64): min and max "
             "of M are the infimum and supremum A -/+ sum |B_i|, approached but not attained"
@@ -177,7 +178,7 @@ def melnikov(
     )
     return MelnikovResult(
         applicable=True,
-        chaos_possible=any(b.sign_change for b in branches.values()),
+        chaos_possible=any(b["sign_change"] for b in branches.values()),
         branches=branches,
         thresholds=thresholds,
         coefficients=coefs,
