@@ -32,7 +32,12 @@ from gearengine.homoclinic.extrema import (
     one_sinusoid_interval,
     sublevel_interval,
 )
-from gearengine.homoclinic.margins import intersect, interval_ends, threshold_document
+from gearengine.homoclinic.margins import (
+    intersect,
+    interval_ends,
+    threshold_document,
+    threshold_fields,
+)
 from gearengine.homoclinic.schemas import (
     ParameterThreshold,
     ThresholdCurve,
@@ -197,7 +202,7 @@ def parameter_threshold(
     """
     coefs = unit_coefficients(params, a, c, method, mean_load) if coefs is None else coefs
     sums = {br: coefs[br].trig_sum() for br in BRANCH_SIGN}
-    return _threshold(parameter, get_alias(params, parameter), coefs, sums)
+    return ParameterThreshold(**_threshold(parameter, get_alias(params, parameter), coefs, sums))
 
 
 def parameter_thresholds(
@@ -205,9 +210,10 @@ def parameter_thresholds(
     values: dict[str, float | None],
     forces: dict[str, float | None],
     f_crit: float,
-) -> dict[str, ParameterThreshold]:
-    """``parameter_threshold`` of every control parameter (``CONTROL_PARAMETERS``), each
-    branch's sum of ``coefs`` (``unit_coefficients``) read once for all of them. ``values`` are
+) -> dict[str, dict]:
+    """``parameter_threshold`` of every control parameter (``CONTROL_PARAMETERS``) as the
+    fields of its document (validated with the verdict's), each branch's sum of ``coefs``
+    (``unit_coefficients``) read once for all of them. ``values`` are
     the design's values of the parameters (``get_alias``); with the margin in the force scale
     ``f_crit``, ``forces`` being the largest force along the loops per unit of each parameter
     (``perturbations.force_per_unit``; None: no such force)."""
@@ -222,10 +228,10 @@ def _threshold(
     sums: dict[HomoclinicBranch, TrigSum],
     force: float | None = None,
     f_crit: float = 1.0,
-) -> ParameterThreshold:
-    """``parameter_threshold`` of a design whose ``parameter`` is ``value``, from the branches'
-    ``unit_coefficients`` and their trig sums; with ``force`` (the largest force along the
-    loops per unit of the parameter) the margin also in the force scale ``f_crit``."""
+) -> dict:
+    """The fields of ``parameter_threshold`` of a design whose ``parameter`` is ``value``, from
+    the branches' ``unit_coefficients`` and their trig sums; with ``force`` (the largest force
+    along the loops per unit of the parameter) the margin also in the force scale ``f_crit``."""
     domain = DOMAIN.get(parameter, Interval(None, None))
     branches: dict[HomoclinicBranch, dict] = {}
     sets: dict[HomoclinicBranch, list[Interval]] = {}
@@ -233,7 +239,7 @@ def _threshold(
         family = _family(coefs[br], sums[br], parameter)
         if family is None:
             exc = _TERM_OF[parameter]
-            return threshold_document(
+            return threshold_fields(
                 parameter, value, [], [], note=f"{exc} is not given: no frequency for {parameter}"
             )
         sets[br] = intersect(no_sign_change(family), [domain])
@@ -242,7 +248,7 @@ def _threshold(
             "no_sign_change": [(i.lo, i.hi) for i in sets[br]],
         }
     overall = intersect(sets["plus"], sets["minus"])
-    return threshold_document(
+    return threshold_fields(
         parameter,
         value,
         interval_ends(overall, domain),
