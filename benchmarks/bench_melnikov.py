@@ -13,7 +13,13 @@ Served (issue 31): POST /v1/melnikov through a real ``gearengine serve`` of the 
 one of commit 9b6ddae (before issue 31, ``git archive`` of gearengine and service), both warm,
 requests alternating between them (a shared machine loads both alike); every request a new
 design (no cache serves it), one excitation or three; and the same verdicts in process
-(``answer_melnikov`` and its JSON) in a worker of each tree, batches alternating.
+(``answer_melnikov`` and its JSON) in a worker of each tree, batches alternating, in wall time
+and in the worker thread's CPU time (which a loaded machine inflates far less).
+
+    .venv/bin/python benchmarks/bench_melnikov.py --served [--before REF]
+
+runs only that part, against REF (a commit, or a directory holding an earlier tree's
+gearengine and service, whose compiled kernels are then reused), into its own section.
 """
 
 from __future__ import annotations
@@ -26,6 +32,8 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from common import extracted, min_median, served  # benchmarks/common.py (the script's folder)
@@ -217,16 +225,17 @@ for line in sys.stdin:
     reqs = [MelnikovRequest.model_validate(d) for d in json.loads(line)]
     times = []
     for r in reqs:
-        t = time.perf_counter()
+        t, cpu = time.perf_counter(), time.thread_time()
         dumps(answer_melnikov(r))
-        times.append(time.perf_counter() - t)
+        times.append((time.perf_counter() - t, time.thread_time() - cpu))
     print(json.dumps(times), flush=True)
 """
 
 
 def in_process_timings(trees: dict[str, Path]) -> dict[tuple[str, str], list[float]]:
     """Wall time [s] of ``answer_melnikov`` and its JSON per new design, by (tree, "one" or
-    "three"), in one worker process per tree, batches alternating between them."""
+    "three"), and its CPU time by (tree, "one cpu" or "three cpu"), in one worker process per
+    tree, batches alternating between them."""
     workers = {
         label: subprocess.Popen(
             [sys.executable, "-c", VERDICTS],
@@ -255,7 +264,8 @@ def in_process_timings(trees: dict[str, Path]) -> dict[tuple[str, str], list[flo
                 for label in order:
                     got = batch(label, docs)
                     if k >= 0:
-                        times.setdefault((label, what), []).extend(got)
+                        times.setdefault((label, what), []).extend(w for w, _ in got)
+                        times.setdefault((label, f"{what} cpu"), []).extend(c for _, c in got)
     finally:
         for worker in workers.values():
             worker.stdin.close()
@@ -263,9 +273,21 @@ def in_process_timings(trees: dict[str, Path]) -> dict[tuple[str, str], list[flo
     return times
 
 
-def served_section() -> list[str]:
-    """The served and in-process rows of issue 31, before (BEFORE) and now, as markdown."""
-    with extracted(BEFORE, ("gearengine", "service")) as old, tempfile.TemporaryDirectory() as d:
+@contextmanager
+def earlier_tree(ref: str) -> Iterator[Path]:
+    """The gearengine and service of ``ref``: a directory holding them, as it is, or a commit,
+    extracted (``git archive``) into a temporary directory."""
+    if Path(ref).is_dir():
+        yield Path(ref)
+        return
+    with extracted(ref, ("gearengine", "service")) as old:
+        yield old
+
+
+def served_section(before: str = BEFORE) -> list[str]:
+    """The served and in-process rows of issue 31, ``before`` (a commit or an earlier tree,
+    ``earlier_tree``) and now, as markdown."""
+    with earlier_tree(before) as old, tempfile.TemporaryDirectory() as d:
         tmp = Path(d)
         for label in ("before", "now"):
             (tmp / label).mkdir()
@@ -280,9 +302,17 @@ def served_section() -> list[str]:
         ("served: GET /v1/health (the floor of any request)", http, "health"),
         ("in process: `answer_melnikov` + JSON, one excitation", local, "one"),
         ("in process: `answer_melnikov` + JSON, three excitations", local, "three"),
+        ("in process, CPU time of the worker thread: one excitation", local, "one cpu"),
+        ("in process, CPU time of the worker thread: three excitations", local, "three cpu"),
     ]
+    label_before = Path(before).name if Path(before).is_dir() else before  # a dir: its name
     lines = [
-        f"### Served (issue 31): before ({BEFORE}) and now",
+        f"### Served (issue 31): before ({label_before}) and now",
+        "",
+        f"Reproduce: `.venv/bin/python benchmarks/bench_melnikov.py --served --before "
+        f"{label_before}` (rewrites this section; REF a commit, or a directory holding that "
+        "commit's gearengine and service, extracted with `git archive`, whose compiled kernels "
+        "are reused).",
         "",
         f"A real `gearengine serve` of each tree (its defaults: one HTTP process per core), warm; "
         f"{ROUNDS} rounds of {PER_ROUND} requests per row, alternating between the trees, from "
@@ -303,11 +333,22 @@ def served_section() -> list[str]:
             f"| {label} | {1e3 * b_min:.3f} / {1e3 * b_med:.3f} | {1e3 * n_min:.3f} / "
             f"{1e3 * n_med:.3f} | {b_med / n_med:.2f}x |"
         )
-    lines += ["", f"Load average (1 min) at the end of the run: {load:.1f} on 2 cores."]
+    lines += [
+        "",
+        f"Load average (1 min) at the end of the run: {load:.1f} on 2 cores. On a loaded machine "
+        "the minima and the CPU-time rows compare the trees; the wall-time medians carry the "
+        "load of other processes as much as the work.",
+    ]
     return lines
 
 
 def main() -> None:
+    if "--served" in sys.argv:
+        before = sys.argv[sys.argv.index("--before") + 1] if "--before" in sys.argv else BEFORE
+        lines = served_section(before)
+        print("\n".join(lines))
+        write_section("melnikov-served", "\n".join(lines))
+        return
     issue31 = served_section()
     print("\n".join(issue31), flush=True)
     old = measure_commit(BASELINE)
@@ -354,12 +395,11 @@ def main() -> None:
         "",
         f"Designs with several excitations take the per-design path of `melnikov_batch`: "
         f"{new['batch_three']:.3f} ms per design (three excitations).",
-        "",
-        *issue31,
     ]
     markdown = "\n".join(lines)
     print(markdown)
     write_section("melnikov", markdown)
+    write_section("melnikov-served", "\n".join(issue31))
 
 
 if __name__ == "__main__":

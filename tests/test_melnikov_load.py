@@ -223,3 +223,28 @@ def test_perturbation_sizes_and_caveat() -> None:
          "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 0.01}]}}
     )  # fmt: skip
     assert not any("stretched" in n for n in melnikov(small).notes)
+
+
+@pytest.mark.parametrize("s", [1.0, -1.0])
+@pytest.mark.parametrize("fm", [0.6 * F_CRIT, -0.3 * F_CRIT, 0.05 * F_CRIT])
+def test_loop_integrals_closed_form_against_quadrature(fm: float, s: float) -> None:
+    """I_1 = int u_s cos(omega t) dt and T_2 = int u_s'^2 cos(omega t) dt of ``loops``
+    (G&R 3.983.2 and the recursion; k and theta_s shared through ``loop_shape``) against
+    QUADPACK's cosine-weighted integral of the loop itself, u_s = s P / (cosh(k t) + cos
+    theta_s), over [0, 80/k] (doubled: both integrands are even)."""
+    _, alpha, p, cos_t, sin_t, k, theta = loops.loop_shape(A, C, fm, s)
+    assert k == math.sqrt(alpha) and theta == pytest.approx(math.atan2(sin_t, cos_t))
+
+    def u(t: float) -> float:
+        return s * p / (math.cosh(k * t) + cos_t)
+
+    def du2(t: float) -> float:
+        return (s * p * k * math.sinh(k * t) / (math.cosh(k * t) + cos_t) ** 2) ** 2
+
+    for omega in (0.0, 0.3, 1.1, 2.5):
+        i1, t2 = loops.loop_integrals(omega, A, C, fm, s)
+        weight = {"weight": "cos", "wvar": omega} if omega else {}
+        q1 = 2 * integrate.quad(u, 0.0, 80 / k, limit=500, epsabs=1e-14, **weight)[0]
+        q2 = 2 * integrate.quad(du2, 0.0, 80 / k, limit=500, epsabs=1e-14, **weight)[0]
+        assert i1 == pytest.approx(q1, rel=1e-9, abs=1e-13)
+        assert t2 == pytest.approx(q2, rel=1e-9, abs=1e-13)

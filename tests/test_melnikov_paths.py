@@ -72,7 +72,7 @@ def test_compiled_scan_equals_the_scan_on_documents() -> None:
         value = p.transmission_error.frequency
         fm = p.mean_force
         fast = th._scan_compiled(p, a, c, fm, (0.05, 3.0, 30), value)
-        slow = th._scan_python(p, a, c, (0.05, 3.0, 30), value, "closed_form", "unperturbed")
+        slow = th._scan_python(p, a, c, (0.05, 3.0, 30), value, "closed_form", fm)
         assert fast is not None
         assert fast[0] == pytest.approx(slow[0], rel=1e-9, abs=1e-9), p
         assert len(fast[1]) == len(slow[1]), p
@@ -82,6 +82,6 @@ def test_single_sinusoid_scan_is_bit_for_bit_the_same() -> None:
     value = 0.5
     fast = th._scan_compiled(PAPER, 0.1667, 0.1667, 0.0, th.OMEGA_SCAN, value)
     slow = th._scan_python(
-        PAPER, 0.1667, 0.1667, th.OMEGA_SCAN, value, "closed_form", "unperturbed"
+        PAPER, 0.1667, 0.1667, th.OMEGA_SCAN, value, "closed_form", PAPER.mean_force
     )
     assert fast == slow

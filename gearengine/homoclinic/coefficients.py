@@ -311,6 +311,8 @@ def active_only(coef: BranchCoefficients, params: GearParams) -> BranchCoefficie
         for r, h in (list(enumerate(exc.harmonics, start=1)) or [(1, None)])
         if r == 1 or h.amplitude != 0.0
     ]
+    if all(amp != 0.0 for amp in amplitudes):
+        return coef  # no inactive harmonic to drop
     return BranchCoefficients.model_construct(
         damping=coef.damping,
         damping_per_unit=coef.damping_per_unit,

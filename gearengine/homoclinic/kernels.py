@@ -68,7 +68,7 @@ def branch_shape(system, s: float):
     """``loops.loop_shape`` of the system's loaded loop s (zeros for F_m = 0, where the closed
     forms of Eq. 19 need none): computed once per branch, not once per coefficient."""
     if system[FM] == 0.0:
-        return 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     return loop_shape(system[A], system[C], system[FM], s)
 
 
@@ -251,10 +251,15 @@ def scan_strength(om: float, value: float, terms, system) -> float:
 @jit
 def _workspace(terms, system):
     """What ``_strength`` reuses from one Omega_e of a scan to the next: both branches'
-    ``branch_shape`` (frequency-independent), and scratch arrays (frequencies, amplitudes, and
-    the grid of a single or incommensurate set, which needs none)."""
+    ``branch_shape`` and damping per unit mu (``damping_on``; both frequency-independent), and
+    scratch arrays (frequencies, amplitudes, and the grid of a single or incommensurate set,
+    which needs none)."""
     n = terms.shape[1]
-    shapes = ((1.0, branch_shape(system, 1.0)), (-1.0, branch_shape(system, -1.0)))
+    plus, minus = branch_shape(system, 1.0), branch_shape(system, -1.0)
+    shapes = (
+        (1.0, plus, damping_on(system, 1.0, plus)),
+        (-1.0, minus, damping_on(system, -1.0, minus)),
+    )
     return shapes, np.empty(n), np.empty(n), np.zeros(2), np.zeros((2, n)), np.empty(2)
 
 
@@ -274,8 +279,8 @@ def _strength(om: float, value: float, terms, system, work) -> float:
         taus, table = grid_sines(freqs, phase, period)
         values = np.empty(taus.size)
     best = -np.inf
-    for s, shape in shapes:
-        damping = damping_on(system, s, shape) * system[MU]
+    for s, shape, damping_per_mu in shapes:
+        damping = damping_per_mu * system[MU]
         nact = 0
         for i in range(n):
             kind = int(terms[KIND_ROW, i])

@@ -71,13 +71,14 @@ def saddle(a: float, c: float, fm: float) -> float:
 
 @jit
 def loop_shape(a: float, c: float, fm: float, s: float):
-    """(x_s, alpha, P, cos theta_s, sin theta_s) of loop s (u_s = s P / (cosh(k t) +
-    cos theta_s))."""
+    """(x_s, alpha, P, cos theta_s, sin theta_s, k, theta_s) of loop s (u_s = s P / (cosh(k t) +
+    cos theta_s), k = sqrt(alpha)): what every frequency's integrals of the loop share."""
     xs = saddle(a, c, fm)
     alpha = a - 3.0 * c * xs * xs
     beta = -2.0 * c * xs
     root = math.sqrt(beta * beta + 2.0 * alpha * c)
-    return xs, alpha, 2.0 * alpha / root, -s * beta / root, math.sqrt(2.0 * alpha * c) / root
+    cos_t, sin_t = -s * beta / root, math.sqrt(2.0 * alpha * c) / root
+    return xs, alpha, 2.0 * alpha / root, cos_t, sin_t, math.sqrt(alpha), math.atan2(sin_t, cos_t)
 
 
 @jit
@@ -105,9 +106,7 @@ def loop_integrals(omega: float, a: float, c: float, fm: float, s: float):
 def shape_integrals(omega: float, c: float, s: float, shape):
     """``loop_integrals`` on the loop of ``shape`` (``loop_shape(a, c, F_m, s)``, computed once
     for every frequency of a scan)."""
-    xs, alpha, p, cos_t, sin_t = shape
-    k = math.sqrt(alpha)
-    theta = math.atan2(sin_t, cos_t)
+    xs, alpha, p, cos_t, sin_t, k, theta = shape
     r, nq = _ratios(omega / k, theta)
     base = 2.0 * math.pi / k
     i1 = s * p * base * r / sin_t

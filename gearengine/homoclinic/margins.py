@@ -64,19 +64,36 @@ def signed_margin(
     return nearest, margin, margin / abs(nearest) if nearest != 0.0 else None
 
 
-def threshold_document(
-    parameter: str, value: float | None, critical: list[float], no_chaos: list, **extra: object
-) -> ParameterThreshold:
-    """The threshold document: critical values and the design's margin (``signed_margin``)."""
+def threshold_fields(
+    parameter: str,
+    value: float | None,
+    critical: list[float],
+    no_chaos: list,
+    force: float | None = None,
+    f_crit: float = 1.0,
+    **extra: object,
+) -> dict:
+    """The fields of the threshold document (a ``ParameterThreshold``, validated where it is
+    built: alone in ``threshold_document``, or with the verdict it belongs to): critical values
+    and the design's margin (``signed_margin``); with ``force``, the largest force along the
+    loops per unit of the parameter, the margin in the force scale ``f_crit`` too (margin *
+    force / F_crit)."""
     nearest = margin = rel = None
     if value is not None:
         nearest, margin, rel = signed_margin(parameter, value, critical, no_chaos)
-    return ParameterThreshold(
-        value=value,
-        critical_values=critical,
-        nearest=nearest,
-        margin=margin,
-        relative_margin=rel,
-        no_chaos=no_chaos,
+    if margin is not None and force is not None:
+        extra["margin_in_force_scale"] = margin * force / f_crit
+    return {
+        "value": value,
+        "critical_values": critical,
+        "nearest": nearest,
+        "margin": margin,
+        "relative_margin": rel,
+        "no_chaos": no_chaos,
         **extra,
-    )
+    }
+
+
+def threshold_document(*args: object, **kwargs: object) -> ParameterThreshold:
+    """The ``ParameterThreshold`` of ``threshold_fields(*args, **kwargs)``."""
+    return ParameterThreshold(**threshold_fields(*args, **kwargs))

@@ -58,11 +58,14 @@ def _commensurability(frequencies: tuple[float, ...]) -> tuple[float, float]:
 
 def system_array(mu: float, a: float, c: float, fm: float, gcd: float, lcm: float) -> np.ndarray:
     """The ``system`` entries in ``kernels``' order."""
-    system = np.empty(kernels.SYSTEM_SIZE)
-    system[[kernels.MU, kernels.A, kernels.C, kernels.FM, kernels.GCD, kernels.LCM]] = (
-        mu, a, c, fm, gcd, lcm,
-    )  # fmt: skip
-    return system
+    entries = [0.0] * kernels.SYSTEM_SIZE
+    for i, v in zip(
+        (kernels.MU, kernels.A, kernels.C, kernels.FM, kernels.GCD, kernels.LCM),
+        (mu, a, c, fm, gcd, lcm),
+        strict=True,
+    ):
+        entries[i] = v
+    return np.array(entries, dtype=float)
 
 
 def pack(

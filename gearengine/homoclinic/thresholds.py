@@ -29,13 +29,16 @@ from gearengine.homoclinic.extrema import (
     Interval,
     TrigSum,
     extrema,
-    one_sinusoid,
     one_sinusoid_interval,
     sublevel_interval,
 )
-from gearengine.homoclinic.margins import intersect, interval_ends, threshold_document
+from gearengine.homoclinic.margins import (
+    intersect,
+    interval_ends,
+    threshold_document,
+    threshold_fields,
+)
 from gearengine.homoclinic.schemas import (
-    BranchThreshold,
     ParameterThreshold,
     ThresholdCurve,
     ThresholdsRequest,
@@ -66,19 +69,18 @@ def sign_change_strength(
     a: float,
     c: float,
     method: Method = "closed_form",
-    mean_load: MeanLoad = "unperturbed",
+    fm: float = 0.0,
 ) -> float:
     """max over branches of min(max M, -min M): > 0 iff some branch changes sign.
 
     Continuous in the parameters (for a fixed set of commensurate frequencies), so its roots
     are the critical values of any parameter. ``method`` names the coefficients (``METHODS``),
-    ``mean_load`` where F_m goes (``coefficients.MeanLoad``; the loops must exist,
+    ``fm`` the mean force the loops carry (``coefficients.loop_load``; the loops must exist,
     ``saddle_loop``).
     The closed form runs compiled (``kernels.scan_strength`` at the design's own speed, on the
     packed form of ``terms``); quadrature, and the rare design on which a coefficient underflows
     to 0, take the same algorithm on the pydantic documents.
     """
-    fm = loop_load(params, mean_load)
     if method == "closed_form":
         strength = packed_terms(params, a, c, fm).strength()
         if not math.isnan(strength):
@@ -108,9 +110,10 @@ def strength_at(
     mean load in the unperturbed system)."""
     design = with_aliases(params, values) if values else params
     a, c = _cubic(design.backlash)
-    if not saddle_loop(a, c, loop_load(design, mean_load)):
+    fm = loop_load(design, mean_load)
+    if not saddle_loop(a, c, fm):
         return math.nan
-    return sign_change_strength(design, a, c, mean_load=mean_load)
+    return sign_change_strength(design, a, c, fm=fm)
 
 
 def chaos_possible(params: GearParams, mean_load: MeanLoad = "unperturbed") -> bool | None:
@@ -123,8 +126,14 @@ def chaos_possible(params: GearParams, mean_load: MeanLoad = "unperturbed") -> b
     return None if math.isnan(strength) else strength > 0.0
 
 
-def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum] | None:
-    """Split M = m0 + p g for the control parameter p (None if p's excitation is absent)."""
+Family = tuple[TrigSum, TrigSum] | tuple[float, float, float, float]
+"""M = m0 + p g of one control parameter p: two trig sums sharing frequencies and phases, or for
+at most one sinusoid the floats (m0.offset, g.offset, a, b) of ``extrema.one_sinusoid``."""
+
+
+def _family(coef: BranchCoefficients, m: TrigSum, parameter: str) -> Family | None:
+    """Split M = m0 + p g for the control parameter p (None if p's excitation is absent);
+    ``m`` is ``coef.trig_sum()``, read once for every parameter."""
     if coef.damping_per_unit is None:
         raise ValueError("coefficients read back from JSON carry no per-unit values (they are "
                          "not serialised): compute them again from the parameters")  # fmt: skip
@@ -134,7 +143,11 @@ def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum]
         j = next((i for i, t in enumerate(coef.terms) if t.excitation == name and t.r == 1), None)
         if j is None:
             return None
-    m = coef.trig_sum()
+    if m.amplitudes.size <= 1:  # the floats of one_sinusoid, without arrays
+        only = float(m.amplitudes[0]) if m.amplitudes.size else 0.0
+        if j is None:
+            return 0.0, float(coef.damping_per_unit), only, 0.0
+        return float(m.offset), 0.0, 0.0, float(coef.terms[j].per_unit)
     zeros = np.zeros_like(m.amplitudes)
     if j is None:
         return (
@@ -151,12 +164,12 @@ def _family(coef: BranchCoefficients, parameter: str) -> tuple[TrigSum, TrigSum]
     )
 
 
-def no_sign_change(m0: TrigSum, g: TrigSum) -> list[Interval]:
+def no_sign_change(family: Family) -> list[Interval]:
     """Intervals of p where m0 + p g keeps one sign: max <= 0 or min >= 0."""
-    if m0.amplitudes.size <= 1:  # the closed forms, on floats (-M: the same floats negated)
-        single = one_sinusoid(m0, g)
-        below = one_sinusoid_interval(*single)
-        return [s for s in (below, one_sinusoid_interval(*(-v for v in single))) if s is not None]
+    if len(family) == 4:  # the closed forms, on floats (-M: the same floats negated)
+        below = one_sinusoid_interval(*family)
+        return [s for s in (below, one_sinusoid_interval(*(-v for v in family))) if s is not None]
+    m0, g = family
     sets = (sublevel_interval(m0, g), sublevel_interval(m0.negated(), g.negated()))
     return [s for s in sets if s is not None]
 
@@ -187,40 +200,73 @@ def parameter_threshold(
     ``coefs`` are the branches' ``unit_coefficients`` if already known (else computed with
     ``method`` and ``mean_load``).
     """
-    value = get_alias(params, parameter)
-    domain = DOMAIN.get(parameter, Interval(None, None))
     coefs = unit_coefficients(params, a, c, method, mean_load) if coefs is None else coefs
-    branches: dict[HomoclinicBranch, BranchThreshold] = {}
+    sums = {br: coefs[br].trig_sum() for br in BRANCH_SIGN}
+    return ParameterThreshold(**_threshold(parameter, get_alias(params, parameter), coefs, sums))
+
+
+def parameter_thresholds(
+    coefs: Coefficients,
+    values: dict[str, float | None],
+    forces: dict[str, float | None],
+    f_crit: float,
+) -> dict[str, dict]:
+    """``parameter_threshold`` of every control parameter (``CONTROL_PARAMETERS``) as the
+    fields of its document (validated with the verdict's), each branch's sum of ``coefs``
+    (``unit_coefficients``) read once for all of them. ``values`` are
+    the design's values of the parameters (``get_alias``); with the margin in the force scale
+    ``f_crit``, ``forces`` being the largest force along the loops per unit of each parameter
+    (``perturbations.force_per_unit``; None: no such force)."""
+    sums = {br: coefs[br].trig_sum() for br in BRANCH_SIGN}
+    return {p: _threshold(p, values[p], coefs, sums, forces[p], f_crit) for p in CONTROL_PARAMETERS}
+
+
+def _threshold(
+    parameter: str,
+    value: float | None,
+    coefs: Coefficients,
+    sums: dict[HomoclinicBranch, TrigSum],
+    force: float | None = None,
+    f_crit: float = 1.0,
+) -> dict:
+    """The fields of ``parameter_threshold`` of a design whose ``parameter`` is ``value``, from
+    the branches' ``unit_coefficients`` and their trig sums; with ``force`` (the largest force
+    along the loops per unit of the parameter) the margin also in the force scale ``f_crit``."""
+    domain = DOMAIN.get(parameter, Interval(None, None))
+    branches: dict[HomoclinicBranch, dict] = {}
     sets: dict[HomoclinicBranch, list[Interval]] = {}
     for br in BRANCH_SIGN:
-        family = _family(coefs[br], parameter)
+        family = _family(coefs[br], sums[br], parameter)
         if family is None:
             exc = _TERM_OF[parameter]
-            return threshold_document(
+            return threshold_fields(
                 parameter, value, [], [], note=f"{exc} is not given: no frequency for {parameter}"
             )
-        sets[br] = intersect(no_sign_change(*family), [domain])
-        branches[br] = BranchThreshold(
-            critical_values=interval_ends(sets[br], domain),
-            no_sign_change=[(i.lo, i.hi) for i in sets[br]],
-        )
+        sets[br] = intersect(no_sign_change(family), [domain])
+        branches[br] = {  # a BranchThreshold, validated with the document in one pass
+            "critical_values": interval_ends(sets[br], domain),
+            "no_sign_change": [(i.lo, i.hi) for i in sets[br]],
+        }
     overall = intersect(sets["plus"], sets["minus"])
-    return threshold_document(
+    return threshold_fields(
         parameter,
         value,
         interval_ends(overall, domain),
         [(i.lo, i.hi) for i in overall],
         branches=branches,
+        force=force,
+        f_crit=f_crit,
     )
 
 
 def frequency_threshold(
     params: GearParams,
+    value: float | None,
     a: float,
     c: float,
+    fm: float,
     scan: tuple = OMEGA_SCAN,
     method: Method = "closed_form",
-    mean_load: MeanLoad = "unperturbed",
 ) -> ParameterThreshold:
     """Critical Omega_e in a scan: where the verdict flips, located by brentq.
 
@@ -231,8 +277,10 @@ def frequency_threshold(
     them, and the verdict would flip at isolated points.) The closed form runs compiled
     (``kernels.scan_roots``); quadrature, and the rare scan on which a coefficient underflows to
     0, take ``_scan_python``, the same algorithm on the pydantic documents.
+
+    ``value`` is the design's Omega_e (None: no transmission error given) and ``fm`` the mean
+    force its loops carry (``coefficients.loop_load``).
     """
-    value = get_alias(params, "Omega_e")
     if value is None:
         return threshold_document(
             "Omega_e",
@@ -242,9 +290,8 @@ def frequency_threshold(
             scan=scan,
             note="transmission_error is not given: no Omega_e to scan",
         )
-    fm = loop_load(params, mean_load)
     found = _scan_compiled(params, a, c, fm, scan, value) if method == "closed_form" else None
-    critical, no_chaos = found or _scan_python(params, a, c, scan, value, method, mean_load)
+    critical, no_chaos = found or _scan_python(params, a, c, scan, value, method, fm)
     return threshold_document(
         "Omega_e",
         value,
@@ -286,9 +333,10 @@ def _scan_python(
     scan: tuple,
     value: float,
     method: Method,
-    mean_load: MeanLoad,
+    fm: float,
 ) -> tuple[list[float], list[tuple[float, float]]]:
-    """The running-speed scan on the documents: ``sign_change_strength`` with ``method``."""
+    """The running-speed scan on the documents: ``sign_change_strength`` with ``method`` on
+    the loops carrying the mean force ``fm``."""
     start, stop, num = scan
 
     def strength(om: float) -> float:
@@ -297,7 +345,7 @@ def _scan_python(
             name: exc.model_copy(update={"frequency": exc.frequency * factor})
             for name, exc in params.excitations()
         }
-        return sign_change_strength(params.model_copy(update=moved), a, c, method, mean_load)
+        return sign_change_strength(params.model_copy(update=moved), a, c, method, fm)
 
     from scipy import optimize
 

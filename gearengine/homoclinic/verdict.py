@@ -16,6 +16,7 @@ from gearengine.homoclinic.coefficients import (
     active_only,
     critical_mean_force,
     loop_load,
+    melnikov_coefficients,
     saddle_loop,
 )
 from gearengine.homoclinic.extrema import Extrema, extrema
@@ -26,30 +27,31 @@ from gearengine.homoclinic.perturbations import (
     loop_extremes,
     perturbation_sizes,
 )
-from gearengine.homoclinic.schemas import BranchVerdict, MelnikovResult, ParameterThreshold
+from gearengine.homoclinic.schemas import MelnikovResult
 from gearengine.homoclinic.thresholds import (
     CONTROL_PARAMETERS,
     OMEGA_SCAN,
     Coefficients,
     frequency_threshold,
-    parameter_threshold,
-    unit_coefficients,
+    parameter_thresholds,
 )
+from gearengine.model.aliases import get_alias
 from gearengine.model.frequencies import poincare_period
 from gearengine.model.params import GearParams
 from gearengine.systems.spur_pair.laws import melnikov_cubic
 
 
-def branch_verdict(ext: Extrema) -> BranchVerdict:
-    """Sign-change decision of one branch from its extrema."""
-    return BranchVerdict(
-        sign_change=ext.minimum.value < 0.0 < ext.maximum.value,
-        min=ext.minimum.value,
-        max=ext.maximum.value,
-        tau0_min=ext.minimum.tau0,
-        tau0_max=ext.maximum.tau0,
-        extrema=ext.method,
-    )
+def branch_verdict(ext: Extrema) -> dict:
+    """Sign-change decision of one branch from its extrema: a ``BranchVerdict``'s fields,
+    validated with the result in one pass."""
+    return {
+        "sign_change": ext.minimum.value < 0.0 < ext.maximum.value,
+        "min": ext.minimum.value,
+        "max": ext.maximum.value,
+        "tau0_min": ext.minimum.tau0,
+        "tau0_max": ext.maximum.tau0,
+        "extrema": ext.method,
+    }
 
 
 def not_applicable(
@@ -99,7 +101,10 @@ def applicability(
         )
         return a, c, notes, None
     # every per-unit coefficient the thresholds will use, inactive first harmonics included
-    units = unit_coefficients(params, a, c, method, mean_load)
+    units = {
+        br: melnikov_coefficients(params, a, c, br, method, include_inactive=True, fm=fm)
+        for br in BRANCH_SIGN
+    }
     scale = [units["plus"].damping_per_unit, *(t.per_unit for t in units["plus"].terms)]
     if not all(math.isfinite(v) and abs(v) < 1e150 for v in scale):
         notes.append(
@@ -108,20 +113,6 @@ def applicability(
         )
         return a, c, notes, None
     return a, c, notes, units
-
-
-def _in_force_scale(
-    params: GearParams,
-    parameter: str,
-    t: ParameterThreshold,
-    extremes: tuple[float, float],
-    f_crit: float,
-) -> ParameterThreshold:
-    """``t`` with its margin measured in the force scale F_crit (``perturbations``)."""
-    unit = force_per_unit(params, parameter, extremes)
-    if t.margin is None or unit is None:
-        return t
-    return t.model_copy(update={"margin_in_force_scale": t.margin * unit / f_crit})
 
 
 def melnikov(
@@ -140,14 +131,15 @@ def melnikov(
         mean_load: ``unperturbed`` (F_m in the unperturbed system, its saddle and loops) or
             ``perturbation`` (the paper's first-order treatment, F_m absent from M).
     """
+    period = poincare_period(params)  # the model room's answers first: T0 and the aliases
+    values = {p: get_alias(params, p) for p in (*CONTROL_PARAMETERS, "Omega_e")}
     a, c, notes, units = applicability(params, method, mean_load)
     if units is None:
         return not_applicable(a, c, method, notes, mean_load)
     fm, f_crit = loop_load(params, mean_load), critical_mean_force(a, c)
     coefs = {br: active_only(units[br], params) for br in BRANCH_SIGN}
-    period = poincare_period(params)
     branches = {br: branch_verdict(extrema(coefs[br].trig_sum(), period)) for br in BRANCH_SIGN}
-    if any(b.extrema == "supremum" for b in branches.values()):
+    if any(b["extrema"] == "supremum" for b in branches.values()):
         notes.append(
             "the active frequencies are incommensurate (no ratio p/q with q <= 64): min and max "
             "of M are the infimum and supremum A -/+ sum |B_i|, approached but not attained"
@@ -179,15 +171,14 @@ def melnikov(
             f"method {method}: the verdict, the thresholds and the Omega_e scan all use "
             f"{method} coefficients"
         )
-    thresholds = {
-        p: _in_force_scale(params, p, parameter_threshold(params, p, a, c, method, units),
-                           extremes, f_crit)
-        for p in CONTROL_PARAMETERS
-    }  # fmt: skip
-    thresholds["Omega_e"] = frequency_threshold(params, a, c, omega_scan, method, mean_load)
+    forces = {p: force_per_unit(params, p, extremes) for p in CONTROL_PARAMETERS}
+    thresholds = parameter_thresholds(units, values, forces, f_crit)
+    thresholds["Omega_e"] = frequency_threshold(
+        params, values["Omega_e"], a, c, fm, omega_scan, method
+    )
     return MelnikovResult(
         applicable=True,
-        chaos_possible=any(b.sign_change for b in branches.values()),
+        chaos_possible=any(b["sign_change"] for b in branches.values()),
         branches=branches,
         thresholds=thresholds,
         coefficients=coefs,

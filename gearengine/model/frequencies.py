@@ -108,8 +108,11 @@ def _fundamental_ratios(params: GearParams) -> dict[str, Fraction] | None:
 def poincare_frequency(params: GearParams) -> float | None:
     """Omega_0 of the forcing of ``params`` (module docstring), None when incommensurate or
     without an active excitation."""
-    if not params.active_frequencies():
+    active = params.active_frequencies()
+    if not active:
         return None
+    if len(active) == 1 and params.shaft_orders is None:
+        return active[0]  # one harmonic: top * gcd / lcm with gcd = lcm = 1, as below
     fundamentals = _fundamental_ratios(params)
     if fundamentals is None:
         return None
