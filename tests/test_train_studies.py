@@ -17,11 +17,16 @@ from pydantic import ValidationError
 import gearengine
 from gearengine.analysis import AnalysisRequest
 from gearengine.gate.envelope import Rules, check_envelope
+from gearengine.gate.remedies.compute import remedies
+from gearengine.gate.remedies.request import RemediesRequest as RemediesRequest_
 from gearengine.model.design import Design
 from gearengine.model.train import EXAMPLE_TRAIN
 from gearengine.numerics.settings import SimulationSettings, work
 from gearengine.numerics.trains import simulate_train, train_work
 from gearengine.studies.basins import basins_work
+from gearengine.studies.robustness.study import RobustnessRequest
+from gearengine.studies.robustness.study import checked as checked_robustness
+from gearengine.studies.robustness.study import run_local as run_robustness
 from gearengine.studies.sweep import run_local, validated
 from gearengine.studies.sweep.plan import sweep_work
 from gearengine.systems.designs import design_model
@@ -152,6 +157,51 @@ def test_basins_of_a_train() -> None:
     train = simulate_train(Design.model_validate(TRAIN), SimulationSettings(**settings))
     assert found[0].dte_um == pytest.approx(train.dte_um, rel=1e-3)
     assert result.verdict.decided_by == "periodic 1T, no impacts from 100 % of starts"
+
+
+def test_robustness_of_a_train_is_the_trains() -> None:
+    """A toleranced train samples the train, not the pair alone (on main the study silently
+    ran the pair): with a damping ratio in [0.0499, 0.0501] every sample is the nominal train
+    to 1e-3, its DTE the train's, far from the pair's alone."""
+    tol = {"mesh.damping_ratio": {"uniform": [0.0499, 0.0501]}}
+    doc = {"design": {**TRAIN, "tolerances": tol}, "samples": 4, "settings": LIGHT}
+    result = run_robustness(checked_robustness(RobustnessRequest.model_validate(doc)))
+    (point,) = result.points
+    settings = SimulationSettings.model_validate(LIGHT)
+    train = simulate_train(Design.model_validate(TRAIN), settings)
+    pair = gearengine.analyze(Design.model_validate(PAIR), settings).engineering.response
+    assert point.probabilities[train.classification].value == 1.0
+    assert point.dte_um["mean"] == pytest.approx(train.dte_um, rel=1e-3)
+    assert point.dte_um["mean"] != pytest.approx(pair.dte_peak_to_peak_um, rel=0.05)
+    assert point.probabilities["melnikov_chaos_possible"].count == 0  # no reduction
+
+
+def test_remedies_of_a_train_pass_the_trains_gate() -> None:
+    """A train failing --max-dte 30 µm at 900-1000 rpm (single-sided impacts, DTE ~50 µm):
+    the remedy found on the mesh damping ratio passes the train's own gate, and the last
+    failing value tried fails it."""
+    body = {"design": TRAIN, "envelope": {"speed": "900:1000", "speed_points": 2},
+            "max_dte_um": 30.0, "starts": 1, "settings": LIGHT,
+            "levers": [{"lever": "mesh.damping_ratio", "bounds": [0.05, 0.4]}]}  # fmt: skip
+    result = remedies(RemediesRequest_.model_validate(body))
+    assert not result.passed_already and result.check.failing_points >= 1
+    (remedy,) = result.remedies
+    settings = SimulationSettings.model_validate(LIGHT)
+    for value, passes in ((remedy.to, True), (remedy.bracket[0], False)):
+        dtes = [
+            simulate_train(
+                Design.model_validate(
+                    {
+                        **TRAIN,
+                        "speed": f"{rpm} rpm",
+                        "mesh": {**TRAIN["mesh"], "damping_ratio": value},
+                    }
+                ),
+                settings,
+            ).dte_um
+            for rpm in (900, 1000)
+        ]
+        assert (max(dtes) <= 30.0) is passes, (value, dtes)
 
 
 @pytest.fixture(scope="module")
