@@ -256,7 +256,8 @@ def convert(request: DesignRequest) -> DesignReport:
 
 def analyze_train(request: AnalysisRequest) -> AnalysisResult:
     """``analyze`` for a design with a ``train``: the numerical verdict from the train's kernel
-    (``systems.gear_train``), the Melnikov verdict of its mesh-mode reduction (or not applicable
+    (``systems.gear_train``; with ``settings.basins`` the attractors of its starts over the mesh
+    coordinate), the Melnikov verdict of its mesh-mode reduction (or not applicable
     with the reason, ``homoclinic.train_reduction``), and the engineering block on the scales of
     its equivalent pair (``model.equivalent_design``). The Melnikov speed windows are those of
     the reduction (its frequencies scale with the speed like the pair's); without a reduction
@@ -264,15 +265,13 @@ def analyze_train(request: AnalysisRequest) -> AnalysisResult:
 
     design = request.design
     assert design is not None and design.train is not None
-    if request.settings.basins is not None:
-        raise InputError(
-            "settings.basins",
-            "basins of a gear train are not built yet; remove settings.basins (the train's "
-            "verdict is over the settings' starts)",
-        )
     model, pair = train_of(design)
     system = train_system(model, pair)
     num = simulate(system, request.settings)
+    basins = request.settings.basins
+    if basins is not None:  # starts over (delta, delta'), the rest at its static deflection
+        found, counts = attractors(system, request.settings, pair.scales)
+        num = num.model_copy(update={"attractors": found, "basins": counts})
     reduced = train_melnikov(system)
     if reduced.applicable:
         assert reduced.melnikov is not None and reduced.params is not None
@@ -284,7 +283,7 @@ def analyze_train(request: AnalysisRequest) -> AnalysisResult:
         a, c, _ = melnikov_cubic(system.params.backlash)
         mel = not_applicable(a, c, "closed_form", [reduced.reason])
         conv = pair
-    eng = engineering(conv, request.speed_rpm_range(), mel, num)
+    eng = engineering(conv, request.speed_rpm_range(), mel, num, decision(num, request.settings))
     if not reduced.applicable:
         lo, hi = eng.speed_range_rpm
         eng = eng.model_copy(
@@ -302,7 +301,7 @@ def analyze_train(request: AnalysisRequest) -> AnalysisResult:
         melnikov=mel,
         numerics=num,
         settings=request.settings,
-        verdict=verdict(mel, num),
+        verdict=verdict(mel, num, 0.0 if basins is None else basins.min_fraction),
         params=system.params,
         engineering=eng,
     )

@@ -259,6 +259,34 @@ def test_analyse_shows_the_verdict(page: Page) -> None:
     page.assert_same_origin()
 
 
+def test_a_gear_train_shows_its_modes_and_campbell_diagram(page: Page) -> None:
+    """Issue 32: the example train inserted into the form; the analysis is the train's, and the
+    page shows its modes (the mesh mode marked) and its Campbell diagram."""
+    page.open()
+    page.type("settings.transient_periods", "100")
+    page.type("settings.record_periods", "50")
+    page.field("train-example", by="id").click()
+    assert '"input_shaft"' in page.field("train", by="id").get_attribute("value")
+    page.field("analyse", by="id").click()
+    table = page.wait(lambda d: page.text("#modes-table"))
+    for hz in ("298.5", "652.6", "1100.3", "1722.5", "2799.9"):
+        assert hz in table
+    assert "5 (mesh mode)" in table and "56.5 %" in table
+    assert "stiff limit 739.3 Hz" in page.text("#modes-note")
+    page.wait(lambda d: page.field("campbell-figure", by="id").get_attribute("data-state")
+              in ("shown", "failed"))  # fmt: skip
+    assert page.field("campbell-figure", by="id").get_attribute("data-state") == "shown"
+    assert "a gear train" in page.text("#threshold-note")
+    page.figures_done()  # the train's response figure shown; no threshold curves for a train
+    states = page.driver.execute_script(
+        "return [...document.querySelectorAll('figure img')].map(i => i.dataset.state)"
+    )
+    assert states == ["shown", "failed"]
+    page.show("#modes")
+    page.screenshot("explorer-train.png", height=1400)
+    page.assert_same_origin()
+
+
 def test_a_wrong_unit_is_shown_next_to_its_field(page: Page) -> None:
     page.open()
     page.type("design.mesh.half_backlash", "100 m")

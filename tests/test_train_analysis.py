@@ -6,13 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import pytest
-from pydantic import ValidationError
-
 import gearengine
-from gearengine.analysis import AnalysisRequest
 from gearengine.model.design import Design
-from gearengine.model.errors import InputError
 from gearengine.model.train import EXAMPLE_TRAIN
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.trains import simulate_train
@@ -31,7 +26,9 @@ def test_analysis_of_a_train_is_the_trains() -> None:
     assert num.period == train.period and num.lle == train.lle
     assert eng.response.dte_peak_to_peak_um == train.dte_um
     assert eng.response.dynamic_factor == train.dynamic_factor
-    assert num.floquet is None and "train" in num.floquet_note
+    # Floquet of the train's periodic response: 2n = 10 multipliers (tests/test_train_floquet.py)
+    assert num.floquet is not None and num.floquet.converged and num.floquet_note is None
+    assert len(num.floquet.multipliers) == 10 and num.floquet.stability_margin > 0
     assert not result.melnikov.applicable and "56.5%" in result.melnikov.notes[0]
     assert result.verdict.agreement == "undecided"
     assert [round(m.frequency_hz, 1) for m in eng.modes.modes][-1] == 2799.9
@@ -41,14 +38,3 @@ def test_analysis_of_a_train_is_the_trains() -> None:
     text = pair.model_dump_json()
     assert '"modes"' not in text and '"train"' not in text
     assert pair.numerics.lle != num.lle
-
-
-def test_train_basins_refused() -> None:
-    with pytest.raises((InputError, ValidationError)) as err:
-        gearengine.analyze(
-            AnalysisRequest(
-                design={**PAIR, "train": EXAMPLE_TRAIN},
-                settings={"basins": {"starts": 4}, "record_periods": 10},
-            )
-        )
-    assert "basins" in str(err.value)

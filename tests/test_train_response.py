@@ -111,37 +111,45 @@ def test_stiff_limit_periodic() -> None:
 
 
 def test_stiff_limit_chaotic() -> None:
-    """3000 rpm, 20 um transmission error, 10 N m: the pair is chaotic (LLE ~ 0.07); the stiff
-    train is chaotic with the same contact regime and its LLE within the stated errors (3
-    standard errors of the difference). A chaotic record's peak to peak is a sample extreme:
-    the train's DTE and dynamic factor lie within the range of the pair's from five starts,
-    widened by 1 %."""
+    """2500 rpm, 40 um transmission error, 30 N m: a chaotic attractor of the pair (LLE ~ 0.10
+    from every start, double-sided impacts). The stiff train is chaotic with the same contact
+    regime, its LLE within the stated errors (3 standard errors of the difference), and its
+    DTE and dynamic factor within 1 % of the pair's from the same start (0.01, 0.01).
+
+    A chaotic record's DTE and dynamic factor are sample extremes: they are compared over a
+    record long enough for them to have converged, which the pair's own spread over five starts
+    (under 1 %) shows. The point of the old test (3000 rpm, 20 um, 10 N m) is a chaotic
+    transient: over 10,000 periods some starts settle on a periodic orbit (LLE -0.02), and 300
+    periods gave sample extremes 2.5 % apart from start to start."""
     pair_only = {k: v for k, v in PAIR.items() if k != "torque_fluctuation"}
     design = Design.model_validate(
         {
             **pair_only,
-            "speed": "3000 rpm",
-            "torque": "10 N*m",
-            "transmission_error": {"harmonics": [{"amplitude": "20 um"}]},
+            "speed": "2500 rpm",
+            "torque": "30 N*m",
+            "transmission_error": {"harmonics": [{"amplitude": "40 um"}]},
             "train": EXAMPLE_TRAIN,
         }
     )
-    settings = SimulationSettings(transient_periods=200, record_periods=300)
+    settings = SimulationSettings(transient_periods=100, record_periods=500)
     train, pair = stiff_limit(design, settings)
-    num = pair.numerics
+    num, response = pair.numerics, pair.engineering.response
     assert train.classification == num.classification == "chaotic"
-    assert train.impact_regime == num.impact_regime
+    assert train.impact_regime == num.impact_regime == "double_sided"
     error = 3.0 * math.hypot(train.lle_stderr, num.lle_stderr)
     assert abs(train.lle - num.lle) <= error, (train.lle, num.lle, error)
+    assert train.dte_um == pytest.approx(response.dte_peak_to_peak_um, rel=0.01)
+    assert train.dynamic_factor == pytest.approx(response.dynamic_factor, rel=0.01)
     equivalent = equivalent_design(design)
-    responses = [pair.engineering.response] + [
+    others = [
         gearengine.analyze(
             equivalent, settings.model_copy(update={"initial_state": [x0, 0.01]})
         ).engineering.response
-        for x0 in (0.02, 0.03, 0.05, 0.1)
+        for x0 in (0.02, 0.05, 0.1, 0.3)
     ]
-    dte = [r.dte_peak_to_peak_um for r in responses]
-    factor = [r.dynamic_factor for r in responses]
-    assert 0.99 * min(dte) <= train.dte_um <= 1.01 * max(dte), (train.dte_um, dte)
-    assert 0.99 * min(factor) <= train.dynamic_factor <= 1.01 * max(factor), factor
+    for values in (
+        [r.dte_peak_to_peak_um for r in [response, *others]],
+        [r.dynamic_factor for r in [response, *others]],
+    ):
+        assert max(values) - min(values) < 0.01 * min(values), values  # converged extremes
     assert np.isfinite(train.force_max)

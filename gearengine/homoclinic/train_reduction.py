@@ -27,6 +27,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from gearengine.homoclinic.schemas import MelnikovResult
 from gearengine.homoclinic.verdict import melnikov
 from gearengine.model.params import CubicBacklash, Excitation, GearParams, Harmonic
+from gearengine.systems.base import System
 from gearengine.systems.gear_train.system import TrainSystem
 from gearengine.systems.spur_pair.laws import melnikov_cubic
 
@@ -108,3 +109,15 @@ def train_melnikov(system: TrainSystem) -> TrainMelnikov:
     )
     return TrainMelnikov(applicable=True, reason=reason, mesh_energy_share=share,
                          params=params, melnikov=melnikov(params))  # fmt: skip
+
+
+def melnikov_point(model: GearParams | System) -> GearParams | None:
+    """The parameter point of Eq. (9) whose Melnikov criterion judges ``model``: a parameter
+    point itself, a system's own point (the pair), a train's mesh-mode reduction when it holds
+    (``train_melnikov``'s, without its verdict), else None (the criterion does not apply)."""
+    if isinstance(model, GearParams):
+        return model
+    if not isinstance(model, TrainSystem):
+        return model.params
+    phi, s, share = mesh_mode(model)
+    return reduced_params(model, phi, s, share) if share >= SHARE_THRESHOLD else None

@@ -344,7 +344,8 @@ class ParamsOrDesign(BaseModel):
             raise InputError(
                 "design.train",
                 "this request does not model a gear train yet: analyse it with /v1/analyses "
-                "(gearengine analyze) or its modes with /v1/analyses/campbell, or remove train",
+                "(gearengine analyze), sweep or gate it with /v1/sweeps (gearengine sweep, "
+                "check), its modes with /v1/analyses/campbell, or remove train",
             )
         conversion = convert_design(self.design)
         # a stored request (a sweep job) carries both: params must be the design's conversion

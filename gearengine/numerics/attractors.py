@@ -25,6 +25,7 @@ of the request alone. Fractions are count / starts with the 95 % Wilson score in
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,14 +34,13 @@ from gearengine.model.design import Design
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import ParamsOrDesign
 from gearengine.model.units import Scales, response_values
-from gearengine.numerics.batch import run_lanes, run_verdict
+from gearengine.numerics.batch import run_lanes, run_verdict, step_plans
 from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint
 from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import BasinSettings, SimulationSettings
 from gearengine.signals.classify import severity
 from gearengine.signals.periodicity import SIZE_FLOOR
 from gearengine.systems.base import System
-from gearengine.systems.spur_pair.forcing import step_plan
 
 ORBIT_TOL = 1e-2
 """Distance, relative to the attractor size, within which two strobes are the same point."""
@@ -214,7 +214,7 @@ def attractors(
 
 
 def points_attractors(
-    points: list[GearParams],
+    points: Sequence[GearParams | System],
     settings: SimulationSettings,
     scales: list[Scales | None],
 ) -> list[tuple[list[Attractor], BasinCounts]]:
@@ -230,10 +230,11 @@ def points_attractors(
     starts = [basin_starts(basins, sc) for sc in scales]
     lanes = [(i, s) for i, ss in enumerate(starts) for s in ss]
     runs = run_lanes(points, lanes, settings)
+    plans = step_plans(points, settings.steps_per_period)
     out = []
-    for i, (params, sc) in enumerate(zip(points, scales, strict=True)):
+    for i, (plan, sc) in enumerate(zip(plans, scales, strict=True)):
         mine = runs[i * len(starts[i]) : (i + 1) * len(starts[i])]
-        commensurate = step_plan(params, settings.steps_per_period).omega0 is not None
+        commensurate = plan.omega0 is not None
         out.append(_group(commensurate, sc, basins, starts[i], mine))
     return out
 

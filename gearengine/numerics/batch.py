@@ -18,15 +18,19 @@ from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams
 from gearengine.numerics.lanes import lane_point, lane_verdicts, last_strobes
 from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
-from gearengine.numerics.runs import Run, finite_or_none, integrate, start_verdict
+from gearengine.numerics.runs import Run, as_system, finite_or_none, integrate, start_verdict
 from gearengine.numerics.settings import SimulationSettings, check_work
 from gearengine.signals.classify import DIVERGENCE_BOUND, severity
+from gearengine.systems.base import System
 from gearengine.systems.spur_pair import kernels
 from gearengine.systems.spur_pair.forcing import StepPlan, packed_forcing, step_plan
 from gearengine.systems.spur_pair.laws import LAWS, law
 
 Lane = tuple[int, tuple[float, float]]
 """One run of a request: (index of its parameter point, initial state (x0, v0))."""
+Point = GearParams | System
+"""A point of a request: a parameter point of Eq. (9) (lock-step lanes) or any ``System`` (its
+own integrator, run by run, from ``System.start_state(x0, v0)``)."""
 
 
 def run_verdict(run: Run, start: Sequence[float], plan: StepPlan, lane: int) -> BatchPoint:
@@ -59,12 +63,16 @@ def _strobes(run: Run) -> np.ndarray:
     return np.column_stack([run.xs, run.vs]) if run.strobes is None else run.strobes
 
 
-def step_plans(points: Sequence[GearParams], steps_per_period: int) -> list[StepPlan]:
+def step_plans(points: Sequence[Point], steps_per_period: int) -> list[StepPlan]:
     """``step_plan`` of each point, computed once per set of active harmonics: the plan depends
-    only on the excitations' frequencies and which of their harmonics are active."""
+    only on the excitations' frequencies and which of their harmonics are active (a ``System``
+    point's own ``plan``)."""
     known: dict[tuple, StepPlan] = {}
     plans = []
     for p in points:
+        if isinstance(p, System):
+            plans.append(p.plan(steps_per_period))
+            continue
         key = (*(
             (name, exc.frequency, tuple(r for r, _ in exc.active()))
             for name, exc in p.excitations()
@@ -76,7 +84,7 @@ def step_plans(points: Sequence[GearParams], steps_per_period: int) -> list[Step
 
 
 def run_lanes(
-    points: Sequence[GearParams],
+    points: Sequence[Point],
     lanes: Sequence[Lane],
     settings: SimulationSettings | None = None,
 ) -> list[BatchPoint]:
@@ -107,7 +115,7 @@ def run_lanes(
 
 
 def _run_lanes(
-    points: Sequence[GearParams],
+    points: Sequence[Point],
     plans: list[StepPlan],
     lanes: Sequence[Lane],
     settings: SimulationSettings,
@@ -115,12 +123,13 @@ def _run_lanes(
     results: list[BatchPoint | None] = [None] * len(lanes)
     groups: dict[tuple[str, int], list[int]] = {}
     for k, (i, s) in enumerate(lanes):
-        plan = plans[i]
-        name = points[i].backlash.model
-        if LAWS[name].lanes is not None and plan.omega0 is not None:
+        plan, point = plans[i], points[i]
+        name = point.backlash.model if isinstance(point, GearParams) else ""
+        if name and LAWS[name].lanes is not None and plan.omega0 is not None:
             groups.setdefault((name, plan.steps), []).append(k)
         else:
-            results[k] = run_verdict(integrate(points[i], settings, s), s, plan, k)
+            start = as_system(point).start_state(*s)
+            results[k] = run_verdict(integrate(point, settings, start), s, plan, k)
     for (name, N), ks in groups.items():
         owner = np.array([lanes[k][0] for k in ks], dtype=np.int64)
         members, inverse = np.unique(owner, return_inverse=True)
@@ -159,7 +168,7 @@ def lle_tolerances(settings: SimulationSettings) -> tuple[float, float]:
 
 
 def simulate_batch(
-    points: list[GearParams], settings: SimulationSettings | None = None
+    points: Sequence[Point], settings: SimulationSettings | None = None
 ) -> list[BatchPoint]:
     """Verdict (period, LLE, final state, last strobes) for each parameter point of a sweep.
 

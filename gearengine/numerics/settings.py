@@ -22,6 +22,7 @@ from pydantic import (
 from gearengine.model.errors import InputError
 from gearengine.model.params import Finite, GearParams, WholeNumber, request_config
 from gearengine.model.units import QUANTITIES, parse_quantity
+from gearengine.systems.base import System
 from gearengine.systems.spur_pair.forcing import step_plan
 
 MAX_PERIODS = 100_000
@@ -320,8 +321,12 @@ def run_steps(settings: SimulationSettings, steps: int) -> int:
     return (settings.transient_periods + settings.record_periods) * steps * settings.lanes()
 
 
-def work(params: GearParams, settings: SimulationSettings) -> int:
-    """RK4 steps ``simulate(params, settings)`` takes (for compute budgets)."""
+def work(params: GearParams | System, settings: SimulationSettings) -> int:
+    """RK4 steps ``simulate(params, settings)`` takes (for compute budgets); a ``System``'s
+    steps count ``System.step_cost`` each (a train's, raised for stiff shafts, 3)."""
+    if isinstance(params, System):
+        steps = params.plan(settings.steps_per_period).steps
+        return params.step_cost * run_steps(settings, steps)
     return run_steps(settings, step_plan(params, settings.steps_per_period).steps)
 
 

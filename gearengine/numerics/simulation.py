@@ -85,8 +85,8 @@ def simulate(
         result = _diverged(base, worst, plan, notes)
     else:
         result = _detailed(base, worst, wv, plan, settings, notes)
-    full = worst.strobes is not None and worst.recorded > 0
-    last = worst.strobes[worst.recorded - 1] if full else None
+    states = worst.strobes if worst.states is None else worst.states
+    last = states[worst.recorded - 1] if states is not None and worst.recorded > 0 else None
     orbit, why = floquet_of(system, settings, result, last)
     return result.model_copy(update={"floquet": orbit, "floquet_note": why})
 

@@ -14,11 +14,11 @@ from gearengine.model.design import Design
 from gearengine.model.errors import InputError
 from gearengine.model.units import response_values
 from gearengine.numerics.runs import integrate, start_verdict
-from gearengine.numerics.settings import MAX_TOTAL_STEPS, SimulationSettings, run_steps
+from gearengine.numerics.settings import MAX_TOTAL_STEPS, SimulationSettings, work
 from gearengine.signals.classify import severity
 from gearengine.signals.diagnostics import ImpactRegime, impact_regime
 from gearengine.systems.gear_train.model import train_of
-from gearengine.systems.gear_train.system import TRAIN_STEP_COST, TrainSystem, train_system
+from gearengine.systems.gear_train.system import TrainSystem, train_system
 
 
 class TrainResponse(BaseModel):
@@ -94,5 +94,4 @@ def train_work(design: Design, settings: SimulationSettings) -> int:
     """The compute budget of analysing a train (``numerics.settings.work``'s unit: the pair's RK4
     steps): its steps (raised for stiff shafts and bearings) times ``TRAIN_STEP_COST``."""
     model, pair = train_of(design)
-    steps = train_system(model, pair).plan(settings.steps_per_period).steps
-    return TRAIN_STEP_COST * run_steps(settings, steps)
+    return work(train_system(model, pair), settings)  # TrainSystem.step_cost = TRAIN_STEP_COST

@@ -15,6 +15,7 @@ from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.jsonio import dumps
 from gearengine.numerics.settings import BasinSettings, work
 from gearengine.studies.jobs import JobKind
+from gearengine.systems.designs import design_model
 
 
 def with_basins(request: AnalysisRequest) -> AnalysisRequest:
@@ -33,9 +34,11 @@ def basin_starts(request: AnalysisRequest, chunk_points: int) -> list[int]:
 
 
 def basins_work(request: AnalysisRequest) -> int:
-    """RK4 steps of the analysis with its basin starts (``numerics.settings.work``)."""
+    """RK4 steps of the analysis with its basin starts (``numerics.settings.work``; a train's
+    at its ``System.step_cost``)."""
     full = with_basins(request)
-    return work(full.params, full.settings)
+    model = full.params if full.design is None else design_model(full.design)[0]
+    return work(model, full.settings)
 
 
 def basins_chunk(request: AnalysisRequest, index: int, chunk_points: int) -> str:

@@ -20,6 +20,9 @@ How to add a system (the contract, as ``scipy.integrate.OdeSolver`` states its o
    linear damping, so that det Phi = exp(trace_rate m T0) (Liouville) checks Phi.
 5. ``method(plan)``: the integrator in words; ``start_state(x, v)``: a full start from a start of
    the mesh coordinate (the other coordinates at rest), as the basin starts are drawn.
+6. For the studies (sweeps, the gate): ``params``, the parameter point of Eq. (9) whose scales
+   and forcing the system shares; ``step_cost``, its RK4 step in steps of the pair's (compute
+   budgets); ``dynamics_key()``, equal for two systems with equal dynamics (None: unknown).
 
 The spur pair of the paper (Eq. 9, ``spur_pair``) is the first system.
 """
@@ -33,6 +36,8 @@ from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
+
+from gearengine.model.params import GearParams
 
 
 @dataclass(frozen=True)
@@ -69,7 +74,10 @@ class Run:
     (fmin, fmax) over the record's steps, ``done`` intervals run (the record is
     ``xs[:recorded]``, shorter than n_rec when the run stopped early), and the ``final`` state of
     all n coordinates. ``strobes``: the full state at the strobes, shape (n_rec, n), for systems
-    with n > 2 (None for the pair, whose state is (x, v))."""
+    with n > 2 (None for the pair, whose state is (x, v)). ``states``: the state the
+    stroboscopic flow takes (its X) at the strobes, shape (n_rec, n), for a system whose
+    coordinates do not begin with (x, v) (a train: x = delta = w . u - e is not one of them;
+    its ``strobes`` stay None and its runs are read on (x, v))."""
 
     xs: np.ndarray
     vs: np.ndarray
@@ -85,6 +93,7 @@ class Run:
     fmin: float = math.nan
     fmax: float = math.nan
     strobes: np.ndarray | None = None
+    states: np.ndarray | None = None
 
 
 class StroboscopicFlow(Protocol):
@@ -105,6 +114,11 @@ class System(ABC):
     name: str
     n: int
     coordinates: tuple[str, ...]
+    params: GearParams
+    """The parameter point of Eq. (9) whose scales and forcing the system shares (the pair's
+    own; a train's equivalent pair's)."""
+    step_cost: int = 1
+    """One RK4 step of this system in RK4 steps of the pair's analysis, for compute budgets."""
 
     @abstractmethod
     def plan(self, steps_per_period: int) -> StepPlan:
@@ -128,3 +142,8 @@ class System(ABC):
     def start_state(self, x: float, v: float) -> tuple[float, ...]:
         """A full start from (x, v) of the mesh coordinate, every other coordinate at rest."""
         return (x, v) + (0.0,) * (self.n - 2)
+
+    def dynamics_key(self) -> tuple | None:
+        """Equal for two systems that integrate the same equations (a sweep axis that leaves it
+        unchanged changes nothing); None when the system cannot tell."""
+        return None

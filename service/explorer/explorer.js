@@ -158,6 +158,14 @@ function readDesign() {
   for (const exc of ["transmission_error", "torque_fluctuation"]) {
     if (design[exc] && !design[exc].harmonics) delete design[exc]; // no amplitude: no excitation
   }
+  const train = $("train").value.trim();
+  if (train) {
+    try {
+      design.train = JSON.parse(train);
+    } catch (err) {
+      throw { errors: [{ path: "design.train", message: "not valid JSON: " + err.message }] };
+    }
+  }
   return design;
 }
 
@@ -323,6 +331,22 @@ function showVerdict(result) {
 }
 
 // With settings.basins: one row per attractor and the basin picture.
+// a gear train's modes (engineering.modes) and its Campbell diagram; hidden for a pair
+function showModes(result, subject) {
+  const found = result.engineering && result.engineering.modes;
+  $("modes").hidden = !found;
+  if (!found) return;
+  const head = el("tr", {}, ...["mode", "frequency Hz", "damping ratio", "mesh energy"]
+    .map((t) => el("th", { text: t })));
+  const rows = found.modes.map((m, k) => el("tr", k === found.mesh_mode ? { class: "mesh-mode" } : {},
+    ...[k === found.mesh_mode ? `${k + 1} (mesh mode)` : String(k + 1), fmt(m.frequency_hz, 5),
+      fmt(m.damping_ratio, 3), `${(100 * m.mesh_energy_share).toFixed(1)} %`]
+      .map((t) => el("td", { text: t }))));
+  $("modes-table").replaceChildren(head, ...rows);
+  $("modes-note").textContent = `(linearised in contact; stiff limit ${fmt(found.stiff_limit_hz, 4)} Hz)`;
+  loadFigure($("campbell-figure"), "/v1/analyses/campbell/plot", { design: subject.design }, $("campbell-note"));
+}
+
 function showAttractors(result, body) {
   const found = result.numerics.attractors;
   $("basins").hidden = !found;
@@ -392,8 +416,14 @@ async function analyse() {
     $("verdict").scrollIntoView({ block: "start" });
     loadFigure($("analysis-figure"), "/v1/analyses/plot", body);
     showAttractors(result, body);
-    thresholdSubject = result.melnikov.applicable ? subject : null;
-    if (thresholdSubject) {
+    showModes(result, subject);
+    const train = result.engineering && result.engineering.modes;
+    thresholdSubject = result.melnikov.applicable && !train ? subject : null;
+    if (train) {  // the threshold curves are the pair's (Eq. 9): not drawn for a train
+      $("threshold-figure").removeAttribute("src");
+      $("threshold-figure").dataset.state = "failed";
+      $("threshold-note").textContent = "(a gear train: " + (result.melnikov.notes[0] || "") + ")";
+    } else if (thresholdSubject) {
       loadThresholds();
     } else {  // above the critical torque: no saddle, so no threshold curves to draw
       const img = $("threshold-figure");
@@ -751,6 +781,7 @@ function switchMode(m) {
 function toggleAdvanced() {
   const on = $("advanced").checked;
   $("design-fields").hidden = on;
+  $("train-box").hidden = on;
   $("params-box").hidden = !on;
   document.querySelectorAll("input[name=form-mode]").forEach((r) => { r.disabled = on; });
   if (on && !$("params").value) $("params").value = JSON.stringify(lastParams || defaults.params, null, 2);
@@ -765,12 +796,13 @@ async function start() {
   fillDesign(defaults.direct);
   document.querySelectorAll("input[name=form-mode]").forEach((r) => r.addEventListener("change", () => switchMode(r.value)));
   $("advanced").addEventListener("change", toggleAdvanced);
+  $("train-example").addEventListener("click", () => { $("train").value = JSON.stringify(defaults.train, null, 1); });
   $("design-form").addEventListener("submit", (e) => { e.preventDefault(); analyse(); });
   $("envelope-form").addEventListener("submit", (e) => { e.preventDefault(); mapRange(); });
   $("cancel-sweep").addEventListener("click", cancelSweep);
   $("fix-it").addEventListener("click", fixIt);
   $("threshold-parameter").addEventListener("change", loadThresholds);
-  document.querySelectorAll("figure img").forEach((img) => img.addEventListener("click", () => enlarge(img)));
+  document.querySelectorAll("figure img, #campbell-figure").forEach((img) => img.addEventListener("click", () => enlarge(img)));
   $("enlarged").addEventListener("click", () => $("enlarged").close());
   listJobs();
   document.body.dataset.ready = "true"; // for tests: the form is built and prefilled

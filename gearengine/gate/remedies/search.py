@@ -47,9 +47,10 @@ from gearengine.gate.remedies.request import (
 )
 from gearengine.gate.remedies.results import Remedy, Sample, Unreachable
 from gearengine.homoclinic.thresholds import chaos_possible
+from gearengine.homoclinic.train_reduction import melnikov_point
 from gearengine.model.design import Design
-from gearengine.model.reduction import convert_design
 from gearengine.studies.sweep.axes import design_with
+from gearengine.systems.designs import design_model
 
 
 def envelope_points(request: RemediesRequest) -> list[dict[str, float]]:
@@ -65,9 +66,11 @@ def melnikov_failures(design: Design, points: list[dict[str, float]],
                       values: dict[str, float]) -> tuple[int, int]:  # fmt: skip
     """(points where the criterion allows chaos, points where it does not apply) over the
     envelope ``points`` of ``design`` with the fields ``values`` set (SI): each point's
-    ``chaos_possible``, as the sweep's ``melnikov_chaos_possible``."""
-    verdicts = [chaos_possible(convert_design(design_with(design, {**values, **p})).params)
-                for p in points]  # fmt: skip
+    ``chaos_possible``, as the sweep's ``melnikov_chaos_possible`` (of a train, its mesh-mode
+    reduction's: ``melnikov_point``)."""
+    judged = [melnikov_point(design_model(design_with(design, {**values, **p}))[0])
+              for p in points]  # fmt: skip
+    verdicts = [None if j is None else chaos_possible(j) for j in judged]
     return sum(v is True for v in verdicts), sum(v is None for v in verdicts)
 
 

@@ -27,6 +27,7 @@ from pydantic import BaseModel, Field
 from pydantic_core import InitErrorDetails
 
 from gearengine.homoclinic.thresholds import chaos_possible
+from gearengine.homoclinic.train_reduction import melnikov_point
 from gearengine.model.design import Design
 from gearengine.model.errors import InputError, Problems
 from gearengine.model.params import request_config
@@ -47,6 +48,7 @@ from gearengine.studies.robustness.tolerances import (
 )
 from gearengine.studies.sweep.axes import axis_problem, design_with, is_dimensionless
 from gearengine.studies.sweep.request import SweepAxis
+from gearengine.systems.designs import design_model
 
 CLASSES = ("periodic", "quasi_periodic", "chaotic", "diverged")
 CONTACTS = ("no_impact", "single_sided", "double_sided")
@@ -161,21 +163,23 @@ def robustness_work(request: RobustnessRequest) -> int:
     """RK4 steps of every run (nominal design at each point, times the rows)."""
     base = base_design(request.design)
     per_point = [
-        work(convert_design(design_with(base, values)).params, request.settings)
+        work(design_model(design_with(base, values))[0], request.settings)
         for values in request.points() or [{}]
     ]
     return request.n_rows() * sum(per_point)
 
 
-def _run(bp: Any, params: Any, scales: Scales) -> list[Any]:
-    """One run's row: class, contact, Melnikov verdict, DTE [um] and dynamic factor (the one
-    definition, ``model.units.response_values``)."""
+def _run(bp: Any, model: Any, scales: Scales) -> list[Any]:
+    """One run's row: class, contact, Melnikov verdict (of a train, its mesh-mode reduction's,
+    null without one), DTE [um] and dynamic factor (the one definition,
+    ``model.units.response_values``)."""
     response = response_values(bp.x_peak_to_peak, bp.force_max, scales)
     contact = CONTACTS.index(bp.impact_regime) if bp.impact_regime in CONTACTS else None
+    judged = melnikov_point(model)
     return [
         CLASSES.index(bp.classification),
         contact,
-        chaos_possible(params),
+        None if judged is None else chaos_possible(judged),
         response["dte"],
         response["dynamic_factor"],
     ]
@@ -192,10 +196,9 @@ def compute_chunk(request: RobustnessRequest, index: int, rows: int) -> str:
     base = base_design(request.design)
     points = request.points() or [{}]
     designs = [sample_design(base, {**v, **p}) for p in points for v in values]
-    conversions = [convert_design(d) for d in designs]
-    params = [c.params for c in conversions]
-    verdicts = simulate_batch(params, request.settings)
-    runs = [_run(bp, c.params, c.scales) for bp, c in zip(verdicts, conversions, strict=True)]
+    models = [design_model(d) for d in designs]  # a design with a train runs as its System
+    verdicts = simulate_batch([m for m, _ in models], request.settings)
+    runs = [_run(bp, m, c.scales) for bp, (m, c) in zip(verdicts, models, strict=True)]
     per_point = [runs[i * len(values) : (i + 1) * len(values)] for i in range(len(points))]
     return json.dumps({"index": index, "first_row": lo, "runs": per_point}, separators=(",", ":"))
 

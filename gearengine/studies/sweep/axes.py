@@ -22,8 +22,9 @@ from pydantic import ValidationError
 from gearengine.model.aliases import ALIASES, with_aliases, with_speed_factor
 from gearengine.model.design import Design
 from gearengine.model.params import GearParams
-from gearengine.model.reduction import convert_design
 from gearengine.model.units import Scales, si_numbers
+from gearengine.systems.base import System
+from gearengine.systems.designs import design_model, params_of
 from gearengine.systems.spur_pair.forcing import packed_forcing
 
 OMEGA = "Omega"
@@ -102,36 +103,60 @@ def fastest_frequency(params: GearParams) -> float | None:
 
 
 def point_params(params: GearParams, design: Design | None, values: dict[str, float]) -> GearParams:
-    """The dimensionless parameters of one grid point (``scaled_point``)."""
+    """The dimensionless parameters of one grid point (``scaled_point``; of a train, those of
+    its equivalent pair)."""
+    return params_of(scaled_point(params, design, None, values)[0])
+
+
+def point_model(
+    params: GearParams, design: Design | None, values: dict[str, float]
+) -> GearParams | System:
+    """What the numerics run at one grid point (``scaled_point``)."""
     return scaled_point(params, design, None, values)[0]
 
 
 def scaled_point(
     params: GearParams, design: Design | None, scales: Scales | None, values: dict[str, float]
-) -> tuple[GearParams, Scales | None]:
-    """The dimensionless parameters of one grid point and, for a design (whose ``scales`` are
-    given), the scales that map its answers back to gear data.
+) -> tuple[GearParams | System, Scales | None]:
+    """What the numerics run at one grid point and, for a design (whose ``scales`` are given),
+    the scales that map its answers back to gear data.
 
     Physical fields are set on the design first (then converted: its scales), aliases and
-    ``Omega`` on the resulting parameters (the static force follows an ``F_m`` axis).
+    ``Omega`` on the resulting parameters (the static force follows an ``F_m`` axis). A design
+    with a ``train`` is its ``System`` at every point (``systems.designs.design_model``), moved
+    by physical fields only: its dimensionless aliases are not free parameters (ValueError).
     """
     physical = {k: v for k, v in values.items() if not is_dimensionless(k)}
-    if physical:
+    model: GearParams | System = params
+    if physical or (design is not None and design.train is not None):
         assert design is not None
-        conversion = convert_design(design_with(design, physical))
-        params, scales = conversion.params, conversion.scales
+        model, conversion = design_model(design_with(design, physical))
+        params, scales = params_of(model), conversion.scales
     aliases = {k: v for k, v in values.items() if k in ALIASES}
+    if OMEGA in values:
+        aliases[OMEGA] = values[OMEGA]
+    if aliases and isinstance(model, System):
+        raise ValueError(
+            f"{', '.join(aliases)} is a parameter of Eq. (9), not of a gear train: sweep the "
+            "train's design fields (speed, torque, train.input_shaft.torsional_stiffness, ...)"
+        )
+    aliases.pop(OMEGA, None)
     if aliases:
         params = with_aliases(params, aliases)
     if OMEGA in values:
         ref = fastest_frequency(params)
         assert ref is not None
         params = with_speed_factor(params, values[OMEGA] / ref)
-    return params, None if scales is None else scales.at(params.mean_force)
+    if not isinstance(model, System):
+        model = params
+    return model, None if scales is None else scales.at(params.mean_force)
 
 
-def dynamics_key(params: GearParams) -> tuple:
-    """What Eq. (9) actually integrates: two designs with equal keys have equal dynamics."""
+def dynamics_key(params: GearParams | System) -> tuple | None:
+    """What Eq. (9) (or a ``System``) actually integrates: two designs with equal keys have
+    equal dynamics; None when a system cannot tell."""
+    if isinstance(params, System):
+        return params.dynamics_key()
     kc, fm, fc = packed_forcing(params)
     return (params.damping, params.backlash, fm, kc.tobytes(), fc.tobytes())
 
@@ -165,5 +190,5 @@ def changes_nothing(
 ) -> bool:  # fmt: skip
     """True when moving ``parameter`` from ``lo`` to ``hi`` leaves Eq. (9) unchanged (an
     ``Omega_e`` axis with no transmission-error harmonic, say)."""
-    ends = [point_params(params, design, {**base, parameter: v}) for v in (lo, hi)]
-    return dynamics_key(ends[0]) == dynamics_key(ends[1])
+    ends = [dynamics_key(point_model(params, design, {**base, parameter: v})) for v in (lo, hi)]
+    return ends[0] is not None and ends[0] == ends[1]

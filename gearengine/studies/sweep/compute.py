@@ -9,6 +9,7 @@ from collections.abc import Callable
 from typing import Any
 
 from gearengine.homoclinic.thresholds import chaos_possible
+from gearengine.homoclinic.train_reduction import melnikov_point
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
 from gearengine.model.units import OUTPUTS, Scales, display_unit, in_display_unit, response_values
@@ -30,6 +31,8 @@ from gearengine.studies.sweep.points import PhysicalValue, SweepBifurcation, Swe
 from gearengine.studies.sweep.request import SweepBranch, SweepRequest
 from gearengine.studies.sweep.results import SweepResult
 from gearengine.studies.sweep.windows import SPEED, speed_windows
+from gearengine.systems.base import System
+from gearengine.systems.designs import params_of
 from gearengine.systems.spur_pair.forcing import step_plan
 
 
@@ -55,7 +58,7 @@ def _physical(
 def _point(
     values: dict[str, float],
     branch: SweepBranch | None,
-    params: GearParams,
+    model: GearParams | System,
     scales: Scales | None,
     bp: BatchPoint,
     basins: dict[str, Any],
@@ -63,8 +66,12 @@ def _point(
     """The sweep's point from the engine's verdict ``bp`` (typed and finite, built by
     ``numerics.batch``), so ``model_construct`` skips a second validation (~0.05 ms a point);
     ``basins`` its attractors, basins and coexisting entries (empty without basins) and the
-    verdict of its worst attractor (``_decided``)."""
-    possible = chaos_possible(params)
+    verdict of its worst attractor (``_decided``). Melnikov judges the point's own Eq. (9), or
+    a train's mesh-mode reduction (``homoclinic.train_reduction.melnikov_point``: null when it
+    does not hold); the dimensionless aliases are the pair's (a train's equivalent pair's)."""
+    params = params_of(model)
+    judged = melnikov_point(model)
+    possible = None if judged is None else chaos_possible(judged)
     verdict = {
         "classification": bp.classification,
         "period": bp.period,
@@ -127,7 +134,7 @@ def _compute(
 
 def _basins(
     request: SweepRequest,
-    scaled: list[tuple[GearParams, Scales | None]],
+    scaled: list[tuple[GearParams | System, Scales | None]],
     verdicts: list[BatchPoint],
 ) -> list[dict[str, Any]]:
     """Per point, with ``settings.basins``: its attractors and basin counts

@@ -178,5 +178,6 @@ class SpeedWindows(BaseModel):
     melnikov_not_applicable: list[list[float]] = Field(
         default_factory=list,
         description="Runs of grid speeds where the Melnikov criterion does not apply (the mean "
-        "load is above the critical torque: no saddle, no homoclinic orbit).",
+        "load is above the critical torque: no saddle, no homoclinic orbit; for a gear train "
+        "also where no single mode holds 90 % of the mesh strain energy: no one-mode reduction).",
     )

@@ -33,10 +33,11 @@ from gearengine.studies.sweep.axes import (
     changes_nothing,
     is_dimensionless,
     is_integer_field,
-    point_params,
+    point_model,
     scaled_point,
     si_value,
 )
+from gearengine.systems.base import System
 
 MAX_AXIS_POINTS = 100_000
 """Upper cap of ``num`` of one axis (the service caps the product lower, max_job_points)."""
@@ -111,6 +112,8 @@ class SweepAxis(BaseModel):
 class SweepRequest(ParamsOrDesign):
     """A bifurcation diagram (one axis) or a chaos map (two axes) of the design ``params``."""
 
+    TRAINS = True  # a train design runs as its System at every point (studies.sweep.axes)
+
     model_config = request_config(
         {
             "params": PAPER_SECTION_41,
@@ -170,13 +173,14 @@ class SweepRequest(ParamsOrDesign):
         """Each axis' values (SI units for physical fields)."""
         return [a.values(self.design) for a in self.axes]
 
-    def point(self, values: dict[str, float]) -> GearParams:
-        """The dimensionless parameters at one grid point (``studies.sweep.axes.point_params``)."""
+    def point(self, values: dict[str, float]) -> GearParams | System:
+        """What the numerics run at one grid point (``studies.sweep.axes.point_model``): its
+        parameters of Eq. (9), or for a design with a train its ``System``."""
         assert self.params is not None
-        return point_params(self.params, self.design, values)
+        return point_model(self.params, self.design, values)
 
-    def scaled_point(self, values: dict[str, float]) -> tuple[GearParams, Scales | None]:
-        """The parameters at one grid point and, for a design, its scales
+    def scaled_point(self, values: dict[str, float]) -> tuple[GearParams | System, Scales | None]:
+        """What runs at one grid point and, for a design, its scales
         (``studies.sweep.axes.scaled_point``)."""
         assert self.params is not None
         scales = None if self.conversion is None else self.conversion.scales
@@ -228,7 +232,7 @@ def request_errors(request: SweepRequest, max_points: int | None = None) -> list
     for i, (axis, grid) in enumerate(zip(request.axes, grids, strict=True)):
         for end, value in (("start", grid[0]), ("stop", grid[-1])):
             try:
-                request.point({**base, axis.parameter: value})
+                model = request.point({**base, axis.parameter: value})
             except ValidationError as exc:
                 e = exc.errors(include_url=False)[0]
                 where = ".".join(map(str, e["loc"]))
@@ -236,6 +240,11 @@ def request_errors(request: SweepRequest, max_points: int | None = None) -> list
             except ValueError as exc:  # the parameter cannot be set on this design at all
                 add(("axes", i, "parameter"), str(exc), axis.parameter)
                 break
+        if not errors and request.continuation and isinstance(model, System) and model.n > 2:
+            add(("continuation",), f"continuation carries the final state [x, v] from point to "
+                f"point; the {model.name.replace('_', ' ')} has {model.n} coordinates, whose full "
+                "state it does not carry yet: set continuation false", True)  # fmt: skip
+            return errors
         if axis.num > 1 and not errors and _changes_nothing(request, i, grids):
             add(("axes", i, "parameter"), f"{axis.parameter} changes nothing in Eq. (9) for this "
                 "design (its excitation has no nonzero harmonic?)", axis.parameter)  # fmt: skip

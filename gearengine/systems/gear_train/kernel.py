@@ -14,6 +14,8 @@ T(tau) = sum tc0 cos(tc1 tau + tc2) the torque fluctuation T_p / (r_p b k_m).
 The backlash law is the pair's ``law_force`` (``systems.spur_pair.kernels.smooth``: cubic, or Eq. 8
 stepped straight across its kinks). Benettin: the 2n-dimensional tangent vector starts with
 equal components and is renormalised every interval T; the log of its norm is recorded.
+``flow_train``: the flow over m intervals T with its 2n x 2n Jacobian (the monodromy matrix for
+Floquet multipliers), the same RK4 arithmetic with the variational equation of every column.
 """
 
 from __future__ import annotations
@@ -144,7 +146,8 @@ def run_train(
         logs: log of the tangent norm before each renormalisation, (n_rec,);
         hx, hv: delta, delta' every ``stride`` recorded steps, (n_rec N // stride,);
         xmin, xmax: extremes of delta over the recorded steps; done: intervals completed;
-        u, v: final state; fmin, fmax: extremes of the mesh force W at the recorded step ends.
+        u, v: final state; fmin, fmax: extremes of the mesh force W at the recorded step ends;
+        full: the state (u, v) at the end of each recorded interval, shape (n_rec, 2n).
     """  # fmt: skip
     n = u0.size
     h = T / N
@@ -165,6 +168,7 @@ def run_train(
     s = np.empty((4, n))
     xs = np.zeros(n_rec)
     vs = np.zeros(n_rec)
+    full = np.zeros((n_rec, 2 * n))
     logs = np.zeros(n_rec)
     hx = np.zeros(n_rec * N // stride)
     hv = np.zeros(n_rec * N // stride)
@@ -233,8 +237,148 @@ def run_train(
             logs[r] = math.log(nrm)
             xs[r] = delta
             vs[r] = deltad
+            for i in range(n):
+                full[r, i] = y[0, i]
+                full[r, n + i] = y[1, i]
         elif it + 1 == n_trans:
             xmin, xmax, count, ih = np.inf, -np.inf, 0, 0
             fmin, fmax = np.inf, -np.inf
         done = it + 1
-    return xs, vs, logs, hx, hv, xmin, xmax, done, y[0].copy(), y[1].copy(), fmin, fmax
+    return xs, vs, logs, hx, hv, xmin, xmax, done, y[0].copy(), y[1].copy(), fmin, fmax, full
+
+
+@njit(**JIT_OPTIONS)
+def _flow_field(
+    law: int,
+    a: float,
+    c: float,
+    alpha: float,
+    twomu: float,
+    AK: np.ndarray,
+    AC: np.ndarray,
+    g: np.ndarray,
+    w: np.ndarray,
+    f: np.ndarray,
+    p: np.ndarray,
+    K: float,
+    e: float,
+    ed: float,
+    T: float,
+    s: np.ndarray,
+    D: np.ndarray,
+    k: np.ndarray,
+    kD: np.ndarray,
+    stage: int,
+) -> None:  # pragma: no cover - compiled
+    """The field at s = (u, v), shape (2, n), and the variational field of every column of
+    D = (du, dv), shape (2, n, 2n), into k[stage] and kD[stage] (module docstring)."""
+    n = s.shape[1]
+    delta = -e
+    deltad = -ed
+    for i in range(n):
+        delta += w[i] * s[0, i]
+        deltad += w[i] * s[1, i]
+    fh, dfh = law_force(law, a, c, alpha, delta)
+    W = K * fh + twomu * deltad
+    for i in range(n):
+        acc = f[i] + p[i] * T - g[i] * W
+        for j in range(n):
+            acc -= AK[i, j] * s[0, j] + AC[i, j] * s[1, j]
+        k[stage, 0, i] = s[1, i]
+        k[stage, 1, i] = acc
+    for col in range(D.shape[2]):
+        wdu = 0.0
+        wdv = 0.0
+        for i in range(n):
+            wdu += w[i] * D[0, i, col]
+            wdv += w[i] * D[1, i, col]
+        dW = K * dfh * wdu + twomu * wdv
+        for i in range(n):
+            dacc = -g[i] * dW
+            for j in range(n):
+                dacc -= AK[i, j] * D[0, j, col] + AC[i, j] * D[1, j, col]
+            kD[stage, 0, i, col] = D[1, i, col]
+            kD[stage, 1, i, col] = dacc
+
+
+@njit(**JIT_OPTIONS)
+def flow_train(
+    law: int,
+    a: float,
+    c: float,
+    alpha: float,
+    mu: float,
+    AK: np.ndarray,
+    AC: np.ndarray,
+    g: np.ndarray,
+    w: np.ndarray,
+    f: np.ndarray,
+    p: np.ndarray,
+    kc: np.ndarray,
+    ec: np.ndarray,
+    tc: np.ndarray,
+    u0: np.ndarray,
+    v0: np.ndarray,
+    T: float,
+    N: int,
+    m: int,
+):  # pragma: no cover - compiled
+    """The flow of the train over m intervals T of N RK4 steps (T-periodic forcing, tabulated
+    at the 2N+1 stage times of a period as ``run_train`` does, so the strobes are the same
+    arithmetic) and its Jacobian, the monodromy matrix for Floquet multipliers.
+
+    Returns:
+        u, v: the state after m T, shape (n,) each; Phi: d(u, v)(m T) / d(u0, v0), (2n, 2n).
+    """  # fmt: skip
+    n = u0.size
+    M = 2 * n
+    h = T / N
+    h2 = 0.5 * h
+    h6 = h / 6.0
+    twomu = 2.0 * mu
+    table = np.empty((2 * N + 1, 4))
+    for q in range(2 * N + 1):
+        table[q, 0], table[q, 1], table[q, 2], table[q, 3] = train_forcing(q * h2, kc, ec, tc)
+    y = np.empty((2, n))
+    D = np.zeros((2, n, M))
+    for i in range(n):
+        y[0, i], y[1, i] = u0[i], v0[i]
+        D[0, i, i] = 1.0
+        D[1, i, n + i] = 1.0
+    k = np.empty((4, 2, n))
+    kD = np.empty((4, 2, n, M))
+    s = np.empty((2, n))
+    sD = np.empty((2, n, M))
+    for _ in range(m):
+        for j in range(N):
+            for stage in range(4):
+                step = 0.0 if stage == 0 else (h if stage == 3 else h2)
+                for r in range(2):
+                    for i in range(n):
+                        s[r, i] = y[r, i] + step * k[stage - 1, r, i] if stage else y[r, i]
+                        for col in range(M):
+                            sD[r, i, col] = (
+                                D[r, i, col] + step * kD[stage - 1, r, i, col]
+                                if stage
+                                else D[r, i, col]
+                            )
+                q = 2 * j + (0 if stage == 0 else (2 if stage == 3 else 1))
+                _flow_field(
+                    law, a, c, alpha, twomu, AK, AC, g, w, f, p,
+                    table[q, 0], table[q, 1], table[q, 2], table[q, 3], s, sD, k, kD, stage,
+                )  # fmt: skip
+            for r in range(2):
+                for i in range(n):
+                    y[r, i] += h6 * (k[0, r, i] + 2.0 * (k[1, r, i] + k[2, r, i]) + k[3, r, i])
+                    for col in range(M):
+                        D[r, i, col] += h6 * (
+                            kD[0, r, i, col]
+                            + 2.0 * (kD[1, r, i, col] + kD[2, r, i, col])
+                            + kD[3, r, i, col]
+                        )
+    phi = np.empty((M, M))
+    for i in range(n):
+        for col in range(M):
+            phi[i, col] = D[0, i, col]
+            phi[n + i, col] = D[1, i, col]
+    return y[0].copy(), y[1].copy(), phi

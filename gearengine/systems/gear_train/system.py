@@ -25,7 +25,7 @@ from gearengine.model.params import GearParams
 from gearengine.model.reduction import DesignConversion
 from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.systems.base import Run, StepPlan, StroboscopicFlow, System
-from gearengine.systems.gear_train.kernel import run_train, train_forcing
+from gearengine.systems.gear_train.kernel import flow_train, run_train, train_forcing
 from gearengine.systems.gear_train.model import (
     RELATIVE,
     Dimensionless,
@@ -81,6 +81,12 @@ class TrainSystem(System):
         return StepPlan(plan.omega0, plan.period, need, plan.omega_ref, (*plan.notes, note))
 
     name = "gear_train"
+    step_cost = TRAIN_STEP_COST
+
+    def dynamics_key(self) -> tuple:
+        """The kernel's arguments (matrices, forcing terms, law and mesh damping) as bytes."""
+        arrays = (self.AK, self.AC, self.g, self.w, self.f, self.p, self.kc, self.ec, self.tc)
+        return (self.params.damping, self.params.backlash, *(a.tobytes() for a in arrays))
 
     @property
     def n(self) -> int:  # type: ignore[override]
@@ -106,10 +112,12 @@ class TrainSystem(System):
         return integrate_train(self, plan, u0, v0, n_trans, n_rec, stride)
 
     def stroboscopic_flow(self, steps_per_period: int) -> StroboscopicFlow:
-        raise ValueError(
-            "Floquet multipliers are computed for the pair of Eq. (9) only, not yet for a train "
-            "(no monodromy kernel of the train)"
-        )
+        """The train's flow sampled every T0 and its n x n Jacobian (``kernel.flow_train``, the
+        RK4 grid of ``plan``); ValueError under incommensurate forcing."""
+        plan = self.plan(steps_per_period)
+        if plan.omega0 is None:
+            raise ValueError("incommensurate forcing: no Poincare period, hence no periodic orbit")
+        return TrainFlow(self, plan.period, plan.steps)
 
     def method(self, plan: StepPlan) -> str:
         return f"rk4 of the gear train ({self.n} states), forcing at abs. time"
@@ -127,6 +135,33 @@ class TrainSystem(System):
         v = np.zeros_like(u)
         v[mesh] = v0 + ed
         return u, v
+
+
+@dataclass(frozen=True)
+class TrainFlow:
+    """phi_{m T0} of a train and its Jacobian (``systems.base.StroboscopicFlow``): X = (u, v)
+    flattened as ``TrainSystem.start_state``; trace J = -tr(A^-1 C~) - 2 mu~ g . w, constant."""
+
+    system: TrainSystem
+    period: float
+    steps: int
+
+    @property
+    def trace_rate(self) -> float:
+        s = self.system
+        return float(-np.trace(s.AC) - 2.0 * s.params.damping * (s.g @ s.w))
+
+    def __call__(self, X: np.ndarray, m: int) -> tuple[np.ndarray, np.ndarray]:
+        s = self.system
+        lw = law(s.params)
+        half = len(X) // 2
+        u0 = np.ascontiguousarray(X[:half], dtype=np.float64)
+        v0 = np.ascontiguousarray(X[half:], dtype=np.float64)
+        u, v, phi = flow_train(
+            lw.code, lw.a, lw.c, lw.alpha, s.params.damping, s.AK, s.AC, s.g, s.w, s.f, s.p,
+            s.kc, s.ec, s.tc, u0, v0, self.period, self.steps, m,
+        )  # fmt: skip
+        return np.concatenate([u, v]), phi
 
 
 def train_system(model: TrainModel, pair: DesignConversion) -> TrainSystem:
@@ -176,9 +211,9 @@ def integrate_train(
         plan.omega0 is not None, plan.period, plan.steps, n_trans, n_rec,
         stride, DIVERGENCE_BOUND,
     )  # fmt: skip
-    xs, vs, logs, hx, hv, xmin, xmax, done, _, _, fmin, fmax = out
+    xs, vs, logs, hx, hv, xmin, xmax, done, _, _, fmin, fmax, full = out
     final = (float(hx[-1]), float(hv[-1])) if hx.size else (math.nan, math.nan)
     return Run(
         xs, vs, logs, hx, hv, xmin, xmax, done, final, done < n_trans + n_rec,
-        max(0, done - n_trans), fmin, fmax,
+        max(0, done - n_trans), fmin, fmax, None, full,
     )  # fmt: skip

@@ -17,6 +17,7 @@ from fastapi.responses import FileResponse
 
 from gearengine.model.design import EXAMPLE_DESIGN
 from gearengine.model.examples import PAPER_SECTION_41
+from gearengine.model.train import EXAMPLE_TRAIN
 from service.errors import ProblemError
 
 router = APIRouter(include_in_schema=False)
@@ -60,8 +61,10 @@ async def explorer_page() -> FileResponse:
 @router.get("/explorer/defaults.json")
 async def explorer_defaults() -> dict[str, Any]:
     """What the form is prefilled with: the README's design (direct form), a geometry-form
-    design, and the paper's dimensionless parameters for the advanced switch."""
-    return {"direct": EXAMPLE_DESIGN, "geometry": GEOMETRY_EXAMPLE, "params": PAPER_SECTION_41}
+    design, the paper's dimensionless parameters for the advanced switch, and issue 32's gear
+    train for the train box's example button."""
+    return {"direct": EXAMPLE_DESIGN, "geometry": GEOMETRY_EXAMPLE, "params": PAPER_SECTION_41,
+            "train": EXAMPLE_TRAIN}  # fmt: skip
 
 
 @router.get("/explorer/{name}")
