@@ -106,6 +106,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(runups.router, tags=["runups"])
     app.include_router(robustness.router, tags=["robustness"])
     app.include_router(basins.router, tags=["basins"])
+    app.include_router(signals.jobs_router, tags=["signals"])
     app.include_router(signals.router, tags=["signals"])
     app.include_router(explorer.router)
     app.add_middleware(
