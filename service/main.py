@@ -68,7 +68,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
         jobs = app.state.jobs = await run_in_threadpool(JobQueue.open, settings)
         ready_checks["job_store"] = jobs.ready
-        warming = app.state.warm_up = KernelWarmUp(jobs, settings)  # after the ready line
+        speed = app.state.limits.speed  # measured after the warm-up: the synchronous budget
+        warming = app.state.warm_up = KernelWarmUp(jobs, settings, speed)  # after the ready line
         ready_checks["kernels"] = warming.done.is_set
         warming.start()
         yield
