@@ -57,6 +57,12 @@ class Settings(BaseSettings):
     database_pool_size: int = Field(
         8, ge=2, le=100, description="Most PostgreSQL connections of one process (a pool)."
     )
+    database_listen: bool = Field(
+        True,
+        description="Dispatchers on a PostgreSQL store LISTEN for submissions of every replica "
+        "and wake at once (one more connection per dispatcher); false: they poll every 0.5 s "
+        "(for a pooler that cannot LISTEN, such as PgBouncer in transaction mode).",
+    )
 
     keep_alive_seconds: float = Field(
         30.0,
