@@ -3,14 +3,15 @@
 The route tests run in-process. The browser tests drive Debian's ``chromium`` through
 ``chromedriver`` (selenium) against a real ``gearengine serve`` with API keys on: fill the form
 and analyse, see a field error for a wrong unit, run a small envelope and open a map point,
-read a measured signal loaded from a CSV file. Every request the page makes is recorded (Chrome's performance log, CDP Network events) and
-must stay on the server's origin. Without chromium, chromedriver or selenium the browser tests
-skip, saying which is missing; with GEARCHAOS_BROWSER_TESTS=required (set by .ci/run after it
-installs the browser) they fail instead.
+read a measured signal loaded from a CSV file. Every request the page makes is recorded
+(Chrome's performance log, CDP Network events) and must stay on the server's origin. Without
+chromium, chromedriver or selenium the browser tests skip, saying which is missing; with
+GEARCHAOS_BROWSER_TESTS=required (set by .ci/run after it installs the browser) they fail
+instead.
 
 GEARCHAOS_EXPLORER_SCREENSHOTS=DIR saves the README's screenshots (explorer-verdict.png,
-explorer-field-error.png, explorer-envelope.png, explorer-signal.png, ...) into DIR, GEARCHAOS_EXPLORER_WIDTH=800 at
-another window width (default 1280).
+explorer-field-error.png, explorer-envelope.png, explorer-signal.png, ...) into DIR,
+GEARCHAOS_EXPLORER_WIDTH=800 at another window width (default 1280).
 """
 
 from __future__ import annotations
