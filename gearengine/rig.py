@@ -15,6 +15,9 @@ When they disagree, a short sweep asks which uncertain quantity of the design mo
 towards the rig: the mesh damping, the half backlash and the transmission-error amplitudes,
 each halved and doubled (``LEVERS`` x ``FACTORS``, one analysis each), with the model's verdict
 for every trial.
+
+A recording over the service's synchronous budget is read as a durable job of kind ``signal``
+(``SIGNAL_JOB``): one chunk, the whole reading, whose result is ``read_signal``'s document.
 """
 
 from __future__ import annotations
@@ -27,10 +30,13 @@ from typing import Any
 import numpy as np
 
 from gearengine.analysis import AnalysisRequest, analyze
+from gearengine.jsonio import dumps
 from gearengine.model.design import Design
+from gearengine.numerics.settings import work
 from gearengine.signals.reading import read
 from gearengine.signals.schema import LeverTrial, ModelReport, SignalResult, SpectrumLine
 from gearengine.signals.series import SignalRequest
+from gearengine.studies.jobs import JobKind
 
 COMPARABLE = frozenset({"periodic", "quasi_periodic", "chaotic"})
 FACTORS = (0.5, 2.0)
@@ -164,3 +170,42 @@ def signal(
         if value is not None:
             body[key] = value
     return read_signal(SignalRequest.model_validate(body))
+
+
+def signal_work(request: SignalRequest) -> int:
+    """RK4 steps of a reading (the job budget's unit): the model's analysis at the signal's
+    speed and, should the model disagree, its six lever trials (``short_sweep``), each costed
+    as the analysis; none without a design (the reading itself integrates nothing; its
+    samples are bounded by ``MAX_SAMPLES``)."""
+    if request.design is None:
+        return 0
+    analysis = AnalysisRequest.model_validate({"design": request.design})
+    return (1 + len(LEVERS) * len(FACTORS)) * work(analysis.params, analysis.settings)
+
+
+def _one_chunk(request: SignalRequest, chunk_points: int) -> list[int]:
+    """One chunk counting the samples (the reading needs the whole series at once)."""
+    return [len(request.signal.values)]
+
+
+def _chunk(request: SignalRequest, index: int, chunk_points: int) -> str:
+    return dumps(read_signal(request))
+
+
+def _result(request: SignalRequest, chunks: list[str]) -> SignalResult:
+    if not chunks:
+        raise ValueError("the signal job has no finished chunk yet")
+    return SignalResult.model_validate_json(chunks[0])
+
+
+SIGNAL_JOB = JobKind(
+    name="signal",
+    request=SignalRequest,
+    chunk_points=1,
+    chunk_counts=_one_chunk,
+    work=signal_work,
+    compute_chunk=_chunk,
+    assemble=_result,
+)
+"""A recording read as a durable job (the service's ``/v1/signals/jobs``): its result is
+``read_signal``'s document for the same request, byte for byte."""

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from pydantic import BaseModel
@@ -11,6 +11,7 @@ from gearengine.homoclinic.schemas import ThresholdsRequest
 from gearengine.studies import jobs
 from service.core.config import Settings
 from service.errors import FieldError, ProblemError
+from service.speed import KernelSpeed
 
 SWEEP_HINT = "submit it as a sweep job: POST /v1/sweeps"
 """Where an analysis over the synchronous budget can run."""
@@ -23,9 +24,14 @@ BASINS_HINT = (
 
 @dataclass(frozen=True)
 class Limits:
-    """The service limits of one app (from Settings)."""
+    """The service limits of one app (from Settings; the synchronous budget from the kernels'
+    speed, ``service.speed``)."""
 
     settings: Settings
+    speed: KernelSpeed = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "speed", KernelSpeed(self.settings))
 
     def document(self, spec: dict[str, Any]) -> None:
         """Write the limits that bound one field into the OpenAPI document, so that its schema
@@ -55,12 +61,12 @@ class Limits:
         """Refuse work over the synchronous budget, naming ``field`` (``settings.basins.starts``
         when basin starts are asked for: they multiply the cost) and saying where such work
         can run (``hint``)."""
-        cap = self.settings.max_sync_steps
+        cap = self.speed.sync_steps
         if steps > cap:
             raise over_limit(
                 field,
                 f"this analysis needs {steps} RK4 steps, over the synchronous compute budget of "
-                f"{cap} steps (max_sync_steps); {hint}",
+                f"{cap} steps ({self.speed.describe()}); {hint}",
                 kind="over-budget",
             )
 

@@ -68,7 +68,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
         jobs = app.state.jobs = await run_in_threadpool(JobQueue.open, settings)
         ready_checks["job_store"] = jobs.ready
-        warming = app.state.warm_up = KernelWarmUp(jobs, settings)  # after the ready line
+        speed = app.state.limits.speed  # measured after the warm-up: the synchronous budget
+        warming = app.state.warm_up = KernelWarmUp(jobs, settings, speed)  # after the ready line
         ready_checks["kernels"] = warming.done.is_set
         warming.start()
         yield
@@ -106,6 +107,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(runups.router, tags=["runups"])
     app.include_router(robustness.router, tags=["robustness"])
     app.include_router(basins.router, tags=["basins"])
+    app.include_router(signals.jobs_router, tags=["signals"])
     app.include_router(signals.router, tags=["signals"])
     app.include_router(explorer.router)
     app.add_middleware(

@@ -15,6 +15,7 @@ import time
 
 from service.core.config import Settings
 from service.jobs.runtime import JobQueue
+from service.speed import KernelSpeed
 
 log = logging.getLogger("gearchaos.startup")
 
@@ -29,12 +30,14 @@ def warm_up_kernels() -> None:
 
 
 class KernelWarmUp:
-    """A daemon thread: ``warm_up_kernels``, then the sweep dispatcher of ``jobs``; ``done``
-    is set when both happened (the ``kernels`` readiness check)."""
+    """A daemon thread: ``warm_up_kernels``, the measurement of the kernels' speed (``speed``,
+    which sets the synchronous budget), then the sweep dispatcher of ``jobs``; ``done`` is set
+    when all happened (the ``kernels`` readiness check)."""
 
-    def __init__(self, jobs: JobQueue, settings: Settings) -> None:
+    def __init__(self, jobs: JobQueue, settings: Settings, speed: KernelSpeed) -> None:
         self.jobs = jobs
         self.settings = settings
+        self.speed = speed
         self.done = threading.Event()
         self._lock = threading.Lock()
         self._stopping = False
@@ -52,6 +55,7 @@ class KernelWarmUp:
         start = time.monotonic()
         try:
             warm_up_kernels()
+            self.speed.measure()  # before the dispatcher's workers load the cores
         except Exception:  # a bug: every request would meet it too; stay not ready
             log.exception("kernel warm-up failed")
             return

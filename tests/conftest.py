@@ -32,6 +32,11 @@ ROOT = Path(__file__).resolve().parents[1]
 settings.register_profile("repeatable", derandomize=True, database=None)
 settings.register_profile("explore", derandomize=False)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "repeatable"))
+# The synchronous budget is sync_seconds at the kernels' speed measured at start (service.speed);
+# tests pin the speed so that what a test sends is refused or answered on any machine and load
+# (10 M steps/s x 0.5 s: the 5 M steps the budget was before it was measured). Servers started
+# as subprocesses inherit it. tests/test_sync_budget.py measures it.
+os.environ.setdefault("GEARCHAOS_KERNEL_STEPS_PER_SECOND", "1e7")
 PAPER_PARAMS = PAPER_SECTION_41
 """The paper's section 4.1 design (``model.examples``), the parameters most tests start from."""
 

@@ -2,15 +2,16 @@
 
 The route tests run in-process. The browser tests drive Debian's ``chromium`` through
 ``chromedriver`` (selenium) against a real ``gearengine serve`` with API keys on: fill the form
-and analyse, see a field error for a wrong unit, run a small envelope and open a map point.
-Every request the page makes is recorded (Chrome's performance log, CDP Network events) and
-must stay on the server's origin. Without chromium, chromedriver or selenium the browser tests
-skip, saying which is missing; with GEARCHAOS_BROWSER_TESTS=required (set by .ci/run after it
-installs the browser) they fail instead.
+and analyse, see a field error for a wrong unit, run a small envelope and open a map point,
+read a measured signal loaded from a CSV file. Every request the page makes is recorded
+(Chrome's performance log, CDP Network events) and must stay on the server's origin. Without
+chromium, chromedriver or selenium the browser tests skip, saying which is missing; with
+GEARCHAOS_BROWSER_TESTS=required (set by .ci/run after it installs the browser) they fail
+instead.
 
 GEARCHAOS_EXPLORER_SCREENSHOTS=DIR saves the README's screenshots (explorer-verdict.png,
-explorer-field-error.png, explorer-envelope.png) into DIR, GEARCHAOS_EXPLORER_WIDTH=800 at
-another window width (default 1280).
+explorer-field-error.png, explorer-envelope.png, explorer-signal.png, ...) into DIR,
+GEARCHAOS_EXPLORER_WIDTH=800 at another window width (default 1280).
 """
 
 from __future__ import annotations
@@ -176,9 +177,10 @@ class Page:
         return self.driver.find_element(By.CSS_SELECTOR, css).text
 
     def figures_done(self) -> None:
+        """The design's figures (those of #verdict) have loaded or failed."""
         self.wait(
             lambda d: d.execute_script(
-                "return [...document.querySelectorAll('figure img')]"
+                "return [...document.querySelectorAll('#verdict figure img')]"
                 ".every(i => ['shown', 'failed'].includes(i.dataset.state))"
             )
         )
@@ -249,7 +251,7 @@ def test_analyse_shows_the_verdict(page: Page) -> None:
     assert "Critical torque" in facts and "9.62 N·m" in facts
     page.figures_done()
     states = page.driver.execute_script(
-        "return [...document.querySelectorAll('figure img')].map(i => i.dataset.state)"
+        "return [...document.querySelectorAll('#verdict figure img')].map(i => i.dataset.state)"
     )
     # no threshold curves above the critical torque, and the note says why
     assert states == ["shown", "failed"]
@@ -552,4 +554,59 @@ def test_basins_show_the_attractors_and_their_picture(page: Page) -> None:
     page.wait(lambda d: page.field("basins-figure", by="id").get_attribute("data-state") == "shown")
     page.show("#basins")
     page.screenshot("explorer-basins.png", height=1400)
+    page.assert_same_origin()
+
+
+def test_a_measured_signal_is_read_with_its_verdict_and_pictures(
+    page: Page, tmp_path: Path
+) -> None:
+    """The signal view: pasted samples too short for the embedding are refused at the box; the
+    project's chaotic gear response (F_e = 0.25, 25 dB of sensor noise) loaded as a CSV whose
+    time column sets the rate is read as chaotic, with its evidence, summary and figure."""
+    from tests.test_signals_gear import RATE, TEETH, recording
+
+    page.open()
+    page.type("signal.values", "0.1\n0.3\n0.2")
+    page.field("read-signal", by="id").click()
+    note = page.wait(lambda d: page.text("label:has(> [data-path='signal.values']) .field-error"))
+    assert note.startswith("signal.values:") and "512" in note
+    assert page.driver.find_element("id", "reading").get_attribute("hidden") is not None
+
+    x, mesh_hz, _, _ = recording(0.25, 25.0)
+    csv = tmp_path / "rig.csv"
+    times = [f"{k / RATE:.8f},{v:.8g}" for k, v in enumerate(x)]
+    csv.write_text("time_s,displacement_um\n" + "\n".join(times) + "\n")
+    page.field("signal-file", by="id").send_keys(str(csv))
+    page.wait(lambda d: f"{x.size + 1:,} lines" in page.text("#signal-file-note"))
+    page.field("signal.sample_rate").clear()  # the time column sets it
+    page.type("speed", f"{mesh_hz * 60.0 / TEETH:.6g} rpm")
+    page.type("teeth", str(TEETH))
+    page.driver.find_element(
+        "css selector", "[data-path='signal.quantity'] [value=displacement]"
+    ).click()
+    page.field("read-signal", by="id").click()
+    summary = page.wait(lambda d: page.text("#reading-summary"), timeout=300)
+    assert page.text("#reading-verdict") == "chaotic", summary
+    assert summary.startswith("Chaotic:") and "IAAFT surrogates" in summary
+    evidence = page.text("#reading-evidence")
+    assert "0-1" in evidence or "K =" in evidence, evidence
+    facts = page.text("#reading-facts")
+    for label in ("Record", "Shaft", "0-1 test K", "Largest Lyapunov exponent", "Surrogate test"):
+        assert label in facts, facts
+    assert f"{x.size:,} samples at 20,000 Hz" in facts
+    page.wait(
+        lambda d: page.field("signal-figure", by="id").get_attribute("data-state") == "shown",
+        timeout=300,
+    )
+    width = page.driver.execute_script(
+        "return document.getElementById('signal-figure').naturalWidth"
+    )
+    assert width > 600
+    # the form on the left beside the results, which stay in view (sticky)
+    page.driver.set_window_size(page.driver.get_window_size()["width"], 1400)
+    page.driver.execute_script("document.getElementById('signal-form').scrollIntoView()")
+    page.screenshot("explorer-signal.png")
+    page.field("signal-figure", by="id").click()  # at full size, as the design's figures
+    page.wait(lambda d: d.execute_script("return document.getElementById('enlarged').open"))
+    page.field("enlarged", by="id").click()
     page.assert_same_origin()

@@ -22,7 +22,7 @@ FLOORS: dict[str, int] = {
     "gearengine.engineering": 5,
     "gearengine.analysis": 6,
     "gearengine.studies": 7,
-    "gearengine.rig": 7,
+    "gearengine.rig": 8,
     "gearengine.gate": 8,
     "gearengine.plots": 9,
     "gearengine.cli": 10,
@@ -30,10 +30,10 @@ FLOORS: dict[str, int] = {
 }
 """Room (a package or module of the engine) -> its floor; the data flows upwards: model ->
 systems (their kernels) -> numerics (drives any system) and homoclinic -> one point's verdicts
--> studies (job kinds) and the model beside a rig's series (``rig``) -> gates -> plots ->
-commands and the facade. ``signals`` reads a series with array functions only (a rig's or a
-simulation's), so it stands on the model alone and the kernels and numerics hand their series
-to it."""
+-> studies (job kinds) -> gates, and the model beside a rig's series (``rig``, whose long
+readings are a job kind of ``studies.jobs``) -> plots -> commands and the facade. ``signals``
+reads a series with array functions only (a rig's or a simulation's), so it stands on the model
+alone and the kernels and numerics hand their series to it."""
 
 MAX_LINES = 450
 LONG_KERNELS: frozenset[str] = frozenset()

@@ -330,3 +330,56 @@ def test_a_postgres_store_cut_off_is_not_ready_and_recovers(database_url: str) -
         allow(True)
         admin.close()
         store.shutdown()
+
+
+def test_a_submission_on_one_replica_notifies_the_others_listeners(database_url: str) -> None:
+    """PostgreSQL LISTEN/NOTIFY: a store listening is woken by a submission committed through
+    another store (another replica's pool), and by chunks released; not by a submission
+    rolled back (queue full), and never when listening is off."""
+    a, b = JobStore.open(database_url), JobStore.open(database_url)
+    deaf = JobStore.open(database_url, listening=False)
+    woken, deaf_woken = threading.Event(), threading.Event()
+    stop, stop_deaf = b.listen(woken.set), deaf.listen(deaf_woken.set)
+    try:
+        poll(woken.is_set, bool, timeout=30.0)  # connected: one wake for what came before
+        woken.clear()
+        job = submit(a, cap=1)
+        poll(woken.is_set, bool, timeout=30.0)
+        woken.clear()
+        with pytest.raises(QueueFullError):
+            submit(a, cap=1)
+        (claim,) = b.claim("b:1:x", LEASE, 3, 1)
+        b.release("b:1:x", [claim.key])
+        poll(woken.is_set, bool, timeout=30.0)
+        assert b.claim("b:1:y", LEASE, 3, 1)[0].key == (job, 0)
+        assert not deaf_woken.is_set()
+    finally:
+        stop()
+        stop_deaf()
+        for s in (a, b, deaf):
+            s.shutdown()
+
+
+def test_a_dispatcher_that_never_polls_claims_another_replicas_submission(
+    database_url: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With polling off (IDLE_POLL an hour, leases of an hour), only the notification can
+    wake the dispatcher after its first look at the empty store: the job submitted through
+    another store is claimed all the same."""
+    from service.jobs import dispatcher as dispatching
+    from service.jobs.backends import LocalPool
+
+    monkeypatch.setattr(dispatching, "IDLE_POLL", 3600.0)
+    here, there = JobStore.open(database_url), JobStore.open(database_url)
+    pool = LocalPool(1)
+    poll(pool.capacity, bool, timeout=300)  # its worker has started: it can take a chunk
+    d = dispatching.Dispatcher(there, pool, lease_seconds=3 * 3600.0)
+    d.start()
+    try:
+        time.sleep(0.5)  # the dispatcher's first round has found nothing; now it waits
+        job = submit(here, chunks=1)
+        claimed = poll(lambda: here.get(job, None), lambda j: j.status != "queued", timeout=60)
+        assert claimed.status in ("running", "failed")  # '{"doc": 1}' is no sweep: it fails
+    finally:
+        d.stop(grace=0.0)
+        here.shutdown()

@@ -165,3 +165,24 @@ def test_tach_and_teeth_are_checked(client: TestClient) -> None:
     assert errors(client.post("/v1/signals", json=doc))[0][0] == "tach.times[2]"
     del doc["tach"]
     assert errors(client.post("/v1/signals", json=doc))[0][0] == "teeth"
+
+
+def test_the_upload_plot_draws_the_reading_of_the_uploaded_text(client: TestClient) -> None:
+    """The explorer's figure of a pasted or loaded CSV: the same bytes as the JSON plot
+    route's for the same request, answered from the reading the upload route cached; a bad
+    query field is a 422 naming it."""
+    x = mesh_tones(0.7)
+    text = "\n".join(f"{v:.10g}" for v in x)
+    query = "?rate=20kHz&speed=1500rpm&teeth=18&quantity=transmission_error&unit=um"
+    headers = {"content-type": "text/csv"}
+    reading = client.post("/v1/signals/upload" + query, content=text, headers=headers)
+    assert reading.status_code == 200 and reading.json()["verdict"] == "periodic"
+    png = client.post("/v1/signals/upload/plot" + query + "&format=png", content=text,
+                      headers=headers)  # fmt: skip
+    assert png.status_code == 200 and png.headers["content-type"] == "image/png"
+    values = [float(v) for v in text.split()]
+    same = client.post("/v1/signals/plot?format=png", json=body(values))
+    assert same.status_code == 200 and same.content == png.content
+    bad = client.post("/v1/signals/upload/plot?rate=20kHz&speed=fast", content=text,
+                      headers=headers)  # fmt: skip
+    assert [path for path, _ in errors(bad)] == ["speed"]

@@ -14,6 +14,7 @@ import pytest
 from service.core.config import Settings
 from service.jobs.runtime import JobQueue
 from service.main import create_app
+from service.speed import KernelSpeed
 from service.warmup import KernelWarmUp
 from tests.conftest import Server, free_port, started
 
@@ -104,7 +105,7 @@ def test_no_dispatcher_starts_once_the_service_stops(tmp_path: Path) -> None:
     """A service stopped while its kernels warm up never starts its pool workers."""
     settings = Settings(data_dir=tmp_path, workers=1)
     jobs = JobQueue.open(settings)
-    warming = KernelWarmUp(jobs, settings)
+    warming = KernelWarmUp(jobs, settings, KernelSpeed(settings))
     warming.stop()
     warming.start()
     warming._thread.join()

@@ -77,6 +77,7 @@ KINDS: dict[str, str] = {
     "runup": "gearengine.studies.runup.compute:RUNUP_JOB",
     "robustness": "gearengine.studies.robustness.study:ROBUSTNESS_JOB",
     "basins": "gearengine.studies.basins:BASINS_JOB",
+    "signal": "gearengine.rig:SIGNAL_JOB",
 }
 """Kind name -> ``module:attribute`` of its ``JobKind``."""
 

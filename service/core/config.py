@@ -57,6 +57,12 @@ class Settings(BaseSettings):
     database_pool_size: int = Field(
         8, ge=2, le=100, description="Most PostgreSQL connections of one process (a pool)."
     )
+    database_listen: bool = Field(
+        True,
+        description="Dispatchers on a PostgreSQL store LISTEN for submissions of every replica "
+        "and wake at once (one more connection per dispatcher); false: they poll every 0.5 s "
+        "(for a pooler that cannot LISTEN, such as PgBouncer in transaction mode).",
+    )
 
     keep_alive_seconds: float = Field(
         30.0,
@@ -69,11 +75,26 @@ class Settings(BaseSettings):
     max_batch_body_bytes: int = Field(
         16 << 20, ge=1024, description="Largest body of POST /v1/melnikov/batch, bytes."
     )
-    max_sync_steps: int = Field(
-        5_000_000,
+    max_sync_steps: int | None = Field(
+        None,
         ge=1000,
-        description="Compute budget of one synchronous analysis, in RK4 steps over all starts "
-        "(the default analysis is 200 000).",
+        description="Compute budget of one synchronous analysis in RK4 steps over all starts, "
+        "set by hand (the default analysis is 200 000); unset, sync_seconds at the kernels' "
+        "measured speed (service.speed).",
+    )
+    sync_seconds: float = Field(
+        0.5,
+        gt=0.0,
+        le=600.0,
+        description="Compute budget of one synchronous analysis in seconds of kernel time, "
+        "turned into RK4 steps with the kernels' speed measured at start (about 6 M steps on a "
+        "loaded 2-core machine; docs/scale-out.md).",
+    )
+    kernel_steps_per_second: float | None = Field(
+        None,
+        gt=0.0,
+        description="Pins the kernels' speed in RK4 steps/s (reproducible budgets, tests); "
+        "unset, it is measured after the warm-up (10 M steps/s assumed until then).",
     )
     max_curve_points: int = Field(2000, ge=2, description="Most frequencies in a threshold curve.")
     cache_entries: int = Field(512, ge=0, description="Responses kept in the in-memory LRU.")

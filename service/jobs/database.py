@@ -83,6 +83,15 @@ class Database(Protocol):
     failure); PostgreSQL's deadlock detector may abort one of two writers."""
     errors: tuple[type[BaseException], ...]
     """Errors meaning the database does not answer (readiness)."""
+    notify_work: str
+    """A statement telling every listening process that there are chunks to claim, delivered
+    when the transaction commits (PostgreSQL: ``pg_notify``); empty on SQLite, whose
+    dispatchers share one machine and poll."""
+
+    def listen(self, wake: Callable[[], None]) -> Callable[[], None]:
+        """Call ``wake()`` whenever another process commits a ``notify_work`` (and once when
+        listening starts or resumes after a lost connection); returns the function that stops
+        listening. A no-op on SQLite."""
 
     def transaction(self) -> AbstractContextManager[Tx]:
         """A write transaction: committed when the block ends, rolled back on an exception."""

@@ -42,7 +42,9 @@ from service.jobs.store import Claim, JobStore
 log = logging.getLogger("gearchaos.jobs")
 
 IDLE_POLL = 0.5
-"""Seconds between looks at the store when nothing wakes the dispatcher."""
+"""Seconds between looks at the store when nothing wakes the dispatcher: a submission to this
+process, a finished chunk, or (PostgreSQL) another process's notification (``store.listen``)
+wake it at once; polling is the fallback."""
 
 HOST = socket.gethostname()
 _LIVE_OWNERS: set[str] = set()
@@ -126,6 +128,7 @@ class Dispatcher:
     def run(self) -> None:
         """Dispatch until ``stop``; then drain gracefully."""
         log.info("dispatcher %s started on %s", self.owner, self.backend.name)
+        unlisten = self.store.listen(self.wake)  # other replicas' submissions wake it at once
         while not self._stop.is_set():
             try:
                 self.step()
@@ -134,6 +137,7 @@ class Dispatcher:
                 time.sleep(1.0)
             self._wake.wait(min(IDLE_POLL, self.lease_seconds / 3.0))
             self._wake.clear()
+        unlisten()
         self._drain()
         self.store.close()
         _LIVE_OWNERS.discard(self.owner)

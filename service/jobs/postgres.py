@@ -8,11 +8,21 @@ claims lock chunks and their jobs with ``SKIP LOCKED`` and so never wait. Should
 deadlock detector still abort a transaction (a heartbeat's and a cancel's chunk locks), the
 store runs it again (``retryable``). The clock of leases is the server's
 (``clock_timestamp()``), one for every replica.
+
+Dispatchers wake at once on work another replica made: every transaction that makes chunks
+claimable (a submission, chunks released by a stopping dispatcher, an attempt to retry) runs
+``pg_notify`` on ``CHANNEL``, which PostgreSQL delivers to every ``LISTEN``ing session when it
+commits; each dispatcher's ``Listener`` (its own connection, outside the pool, in a thread)
+wakes its loop. Polling every ``IDLE_POLL`` stays as the fallback (a lost notification, a
+connection being re-opened, a pooler such as PgBouncer in transaction mode that cannot
+``LISTEN``: ``database_listen = false``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+import logging
+import threading
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from functools import lru_cache
 from typing import Any
@@ -29,6 +39,12 @@ IDLE_IN_TRANSACTION_MS = 10_000
 process frozen mid-transaction (SIGSTOP, a paused VM, a stalled pod) would otherwise hold its
 job's row and stall every dispatcher's claims and commits of that job. The store's own
 transactions never wait for anything but the database."""
+CHANNEL = "gearchaos_work"
+"""The notification channel of claimable work."""
+LISTEN_POLL = 1.0
+"""Seconds a listener waits for notifications before looking whether it should stop."""
+LISTEN_RETRY = 1.0
+"""Seconds before a listener whose connection failed connects again."""
 LOCK_KEY = 0x6765_6172
 """Advisory lock namespace of gearchaos ("gear"); the second key picks the lock."""
 
@@ -145,6 +161,41 @@ def redacted(url: str) -> str:
     return make_conninfo("", **params)
 
 
+log = logging.getLogger("gearchaos.jobs")
+
+
+class Listener:
+    """A thread holding one connection that ``LISTEN``s on ``CHANNEL`` and calls ``wake()``
+    for each notification; it calls ``wake()`` too each time it (re)connects, for the work
+    committed while it was not listening. A failed connection is opened again after
+    ``LISTEN_RETRY`` seconds (the dispatcher polls meanwhile)."""
+
+    def __init__(self, url: str, wake: Callable[[], None]) -> None:
+        self.url = url
+        self.wake = wake
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="job-listener", daemon=True)
+        self._thread.start()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            try:
+                with psycopg.connect(self.url, autocommit=True) as conn:
+                    conn.execute(f"LISTEN {CHANNEL}")
+                    self.wake()
+                    while not self._stop.is_set():
+                        for _ in conn.notifies(timeout=LISTEN_POLL):
+                            self.wake()
+            except psycopg.Error as exc:
+                log.warning("job listener lost its connection (%s); polling meanwhile", exc)
+                self._stop.wait(LISTEN_RETRY)
+
+    def stop(self) -> None:
+        """Stop listening (within ``LISTEN_POLL`` seconds) and close the connection."""
+        self._stop.set()
+        self._thread.join(timeout=LISTEN_POLL + 5.0)
+
+
 class PostgresDatabase:
     """The database at ``url`` (``postgresql://user:pass@host:port/db``), ``pool_size``
     connections at most in this process."""
@@ -160,8 +211,10 @@ class PostgresDatabase:
         pg_errors.SerializationFailure,
     )
     errors: tuple[type[BaseException], ...] = (psycopg.Error,)
+    notify_work = f"SELECT pg_notify('{CHANNEL}', '')"
 
     def __init__(self, url: str, pool_size: int = 8) -> None:
+        self.url = url
         self.location = redacted(url)
         self.pool = ConnectionPool(
             url,
@@ -176,6 +229,9 @@ class PostgresDatabase:
             name="gearchaos-jobs",
             open=True,
         )
+
+    def listen(self, wake: Callable[[], None]) -> Callable[[], None]:
+        return Listener(self.url, wake).stop
 
     @contextmanager
     def transaction(self) -> Iterator[Tx]:

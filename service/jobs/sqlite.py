@@ -10,7 +10,7 @@ from __future__ import annotations
 import sqlite3
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -100,12 +100,17 @@ class SqliteDatabase:
     migration_lock = serialize_submits = ""
     retryable: tuple[type[BaseException], ...] = ()
     errors: tuple[type[BaseException], ...] = (sqlite3.Error,)
+    notify_work = ""
 
     def __init__(self, path: Path) -> None:
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self.location = str(self.path)
         self._local = threading.local()
+
+    def listen(self, wake: Callable[[], None]) -> Callable[[], None]:
+        """Nothing to listen to: dispatchers on one machine poll the file."""
+        return lambda: None
 
     def _db(self) -> sqlite3.Connection:
         db = getattr(self._local, "db", None)

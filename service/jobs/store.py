@@ -106,18 +106,20 @@ def retried(method: Callable[P, T]) -> Callable[P, T]:
 class JobStore:
     """The job queue's state in one database (``service.jobs.database.Database``)."""
 
-    def __init__(self, db: Database) -> None:
+    def __init__(self, db: Database, listening: bool = True) -> None:
         self.db = db
+        self.listening = listening
         migrate(db)
 
     @classmethod
-    def open(cls, location: str | Path, pool_size: int = 8) -> JobStore:
+    def open(cls, location: str | Path, pool_size: int = 8, listening: bool = True) -> JobStore:
         """The store at ``location``: a ``postgresql://`` URL (``pool_size`` connections at
-        most), else a SQLite file path."""
+        most; ``listening``: dispatchers woken by notifications, ``listen``), else a SQLite
+        file path."""
         if str(location).startswith(("postgresql://", "postgres://")):
             from service.jobs.postgres import PostgresDatabase
 
-            return cls(PostgresDatabase(str(location), pool_size))
+            return cls(PostgresDatabase(str(location), pool_size), listening)
         return cls(SqliteDatabase(Path(location)))
 
     @classmethod
@@ -129,7 +131,9 @@ class JobStore:
     def configured(cls, settings: Settings) -> JobStore:
         """The store the settings name: ``database_url`` when set, else the data directory's."""
         if settings.database_url:
-            return cls.open(settings.database_url, settings.database_pool_size)
+            return cls.open(
+                settings.database_url, settings.database_pool_size, settings.database_listen
+            )
         return cls.in_dir(Path(settings.data_dir))
 
     @contextmanager
@@ -145,6 +149,18 @@ class JobStore:
     def _lock_job(self, db: Tx, job_id: str) -> None:
         """Lock the job's row before its chunks (the order every writer keeps)."""
         db.execute(f"SELECT id FROM jobs WHERE id = ?{self.db.lock_rows}", (job_id,))
+
+    def listen(self, wake: Callable[[], None]) -> Callable[[], None]:
+        """Call ``wake()`` when another process makes chunks claimable (PostgreSQL
+        ``LISTEN/NOTIFY``; nothing on SQLite or with ``listening`` off); returns the stop."""
+        if not self.listening:
+            return lambda: None
+        return self.db.listen(wake)
+
+    def _notify(self, db: Tx) -> None:
+        """Tell the listening dispatchers, at commit, that there are chunks to claim."""
+        if self.db.notify_work:
+            db.execute(self.db.notify_work)
 
     def close(self) -> None:
         """Give back what this thread holds (its SQLite connection)."""
@@ -193,6 +209,7 @@ class JobStore:
             ).fetchone()
             if n > max_unfinished:
                 raise QueueFullError(f"{n - 1} unfinished jobs, the limit is {max_unfinished}")
+            self._notify(db)
         job = self.get(job_id, owner)
         assert job is not None
         return job
@@ -370,6 +387,7 @@ class JobStore:
                     "lease_expires = NULL, error = ? WHERE job_id = ? AND idx = ?",
                     (reason, job_id, idx),
                 )
+                self._notify(db)
             else:
                 self._fail_job(db, job_id, idx, row["attempts"], reason, now)
 
@@ -383,6 +401,8 @@ class JobStore:
                 "WHERE job_id = ? AND idx = ? AND status = 'leased' AND lease_owner = ?",
                 [(job_id, idx, owner) for job_id, idx in sorted(keys)],
             )
+            if keys:
+                self._notify(db)
 
     def lease_holders(self) -> set[str]:
         """Owners of the leases that have not expired."""

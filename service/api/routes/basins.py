@@ -8,13 +8,9 @@ succeeded job (``/plot``, the bytes of ``gearengine basins FILE --plot``).
 
 from __future__ import annotations
 
-from typing import Literal
-
 from gearengine.analysis import AnalysisResult
 from gearengine.plots import basins_figure
-from gearengine.studies import jobs as job_kinds
 from service.api.routes.jobs import JobRoutes
-from service.jobs.runtime import JobQueue
 
 BASINS = JobRoutes(
     kind="basins",
@@ -37,18 +33,10 @@ BASINS = JobRoutes(
 router = BASINS.router()
 
 
-def _draw(jobs: JobQueue, job_id: str, fmt: Literal["png", "svg"]) -> bytes:
-    kind = job_kinds.kind("basins")
-    body = kind.request.model_validate_json(jobs.store.request_json(job_id))
-    result = kind.assemble(body, list(jobs.store.chunk_results(job_id)))
-    assert isinstance(result, AnalysisResult)
-    return basins_figure(result, fmt)
-
-
-BASINS.plot_route(
+BASINS.figure_route(
     router,
     "Basin picture of a succeeded basins job (PNG or SVG)",
     "The starts coloured by the attractor they reach, with the attractors' stroboscopic points "
     "(the\nbytes of ``POST /v1/analyses/basins/plot`` and ``gearengine basins FILE --plot``).",
-    _draw,
+    basins_figure,
 )

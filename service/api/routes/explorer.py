@@ -26,6 +26,7 @@ PAGE_DIR = Path(__file__).resolve().parents[2] / "explorer"
 ASSETS = {
     "explorer.js": "text/javascript; charset=utf-8",
     "robustness.js": "text/javascript; charset=utf-8",
+    "signal.js": "text/javascript; charset=utf-8",
     "explorer.css": "text/css; charset=utf-8",
 }
 """The page's own files, by name, with their media types (nothing else is served)."""

@@ -269,6 +269,29 @@ class JobRoutes:
             self._result_route(router)
         return router
 
+    def assembled(self, jobs: JobQueue, job_id: str) -> BaseModel:
+        """The kind's result document of job ``job_id``: its stored request and chunk results
+        joined by the kind's ``assemble`` (ValueError from a kind with no partial result)."""
+        kind = job_kinds.kind(self.kind)
+        request = kind.request.model_validate_json(jobs.store.request_json(job_id))
+        return kind.assemble(request, list(jobs.store.chunk_results(job_id)))
+
+    def figure_route(
+        self,
+        router: APIRouter,
+        summary: str,
+        description: str,
+        figure: Callable[[Any, Literal["png", "svg"]], bytes],
+    ) -> None:
+        """``plot_route`` for a kind whose figure is drawn from its result document alone:
+        ``figure(result, fmt)`` of the ``assembled`` result of a succeeded job."""
+        routes = self
+
+        def draw(jobs: JobQueue, job_id: str, fmt: Literal["png", "svg"]) -> bytes:
+            return figure(routes.assembled(jobs, job_id), fmt)
+
+        self.plot_route(router, summary, description, draw)
+
     def plot_route(
         self,
         router: APIRouter,
@@ -301,7 +324,6 @@ class JobRoutes:
 
     def _result_route(self, router: APIRouter) -> None:
         routes = self
-        kind = job_kinds.kind(self.kind)
 
         async def result(
             job_id: str,
@@ -321,9 +343,8 @@ class JobRoutes:
             missing = job.status != "succeeded"
 
             def assemble() -> bytes:
-                request = kind.request.model_validate_json(jobs.store.request_json(job_id))
                 try:
-                    document = kind.assemble(request, list(jobs.store.chunk_results(job_id)))
+                    document = routes.assembled(jobs, job_id)
                 except ValueError as exc:  # a kind with no partial result before its chunks
                     raise ProblemError(
                         409, "no-result", "No result", f"{routes.noun} {job_id}: {exc}",

@@ -9,18 +9,14 @@ the field, from the request's checks, before anything is stored or computed.
 
 from __future__ import annotations
 
-from typing import Literal
-
 from fastapi import Request
 
 from gearengine.plots import runup_figure
-from gearengine.studies import jobs as job_kinds
 from gearengine.studies.runup.profile import checked
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.studies.runup.results import RunupResult
 from service.api.routes.jobs import JobRoutes
 from service.core.config import Settings
-from service.jobs.runtime import JobQueue
 
 
 def _check(body: RunupRequest, request: Request, settings: Settings) -> None:
@@ -44,18 +40,10 @@ RUNUPS = JobRoutes(
 router = RUNUPS.router()
 
 
-def _draw(jobs: JobQueue, job_id: str, fmt: Literal["png", "svg"]) -> bytes:
-    kind = job_kinds.kind("runup")
-    body = kind.request.model_validate_json(jobs.store.request_json(job_id))
-    result = kind.assemble(body, list(jobs.store.chunk_results(job_id)))
-    assert isinstance(result, RunupResult)
-    return runup_figure(result, fmt)
-
-
-RUNUPS.plot_route(
+RUNUPS.figure_route(
     router,
     "Figure of a succeeded run-up (PNG or SVG)",
     "Speed on x: the DTE envelope up and down over the quasi-static hysteresis loop, jumps\n"
     "marked, contact-status bands, the finite-time Lyapunov exponent, the Melnikov window.",
-    _draw,
+    runup_figure,
 )

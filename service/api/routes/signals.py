@@ -5,12 +5,15 @@ The JSON body is ``SignalRequest``; the upload takes the samples as CSV or text 
 line, or columns: the last is read, a first column of increasing times sets the rate) with the
 other fields as query parameters. Bad input is a 422 problem naming the field
 (``signal.values[3]`` for a NaN, ``signal.sample_rate`` below twice the mesh frequency); a
-series longer than ``SYNC_SAMPLES`` is refused before any compute with the budget named
-(``gearengine signal FILE`` reads up to ``MAX_SAMPLES``).
+series longer than ``SYNC_SAMPLES`` is refused before any compute with the budget named and
+the job route to use: ``POST /v1/signals/jobs`` reads the same request as a durable job (kind
+``signal``, ``gearengine.rig.SIGNAL_JOB``) up to ``MAX_SAMPLES`` and the body limit, with the
+generic job routes and the figure of a succeeded reading (``/plot``).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Annotated, Any, Literal
 
 from fastapi import APIRouter, Depends, Query, Request, Response
@@ -21,14 +24,44 @@ from gearengine.plots import MEDIA_TYPES
 from gearengine.rig import read_signal
 from gearengine.signals.schema import SignalResult
 from gearengine.signals.series import SYNC_SAMPLES, Quantity, SignalRequest, read_table
-from service.api.deps import cached_compute, engine_refusal, require_key
+from service.api.deps import cached_compute, engine_refusal, require_key, response_cache
 from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
+from service.api.routes.jobs import JobRoutes
+from service.cache import etag_for
 from service.limits import over_limit
 
 router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 
-PATHS = ("/v1/signals", "/v1/signals/upload", "/v1/signals/plot")
+PATHS = (
+    "/v1/signals", "/v1/signals/upload", "/v1/signals/plot", "/v1/signals/upload/plot",
+    "/v1/signals/jobs",
+)  # fmt: skip
 """The routes whose bodies hold a recording (a larger body limit, ``service.main``)."""
+JOB_HINT = (
+    "submit it as a job: POST /v1/signals/jobs (the same JSON body; poll the job, then its "
+    "/result and /plot)"
+)
+"""Where a recording over the synchronous budget is read."""
+
+SIGNAL_JOBS = JobRoutes(
+    kind="signal",
+    prefix="signals/jobs",
+    noun="signal",
+    plural="signals",
+    submit_summary="Submit a long recording to be read as a job",
+    submit_doc="The request of ``POST /v1/signals`` with any number of samples up to the "
+    f"reader's limit (not the synchronous budget of {SYNC_SAMPLES} samples) and the body "
+    "limit of signal routes (max_batch_body_bytes). It runs on the workers as one chunk; "
+    "answers 202 with the job and its ``Location``; poll it and fetch ``/result`` or ``/plot`` "
+    "once succeeded.",
+    result_model=SignalResult,
+    result_summary="Result of a succeeded signal job: the reading",
+    result_doc="The body ``POST /v1/signals`` returns for the same request (``gearengine "
+    "signal FILE --json``): the verdict, its evidence, the summary in plain words and, with a "
+    "design, the model beside it.",
+    budget_path="design",
+)
+jobs_router = SIGNAL_JOBS.router()
 
 
 def check_signal_budget(body: SignalRequest) -> None:
@@ -38,7 +71,7 @@ def check_signal_budget(body: SignalRequest) -> None:
         raise over_limit(
             "signal.values",
             f"{n} samples, over the synchronous budget of {SYNC_SAMPLES} samples per request; "
-            "read longer recordings where no budget applies: gearengine signal FILE --rate ...",
+            f"{JOB_HINT}, or read it with gearengine signal FILE --rate ...",
             kind="over-budget",
         )
 
@@ -82,15 +115,19 @@ UPLOAD_BODY = {
 }
 
 
-@router.post(
-    "/signals/upload",
-    response_model=SignalResult,
-    responses=CACHED,
-    summary="Read a recorded series uploaded as CSV or text",
-    openapi_extra=UPLOAD_BODY,
-)
-async def post_signal_upload(
-    request: Request,
+@dataclass(frozen=True)
+class UploadFields:
+    """The query of the upload routes: what the CSV or text does not say."""
+
+    rate: str | None
+    speed: str | None
+    teeth: int | None
+    quantity: Quantity
+    unit: str
+    seed: int
+
+
+def upload_fields(
     rate: Annotated[
         str | None, Query(description="Sample rate, e.g. '20 kHz' (Hz if bare).")
     ] = None,
@@ -101,23 +138,45 @@ async def post_signal_upload(
     quantity: Annotated[Quantity, Query(description="What was measured.")] = "other",
     unit: Annotated[str, Query(max_length=40, description="Unit of the values.")] = "1",
     seed: Annotated[int, Query(ge=0, le=2**32 - 1, description="Seed of the tests.")] = 0,
-) -> Response:
-    """As ``POST /v1/signals``, the samples in the body as CSV or text."""
+) -> UploadFields:
+    return UploadFields(rate, speed, teeth, quantity, unit, seed)
+
+
+Upload = Annotated[UploadFields, Depends(upload_fields)]
+
+
+async def uploaded(request: Request, fields: UploadFields) -> SignalRequest:
+    """The ``SignalRequest`` of an upload: the samples from the body (``read_table``: one value
+    a line, or columns whose first may be times setting the rate), the rest from the query;
+    422 naming the field for bad input."""
     try:
         values, table_rate = read_table((await request.body()).decode("utf-8", "replace"))
     except InputError as exc:
         raise engine_refusal(exc) from None
-    signal: dict[str, Any] = {"values": values.tolist(), "quantity": quantity, "unit": unit}
-    sample_rate = rate if rate is not None else table_rate
+    signal: dict[str, Any] = {
+        "values": values.tolist(), "quantity": fields.quantity, "unit": fields.unit
+    }  # fmt: skip
+    sample_rate = fields.rate if fields.rate is not None else table_rate
     if sample_rate is not None:
         signal["sample_rate"] = _number_or_text(sample_rate)
-    doc: dict[str, Any] = {"signal": signal, "seed": seed}
-    if speed is not None:
-        doc["speed"] = _number_or_text(speed)
-    if teeth is not None:
-        doc["teeth"] = teeth
-    body = SignalRequest.model_validate(doc)  # ValidationError: 422 naming the field
-    return await _answer(request, body)
+    doc: dict[str, Any] = {"signal": signal, "seed": fields.seed}
+    if fields.speed is not None:
+        doc["speed"] = _number_or_text(fields.speed)
+    if fields.teeth is not None:
+        doc["teeth"] = fields.teeth
+    return SignalRequest.model_validate(doc)  # ValidationError: 422 naming the field
+
+
+@router.post(
+    "/signals/upload",
+    response_model=SignalResult,
+    responses=CACHED,
+    summary="Read a recorded series uploaded as CSV or text",
+    openapi_extra=UPLOAD_BODY,
+)
+async def post_signal_upload(request: Request, fields: Upload) -> Response:
+    """As ``POST /v1/signals``, the samples in the body as CSV or text."""
+    return await _answer(request, await uploaded(request, fields))
 
 
 def _number_or_text(text: str | float) -> str | float:
@@ -127,6 +186,26 @@ def _number_or_text(text: str | float) -> str | float:
         return float(text)
     except ValueError:
         return text
+
+
+def _reading(request: Request, body: SignalRequest) -> SignalResult:
+    """The reading of ``body``: the one ``POST /v1/signals`` cached for it when there is one
+    (the explorer asks for the verdict, then the figure), else computed."""
+    hit = response_cache(request).get(etag_for("signals", body.model_dump_json()))
+    if hit is not None:
+        return SignalResult.model_validate_json(hit[0])
+    return read_signal(body)
+
+
+async def _figure_answer(
+    request: Request, body: SignalRequest, format: Literal["png", "svg"] | None
+) -> Response:
+    fmt = image_format(request, format)
+    check_signal_budget(body)
+    return await cached_compute(
+        request, f"signals/plot.{fmt}", body.model_dump_json(),
+        lambda: (_figure(_reading(request, body), fmt), MEDIA_TYPES[fmt]),
+    )  # fmt: skip
 
 
 @router.post(
@@ -144,11 +223,36 @@ async def post_signal_plot(
     """The figure of ``gearengine signal FILE --plot``: order (or frequency) spectrum with the
     model's lines, strobe map (x_k, x_k+1), reconstructed attractor, the 0-1 test's (p, q)
     path, Rosenstein's divergence with its fit, and the surrogate distribution."""
+    return await _figure_answer(request, body, format)
+
+
+@router.post(
+    "/signals/upload/plot",
+    response_class=Response,
+    responses=IMAGE_RESPONSES,
+    summary="Figure of the reading of a series uploaded as CSV or text",
+    openapi_extra=UPLOAD_BODY,
+)
+async def post_signal_upload_plot(
+    request: Request,
+    fields: Upload,
+    format: Literal["png", "svg"] | None = FormatQuery,
+) -> Response:
+    """As ``POST /v1/signals/plot``, the samples in the body as CSV or text (the query of
+    ``POST /v1/signals/upload``)."""
+    return await _figure_answer(request, await uploaded(request, fields), format)
+
+
+def _figure(result: SignalResult, fmt: Literal["png", "svg"]) -> bytes:
     from gearengine.plots.signal import signal_figure
 
-    fmt = image_format(request, format)
-    check_signal_budget(body)
-    return await cached_compute(
-        request, f"signals/plot.{fmt}", body.model_dump_json(),
-        lambda: (signal_figure(read_signal(body), fmt), MEDIA_TYPES[fmt]),
-    )  # fmt: skip
+    return signal_figure(result, fmt)
+
+
+SIGNAL_JOBS.figure_route(
+    jobs_router,
+    "Figure of a succeeded signal job (PNG or SVG)",
+    "The figure of ``POST /v1/signals/plot`` for the job's request: order spectrum, strobe "
+    "map,\nattractor, the 0-1 test's (p, q) path, Rosenstein's divergence, the surrogates.",
+    _figure,
+)
