@@ -10,6 +10,7 @@ import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import psycopg
 import pytest
@@ -145,11 +146,25 @@ def test_release_gives_chunks_back_without_counting_the_attempt(store: JobStore)
     assert c.attempt == 1 and store.attempts(job) == [1]
 
 
-def _claim_all(location: str, owner: str, out: multiprocessing.Queue) -> None:
+def _claim_all(
+    location: str, owner: str, out: multiprocessing.Queue, total: Any, chunks: int
+) -> None:
+    """Claim one chunk at a time until the dispatchers together hold ``chunks`` claims.
+
+    An empty claim does not mean the queue is empty: PostgreSQL's claim skips a job row that
+    another claimer holds locked for a moment (``FOR UPDATE OF c, j SKIP LOCKED``), and a
+    dispatcher then simply polls again; so each process stops on the shared count, or after
+    60 s, and the test then checks that no chunk was claimed twice or left out."""
     store = JobStore.open(location)
     got = []
-    while claims := store.claim(owner, LEASE, 3, 1):
+    deadline = time.monotonic() + 60.0
+    while total.value < chunks and time.monotonic() < deadline:
+        claims = store.claim(owner, LEASE, 3, 1)
+        with total.get_lock():
+            total.value += len(claims)
         got += [c.key for c in claims]
+        if not claims:
+            time.sleep(0.01)
     out.put(got)
     store.shutdown()
 
@@ -157,11 +172,13 @@ def _claim_all(location: str, owner: str, out: multiprocessing.Queue) -> None:
 def test_concurrent_dispatchers_never_claim_a_chunk_twice(store: JobStore, location: str) -> None:
     job = submit(store, chunks=60, cap=10)
     ctx = multiprocessing.get_context("spawn")
-    out = ctx.Queue()
-    procs = [ctx.Process(target=_claim_all, args=(location, f"p{i}", out)) for i in range(4)]
+    out, total = ctx.Queue(), ctx.Value("i", 0)
+    procs = [
+        ctx.Process(target=_claim_all, args=(location, f"p{i}", out, total, 60)) for i in range(4)
+    ]
     for p in procs:
         p.start()
-    claimed = [key for _ in procs for key in out.get(timeout=60)]
+    claimed = [key for _ in procs for key in out.get(timeout=90)]
     for p in procs:
         p.join()
     assert sorted(claimed) == [(job, i) for i in range(60)]
