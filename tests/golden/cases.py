@@ -8,6 +8,7 @@ records them anew (only when a number is meant to change, said in the commit).
 
 from __future__ import annotations
 
+import fnmatch
 import json
 import math
 import subprocess
@@ -161,8 +162,18 @@ def golden_path(name: str) -> Path:
 
 
 def main(argv: list[str]) -> int:
-    """``--write [NAME...]`` records, ``--check [NAME...]`` compares (all cases by default)."""
-    mode, names = argv[0], argv[1:] or list(CASES)
+    """``--write [NAME...]`` records, ``--check [NAME...]`` compares (all cases by default; a
+    NAME may be a shell pattern such as ``melnikov-*``)."""
+    if not argv or argv[0] not in ("--check", "--write"):
+        print("usage: python -m tests.golden.cases --check|--write [NAME...]")
+        print(f"cases: {list(CASES)}")
+        return 2
+    mode, patterns = argv[0], argv[1:] or ["*"]
+    names = [n for n in CASES if any(fnmatch.fnmatch(n, p) for p in patterns)]
+    unknown = [p for p in patterns if not fnmatch.filter(CASES, p)]
+    if unknown:
+        print(f"no case matches {unknown}; cases: {list(CASES)}")
+        return 2
     failed = 0
     for name in names:
         doc = run_case(name)
