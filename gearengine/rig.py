@@ -30,13 +30,12 @@ from typing import Any
 import numpy as np
 
 from gearengine.analysis import AnalysisRequest, analyze
-from gearengine.jsonio import dumps
 from gearengine.model.design import Design
 from gearengine.numerics.settings import work
 from gearengine.signals.reading import read
 from gearengine.signals.schema import LeverTrial, ModelReport, SignalResult, SpectrumLine
 from gearengine.signals.series import SignalRequest
-from gearengine.studies.jobs import JobKind
+from gearengine.studies.jobs import one_chunk_kind
 
 COMPARABLE = frozenset({"periodic", "quasi_periodic", "chaotic"})
 FACTORS = (0.5, 2.0)
@@ -183,29 +182,13 @@ def signal_work(request: SignalRequest) -> int:
     return (1 + len(LEVERS) * len(FACTORS)) * work(analysis.params, analysis.settings)
 
 
-def _one_chunk(request: SignalRequest, chunk_points: int) -> list[int]:
-    """One chunk counting the samples (the reading needs the whole series at once)."""
-    return [len(request.signal.values)]
-
-
-def _chunk(request: SignalRequest, index: int, chunk_points: int) -> str:
-    return dumps(read_signal(request))
-
-
-def _result(request: SignalRequest, chunks: list[str]) -> SignalResult:
-    if not chunks:
-        raise ValueError("the signal job has no finished chunk yet")
-    return SignalResult.model_validate_json(chunks[0])
-
-
-SIGNAL_JOB = JobKind(
-    name="signal",
-    request=SignalRequest,
-    chunk_points=1,
-    chunk_counts=_one_chunk,
+SIGNAL_JOB = one_chunk_kind(
+    "signal",
+    SignalRequest,
+    SignalResult,
+    units=lambda request: len(request.signal.values),
     work=signal_work,
-    compute_chunk=_chunk,
-    assemble=_result,
+    compute=read_signal,
 )
 """A recording read as a durable job (the service's ``/v1/signals/jobs``): its result is
 ``read_signal``'s document for the same request, byte for byte."""

@@ -12,9 +12,8 @@ and its result is the CLI's document byte for byte.
 from __future__ import annotations
 
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
-from gearengine.jsonio import dumps
 from gearengine.numerics.settings import BasinSettings, work
-from gearengine.studies.jobs import JobKind
+from gearengine.studies.jobs import one_chunk_kind
 from gearengine.systems.designs import design_model
 
 
@@ -26,13 +25,6 @@ def with_basins(request: AnalysisRequest) -> AnalysisRequest:
     return request.model_copy(update={"settings": settings})
 
 
-def basin_starts(request: AnalysisRequest, chunk_points: int) -> list[int]:
-    """One chunk, counting the request's basin starts."""
-    basins = with_basins(request).settings.basins
-    assert basins is not None
-    return [basins.starts]
-
-
 def basins_work(request: AnalysisRequest) -> int:
     """RK4 steps of the analysis with its basin starts (``numerics.settings.work``; a train's
     at its ``System.step_cost``)."""
@@ -41,24 +33,11 @@ def basins_work(request: AnalysisRequest) -> int:
     return work(model, full.settings)
 
 
-def basins_chunk(request: AnalysisRequest, index: int, chunk_points: int) -> str:
-    """The analysis with basins as JSON text (``gearengine basins --json``'s document)."""
-    return dumps(analyze(with_basins(request)))
-
-
-def basins_result(request: AnalysisRequest, chunks: list[str]) -> AnalysisResult:
-    """The job's result: its one chunk's analysis (ValueError while it has none)."""
-    if not chunks:
-        raise ValueError("the basins job has no finished chunk yet")
-    return AnalysisResult.model_validate_json(chunks[0])
-
-
-BASINS_JOB = JobKind(
-    name="basins",
-    request=AnalysisRequest,
-    chunk_points=1,
-    chunk_counts=basin_starts,
+BASINS_JOB = one_chunk_kind(
+    "basins",
+    AnalysisRequest,
+    AnalysisResult,
+    units=lambda request: with_basins(request).settings.basins.starts,
     work=basins_work,
-    compute_chunk=basins_chunk,
-    assemble=basins_result,
+    compute=lambda request: analyze(with_basins(request)),
 )

@@ -24,6 +24,8 @@ from typing import Any
 
 from pydantic import BaseModel
 
+from gearengine.jsonio import dumps
+
 
 @dataclass(frozen=True)
 class JobKind:
@@ -47,6 +49,38 @@ class JobKind:
     work: Callable[[Any], int]
     compute_chunk: Callable[[Any, int, int], str]
     assemble: Callable[[Any, list[str]], BaseModel]
+
+
+def one_chunk_kind(
+    name: str,
+    request: type[BaseModel],
+    result: type[BaseModel],
+    units: Callable[[Any], int],
+    work: Callable[[Any], int],
+    compute: Callable[[Any], BaseModel],
+) -> JobKind:
+    """A kind whose whole answer is one chunk (an answer that cannot be split: the attractors of
+    all basin starts clustered together, a recording read at once): ``compute(request)``'s
+    document as JSON text (``jsonio.dumps``, the CLI's bytes), progress counted in
+    ``units(request)``, and the job's result that document read back as ``result``."""
+
+    def chunk(req: Any, index: int, chunk_points: int) -> str:
+        return dumps(compute(req))
+
+    def assemble(req: Any, chunks: list[str]) -> BaseModel:
+        if not chunks:
+            raise ValueError(f"the {name} job has no finished chunk yet")
+        return result.model_validate_json(chunks[0])
+
+    return JobKind(
+        name=name,
+        request=request,
+        chunk_points=1,
+        chunk_counts=lambda req, chunk_points: [units(req)],
+        work=work,
+        compute_chunk=chunk,
+        assemble=assemble,
+    )
 
 
 MAX_JOB_POINTS = 40_000
