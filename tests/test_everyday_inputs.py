@@ -1,18 +1,23 @@
-"""Everyday inputs (issue 30 item 9): a nominal circumferential backlash j_t and the TE
-amplitude from an ISO 1328 accuracy class, each read with a note, in the library, the API and
-the CLI's documents alike (one ``Design``)."""
+"""Everyday inputs and outputs (issue 30 item 9): a nominal circumferential backlash j_t and the
+TE amplitude from an ISO 1328 accuracy class, each read with a note, in the library, the API and
+the CLI's documents alike (one ``Design``); the basins' box in µm and mm/s with the starts used,
+in the result and the picture; the LLE in 1/s in the summaries."""
 
 from __future__ import annotations
 
 import copy
+import json
 import math
 
 import pytest
 from pydantic import ValidationError
 
+from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.model.design import Design
 from gearengine.model.reduction import convert_design
 from gearengine.model.standards import iso1328
+from gearengine.plots.basins import basins_figure, starts_words
+from tests.conftest import ROOT
 
 GEAR = {"module": "2.5 mm", "face_width": "20 mm"}
 DESIGN = {
@@ -79,3 +84,42 @@ def test_one_of_each_pair_of_inputs() -> None:
     doc["driver"] = {"teeth": 23, "base_radius": "27 mm", "inertia": "1e-3 kg*m^2"}
     with pytest.raises(ValidationError, match="accuracy_class: an ISO 1328 class needs"):
         Design.model_validate(doc)
+
+
+BASINS_DOC = json.loads((ROOT / "examples" / "basins-5750rpm.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def basins_analysis():
+    """The pair of examples/basins-5750rpm.json with 16 basin starts over +-30 um, +-250 mm/s."""
+    basins = {"starts": 16, "box": [["-30 um", "30 um"], ["-250 mm/s", "250 mm/s"]]}
+    settings = {**BASINS_DOC["settings"], "basins": basins}
+    return analyze(AnalysisRequest.model_validate({**BASINS_DOC, "settings": settings}))
+
+
+def test_the_basin_box_is_in_um_and_mm_per_s_in_the_result_and_the_picture(basins_analysis):
+    counts = basins_analysis.numerics.basins
+    assert counts.starts == 16
+    assert counts.box_um_mm_s == [[-30.0, 30.0], [-250.0, 250.0]]
+    b_um = basins_analysis.engineering.half_backlash_um
+    assert counts.box[0][1] * b_um == pytest.approx(30.0, rel=1e-9)
+    assert starts_words(counts) == "16 starts (4 x 4 grid) over x -30..30 µm, v -250..250 mm/s"
+    assert basins_figure(basins_analysis, "svg").decode().count("-250..250 mm/s") == 1
+
+
+def test_the_lle_is_in_1_per_s_in_the_summaries(basins_analysis):
+    """Both summaries name the worst attractor's LLE in 1/s (lambda / time_scale_s, tau =
+    omega_n t) beside its value per unit tau (the recorded run from the settings' start is
+    periodic, its LLE negative)."""
+    eng = basins_analysis.engineering
+    worst = basins_analysis.numerics.attractors[0]
+    per_s = worst.lle / eng.time_scale_s
+    three = float(f"{per_s:.3g}")  # 3 significant digits, with thousands separators
+    assert f"largest Lyapunov exponent {three:+,g} 1/s ({worst.lle:+.3g} per unit tau)" in (
+        eng.summary
+    )
+    line = basins_analysis.summary()
+    four = float(f"{per_s:.4g}")
+    lle = f"LLE {worst.lle:+.4g} ± {worst.lle_stderr:.2g} per unit tau = {four:+,g} 1/s"
+    assert f"({lle}, " in line
+    assert "impacts on both flanks" in line and worst.lle > 0 > basins_analysis.numerics.lle
