@@ -253,10 +253,26 @@ EXAMPLE_DESIGN = {
 """The README's design (direct form)."""
 
 
+GEOMETRY = {"allOf": [given("module"), given("face_width")]}
+GEOMETRY_FORM = {"properties": {"driver": GEOMETRY, "driven": GEOMETRY}}
+"""JSON schema: both gears in the geometry form (module and face width)."""
+
+
 class Design(StrictModel):
     """A spur-gear pair in physical units; the driver (gear a) drives the driven gear (b)."""
 
     model_config = request_config(EXAMPLE_DESIGN)
+    model_config["json_schema_extra"] |= {"allOf": [  # as _consistent, _derived_inputs check
+        {"if": {"required": ["mesh"], "properties": {"mesh": {
+            "required": ["stiffness"], "properties": {"stiffness": {"const": "iso6336"}}}}},
+         "then": GEOMETRY_FORM},
+        {"if": {"required": ["tolerances"], "properties": {"tolerances": given("accuracy")}},
+         "then": {**GEOMETRY_FORM, "properties": {**GEOMETRY_FORM["properties"],
+                  "transmission_error": {"anyOf": [{"type": "null"}, {"not": given("order")}]}}}},
+        {"if": {"required": ["transmission_error"],
+                "properties": {"transmission_error": given("accuracy_class")}},
+         "then": GEOMETRY_FORM},
+    ]}  # fmt: skip
 
     driver: Gear = Field(description="The driving gear a.")
     driven: Gear = Field(description="The driven gear b.")

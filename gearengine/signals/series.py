@@ -26,7 +26,7 @@ from pydantic import Field, model_validator
 
 from gearengine.model.design import Design
 from gearengine.model.errors import InputError
-from gearengine.model.params import StrictModel, WholeNumber, request_config
+from gearengine.model.params import StrictModel, WholeNumber, given, not_both, request_config
 from gearengine.model.units import SampleRate, Speed, registry
 
 MIN_SAMPLES = 512
@@ -140,6 +140,13 @@ class SignalRequest(StrictModel):
             "teeth": 18,
         }
     )  # fmt: skip
+    model_config["json_schema_extra"] |= {  # as _consistent checks
+        "allOf": [
+            not_both("speed", "tach"),
+            {"if": given("teeth"),
+             "then": {"anyOf": [given("speed"), given("tach"), given("design")]}},
+        ]
+    }  # fmt: skip
 
     signal: Signal
     speed: Speed | None = Field(None, description="Shaft speed, constant, e.g. '1500 rpm'.")

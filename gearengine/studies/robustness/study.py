@@ -83,8 +83,9 @@ class RobustnessRequest(BaseModel):
         default_factory=SimulationSettings, description="Integration settings of every run."
     )
     samples: int = Field(
-        256, ge=2, le=MAX_SAMPLES, description="Samples N of the tolerances (a power of 2)."
-    )
+        256, ge=2, le=MAX_SAMPLES, description="Samples N of the tolerances (a power of 2).",
+        json_schema_extra={"enum": [1 << k for k in range(1, MAX_SAMPLES.bit_length())]},
+    )  # fmt: skip
     seed: int = Field(0, ge=0, le=2**32 - 1, description="Seed of the scrambled Sobol samples.")
     sensitivity: bool = Field(
         False, description="Also Sobol indices (SALib): N (D + 2) runs per point, D the fields."
