@@ -39,3 +39,21 @@ def test_the_linked_parameter_is_the_submitted_job_id() -> None:
         body = SPEC["paths"][base]["post"]["responses"]["202"]["content"]["application/json"]
         assert body["schema"] == {"$ref": "#/components/schemas/Job"}
     assert "id" in SPEC["components"]["schemas"]["Job"]["required"]
+
+
+def test_a_405_allows_every_documented_method_of_the_path(tmp_path) -> None:
+    """Starlette's 405 named only the first matching route's methods (``Allow: POST`` on
+    /v1/sweeps, which also lists jobs with GET); schemathesis' ST205 found it."""
+    from fastapi.testclient import TestClient
+
+    from service.core.config import Settings
+    from service.main import create_app
+
+    with TestClient(create_app(Settings(data_dir=tmp_path, workers=0, api_keys=""))) as client:
+        cases = [("/v1/sweeps", "GET, POST"), ("/v1/runups/0", "DELETE, GET"),
+                 ("/v1/sweeps/0/result", "GET"), ("/v1/melnikov", "POST")]  # fmt: skip
+        for path, allowed in cases:
+            response = client.request("OPTIONS", path)
+            assert response.status_code == 405
+            assert response.headers["allow"] == allowed, path
+            assert response.headers["content-type"] == "application/problem+json"

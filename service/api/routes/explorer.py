@@ -25,6 +25,7 @@ PAGE_DIR = Path(__file__).resolve().parents[2] / "explorer"
 ASSETS = {
     "explorer.js": "text/javascript; charset=utf-8",
     "robustness.js": "text/javascript; charset=utf-8",
+    "runup.js": "text/javascript; charset=utf-8",
     "explorer.css": "text/css; charset=utf-8",
 }
 """The page's own files, by name, with their media types (nothing else is served)."""
