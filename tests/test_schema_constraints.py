@@ -86,3 +86,25 @@ def test_the_models_agree(name: str, good: Any, bad: Any) -> None:
     validate(good)
     with pytest.raises(ValidationError):
         validate(bad)
+
+
+def test_the_documented_examples_are_accepted(tmp_path) -> None:
+    """Schemathesis' examples phase sends the fields' examples combined: each must pass the
+    validation (it found speed_range ['1500 rpm', '1500 rpm'], a 2-row upload, and a constant
+    series built from no example)."""
+    from fastapi.testclient import TestClient
+
+    from service.core.config import Settings
+    from service.main import create_app
+
+    props = SPEC["components"]["schemas"]["Design"]["properties"]
+    low, high = props["speed_range"]["examples"][0]
+    assert float(low.split()[0]) < float(high.split()[0])
+    values = SPEC["components"]["schemas"]["Signal"]["properties"]["values"]["examples"][0]
+    upload = SPEC["paths"]["/v1/signals/upload"]["post"]["requestBody"]["content"]["text/csv"]
+    with TestClient(create_app(Settings(data_dir=tmp_path, workers=0, api_keys=""))) as client:
+        body = {"signal": {"values": values, "sample_rate": "20 kHz"}}
+        assert client.post("/v1/signals", json=body).status_code == 200
+        response = client.post("/v1/signals/upload", content=upload["example"],
+                               headers={"content-type": "text/csv"})  # fmt: skip
+        assert response.status_code == 200

@@ -291,7 +291,7 @@ class Design(StrictModel):
     )
     speed_range: Annotated[list[Speed], Field(min_length=2, max_length=2)] | None = Field(
         None, description="Driver speeds scanned for Melnikov windows (default 10 rpm to 3x "
-        "speed).",
+        "speed).", examples=[["500 rpm", "4500 rpm"]],
     )  # fmt: skip
     tolerances: Tolerances | None = Field(
         None,
