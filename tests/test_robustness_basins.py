@@ -55,3 +55,25 @@ def test_a_basin_below_min_fraction_leaves_the_verdict_to_the_start():
     point, model = study({**BASINS, "min_fraction": 0.6})
     assert point.probabilities["chaotic"].count == 0
     assert any("above 0.6" in line for line in model)
+
+
+def test_a_pair_that_does_not_mesh_is_refused_naming_the_design(tmp_path) -> None:
+    """POST /v1/robustness answered 500 for gears of different modules (the conversion's
+    ValueError after validation; schemathesis' stateful phase found it): now 422."""
+    from fastapi.testclient import TestClient
+
+    from service.core.config import Settings
+    from service.main import create_app
+
+    gear = {"module": "2.5 mm", "face_width": "20 mm"}
+    design = {"driver": {"teeth": 23, **gear}, "driven": {"teeth": 67, **gear, "module": "3 mm"},
+              "speed": "3000 rpm", "torque": "10 N*m",
+              "mesh": {"stiffness": "iso6336", "damping_ratio": 0.05, "half_backlash": "50 um"},
+              "tolerances": {"mesh.damping_ratio": {"uniform": [0.04, 0.06]}}}  # fmt: skip
+    axis = {"parameter": "speed", "start": "1000 rpm", "stop": "2000 rpm", "num": 2}
+    body = {"design": design, "samples": 4, "axes": [axis]}
+    with TestClient(create_app(Settings(data_dir=tmp_path, workers=0, api_keys=""))) as client:
+        response = client.post("/v1/robustness", json=body)
+    assert response.status_code == 422, response.text
+    (error,) = response.json()["errors"]
+    assert error["path"] == "design" and "same module" in error["message"]

@@ -289,9 +289,11 @@ class Design(StrictModel):
         description="piecewise: the exact law of Eq. (6); cubic_fit: the paper's "
         "-x/6 + x^3/6. The Melnikov criterion always uses the cubic fit.",
     )
-    speed_range: Annotated[list[Speed], Field(min_length=2, max_length=2)] | None = Field(
+    speed_range: Annotated[list[Speed], Field(min_length=2, max_length=2),
+                           Field(json_schema_extra={"examples": [["500 rpm", "4500 rpm"]]})
+                           ] | None = Field(
         None, description="Driver speeds scanned for Melnikov windows (default 10 rpm to 3x "
-        "speed).", examples=[["500 rpm", "4500 rpm"]],
+        "speed).",
     )  # fmt: skip
     tolerances: Tolerances | None = Field(
         None,

@@ -136,6 +136,11 @@ def request_errors(request: RobustnessRequest) -> list[InitErrorDetails]:
         problems.add_error(exc, exc.loc[-1] if exc.loc else None)
     if request.samples & (request.samples - 1):
         problems.add(("samples",), "give a power of 2 (the Sobol points' balance)", 0)
+    try:  # the pair itself, before its axes: a geometry that does not mesh is the design's
+        convert_design(request.design)
+    except ValueError as exc:
+        problems.add(("design",), str(exc), 0)
+        return problems.details
     for i, axis in enumerate(request.axes):
         if is_dimensionless(axis.parameter):
             problems.add(("axes", i, "parameter"), "a physical field of the design", 0)
