@@ -91,19 +91,25 @@ class AnalysisResult(BaseModel):
     )
 
     def summary(self) -> str:
-        """The verdicts in one line: response, LLE, contact, Melnikov, and with a design the
-        DTE, dynamic factor and Melnikov speed windows (the gate's PASS or FAIL line)."""
+        """The verdicts in one line: response, LLE (with a design also in 1/s), contact (with
+        basins the deciding attractor's), Melnikov, and with a design the DTE, dynamic factor and
+        Melnikov speed windows (the gate's PASS or FAIL line)."""
         num = self.numerics
         decided = decision(num, self.settings) or num  # with basins the worst attractor's
         kind = f"periodic {decided.period}T" if decided.period else decided.classification
         if decided is not num:
             kind += f" ({decided.decided_by})"
-        lle = "LLE n/a" if num.lle is None else f"LLE {num.lle:+.4g} ± {num.lle_stderr or 0:.2g}"
-        contact = IMPACT_WORDS.get(num.impact_regime or "", "no verdict on impacts")
+        who = num if decided is num else decided.attractor  # its LLE and contact (or diverged)
+        value, err = (None, None) if who is None else (who.lle, who.lle_stderr)
+        lle = "LLE n/a" if value is None else f"LLE {value:+.4g} ± {err or 0:.2g} per unit tau"
+        if value is not None and self.engineering is not None:  # tau = omega_n t
+            lle += f" = {float(f'{value / self.engineering.time_scale_s:.4g}'):+,g} 1/s"
+        regime = None if who is None else who.impact_regime
+        contact = IMPACT_WORDS.get(regime or "", "no verdict on impacts")
         mel = {True: "chaos possible", False: "chaos not possible"}.get(
             self.melnikov.chaos_possible, "not applicable, not judged"
         )
-        line = f"{kind} ({lle} per unit tau, {contact}), Melnikov: {mel}"
+        line = f"{kind} ({lle}, {contact}), Melnikov: {mel}"
         eng = self.engineering
         if eng is not None:
             resp = eng.response

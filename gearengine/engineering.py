@@ -389,6 +389,10 @@ def summary(
             text += f", dynamic transmission error {resp.dte_peak_to_peak_um:.3g} µm peak to peak"
         if resp.dynamic_factor is not None:
             text += f", dynamic factor {resp.dynamic_factor:.3g}"
+        a = None if decided is None else decided.attractor  # the response named's LLE, in 1/s
+        if (lle := num.lle if decided is None else a and a.lle) is not None:  # tau = omega_n t
+            per_s = float(f"{lle / conv.time_scale_s:.3g}")  # 3 digits, no exponent below 1e6
+            text += f", largest Lyapunov exponent {per_s:+,g} 1/s ({lle:+.3g} per unit tau)"
         text += "."
     return text
 

@@ -8,6 +8,7 @@
 from __future__ import annotations
 
 import logging
+import re
 from typing import Any
 
 from fastapi import FastAPI, Request
@@ -132,6 +133,20 @@ def engine_refusal(exc: ValueError) -> ProblemError:
     return ProblemError(422, "refused", "Refused by the engine", str(exc), errors)
 
 
+def allowed_methods(request: Request) -> list[str]:
+    """The documented methods of the request's path (the OpenAPI document's, so ``Allow``
+    lists what the document says; Starlette's 405 names only the first matching route's:
+    ``Allow: POST`` on ``/v1/sweeps``, which also has GET); empty for an undocumented path."""
+    for template, ops in request.app.openapi().get("paths", {}).items():
+        pattern = re.sub(r"\\\{[^/]+?\\\}", "[^/]+", re.escape(template))
+        if re.fullmatch(pattern, request.url.path):
+            return sorted(m.upper() for m in ops if m in HTTP_METHODS)
+    return []
+
+
+HTTP_METHODS = ("get", "put", "post", "delete", "options", "head", "patch", "trace")
+
+
 def install(app: FastAPI) -> None:
     """Register the handlers that turn every error into problem+json."""
 
@@ -159,13 +174,16 @@ def install(app: FastAPI) -> None:
         return problem_response(engine_refusal(exc).problem)
 
     @app.exception_handler(StarletteHTTPException)
-    async def _http(_: Request, exc: StarletteHTTPException) -> JSONResponse:
+    async def _http(request: Request, exc: StarletteHTTPException) -> JSONResponse:
         title = _TITLES.get(exc.status_code, "Error")
         slug = title.lower().replace(" ", "-")
         problem = Problem(
             type=TYPE_BASE + slug, title=title, status=exc.status_code, detail=str(exc.detail)
         )
-        return problem_response(problem, getattr(exc, "headers", None))
+        headers = dict(getattr(exc, "headers", None) or {})
+        if exc.status_code == 405 and (methods := allowed_methods(request)):
+            headers["Allow"] = ", ".join(methods)  # every method of the path
+        return problem_response(problem, headers or None)
 
     @app.exception_handler(Exception)
     async def _crash(request: Request, exc: Exception) -> JSONResponse:

@@ -14,6 +14,7 @@ from starlette.concurrency import run_in_threadpool
 
 from service import errors
 from service.api.deps import load_key_hashes
+from service.api.links import add_job_links
 from service.api.routes import (
     analyses,
     basins,
@@ -91,6 +92,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     def openapi() -> dict[str, Any]:  # the schema states this app's limits (Limits.document)
         if app.openapi_schema is None:
             app.state.limits.document(base_openapi())
+            add_job_links(app.openapi_schema)  # submit -> status, result, plot, cancel
         return app.openapi_schema
 
     app.openapi = openapi  # type: ignore[method-assign]

@@ -183,7 +183,13 @@ def test_ci_examples_run_as_written(example: str, tmp_path: Path) -> None:
     out = gearengine(*argv)
     assert out.returncode == 0, out.stdout + out.stderr
     xmlschema.XMLSchema(ROOT / "tests" / "data" / "junit.xsd").validate(tmp_path / "envelope.xml")
-    assert "python -m pip install ." in text
+    # installed from gearchaos' git repository, not the checkout (`pip install .` works only
+    # inside this repository), and the report published where the CI shows it
+    assert 'python -m pip install "$GEARCHAOS"' in text and "pip install ." not in text
+    assert re.search(r'GEARCHAOS: "gearchaos @ git\+https://\S+\.git@\S+"', text)
+    if example == "github-actions.yml":  # GitHub shows a check and a summary, not an artifact
+        assert "uses: mikepenz/action-junit-report@v4" in text
+        assert "report_paths: envelope.xml" in text and "checks: write" in text
 
 
 def test_period_doubling_of_a_design_is_reported_in_rpm() -> None:

@@ -44,7 +44,7 @@ def test_the_gate_fails_on_the_upper_bound_and_names_the_points(
     # 8 samples prove 0.4 (0 events: upper bound 0.369); 7 of 8 impact at 5000 rpm
     assert main([*base, "--samples", "8", "--max-probability", "impacts=0.4",
                  "--junit", str(junit)]) == 1  # fmt: skip
-    cases = ElementTree.parse(junit).getroot().findall("testcase")
+    cases = ElementTree.parse(junit).getroot().findall("testsuite/testcase")
     assert [c.get("name") for c in cases] == ["speed 2000 rpm", "speed 5000 rpm"]
     assert [c.find("failure") is not None for c in cases] == [False, True]
     assert "upper bound" in capsys.readouterr().out

@@ -32,6 +32,7 @@ from gearengine.cli.documents import (
     read_document,
     validated_input,
 )
+from gearengine.cli.junit import envelope_junit
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import (
     EnvelopeReport,
@@ -41,7 +42,6 @@ from gearengine.gate.envelope import (
     envelope_report,
     envelope_sweep,
     gate_settings,
-    junit_xml,
     level_text,
     window_text,
 )
@@ -238,6 +238,5 @@ def cmd_envelope(args: argparse.Namespace) -> int:
     if args.json:
         Path(args.json).write_text(dumps(report))
     if args.junit:
-        levels = [w.level for w in report.windows] or [{}]
-        Path(args.junit).write_text(junit_xml(report, f"operating envelope of {args.file}", levels))
+        Path(args.junit).write_text(envelope_junit(report, f"operating envelope of {args.file}"))
     return EXIT_OK if report.passed else EXIT_FAIL

@@ -12,7 +12,6 @@ import os
 import sys
 import time
 from pathlib import Path
-from xml.etree import ElementTree
 
 from gearengine.cli.documents import (
     EXIT_FAIL,
@@ -23,6 +22,7 @@ from gearengine.cli.documents import (
     validated_input,
 )
 from gearengine.cli.envelope import axis
+from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import ENVELOPE_SETTINGS
 from gearengine.model.units import display_unit
@@ -116,15 +116,10 @@ def failures(result: RobustnessResult, limits: dict[str, float]) -> list[list[st
 
 
 def junit(result: RobustnessResult, why: list[list[str]], name: str) -> str:
-    """JUnit XML: one test case per operating point, failed with its reasons."""
-    suite = ElementTree.Element("testsuite", name=name, tests=str(len(why)),
-                                failures=str(sum(bool(w) for w in why)))  # fmt: skip
-    for p, reasons in zip(result.points, why, strict=True):
-        case = ElementTree.SubElement(suite, "testcase", classname="robustness",
-                                      name=point_name(p.shown))  # fmt: skip
-        if reasons:
-            ElementTree.SubElement(case, "failure", message="; ".join(reasons))
-    return ElementTree.tostring(suite, encoding="unicode", xml_declaration=True) + "\n"
+    """JUnit XML: one test case per operating point, failed once with its reasons."""
+    cases = [Case(point_name(p.shown), reasons, [r.split(")")[0] + ")" for r in reasons])
+             for p, reasons in zip(result.points, why, strict=True)]  # fmt: skip
+    return junit_xml("gearchaos robustness", name, "robustness", cases)
 
 
 def cmd_robustness(args: argparse.Namespace) -> int:

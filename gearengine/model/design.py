@@ -28,6 +28,7 @@ from pydantic import (
     model_validator,
 )
 
+from gearengine.model import geometry
 from gearengine.model.errors import InputError
 from gearengine.model.params import (
     MAX_HARMONICS,
@@ -37,11 +38,13 @@ from gearengine.model.params import (
     given,
     request_config,
 )
+from gearengine.model.standards import backlash, iso1328
 from gearengine.model.tolerances import Tolerances
 from gearengine.model.train import Train
 from gearengine.model.units import (
     QUANTITIES,
     Angle,
+    Backlash,
     Bore,
     Damping,
     ErrorAmplitude,
@@ -53,8 +56,10 @@ from gearengine.model.units import (
     Speed,
     StiffnessVariation,
     Torque,
+    note,
     parse_quantity,
     readings,
+    si_numbers,
 )
 
 
@@ -142,8 +147,12 @@ class Mesh(StrictModel):
     """The tooth mesh: stiffness, damping and half backlash."""
 
     model_config = ConfigDict(
-        **request_config(), json_schema_extra={"oneOf": [given("damping_ratio"), given("damping")]}
-    )
+        **request_config(),
+        json_schema_extra={"allOf": [
+            {"oneOf": [given("damping_ratio"), given("damping")]},
+            {"oneOf": [given("half_backlash"), given("backlash")]},
+        ]},
+    )  # fmt: skip
 
     stiffness: MeshStiffness = Field(
         description="Mean mesh stiffness k_m, or 'iso6336' to derive it from both gears' "
@@ -160,24 +169,60 @@ class Mesh(StrictModel):
         None, ge=0.0, le=1.0, allow_inf_nan=False, description="Mesh damping ratio zeta."
     )
     damping: Damping | None = Field(None, description="Mesh damping c (instead of zeta).")
-    half_backlash: HalfBacklash = Field(description="Half backlash b (total 2b).")
+    half_backlash: HalfBacklash | None = Field(
+        None,
+        description="Half backlash b along the line of action (total clearance 2b); or give "
+        "backlash.",
+    )
+    backlash: Backlash | None = Field(
+        None,
+        description="Nominal circumferential backlash j_t (a fit table's, DIN 3967, ISO/TR "
+        "10064-2), instead of half_backlash: read as b = j_t cos(alpha_wt) / 2 with the "
+        "operating transverse pressure angle alpha_wt, with a note (docs/units.md).",
+        examples=["100 um"],
+    )
 
     @model_validator(mode="after")
     def _one_damping(self) -> Mesh:
         if (self.damping_ratio is None) == (self.damping is None):
             raise ValueError("give exactly one of damping_ratio and damping")
+        if (self.half_backlash is None) == (self.backlash is None):
+            raise ValueError("give exactly one of half_backlash and backlash (circumferential)")
         return self
 
 
 class TransmissionError(StrictModel):
-    """Static transmission error e(t) = sum e_r cos(r w_e t + phi_r)."""
+    """Static transmission error e(t) = sum e_r cos(r w_e t + phi_r): its harmonics, or the
+    bound of an ISO 1328 accuracy class (``accuracy_class``)."""
+
+    model_config = ConfigDict(
+        **request_config(),
+        json_schema_extra={"oneOf": [given("harmonics"), given("accuracy_class")]},
+    )
 
     order: float | None = Field(
         None, gt=0.0, le=1000.0, allow_inf_nan=False,
         description="Fundamental in multiples of the driver speed (default: teeth, the mesh "
         "frequency).",
     )  # fmt: skip
-    harmonics: list[ErrorHarmonic] = Field(max_length=MAX_HARMONICS)
+    harmonics: list[ErrorHarmonic] | None = Field(
+        None, max_length=MAX_HARMONICS, description="The harmonics e_r; or give accuracy_class."
+    )
+    accuracy_class: WholeNumber | None = Field(
+        None,
+        ge=1,
+        le=11,
+        description="ISO 1328-1:2013 flank tolerance class of both gears (geometry form): one "
+        "mesh-frequency harmonic whose amplitude is the class's bound sqrt(F_alpha,1^2 + "
+        "F_alpha,2^2) / 2 (model.standards.iso1328.mesh_error_bound), with a note.",
+        examples=[7],
+    )
+
+    @model_validator(mode="after")
+    def _one_source(self) -> TransmissionError:
+        if (self.harmonics is None) == (self.accuracy_class is None):
+            raise ValueError("give exactly one of harmonics and accuracy_class")
+        return self
 
 
 class TorqueFluctuation(StrictModel):
@@ -208,10 +253,26 @@ EXAMPLE_DESIGN = {
 """The README's design (direct form)."""
 
 
+GEOMETRY = {"allOf": [given("module"), given("face_width")]}
+GEOMETRY_FORM = {"properties": {"driver": GEOMETRY, "driven": GEOMETRY}}
+"""JSON schema: both gears in the geometry form (module and face width)."""
+
+
 class Design(StrictModel):
     """A spur-gear pair in physical units; the driver (gear a) drives the driven gear (b)."""
 
     model_config = request_config(EXAMPLE_DESIGN)
+    model_config["json_schema_extra"] |= {"allOf": [  # as _consistent, _derived_inputs check
+        {"if": {"required": ["mesh"], "properties": {"mesh": {
+            "required": ["stiffness"], "properties": {"stiffness": {"const": "iso6336"}}}}},
+         "then": GEOMETRY_FORM},
+        {"if": {"required": ["tolerances"], "properties": {"tolerances": given("accuracy")}},
+         "then": {**GEOMETRY_FORM, "properties": {**GEOMETRY_FORM["properties"],
+                  "transmission_error": {"anyOf": [{"type": "null"}, {"not": given("order")}]}}}},
+        {"if": {"required": ["transmission_error"],
+                "properties": {"transmission_error": given("accuracy_class")}},
+         "then": GEOMETRY_FORM},
+    ]}  # fmt: skip
 
     driver: Gear = Field(description="The driving gear a.")
     driven: Gear = Field(description="The driven gear b.")
@@ -228,7 +289,9 @@ class Design(StrictModel):
         description="piecewise: the exact law of Eq. (6); cubic_fit: the paper's "
         "-x/6 + x^3/6. The Melnikov criterion always uses the cubic fit.",
     )
-    speed_range: Annotated[list[Speed], Field(min_length=2, max_length=2)] | None = Field(
+    speed_range: Annotated[list[Speed], Field(min_length=2, max_length=2),
+                           Field(json_schema_extra={"examples": [["500 rpm", "4500 rpm"]]})
+                           ] | None = Field(
         None, description="Driver speeds scanned for Melnikov windows (default 10 rpm to 3x "
         "speed).",
     )  # fmt: skip
@@ -255,7 +318,7 @@ class Design(StrictModel):
         bare numbers and torque fluctuation amplitudes in % of the mean torque."""
         with readings() as found:
             data, shares = ripple_of_mean_torque(data, found)
-            design = handler(data)
+            design = handler(data)._derived_inputs()
         design._readings = found
         design._ripple_shares = shares
         return design
@@ -271,6 +334,49 @@ class Design(StrictModel):
         """How unit spellings pint reads otherwise were understood ("torque '40 Nm' read as
         '40 N*m'"), for the notes."""
         return list(self._readings)
+
+    def operating_pressure_angle(self) -> float:
+        """alpha_wt [rad] of the pair: from the profile shifts (``model.geometry``), else the
+        driver's pressure angle."""
+        a, b = self.driver, self.driven
+        if a.profile_shift == 0.0 and b.profile_shift == 0.0:
+            return a.pressure_angle
+        return geometry.operating_pressure_angle(
+            a.teeth, b.teeth, a.profile_shift, b.profile_shift, a.pressure_angle
+        )
+
+    def _derived_inputs(self) -> Design:
+        """A circumferential backlash j_t written as the half backlash b = j_t cos(alpha_wt) / 2
+        (``model.standards.backlash``) and an accuracy class as its transmission-error bound
+        (``model.standards.iso1328``), each with a note; the design then holds b and e_1 alone,
+        so its dump reads back the same."""
+        j_t = self.mesh.backlash
+        if j_t is not None:
+            alpha = self.operating_pressure_angle()
+            b = backlash.half_backlash(j_t, alpha)
+            mesh = self.mesh.model_copy(update={"half_backlash": b, "backlash": None})
+            object.__setattr__(self, "mesh", mesh)  # frozen: the validator's own rewrite
+            note(f"mesh.backlash j_t = {j_t * 1e6:.6g} um (circumferential) read as the half "
+                 f"backlash b = j_t cos(alpha_wt) / 2 = {b * 1e6:.6g} um along the line of "
+                 f"action (alpha_wt = {math.degrees(alpha):.4g} deg)")  # fmt: skip
+        te = self.transmission_error
+        if te is not None and te.accuracy_class is not None:
+            grade = te.accuracy_class
+            if self.driver.geometry() is None or self.driven.geometry() is None:
+                raise InputError(
+                    "transmission_error.accuracy_class",
+                    "an ISO 1328 class needs the geometry form (module and face_width) on both "
+                    "gears",
+                )
+            bound = iso1328.pair_te_bound(grade, self.driver, self.driven)
+            with si_numbers():  # the engine's own SI value, not a user's bare number
+                harmonic = ErrorHarmonic(amplitude=bound)
+            te = te.model_copy(update={"harmonics": [harmonic], "accuracy_class": None})
+            object.__setattr__(self, "transmission_error", te)
+            note(f"transmission_error.accuracy_class {grade} read as one mesh-frequency harmonic "
+                 f"e_1 = {bound * 1e6:.4g} um, the {iso1328.STANDARD} class-{grade} bound "
+                 "sqrt(F_alpha,driver^2 + F_alpha,driven^2) / 2")  # fmt: skip
+        return self
 
     @model_validator(mode="after")
     def _consistent(self) -> Design:

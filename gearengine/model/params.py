@@ -57,6 +57,11 @@ def given(name: str) -> dict[str, Any]:
     return {"required": [name], "properties": {name: {"not": {"type": "null"}}}}
 
 
+def not_both(a: str, b: str) -> dict[str, Any]:
+    """JSON schema: the object does not have both fields ``a`` and ``b`` (``given``)."""
+    return {"not": {"allOf": [given(a), given(b)]}}
+
+
 class StrictModel(BaseModel):
     """Base of every request model of the engine (``request_config``)."""
 

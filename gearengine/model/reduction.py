@@ -244,14 +244,8 @@ def tolerance_derived(design: Design) -> dict[str, Derived]:
 
 
 def operating_pressure_angle(design: Design) -> float:
-    """alpha_wt [rad] of the pair: from the profile shifts with the geometry form, else the
-    driver's pressure angle."""
-    a, b = design.driver, design.driven
-    if a.profile_shift == 0.0 and b.profile_shift == 0.0:
-        return a.pressure_angle
-    return geometry.operating_pressure_angle(
-        a.teeth, b.teeth, a.profile_shift, b.profile_shift, a.pressure_angle
-    )
+    """alpha_wt [rad] of the pair (``Design.operating_pressure_angle``)."""
+    return design.operating_pressure_angle()
 
 
 def half_backlash_band(design: Design, j_min: float, j_max: float) -> tuple[float, float]:

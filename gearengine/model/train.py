@@ -20,7 +20,7 @@ from typing import Annotated
 from pydantic import Field, model_validator
 
 from gearengine.model.errors import InputError
-from gearengine.model.params import StrictModel
+from gearengine.model.params import StrictModel, given
 from gearengine.model.units import (
     BearingStiffness,
     Inertia,
@@ -45,6 +45,17 @@ class Inertial(StrictModel):
 
 class Shaft(StrictModel):
     """A shaft as a torsional spring and damper between two inertias."""
+
+    model_config = StrictModel.model_config | {  # as _one_form checks: one form of the two
+        "json_schema_extra": {
+            "oneOf": [
+                {**given("torsional_stiffness"), "not": {"anyOf": [
+                    given("length"), given("diameter"), given("shear_modulus")]}},
+                {"allOf": [given("length"), given("diameter")],
+                 "not": given("torsional_stiffness")},
+            ]
+        }
+    }  # fmt: skip
 
     torsional_stiffness: TorsionalStiffness | None = Field(
         None, description="Torsional stiffness k (or give length and diameter).",

@@ -63,6 +63,15 @@ def scale_pair(scales: Scales | None) -> tuple[float, float]:
     return scales.half_backlash, scales.half_backlash * scales.natural_frequency
 
 
+def physical_box(box: list[list[float]], scales: Scales) -> list[list[float]]:
+    """A dimensionless box [[x0, x1], [v0, v1]] in µm and mm/s (x b, v b omega_n), rounded to
+    6 significant digits."""
+    b, v = scale_pair(scales)
+    return [
+        [float(f"{e * f:.6g}") for e in r] for r, f in zip(box, (b * 1e6, v * 1e3), strict=True)
+    ]
+
+
 def basin_starts(basins: BasinSettings, scales: Scales | None) -> list[tuple[float, float]]:
     """The dimensionless starts of ``basins``; a box in units needs a design's ``scales``."""
     if basins.physical() and scales is None:
@@ -259,13 +268,15 @@ def _group(
     relabel = {keys[old]: new for new, old in enumerate(order)}
     found = _distinct_labels([found[k] for k in order])
     n = int(np.sqrt(len(starts)))
+    box = basins.dimensionless_box(*scale_pair(scales))
     counts = BasinCounts(
         starts=len(starts),
         diverged=labels.count(DIVERGED),
         unsettled=labels.count(UNSETTLED),
         labels=[relabel.get(label, label) for label in labels],
         grid=[n, n] if basins.grid else None,
-        box=basins.dimensionless_box(*scale_pair(scales)),
+        box=box,
+        box_um_mm_s=None if scales is None else physical_box(box, scales),
     )
     return found, counts
 

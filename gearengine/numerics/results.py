@@ -131,7 +131,15 @@ class BasinCounts(_Result):
     grid: list[int] | None = Field(
         description="[nx, nv] of a grid of starts (x fastest); null for random draws."
     )
-    box: list[list[float]] = Field(description="The box of the starts, dimensionless.")
+    box: list[list[float]] = Field(
+        description="The box of the starts, dimensionless: [[xmin, xmax] in half backlashes b, "
+        "[vmin, vmax] in b omega_n]."
+    )
+    box_um_mm_s: list[list[float]] | None = Field(
+        None,
+        description="With a design: the same box in gear units, [[xmin, xmax] µm (x b), "
+        "[vmin, vmax] mm/s (v b omega_n)]; null for dimensionless params.",
+    )
 
 
 class NumericsResult(_Result):

@@ -20,7 +20,7 @@ from pydantic import (
 )
 
 from gearengine.model.errors import InputError
-from gearengine.model.params import Finite, GearParams, WholeNumber, request_config
+from gearengine.model.params import Finite, GearParams, WholeNumber, not_both, request_config
 from gearengine.model.units import QUANTITIES, parse_quantity
 from gearengine.systems.base import System
 from gearengine.systems.spur_pair.forcing import step_plan
@@ -75,6 +75,10 @@ class RandomStarts(BaseModel):
         return self
 
 
+SQUARE_STARTS = [k * k for k in range(1, math.isqrt(MAX_BASIN_STARTS) + 1)]
+"""The counts of starts a grid takes (1, 4, 9, ..., 4096)."""
+
+
 class BasinSettings(BaseModel):
     """Many starts of one design, to find every attractor and the fraction of starts reaching
     each (``numerics.attractors``).
@@ -88,6 +92,10 @@ class BasinSettings(BaseModel):
     """
 
     model_config = request_config()
+    model_config["json_schema_extra"] = {  # as _square checks: a grid (the default) is square
+        "if": {"not": {"required": ["grid"], "properties": {"grid": {"const": False}}}},
+        "then": {"properties": {"starts": {"enum": SQUARE_STARTS}}},
+    }
 
     starts: int = Field(
         16,
@@ -188,6 +196,7 @@ class SimulationSettings(BaseModel):
             "initial_state": [0.01, 0.01],
         }
     )
+    model_config["json_schema_extra"] |= not_both("initial_states", "random_initial_states")
 
     transient_periods: WholeNumber = Field(
         500,

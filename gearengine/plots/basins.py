@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 
 from gearengine.analysis import AnalysisResult
+from gearengine.numerics.results import BasinCounts
 from gearengine.plots.style import ImageFormat, figure_bytes
 
 CHAOTIC_COLOURS = ["#d62728", "#ff9896", "#8c1c13"]
@@ -30,6 +31,19 @@ def basin_scales(result: AnalysisResult) -> tuple[float, float, str, str]:
     b_um = eng.half_backlash_um
     return (b_um, b_um / eng.time_scale_s * 1e-3, "relative displacement x b [µm]",
             "relative velocity v b ω_n [mm/s]")  # fmt: skip
+
+
+def starts_words(counts: BasinCounts) -> str:
+    """ "256 starts (16 x 16 grid) over x -30..30 µm, v -250..250 mm/s": the starts used and
+    their box, in gear units with a design (``BasinCounts.box_um_mm_s``), else dimensionless."""
+    how = "random" if counts.grid is None else f"{counts.grid[0]} x {counts.grid[1]} grid"
+    if counts.box_um_mm_s is not None:
+        (x0, x1), (v0, v1) = counts.box_um_mm_s
+        box = f"x {x0:g}..{x1:g} µm, v {v0:g}..{v1:g} mm/s"
+    else:
+        (x0, x1), (v0, v1) = counts.box
+        box = f"x {x0:g}..{x1:g} b, v {v0:g}..{v1:g} b ω_n"
+    return f"{counts.starts} starts ({how}) over {box}"
 
 
 def basins_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
@@ -92,6 +106,6 @@ def basins_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
         frameon=False,
     )
     where = "" if result.engineering is None else f" at {result.engineering.speed_rpm:,.0f} rpm"
-    ax.set_title(f"Basins of attraction{where}: {counts.starts} starts, dots = each "
-                 "attractor's strobes", fontsize=9)  # fmt: skip
+    ax.set_title(f"Basins of attraction{where}: {starts_words(counts)}\n"
+                 "dots = each attractor's strobes", fontsize=9)  # fmt: skip
     return figure_bytes(fig, fmt)

@@ -26,11 +26,13 @@ from pydantic import Field, model_validator
 
 from gearengine.model.design import Design
 from gearengine.model.errors import InputError
-from gearengine.model.params import StrictModel, WholeNumber, request_config
+from gearengine.model.params import StrictModel, WholeNumber, given, not_both, request_config
 from gearengine.model.units import SampleRate, Speed, registry
 
 MIN_SAMPLES = 512
 """Shortest series read: the embedding and the 0-1 test need a few hundred points."""
+EXAMPLE_VALUES = [round(math.sin(0.7 * k), 3) for k in range(MIN_SAMPLES)]
+"""A series the reading accepts (the shortest, not constant): the schema's example."""
 MAX_SAMPLES = 10_000_000
 """Longest series read (80 MB as float64); the service's synchronous budget is lower
 (``SYNC_SAMPLES``)."""
@@ -80,6 +82,7 @@ class Signal(StrictModel):
     values: list[Finite] = Field(
         min_length=MIN_SAMPLES, max_length=MAX_SAMPLES,
         description=f"Samples, equally spaced in time, {MIN_SAMPLES} to {MAX_SAMPLES}.",
+        examples=[EXAMPLE_VALUES],
     )  # fmt: skip
     sample_rate: SampleRate = Field(description="Samples per second, e.g. '20 kHz'.")
     quantity: Quantity = Field("other", description="What was measured.")
@@ -140,6 +143,13 @@ class SignalRequest(StrictModel):
             "teeth": 18,
         }
     )  # fmt: skip
+    model_config["json_schema_extra"] |= {  # as _consistent checks
+        "allOf": [
+            not_both("speed", "tach"),
+            {"if": given("teeth"),
+             "then": {"anyOf": [given("speed"), given("tach"), given("design")]}},
+        ]
+    }  # fmt: skip
 
     signal: Signal
     speed: Speed | None = Field(None, description="Shaft speed, constant, e.g. '1500 rpm'.")

@@ -81,6 +81,14 @@ def readings() -> Iterator[list[str]]:
         _READINGS.reset(token)
 
 
+def note(text: str) -> None:
+    """Add ``text`` to the current ``readings`` (a value the design derived from another one
+    the user gave, said in words); nothing outside a ``readings`` block."""
+    found = _READINGS.get()
+    if found is not None:
+        found.append(text)
+
+
 _SI_NUMBERS: ContextVar[bool] = ContextVar("si_numbers", default=False)
 
 
@@ -115,6 +123,7 @@ QUANTITIES: dict[str, QuantityKind] = {
     "length": QuantityKind("length", "m", 1e-9, 10.0, ("um", "mm"), "30 mm"),
     "module": QuantityKind("module", "m", 1e-5, 0.1, ("mm",), "3 mm"),
     "half_backlash": QuantityKind("half backlash", "m", 1e-7, 5e-3, ("um", "mm"), "50 um"),
+    "backlash": QuantityKind("circumferential backlash", "m", 2e-7, 1e-2, ("um", "mm"), "100 um"),
     "error": QuantityKind("transmission error", "m", 0.0, 1e-3, ("um", "mm"), "5 um"),
     "speed": QuantityKind(
         "shaft speed", "rad/s", 2 * math.pi / 60, 2e5 * 2 * math.pi / 60, ("rpm",), "1500 rpm"
@@ -333,6 +342,8 @@ Length = quantity_type("length")
 Module = quantity_type("module")
 Bore = quantity_type("length", allow_zero=True)
 HalfBacklash = quantity_type("half_backlash")
+Backlash = quantity_type("backlash")
+"""The circumferential backlash j_t of a fit table (DIN 3967, ISO/TR 10064-2)."""
 ErrorAmplitude = quantity_type("error", allow_zero=True)
 Speed = quantity_type("speed")
 Torque = quantity_type("torque", allow_zero=True)

@@ -10,6 +10,12 @@ design, ``studies.robustness.sensitivity``) at every operating point; chunk k ho
 resumed job equals an uninterrupted one. Every (point, row) is one design, analysed from every
 start of the settings by ``numerics.batch.simulate_batch`` (lanes of ``run_lanes``; the sample
 counts as its worst start, as the single analysis does), with the Melnikov verdict beside it.
+With ``settings.basins`` every sample also runs the basin starts (``numerics.attractors``,
+every sample's starts in one ``run_lanes`` call, as a sweep's chunk) and counts as its worst
+attractor whose basin fraction is above ``basins.min_fraction`` (``numerics.attractors.headline``,
+as the gate and the sweep decide a point): class, contact, DTE and dynamic factor are that
+attractor's. Without basins (the default) a sample is its settings' own start: N runs a point;
+with B basin starts N (1 + B) (the budget, ``robustness_work``, counts them).
 
 A chunk stores, per point and row: class code, contact code, Melnikov flag, DTE [µm] and
 dynamic factor F_max / F_m (compact JSON, ``RUN_FIELDS``).
@@ -33,6 +39,7 @@ from gearengine.model.errors import InputError, Problems
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
 from gearengine.model.units import Scales, in_display_unit, response_values
+from gearengine.numerics.attractors import headline, points_attractors
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.settings import SimulationSettings, work
 from gearengine.studies import jobs
@@ -78,8 +85,9 @@ class RobustnessRequest(BaseModel):
         default_factory=SimulationSettings, description="Integration settings of every run."
     )
     samples: int = Field(
-        256, ge=2, le=MAX_SAMPLES, description="Samples N of the tolerances (a power of 2)."
-    )
+        256, ge=2, le=MAX_SAMPLES, description="Samples N of the tolerances (a power of 2).",
+        json_schema_extra={"enum": [1 << k for k in range(1, MAX_SAMPLES.bit_length())]},
+    )  # fmt: skip
     seed: int = Field(0, ge=0, le=2**32 - 1, description="Seed of the scrambled Sobol samples.")
     sensitivity: bool = Field(
         False, description="Also Sobol indices (SALib): N (D + 2) runs per point, D the fields."
@@ -130,6 +138,11 @@ def request_errors(request: RobustnessRequest) -> list[InitErrorDetails]:
         problems.add_error(exc, exc.loc[-1] if exc.loc else None)
     if request.samples & (request.samples - 1):
         problems.add(("samples",), "give a power of 2 (the Sobol points' balance)", 0)
+    try:  # the pair itself, before its axes: a geometry that does not mesh is the design's
+        convert_design(request.design)
+    except ValueError as exc:
+        problems.add(("design",), str(exc), 0)
+        return problems.details
     for i, axis in enumerate(request.axes):
         if is_dimensionless(axis.parameter):
             problems.add(("axes", i, "parameter"), "a physical field of the design", 0)
@@ -185,6 +198,20 @@ def _run(bp: Any, model: Any, scales: Scales) -> list[Any]:
     ]
 
 
+def _worst(run: list[Any], found: list[Any], counts: Any, min_fraction: float) -> list[Any]:
+    """``run`` decided by its worst attractor above ``min_fraction`` (``headline``): its class,
+    contact, DTE and dynamic factor (None where it diverged); ``run`` itself when no basin is
+    above the fraction (the settings' own start decides, as in a sweep)."""
+    head = headline(found, counts, min_fraction)
+    if head is None:
+        return run
+    a = head.attractor
+    if a is None:  # diverged: no contact or response numbers
+        return [CLASSES.index("diverged"), None, run[2], None, None]
+    contact = CONTACTS.index(a.impact_regime) if a.impact_regime in CONTACTS else None
+    return [CLASSES.index(a.classification), contact, run[2], a.dte_um, a.dynamic_factor]
+
+
 def compute_chunk(request: RobustnessRequest, index: int, rows: int) -> str:
     """Chunk ``index``: rows [index rows, (index + 1) rows) at every point, as compact JSON
     ``{"index", "first_row", "runs": [[run per row] per point]}``."""
@@ -197,8 +224,13 @@ def compute_chunk(request: RobustnessRequest, index: int, rows: int) -> str:
     points = request.points() or [{}]
     designs = [sample_design(base, {**v, **p}) for p in points for v in values]
     models = [design_model(d) for d in designs]  # a design with a train runs as its System
-    verdicts = simulate_batch([m for m, _ in models], request.settings)
+    systems = [m for m, _ in models]
+    verdicts = simulate_batch(systems, request.settings)
     runs = [_run(bp, m, c.scales) for bp, (m, c) in zip(verdicts, models, strict=True)]
+    basins = request.settings.basins
+    if basins is not None:
+        found = points_attractors(systems, request.settings, [c.scales for _, c in models])
+        runs = [_worst(r, a, n, basins.min_fraction) for r, (a, n) in zip(runs, found, strict=True)]
     per_point = [runs[i * len(values) : (i + 1) * len(values)] for i in range(len(points))]
     return json.dumps({"index": index, "first_row": lo, "runs": per_point}, separators=(",", ":"))
 
@@ -260,6 +292,13 @@ ASSUMPTIONS = [
 ]
 
 
+def basin_assumption(basins: Any) -> str:
+    """The model line of a study with ``settings.basins``: how a sample is decided."""
+    return (f"with settings.basins a sample counts as its worst attractor whose basin fraction "
+            f"is above {basins.min_fraction:g}, found from {basins.starts} basin starts per "
+            "sample (the gate's and the sweep's verdict of a point)")  # fmt: skip
+
+
 def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[int],
                   complete: bool, variables_: list[Variable]) -> dict[str, Any]:  # fmt: skip
     names, d = [v.path for v in variables_], len(variables_)
@@ -302,6 +341,7 @@ def assemble(request: RobustnessRequest, chunks: list[str]) -> RobustnessResult:
     """The result from the chunks present (any subset, any order: a partial result counts the
     samples it has; Sobol indices need every chunk)."""
     variables_ = request.variables()
+    basins = request.settings.basins
     points = request.points() or [{}]
     decoded = sorted((json.loads(c) for c in chunks), key=lambda c: c["first_row"])
     complete = sum(len(c["runs"][0]) for c in decoded) == request.n_rows()
@@ -318,7 +358,7 @@ def assemble(request: RobustnessRequest, chunks: list[str]) -> RobustnessResult:
         seed=request.seed,
         variables=[RobustnessVariable(path=v.path, distribution=v.words) for v in variables_],
         partial=not complete,
-        model=ASSUMPTIONS,
+        model=ASSUMPTIONS + ([] if basins is None else [basin_assumption(basins)]),
     )
 
 

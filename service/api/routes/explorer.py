@@ -27,6 +27,7 @@ ASSETS = {
     "explorer.js": "text/javascript; charset=utf-8",
     "robustness.js": "text/javascript; charset=utf-8",
     "signal.js": "text/javascript; charset=utf-8",
+    "runup.js": "text/javascript; charset=utf-8",
     "explorer.css": "text/css; charset=utf-8",
 }
 """The page's own files, by name, with their media types (nothing else is served)."""

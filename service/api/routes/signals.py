@@ -23,7 +23,13 @@ from gearengine.model.errors import InputError
 from gearengine.plots import MEDIA_TYPES
 from gearengine.rig import read_signal
 from gearengine.signals.schema import SignalResult
-from gearengine.signals.series import SYNC_SAMPLES, Quantity, SignalRequest, read_table
+from gearengine.signals.series import (
+    EXAMPLE_VALUES,
+    SYNC_SAMPLES,
+    Quantity,
+    SignalRequest,
+    read_table,
+)
 from service.api.deps import cached_compute, engine_refusal, require_key, response_cache
 from service.api.responses import CACHED, IMAGE_RESPONSES, JSON, FormatQuery, image_format
 from service.api.routes.jobs import JobRoutes
@@ -102,11 +108,15 @@ async def post_signal(body: SignalRequest, request: Request) -> Response:
     return await _answer(request, body)
 
 
+UPLOAD_EXAMPLE = "time,te\n" + "".join(
+    f"{k * 5e-5:.5f},{v}\n" for k, v in enumerate(EXAMPLE_VALUES)
+)
+"""A table the reading accepts (512 samples at 20 kHz, times in the first column)."""
 UPLOAD_BODY = {
     "requestBody": {
         "required": True,
         "content": {
-            media: {"schema": {"type": "string"}, "example": "time,te\n0,0.1\n5e-5,0.12\n"}
+            media: {"schema": {"type": "string"}, "example": UPLOAD_EXAMPLE}
             for media in ("text/csv", "text/plain")
         },
         "description": "Samples: one value a line, or columns (the last is read; a first "
