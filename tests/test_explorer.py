@@ -281,7 +281,7 @@ def test_a_gear_train_shows_its_modes_and_campbell_diagram(page: Page) -> None:
     assert "a gear train" in page.text("#threshold-note")
     page.figures_done()  # the train's response figure shown; no threshold curves for a train
     states = page.driver.execute_script(
-        "return [...document.querySelectorAll('figure img')].map(i => i.dataset.state)"
+        "return [...document.querySelectorAll('#verdict figure img')].map(i => i.dataset.state)"
     )
     assert states == ["shown", "failed"]
     page.show("#modes")
