@@ -234,7 +234,22 @@ class SimulationSettings(BaseModel):
         "at three checks 10 intervals apart; "
         "false runs every point transient_periods + record_periods. Applies to the lanes of the "
         "lock-step kernels: commensurate forcing, both backlash laws; incommensurate points and "
-        "simulate() run the full length.",
+        "simulate() run the full length. With physical_time (default) the lengths of every run, "
+        "simulate() too, are decided in physical time instead; false: fixed lengths everywhere, "
+        "the numbers of before.",
+        examples=[True],
+    )
+    physical_time: bool = Field(
+        True,
+        description="With adaptive: the transient and the record in physical time "
+        "(numerics.physical): the transient ends once the response has settled on a cycle of "
+        "period <= 12 T0 to 1e-5 of its size (strobes at T0 repeating over >= 60 mesh periods, "
+        "three cycles) or, not periodic, its LLE and amplitude no longer drift (>= 400 mesh "
+        "periods), after at least 10 damping time constants 1/(zeta omega_n); the record is "
+        "160 mesh periods (10 cycles at least) when periodic, else grows from 400 until the "
+        "LLE's standard error meets lle_stderr_abs / lle_stderr_rel; transient_periods and "
+        "record_periods are the upper bounds. Commensurate forcing only. false (or adaptive "
+        "false): transient_periods + record_periods as counts of T0, as before.",
         examples=[True],
     )
     basins: BasinSettings | None = Field(
