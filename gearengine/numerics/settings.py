@@ -295,6 +295,12 @@ class SimulationSettings(BaseModel):
             )
         return self
 
+    def lengths_text(self) -> str:
+        """The transient and record lengths in words: "500 + 500 periods", or with physical
+        time "<= 500 + 500 periods (ended when settled)" (they are upper bounds then)."""
+        text = f"{self.transient_periods} + {self.record_periods} periods"
+        return f"<= {text} (ended when settled)" if self.adaptive and self.physical_time else text
+
     def starts(self) -> list[tuple[float, float]]:
         """Initial states (x0, v0) in order: initial_states, random ones, or initial_state."""
         if self.initial_states is not None:
