@@ -85,7 +85,8 @@ def test_verdict_agrees_with_the_fixed_length_run(point: GearParams, verdict: st
     assert a.transient is not None and a.record is not None
     assert a.transient.periods + a.record.periods <= 1000
     if verdict == "chaotic":
-        assert (a.transient.reason, a.record.reason) == ("stationary", "lle_stderr")
+        assert (a.transient.reason, a.record.reason) == ("cap", "lle_stderr")
+        assert a.transient.periods == 500  # chaos keeps the whole transient
         settings = SimulationSettings()
         assert a.lle_stderr <= max(settings.lle_stderr_abs, settings.lle_stderr_rel * a.lle)
         assert abs(a.lle - f.lle) <= 3.0 * math.hypot(a.lle_stderr, f.lle_stderr)

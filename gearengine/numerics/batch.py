@@ -178,17 +178,27 @@ def physical_lanes(
         out = lanes_of(laws, owner, packed, mu[idx], xa.copy(), va.copy(),
                        (tabled[0], tabled[1], owner), shared)  # fmt: skip
         xs, vs, logs, xmin, xmax, _, _, _, _, diverged, xf, vf = out
-        keep = [(out, j, per[idx]) for j in range(idx.size)]
+        per_of = per[idx]
+        keep = [(out, j, per_of) for j in range(idx.size)]
         return physical.Chunk(xs, vs, logs, xmin, xmax, xf, vf, diverged.astype(bool), keep)
 
     spans = physical.lengths(advance, x0, v0, per, mu, N / settings.steps_per_period, settings)
     verdicts: dict[int, list[tuple]] = {}
-    points = []
-    for s in spans:
+    rows: dict[int, list[int]] = {}
+    for s in spans:  # one verdict and one gather of strobes per kernel call
         out, j, per_of = s.keep
         if id(out) not in verdicts:
-            verdicts[id(out)] = lane_verdicts(out, per_of)
-        point = lane_point(out, j, 0, verdicts[id(out)][j], last_strobes(out, [j])[0])
+            verdicts[id(out)], rows[id(out)] = lane_verdicts(out, per_of), []
+        rows[id(out)].append(j)
+    outs = {id(s.keep[0]): s.keep[0] for s in spans}
+    strobes: dict[tuple[int, int], list] = {}
+    for key, out in outs.items():
+        got = last_strobes(out, rows[key])
+        strobes.update({(key, j): w for j, w in zip(rows[key], got, strict=True)})
+    points = []
+    for s in spans:
+        out, j, _ = s.keep
+        point = lane_point(out, j, 0, verdicts[id(out)][j], strobes[(id(out), j)])
         n = out[0].shape[1]
         before = s.transient - (n if s.transient_reason == "diverged" else 0)
         points.append(point.model_copy(update={"periods_run": before + int(out[7][j])}))

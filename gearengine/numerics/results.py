@@ -146,7 +146,7 @@ class RunLength(_Result):
         None, description="The same time in seconds (null without a design's time scale)."
     )
     reason: str = Field(
-        description="Why it stopped. Transient: settled | stationary | transient_extended | cap | "
+        description="Why it stopped. Transient: settled | transient_extended | cap | "
         "diverged | fixed; record: period | lle_stderr | cap | diverged | fixed "
         "(numerics.physical)."
     )
