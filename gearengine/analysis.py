@@ -26,6 +26,7 @@ from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
 from gearengine.numerics.attractors import Headline, attractors, coexistence, headline
+from gearengine.numerics.physical import in_seconds
 from gearengine.numerics.results import NumericsResult
 from gearengine.numerics.settings import RequestSettings, SimulationSettings
 from gearengine.numerics.simulation import simulate
@@ -206,6 +207,10 @@ def analyze(
     mel = melnikov(request.params)
     num = simulate(request.params, request.settings)
     conv = request.conversion
+    if conv is not None:
+        ts = conv.time_scale_s
+        num = num.model_copy(update={"transient": in_seconds(num.transient, ts),
+                                     "record": in_seconds(num.record, ts)})  # fmt: skip
     basins = request.settings.basins
     if basins is not None:
         scales = None if conv is None else conv.scales

@@ -1,6 +1,7 @@
-"""Adaptive stopping (``systems.spur_pair.kernels.adaptive``) against the fixed-length run on a 40
-x 40 subsample of the chaos map, the mesh-force extremes of the three kernels, and the gate's
---max-dynamic-factor rule."""
+"""Adaptive stopping (``systems.spur_pair.kernels.adaptive``, lengths counted in T0:
+``physical_time`` false; the physical-time lengths are tests/test_physical.py's) against the
+fixed-length run on a 40 x 40 subsample of the chaos map, the mesh-force extremes of the three
+kernels, and the gate's --max-dynamic-factor rule."""
 
 from __future__ import annotations
 
@@ -46,7 +47,7 @@ def chaos_map(num: int) -> list[GearParams]:
 @pytest.fixture(scope="module")
 def map_40() -> tuple[list, list]:
     points = chaos_map(40)
-    adaptive = simulate_batch(points, SimulationSettings())
+    adaptive = simulate_batch(points, SimulationSettings(physical_time=False))
     fixed = simulate_batch(points, SimulationSettings(adaptive=False))
     return adaptive, fixed
 
@@ -94,7 +95,9 @@ def test_early_stopped_record_is_the_settled_window(map_40: tuple[list, list]) -
 
 def test_adaptive_needs_a_window_of_record() -> None:
     points = chaos_map(4)
-    out = simulate_batch(points, SimulationSettings(transient_periods=100, record_periods=60))
+    out = simulate_batch(
+        points, SimulationSettings(transient_periods=100, record_periods=60, physical_time=False)
+    )
     assert all(p.periods_run == 160 for p in out)
 
 
@@ -126,7 +129,7 @@ def test_kink_kernel_mesh_force() -> None:
         {"damping": 0.05, "mean_force": 0.1, "backlash": {"model": "piecewise", "alpha": 0.0},
          "transmission_error": {"frequency": 0.8, "harmonics": [{"amplitude": 0.3}]}}
     )  # fmt: skip
-    settings = SimulationSettings(transient_periods=30, record_periods=20)
+    settings = SimulationSettings(transient_periods=30, record_periods=20, physical_time=False)
     (bp,) = simulate_batch([p], settings)
     assert bp.force_min is not None and bp.force_max > 0.1  # the mean force, exceeded
     lw = law(p)

@@ -91,7 +91,7 @@ def test_envelope_pass_line_names_impact_and_melnikov_windows(
         "  windows: teeth always in contact; "
         "Melnikov: not applicable at 1000-3000 rpm (above T_crit)"
     )
-    assert "settings: 60 + 60 periods, 128 steps per period" in captured.err
+    assert "settings: <= 60 + 60 periods (ended when settled), 128 steps per period" in captured.err
 
 
 def test_envelope_settings_merge_over_the_light_defaults(tmp_path: Path) -> None:

@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from gearengine.cli import main
-from tests.golden.cases import CASES, ROOT, SLOW, differences, golden_path
+from tests.golden.cases import CASES, ROOT, SLOW, differences, golden_path, pinned_input
 
 
 @pytest.mark.parametrize("name", sorted(set(CASES) - SLOW))
@@ -26,6 +26,7 @@ def test_numbers_unchanged(name: str) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "out.json"
         argv = [a.replace("{out}", str(out)) for a in CASES[name]]
+        argv = pinned_input(name, argv, Path(tmp))  # fixed lengths, as recorded
         printed = io.StringIO()
         cwd = os.getcwd()
         os.chdir(ROOT)

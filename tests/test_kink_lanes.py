@@ -89,7 +89,7 @@ def test_piecewise_lanes_give_simulates_verdicts() -> None:
 )
 def test_chaotic_lane_stops_once_its_lle_is_known(point: GearParams) -> None:
     fixed_settings = SimulationSettings(adaptive=False)
-    adaptive_settings = SimulationSettings()
+    adaptive_settings = SimulationSettings(physical_time=False)  # the kernels' LLE rule
     (fixed,) = run_lanes([point], [(0, (0.01, 0.01))], fixed_settings)
     (early,) = run_lanes([point], [(0, (0.01, 0.01))], adaptive_settings)
     assert fixed.classification == early.classification == "chaotic"
@@ -104,7 +104,7 @@ def test_chaotic_lane_stops_once_its_lle_is_known(point: GearParams) -> None:
 
 def test_lle_rule_off_runs_the_full_length_bit_for_bit() -> None:
     point = paper(0.2, model="piecewise")
-    off = SimulationSettings(lle_stderr_rel=0.0, lle_stderr_abs=0.0)
+    off = SimulationSettings(lle_stderr_rel=0.0, lle_stderr_abs=0.0, physical_time=False)
     (a,) = run_lanes([point], [(0, (0.01, 0.01))], off)
     (f,) = run_lanes([point], [(0, (0.01, 0.01))], SimulationSettings(adaptive=False))
     assert a == f and a.periods_run == 1000

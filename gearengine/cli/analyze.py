@@ -29,6 +29,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         print(f"Numerical verdict: {result.summary()}")
         print(f"  {result.verdict.summary}")
         print(f"  forcing period T0 = {fmt_value(result.numerics.forcing_period)}")
+        print(f"  {lengths_line(result)}")
         line = floquet_line(result)
         if line is not None:
             print(f"  {line}")
@@ -37,6 +38,19 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         if result.engineering is not None:
             print(render_engineering(result.engineering))
     return EXIT_OK
+
+
+def lengths_line(r: AnalysisResult) -> str:
+    """How long the worst start ran: transient and record, in mesh periods (and seconds with a
+    design), and why each stopped (``numerics.physical``)."""
+    parts = []
+    for name, part in (("transient", r.numerics.transient), ("record", r.numerics.record)):
+        if part is None:
+            continue
+        sec = "" if part.seconds is None else f", {part.seconds:.3g} s"
+        parts.append(f"{name} {part.periods} T0 = {part.mesh_periods:g} mesh periods{sec} "
+                     f"({part.reason})")  # fmt: skip
+    return "ran: " + "; ".join(parts)
 
 
 def floquet_line(r: AnalysisResult) -> str | None:

@@ -16,6 +16,7 @@ import numpy as np
 
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams
+from gearengine.numerics import physical
 from gearengine.numerics.lanes import lane_point, lane_verdicts, last_strobes
 from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
 from gearengine.numerics.runs import Run, as_system, finite_or_none, integrate, start_verdict
@@ -145,18 +146,72 @@ def _run_lanes(
             np.array([ft for _, ft in tables]),
             inverse.astype(np.int64),
         )  # one table per point, shared by its lanes
+        lanes_of = LAWS[name].lanes
+        assert lanes_of is not None
+        laws = [law(points[i]) for i in members.tolist()]
+        if physical.applies(settings, plans[members[0]], 0.0):
+            group = (lanes_of, laws, inverse, packed, mu, tabled, per, N)
+            for k, point in zip(ks, physical_lanes(group, x0, v0, settings), strict=True):
+                results[k] = point.model_copy(update={"start_index": k})
+            continue
         streams = max(1, min(numba.get_num_threads(), -(-len(ks) // kernels.LANES)))
         shared = (per, N, settings.transient_periods, settings.record_periods, DIVERGENCE_BOUND,
                   settings.adaptive, streams, *lle_tolerances(settings))  # fmt: skip
-        lanes_of = LAWS[name].lanes
-        assert lanes_of is not None
-        out = lanes_of([law(points[i]) for i in members.tolist()], inverse, packed, mu, x0, v0,
-                       tabled, shared)  # fmt: skip
+        out = lanes_of(laws, inverse, packed, mu, x0, v0, tabled, shared)
         verdicts = lane_verdicts(out, per)
         strobes = last_strobes(out, list(range(len(ks))))
         for j, k in enumerate(ks):
             results[k] = lane_point(out, j, k, verdicts[j], strobes[j])
     return results  # type: ignore[return-value]
+
+
+def physical_lanes(
+    group: tuple, x0: np.ndarray, v0: np.ndarray, settings: SimulationSettings
+) -> list[BatchPoint]:
+    """The ``BatchPoint`` of every lane of one lock-step group, its lengths decided in physical
+    time (``numerics.physical``): the transient and the record run in chunks through the same
+    lock-step kernel (no early stopping inside it); ``periods_run`` counts both.
+
+    Args:
+        group: (lanes kernel, laws of the points, point of each lane (L,), packed forcing,
+            damping (L,), forcing tables, T0 (L,), steps N per T0), as ``_run_lanes`` has them.
+        x0, v0: the lanes' starts, shape (L,).
+        settings: caps and tolerances.
+    """
+    lanes_of, laws, inverse, packed, mu, tabled, per, N = group
+
+    def advance(idx: np.ndarray, xa: np.ndarray, va: np.ndarray, n: int) -> physical.Chunk:
+        streams = max(1, min(numba.get_num_threads(), -(-idx.size // kernels.LANES)))
+        owner = inverse[idx].astype(np.int64)
+        shared = (per[idx], N, 0, n, DIVERGENCE_BOUND, False, streams, 0.0, 0.0)
+        out = lanes_of(laws, owner, packed, mu[idx], xa.copy(), va.copy(),
+                       (tabled[0], tabled[1], owner), shared)  # fmt: skip
+        xs, vs, logs, xmin, xmax, _, _, _, _, diverged, xf, vf = out
+        per_of = per[idx]
+        keep = [(out, j, per_of) for j in range(idx.size)]
+        return physical.Chunk(xs, vs, logs, xmin, xmax, xf, vf, diverged.astype(bool), keep)
+
+    spans = physical.lengths(advance, x0, v0, per, mu, N / settings.steps_per_period, settings)
+    verdicts: dict[int, list[tuple]] = {}
+    rows: dict[int, list[int]] = {}
+    for s in spans:  # one verdict and one gather of strobes per kernel call
+        out, j, per_of = s.keep
+        if id(out) not in verdicts:
+            verdicts[id(out)], rows[id(out)] = lane_verdicts(out, per_of), []
+        rows[id(out)].append(j)
+    outs = {id(s.keep[0]): s.keep[0] for s in spans}
+    strobes: dict[tuple[int, int], list] = {}
+    for key, out in outs.items():
+        got = last_strobes(out, rows[key])
+        strobes.update({(key, j): w for j, w in zip(rows[key], got, strict=True)})
+    points = []
+    for s in spans:
+        out, j, _ = s.keep
+        point = lane_point(out, j, 0, verdicts[id(out)][j], strobes[(id(out), j)])
+        n = out[0].shape[1]
+        before = s.transient - (n if s.transient_reason == "diverged" else 0)
+        points.append(point.model_copy(update={"periods_run": before + int(out[7][j])}))
+    return points
 
 
 def lle_tolerances(settings: SimulationSettings) -> tuple[float, float]:

@@ -142,6 +142,24 @@ class BasinCounts(_Result):
     )
 
 
+class RunLength(_Result):
+    """How long one part of a run (the transient or the record) lasted, and why it stopped."""
+
+    periods: int = Field(description="Intervals T0 (Poincare periods).")
+    mesh_periods: float = Field(
+        description="The same time in periods of the fastest excitation (the mesh)."
+    )
+    tau: float = Field(description="The same time in dimensionless time tau.")
+    seconds: float | None = Field(
+        None, description="The same time in seconds (null without a design's time scale)."
+    )
+    reason: str = Field(
+        description="Why it stopped. Transient: settled | transient_extended | cap | "
+        "diverged | fixed; record: period | lle_stderr | cap | diverged | fixed "
+        "(numerics.physical)."
+    )
+
+
 class NumericsResult(_Result):
     """Numerical verdict. Detailed fields describe the worst-case start (``worst_case``)."""
 
@@ -180,6 +198,12 @@ class NumericsResult(_Result):
         "Newton shooting did not converge (floquet_note says which).",
     )
     floquet_note: str | None = Field(None, description="Why floquet is null; else null.")
+    transient: RunLength | None = Field(
+        None, description="How long the worst start's transient ran and why it stopped."
+    )
+    record: RunLength | None = Field(
+        None, description="How long the worst start's record ran and why it stopped."
+    )
     attractors: list[Attractor] | None = Field(
         None,
         description="With settings.basins: every distinct attractor found, worst first; "

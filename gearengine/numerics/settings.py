@@ -244,7 +244,22 @@ class SimulationSettings(BaseModel):
         "at three checks 10 intervals apart; "
         "false runs every point transient_periods + record_periods. Applies to the lanes of the "
         "lock-step kernels: commensurate forcing, both backlash laws; incommensurate points and "
-        "simulate() run the full length.",
+        "simulate() run the full length. With physical_time (default) the lengths of every run, "
+        "simulate() too, are decided in physical time instead; false: fixed lengths everywhere, "
+        "the numbers of before.",
+        examples=[True],
+    )
+    physical_time: bool = Field(
+        True,
+        description="With adaptive: the transient and the record in physical time "
+        "(numerics.physical): the transient ends once the response has settled on a cycle of "
+        "period <= 12 T0 to 1e-5 of its size (strobes at T0 repeating over >= 60 mesh periods, "
+        "three cycles), after at least 10 damping time constants 1/(zeta omega_n); a response "
+        "that does not settle (chaos, quasi-periodic) keeps the whole transient; the record is "
+        "160 mesh periods (10 cycles at least) when periodic, else grows from 400 until the "
+        "LLE's standard error meets lle_stderr_abs / lle_stderr_rel; transient_periods and "
+        "record_periods are the upper bounds. Commensurate forcing only. false (or adaptive "
+        "false): transient_periods + record_periods as counts of T0, as before.",
         examples=[True],
     )
     basins: BasinSettings | None = Field(
@@ -289,6 +304,12 @@ class SimulationSettings(BaseModel):
                 f"steps exceeds {MAX_TOTAL_STEPS}"
             )
         return self
+
+    def lengths_text(self) -> str:
+        """The transient and record lengths in words: "500 + 500 periods", or with physical
+        time "<= 500 + 500 periods (ended when settled)" (they are upper bounds then)."""
+        text = f"{self.transient_periods} + {self.record_periods} periods"
+        return f"<= {text} (ended when settled)" if self.adaptive and self.physical_time else text
 
     def starts(self) -> list[tuple[float, float]]:
         """Initial states (x0, v0) in order: initial_states, random ones, or initial_state."""

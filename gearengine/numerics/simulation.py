@@ -18,9 +18,13 @@ Chaotic Systems* (Springer 1989), ch. 6.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
+import numpy as np
+
 from gearengine.model.params import GearParams
+from gearengine.numerics import physical
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.floquet import floquet_of
 from gearengine.numerics.results import NumericsResult, SpectrumPeak, TimeHistory
@@ -66,11 +70,19 @@ def simulate(
     commensurate = plan.omega0 is not None
     notes = list(plan.notes)
     runs: list[tuple[Run, StartVerdict]] = []
-    for x0, v0 in settings.starts():
-        start = system.start_state(x0, v0)
-        run = integrate(system, settings, start)
+    starts = [system.start_state(x0, v0) for x0, v0 in settings.starts()]
+    if physical.applies(settings, plan, system.damping_rate()):
+        done, spans = physical_runs(system, plan, settings, starts)
+    else:
+        done = [integrate(system, settings, start) for start in starts]
+        fixed = (settings.transient_periods, "fixed", settings.record_periods, "fixed")
+        spans = [fixed] * len(starts)
+    for run, start in zip(done, starts, strict=True):
         runs.append((run, start_verdict(run, start, plan.period, commensurate)))
-    worst, wv = max(runs, key=lambda rv: severity(rv[1].classification, rv[1].period))
+    w = max(range(len(runs)), key=lambda i: severity(runs[i][1].classification, runs[i][1].period))
+    (worst, wv), span = runs[w], spans[w]
+    n_trans, why_trans, n_rec, why_rec = span
+    settings = settings.model_copy(update={"transient_periods": n_trans, "record_periods": n_rec})
     base: dict[str, Any] = {
         "classification": wv.classification,
         "period": wv.period,
@@ -88,7 +100,47 @@ def simulate(
     states = worst.strobes if worst.states is None else worst.states
     last = states[worst.recorded - 1] if states is not None and worst.recorded > 0 else None
     orbit, why = floquet_of(system, settings, result, last)
-    return result.model_copy(update={"floquet": orbit, "floquet_note": why})
+    spp = settings.steps_per_period
+    return result.model_copy(update={
+        "floquet": orbit, "floquet_note": why,
+        "transient": physical.run_length(n_trans, plan, spp, why_trans),
+        "record": physical.run_length(n_rec, plan, spp, why_rec),
+    })  # fmt: skip
+
+
+def physical_runs(
+    system: System, plan: StepPlan, settings: SimulationSettings, starts: list[tuple]
+) -> tuple[list[Run], list[tuple[int, str, int, str]]]:
+    """The runs of ``starts`` with their lengths decided in physical time
+    (``numerics.physical``) through the single kernels, and per start (transient periods,
+    reason, record periods, reason); each ``Run`` is its record, ``done`` counting the
+    transient too."""
+
+    def advance(idx: np.ndarray, x0: np.ndarray, v0: np.ndarray, n: int) -> physical.Chunk:
+        stride = history_stride(settings.model_copy(update={"record_periods": n}), plan.steps)
+        got = [system.integrate(plan, (float(a), float(b)), 0, n, stride)
+               for a, b in zip(x0, v0, strict=True)]  # fmt: skip
+        return physical.Chunk(
+            np.array([r.xs for r in got]), np.array([r.vs for r in got]),
+            np.array([r.logs for r in got]), np.array([r.xmin for r in got]),
+            np.array([r.xmax for r in got]), np.array([r.final[0] for r in got]),
+            np.array([r.final[1] for r in got]), np.array([r.diverged for r in got]), got,
+        )  # fmt: skip
+
+    x0 = np.array([s[0] for s in starts], dtype=np.float64)
+    v0 = np.array([s[1] for s in starts], dtype=np.float64)
+    mu = system.damping_rate()
+    assert mu is not None
+    r = plan.steps / settings.steps_per_period
+    lanes = physical.lengths(advance, x0, v0, np.full(x0.size, plan.period), np.full(x0.size, mu),
+                             r, settings)  # fmt: skip
+    runs, spans = [], []
+    for s in lanes:
+        run: Run = s.keep
+        before = s.transient - (run.xs.size if s.transient_reason == "diverged" else 0)
+        runs.append(replace(run, done=run.done + before))
+        spans.append((s.transient, s.transient_reason, s.record, s.record_reason or "diverged"))
+    return runs, spans
 
 
 def _diverged(base: dict[str, Any], worst: Run, plan: StepPlan, notes: list[str]) -> NumericsResult:

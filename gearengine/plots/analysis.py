@@ -108,7 +108,8 @@ def analysis_figure(result: AnalysisResult, fmt: ImageFormat = "png") -> bytes:
     ax_t.set(title="(a) time history", xlabel=u.t_label, ylabel=u.x_label)
     ax_p.set(title="(b) phase plane", xlabel=u.x_label, ylabel=u.v_label)
     ax_s.set(title="(c) Poincaré section (one point per $T_0$)", xlabel=u.x_label, ylabel=u.v_label)
-    _spectrum(ax_f, num.spectrum_peaks, result.settings.record_periods, u)
+    recorded = result.settings.record_periods if num.record is None else num.record.periods
+    _spectrum(ax_f, num.spectrum_peaks, recorded, u)
     for ax in axes.flat:
         ax.grid(alpha=0.3)
     return figure_bytes(fig, fmt)

@@ -125,8 +125,7 @@ def envelope_map(request: SweepRequest, points: Sequence[SweepPoint]) -> Figure:
     s = request.settings
     ax.set_title(
         "Operating envelope: response of the gear pair at each operating point\n"
-        f"RK4, {s.steps_per_period} steps per excitation period, {s.transient_periods} + "
-        f"{s.record_periods} periods per point",
+        f"RK4, {s.steps_per_period} steps per excitation period, {s.lengths_text()} per point",
         fontsize=10,
     )
     present = sorted({int(c) for c in cls[np.isfinite(cls)]})

@@ -87,10 +87,7 @@ def _settings_note(request: SweepRequest) -> str:
     s = request.settings
     x0 = ", ".join(f"{v:g}" for v in s.initial_state)
     how = "continuation" if request.continuation else f"$(x, \\dot x)_0$ = ({x0})"
-    return (
-        f"RK4, {s.steps_per_period} steps per $T_0$, {s.transient_periods} + "
-        f"{s.record_periods} periods, {how}"
-    )
+    return f"RK4, {s.steps_per_period} steps per $T_0$, {s.lengths_text()}, {how}"
 
 
 def bifurcation(

@@ -139,6 +139,11 @@ class System(ABC):
     def method(self, plan: StepPlan) -> str:
         """How ``integrate`` runs this system, in words."""
 
+    def damping_rate(self) -> float | None:
+        """The decay rate of free vibration per unit tau (the damping ratio mu of Eq. 9), for
+        transients counted in damping time constants; None when the system has no single one."""
+        return None
+
     def start_state(self, x: float, v: float) -> tuple[float, ...]:
         """A full start from (x, v) of the mesh coordinate, every other coordinate at rest."""
         return (x, v) + (0.0,) * (self.n - 2)

@@ -16,6 +16,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from gearengine.studies.runup.request import QUASI_STATIC_SETTINGS
+
 ROOT = Path(__file__).resolve().parents[2]
 HERE = Path(__file__).resolve().parent
 EX = "examples"
@@ -122,11 +124,41 @@ SLOW = {"remedies", "robustness", "runup-ci", "sweep-fig6", "check-envelope"}
 """Cases left out of the test suite's quick run (the before/after check runs them all)."""
 
 
+FIXED_LENGTH = {"physical_time": False}
+"""Settings every integrating case runs with: its transient and record as fixed counts of T0,
+the lengths these numbers were recorded with before transients were decided in physical time
+(``numerics.physical``, issue 31); tests/test_physical.py checks the physical-time default."""
+PINNED: dict[str, str] = {
+    **{n: "settings" for n in CASES if n.split("-")[0] in
+       ("analyze", "basins", "check", "sweep", "robustness", "remedies")},
+    "runup-ci": "quasi_static",
+}  # fmt: skip
+"""Case -> the field of its input document that takes ``FIXED_LENGTH``."""
+
+
+def pinned_input(name: str, argv: list[str], tmp: Path) -> list[str]:
+    """``argv`` with its input document replaced by a copy in ``tmp`` whose settings (or
+    ``quasi_static``, the run-up's) carry ``FIXED_LENGTH``."""
+    field = PINNED.get(name)
+    if field is None:
+        return argv
+    i = next(k for k, a in enumerate(argv) if a.endswith(".json") and k == 1)
+    doc = json.loads((ROOT / argv[i]).read_text())
+    base = dict(doc.get(field) or {})
+    if field == "quasi_static":
+        base = {**QUASI_STATIC_SETTINGS, **base}
+    doc[field] = {**base, **FIXED_LENGTH}
+    copy = tmp / Path(argv[i]).name
+    copy.write_text(json.dumps(doc))
+    return [*argv[:i], str(copy), *argv[i + 1 :]]
+
+
 def run_case(name: str) -> object:
     """The JSON document of one case, computed now (a ``gearengine`` subprocess in ROOT)."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "out.json"
         argv = [a.replace("{out}", str(out)) for a in CASES[name]]
+        argv = pinned_input(name, argv, Path(tmp))
         done = subprocess.run(
             [sys.executable, "-m", "gearengine.cli", *argv], cwd=ROOT, capture_output=True,
             text=True, timeout=900,

@@ -83,6 +83,9 @@ class SpurPair(System):
         return PairFlow(law(self.params), self.params.damping, kc, fm, fc, plan.period,
                         plan.steps)  # fmt: skip
 
+    def damping_rate(self) -> float:
+        return self.params.damping
+
     def method(self, plan: StepPlan) -> str:
         name = self.params.backlash.model
         table = plan.omega0 is not None

@@ -1,0 +1,320 @@
+"""Transient and record in physical time: how long a run integrates before and while it
+records, decided by the response (``SimulationSettings.adaptive`` with ``physical_time``).
+
+Counted in Poincare periods T0, a fixed transient and record cost r = T0 / T_f times more for
+a design whose T0 is r periods T_f = 2 pi / Omega_fast of its fastest excitation (the mesh; one
+shaft revolution is z mesh periods) than for its twin without shaft-order forcing, though both
+settle in the same physical time. Here lengths are set in mesh periods T_f and run in whole
+intervals T0, so the strobes stay on the Poincare section and the forcing table stays in phase.
+
+**Transient** (``lengths``), run from the start in chunks of ``CHUNK_MESH`` mesh periods (at
+least one T0), twice and then four times as long after two and four chunks; the same chunks for
+every lane, so a lane's numbers do not depend on the lanes it shares a kernel call with:
+
+1. at least ``DAMPING_TIMES`` damping time constants 1/(zeta omega_n) = 1/mu (tau units): a
+   linear transient has decayed by e^-10 = 4.5e-5 by then;
+2. then it ends ("settled") when the T0 strobes of the last ``SETTLE_WINDOW_MESH`` mesh periods
+   (at least 3 strobes; longer as the transient grows, up to 3 ``SETTLE_MAX_PERIOD``) repeat with
+   a period p <= min(``SETTLE_MAX_PERIOD``, strobes / 3), every lag-p pair within the tolerance
+   of ``signals.periodicity`` (REL_TOL x the peak-to-peak of x over those chunks), and the
+   distance left to the cycle, extrapolated from how fast the lag-p mismatch decays over the
+   window, is below ``SETTLE_TOL`` x that size (near a bifurcation the decay is slow and the
+   transient runs on). A T0 strobe is the state at one phase of the cycle; the flow over one
+   T0 is continuous, so the whole cycle has settled with it;
+3. otherwise ("cap") after ``transient_periods`` intervals T0, today's fixed length. A response
+   that has not settled on a cycle (chaotic, quasi-periodic, a long cycle) keeps the whole
+   transient: no statistic of a finite window tells a chaotic transient from chaos (at 5,250
+   rpm, 2 N m, TE 1.21 um the design of examples/envelope-map.json is chaotic for ~1,000 mesh
+   periods, periodic 3T after 500 T0), so a chaotic verdict never rests on less transient than
+   the fixed-length run's.
+
+**Record**, from the transient's end state: R0 = ``RECORD_MESH`` mesh periods, at least
+``BLOCKS`` periods p of the settled cycle (one cycle per block of the LLE's standard error),
+rounded up to a multiple of ``BLOCKS`` p; a response that did not settle on a cycle records at
+least ``LLE_RECORD_MESH`` mesh periods (2 ``BLOCKS`` intervals). The record is run again from
+the same state twice as long (so its LLE sums are one uninterrupted record's, as a fixed-length
+run's) until
+
+* ``detect_period`` finds a period <= 64 in it ("period");
+* no period and the LLE's standard error over ``BLOCKS`` blocks is within the settings'
+  tolerances max(lle_stderr_abs, lle_stderr_rel |lle|) with the verdict clear by 3 standard
+  errors, chaotic or not ("lle_stderr");
+* no period but an LLE clearly below zero: an unfinished transient (or a cycle longer than 64
+  T0); the record's intervals join the transient ("transient_extended") and the record starts
+  again from its end, while the transient's cap allows;
+* ``record_periods`` intervals ("cap").
+
+A run that leaves the divergence bound stops there ("diverged"). The driver is the same for the
+single kernels (``simulate``) and the lock-step lanes (``batch.run_lanes``): ``advance`` runs a
+set of lanes a given number of recorded intervals from given states through the existing
+kernels.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from gearengine.numerics.results import RunLength
+from gearengine.numerics.settings import SimulationSettings
+from gearengine.signals.classify import LLE_FLOOR
+from gearengine.signals.lyapunov import BLOCKS, benettin
+from gearengine.signals.periodicity import attractor_size, detect_period
+from gearengine.systems.base import StepPlan
+
+DAMPING_TIMES = 10.0
+"""Damping time constants 1/mu (tau) a transient lasts at least."""
+CHUNK_MESH = 40
+"""Mesh periods run between two checks of the transient (at least one T0)."""
+SETTLE_WINDOW_MESH = 60
+"""Mesh periods of strobes that must repeat for the transient to count as settled."""
+SETTLE_MAX_PERIOD = 12
+"""Longest cycle (in T0) the transient test recognises; longer ones run to the cap."""
+SETTLE_TOL = 1e-7
+"""Largest distance left to the cycle, relative to its size, extrapolated geometrically from
+the decay of the strobes' mismatch (near a bifurcation the decay is slow and the transient
+runs on); ten times below the period test's REL_TOL."""
+NOISE_TOL = 1e-10
+"""Mismatch (relative to the size) that is the integration's noise: converged as it stands."""
+RECORD_MESH = 160
+"""Shortest record of a settled cycle, in mesh periods (rounded up to BLOCKS cycles)."""
+LLE_RECORD_MESH = 400
+"""Shortest record of a response that did not settle on a cycle, in mesh periods."""
+NEGATIVE_LLE = 0.01
+"""An LLE below -NEGATIVE_LLE (per tau, by 3 standard errors) with no period: unfinished."""
+
+
+def run_length(periods: int, plan: StepPlan, steps_per_period: int, reason: str) -> RunLength:
+    """``periods`` intervals T0 of ``plan`` as a ``RunLength``."""
+    return RunLength(
+        periods=int(periods),
+        mesh_periods=periods * plan.steps / steps_per_period,
+        tau=periods * plan.period,
+        reason=reason,
+    )
+
+
+def in_seconds(length: RunLength | None, time_scale: float) -> RunLength | None:
+    """``length`` with ``seconds`` from the design's time scale (s per unit tau)."""
+    if length is None:
+        return None
+    return length.model_copy(update={"seconds": length.tau * time_scale})
+
+
+def applies(settings: SimulationSettings, plan: StepPlan, damping: float | None) -> bool:
+    """True when a run's lengths are decided in physical time: ``adaptive`` and
+    ``physical_time`` set, commensurate forcing (a Poincare section) and a known damping."""
+    return (
+        settings.adaptive
+        and settings.physical_time
+        and plan.omega0 is not None
+        and damping is not None
+    )
+
+
+@dataclass
+class Chunk:
+    """What ``advance`` gives for m lanes run n recorded intervals: strobes, logs (m, n);
+    extremes of x over the steps, final state and divergence flag (m,); ``keep`` one opaque
+    handle per lane (the caller's record of that lane's run)."""
+
+    xs: np.ndarray
+    vs: np.ndarray
+    logs: np.ndarray
+    xmin: np.ndarray
+    xmax: np.ndarray
+    xf: np.ndarray
+    vf: np.ndarray
+    diverged: np.ndarray
+    keep: list[Any]
+
+
+Advance = Callable[[np.ndarray, np.ndarray, np.ndarray, int], Chunk]
+"""advance(lanes, x0, v0, n): the lanes (indices, shape (m,)) run n intervals T0 from (x0, v0),
+all recorded (no transient), through the kernels."""
+
+
+@dataclass
+class Lengths:
+    """The decided lengths of one lane: transient and record (intervals T0), the reasons, and
+    ``keep``, the handle of the chunk that is its record (or where it diverged)."""
+
+    transient: int = 0
+    transient_reason: str = ""
+    record: int = 0
+    record_reason: str = ""
+    keep: Any = None
+    period: int | None = None
+    stats: list[tuple[float, int, float, float]] = field(default_factory=list)
+    strobes: list[np.ndarray] = field(default_factory=list)
+
+
+def lengths(
+    advance: Advance,
+    x0: np.ndarray,
+    v0: np.ndarray,
+    period: np.ndarray,
+    mu: np.ndarray,
+    mesh_per_T0: float,
+    settings: SimulationSettings,
+) -> list[Lengths]:
+    """Run the transient and the record of every lane in physical time (see the module doc).
+
+    Args:
+        advance: runs lanes through the kernels (``Advance``).
+        x0, v0: starts, shape (L,).
+        period: T0 of each lane's point (tau), shape (L,).
+        mu: damping ratio of each lane's point, shape (L,).
+        mesh_per_T0: r = T0 / T_f, shared by the lanes (same steps per T0).
+        settings: caps (transient_periods, record_periods) and the LLE tolerances.
+    """
+    out = [Lengths() for _ in range(x0.size)]
+    x, v = _settle(advance, x0.copy(), v0.copy(), period, mu, mesh_per_T0, settings, out)
+    _record(advance, x, v, period, mesh_per_T0, settings, out)
+    return out
+
+
+def _settle(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, mu: np.ndarray,
+            r: float, settings: SimulationSettings, out: list[Lengths]) -> tuple:  # fmt: skip
+    """The transient of every lane; returns the states at its end."""
+    cap = settings.transient_periods
+    floor = np.ceil(DAMPING_TIMES / (np.maximum(mu, 1e-12) * period))
+    n_min = np.minimum(floor, cap).astype(np.int64)
+    chunk = max(1, math.ceil(CHUNK_MESH / r))
+    active = np.ones(x.size, dtype=bool)
+    if cap == 0:
+        active[:] = False
+        for s in out:
+            s.transient_reason = "cap"
+    ran, rounds = 0, 0
+    while active.any():
+        idx = np.flatnonzero(active)
+        # the same chunk boundaries for a lane in any company: 1, 1, 2, 2, 4, 4, 4 ... chunks
+        n = min(chunk * 2 ** min(rounds // 2, 2), cap - ran)
+        rounds += 1
+        c = advance(idx, x[idx], v[idx], n)
+        ran += n
+        sums, pairs = c.logs.sum(axis=1), np.stack([c.xs, c.vs], axis=2)
+        for j, lane in enumerate(idx.tolist()):
+            s = out[lane]
+            s.transient = ran
+            x[lane], v[lane] = c.xf[j], c.vf[j]
+            if c.diverged[j]:
+                s.transient_reason, s.keep, active[lane] = "diverged", c.keep[j], False
+                continue
+            s.stats.append((float(sums[j]), n, float(c.xmin[j]), float(c.xmax[j])))
+            s.strobes.append(pairs[j])
+            why = _settled(s, ran, int(n_min[lane]), r)
+            if why is None and ran >= cap:
+                why = "cap"
+            if why is not None:
+                s.transient_reason, active[lane] = why, False
+                s.stats, s.strobes = [], []
+    return x, v
+
+
+def _settled(s: Lengths, ran: int, n_min: int, r: float) -> str | None:
+    """ "settled" when the transient of a lane may end here, else None."""
+    if ran < n_min:
+        return None
+    want = max(3, math.ceil(SETTLE_WINDOW_MESH / r), min(ran // 2, 3 * SETTLE_MAX_PERIOD))
+    k, got = len(s.strobes), 0
+    while k > 0 and got < want:
+        k -= 1
+        got += s.strobes[k].shape[0]
+    if got >= 3:
+        window = np.concatenate(s.strobes[k:])
+        lo = min(st[2] for st in s.stats[k:])
+        hi = max(st[3] for st in s.stats[k:])
+        p = detect_period(window[:, 0], window[:, 1], attractor_size(lo, hi),
+                          max_period=min(SETTLE_MAX_PERIOD, window.shape[0] // 3))  # fmt: skip
+        if p is not None and _converged(window, p, attractor_size(lo, hi)):
+            s.period = p
+            return "settled"
+    return None
+
+
+def _converged(window: np.ndarray, p: int, size: float) -> bool:
+    """The strobes (k, 2) approach their cycle of period p closer than ``SETTLE_TOL`` x size:
+    the lag-p mismatch d shrinks by lambda per cycle (from the window's first and last cycle),
+    so the distance left to the cycle is at most d_last lambda / (1 - lambda). A mismatch at
+    the integration's noise (``NOISE_TOL`` x size) is converged as it stands."""
+    d = np.hypot(window[p:, 0] - window[:-p, 0], window[p:, 1] - window[:-p, 1])
+    first, last = float(d[:p].max()), float(d[-p:].max())
+    if last <= NOISE_TOL * size:
+        return True
+    cycles = (d.size - p) / p
+    if first <= last or cycles < 1:
+        return False
+    lam = (last / first) ** (1.0 / cycles)
+    return last * lam / (1.0 - lam) < SETTLE_TOL * size
+
+
+def _first_record(s: Lengths, r: float, cap: int) -> int:
+    """R0 of a lane (see the module doc), at most ``cap``."""
+    if s.period is not None:
+        unit = BLOCKS * s.period
+        n = max(unit, math.ceil(RECORD_MESH / r))
+    else:
+        unit = BLOCKS
+        n = max(2 * BLOCKS, math.ceil(LLE_RECORD_MESH / r))
+    return min(cap, unit * math.ceil(n / unit))
+
+
+def _record(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, r: float,
+            settings: SimulationSettings, out: list[Lengths]) -> None:  # fmt: skip
+    """The record of every lane that did not diverge in its transient."""
+    cap = settings.record_periods
+    want = {lane: _first_record(s, r, cap) for lane, s in enumerate(out)
+            if s.transient_reason != "diverged"}  # fmt: skip
+    while want:
+        by_length: dict[int, list[int]] = {}
+        for lane, n in want.items():
+            by_length.setdefault(n, []).append(lane)
+        want = {}
+        for n, lanes in by_length.items():
+            idx = np.array(lanes, dtype=np.int64)
+            c = advance(idx, x[idx], v[idx], n)
+            for j, lane in enumerate(lanes):
+                s = out[lane]
+                s.record, s.keep = n, c.keep[j]
+                if c.diverged[j]:
+                    s.record_reason = "diverged"
+                    continue
+                nxt = _next(c, j, n, float(period[lane]), s, settings)
+                if nxt is None:
+                    continue
+                if nxt < 0:  # unfinished transient: the record joins it, recorded again
+                    s.transient += n
+                    s.transient_reason = "transient_extended"
+                    x[lane], v[lane] = c.xf[j], c.vf[j]
+                    nxt = n
+                want[lane] = nxt
+
+
+def _next(c: Chunk, j: int, n: int, T0: float, s: Lengths, settings: SimulationSettings
+          ) -> int | None:  # fmt: skip
+    """After a record of n intervals: None (done, ``s.record_reason`` set), the next record
+    length, or -1 (move the record into the transient and record again)."""
+    cap = settings.record_periods
+    size = attractor_size(float(c.xmin[j]), float(c.xmax[j]))
+    if detect_period(c.xs[j], c.vs[j], size) is not None:
+        s.record_reason = "period"
+        return None
+    est = benettin(c.logs[j], T0)
+    e, se = est.lle, est.stderr or 0.0
+    tol = max(settings.lle_stderr_abs, settings.lle_stderr_rel * abs(e))
+    if e + 3.0 * se < -NEGATIVE_LLE and s.transient + n <= settings.transient_periods:
+        return -1
+    clear = e - 3.0 * se > LLE_FLOOR or e + 3.0 * se < LLE_FLOOR
+    if est.stderr is not None and se <= tol and clear:
+        s.record_reason = "lle_stderr"
+        return None
+    if n >= cap:
+        s.record_reason = "cap"
+        return None
+    return min(cap, 2 * n)
