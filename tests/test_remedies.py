@@ -20,12 +20,14 @@ import httpx
 import pytest
 from pydantic import ValidationError
 
+from gearengine.gate.envelope import EnvelopeReport
+from gearengine.gate.remedies.compute import answer as answer_words
 from gearengine.gate.remedies.compute import remedies
 from gearengine.gate.remedies.levers import iso1328_class
 from gearengine.gate.remedies.request import Lever, RemediesRequest
-from gearengine.gate.remedies.results import RemediesResult
+from gearengine.gate.remedies.results import RemediesResult, Remedy
 from gearengine.gate.remedies.search import _narrow, _search, envelope_points
-from gearengine.model.design import Design
+from gearengine.model.design import ACCURACY_FIELD, Design
 from gearengine.model.standards import iso1328
 from gearengine.model.units import in_display_unit
 from tests.conftest import ROOT, Server
@@ -268,6 +270,34 @@ def test_iso1328_class_that_delivers_a_transmission_error() -> None:
         iso1328_class(Design.model_validate(json.loads(EXAMPLE.read_text())["design"]), 1e-5)
         is None
     )
+
+
+def test_melnikov_guarantee_only_where_the_criterion_applies() -> None:
+    """A Melnikov bound whose criterion applies at none of the envelope's points guarantees
+    nothing and the answer says so; applying at some, it says at how many."""
+    check = EnvelopeReport.model_construct(passed=False, points=115, failing_points=3)
+
+    def said(blind: int) -> str:
+        mel = Remedy.model_construct(lever=ACCURACY_FIELD, from_=11.3, to=4.0, unit="um",
+                                     bound="melnikov", monotone=True, iso1328_class=None,
+                                     not_applicable_points=blind, melnikov_points=115,
+                                     check=check)  # fmt: skip
+        return answer_words([mel], [], None)
+
+    assert "guarantee against" not in said(115) and "applies at none of the 115" in said(115)
+    assert "guarantee against homoclinic chaos at the 40 of 115 points" in said(75)
+    assert "(Melnikov guarantee against homoclinic chaos;" in said(0)
+
+
+def test_a_class_bound_written_rounded_is_that_class() -> None:
+    """The z = 23/67 pair's class-7 bound is 11.31 µm; the 11.3 µm a designer writes for it is
+    class 7 (within ISO_ROUNDING), not class 6; 1 % below the bound is class 6."""
+    design = Design.model_validate(json.loads((ROOT / "examples" / "remedies-z23-67.json")
+                                              .read_text())["design"])  # fmt: skip
+    bound = iso1328.pair_te_bound(7, design.driver, design.driven)
+    assert 11.3e-6 < bound < 11.32e-6
+    assert iso1328_class(design, 11.3e-6) == 7
+    assert iso1328_class(design, 0.99 * bound) == 6
 
 
 def test_two_levers_together_when_neither_alone_clears_the_envelope(tmp_path: Path) -> None:

@@ -147,8 +147,18 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
             text += ")" if num.monotone else "; not unique: the response is not monotone)"
         if mel is not None:
             outcome = "passes" if mel.check.passed else "still fails"
-            text += (f"{' or' if num else ' to'} {mel.to:.4g}{unit} (Melnikov guarantee against "
-                     f"homoclinic chaos; the envelope check {outcome} there)")  # fmt: skip
+            points = mel.melnikov_points or 0
+            applies = points - (mel.not_applicable_points or 0)
+            if applies == points:
+                what = "Melnikov guarantee against homoclinic chaos"
+            elif applies:
+                what = (f"Melnikov guarantee against homoclinic chaos at the {applies} of "
+                        f"{points} points where the criterion applies")  # fmt: skip
+            else:
+                what = (f"the Melnikov criterion allows chaos nowhere but applies at none of "
+                        f"the {points} points: no guarantee")  # fmt: skip
+            text += (f"{' or' if num else ' to'} {mel.to:.4g}{unit} ({what}; the envelope check "
+                     f"{outcome} there)")  # fmt: skip
         parts.append(text)
     words = "; or ".join(parts) if parts else "no single lever clears the envelope"
     for u in unreachable:

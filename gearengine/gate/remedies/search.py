@@ -189,24 +189,36 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
             unit=lever.unit, bound=bound, monotone=monotone,
             bracket=[lever.shown(fail), lever.shown(to)], samples=shown,
             not_applicable_points=blind, check=report,
+            melnikov_points=len(points) if bound == "melnikov" else None,
             contact_ratio=contact_ratio(design_with(request.design, {lever.path: to})),
             iso1328_class=accuracy_classes(request.design, lever, to),
-            summary=_summary(bound, lever, to, monotone, report, blind),
+            summary=_summary(bound, lever, to, monotone, report, blind, len(points)),
         ))  # fmt: skip
     return remedies, unreachable
 
 
+def melnikov_words(applies: int, points: int) -> str:
+    """What the Melnikov criterion guarantees at a value where it allows chaos nowhere:
+    ``applies`` of ``points`` envelope grid points are judged (the rest have no saddle under
+    their load), and the guarantee is stated only where it applies."""
+    if applies == 0:
+        return (f"the Melnikov criterion applies at none of the {points} envelope points (no "
+                "saddle under their load), so it guarantees nothing there")  # fmt: skip
+    where = ("every envelope point" if applies == points else
+             f"the {applies} of {points} envelope points where it applies (no saddle under the "
+             "load at the others: not judged)")  # fmt: skip
+    return f"the Melnikov criterion rules out homoclinic chaos at {where}"
+
+
 def _summary(bound: str, lever: Lever, to: float, monotone: bool, report: EnvelopeReport,
-             blind: int | None) -> str:  # fmt: skip
+             blind: int | None, points: int) -> str:  # fmt: skip
     run = (f"the envelope check passes there ({report.points} points run)" if report.passed
            else f"the envelope check still fails there at {report.failing_points} of "
            f"{report.points} points")  # fmt: skip
     if bound == "numerical":
         return f"{change_words(lever, to)}: {run}{_uniqueness(monotone)}"
-    na = (f"; the criterion does not apply at {blind} of {report.points} points (no saddle "
-          "under that load: not judged there)" if blind else "")  # fmt: skip
-    return (f"{change_words(lever, to)}: the Melnikov criterion rules out homoclinic chaos at "
-            f"every envelope point{na}; {run}{_uniqueness(monotone)}")  # fmt: skip
+    words = melnikov_words(points - (blind or 0), points)
+    return f"{change_words(lever, to)}: {words}; {run}{_uniqueness(monotone)}"
 
 
 def _why(bound: str, lever: Lever, samples: list[Sample], far: EnvelopeReport | None) -> str:
