@@ -20,7 +20,7 @@ import httpx
 import pytest
 from pydantic import ValidationError
 
-from gearengine.gate.envelope import EnvelopeReport
+from gearengine.gate.envelope import EnvelopeReport, check_envelope
 from gearengine.gate.remedies.compute import answer as answer_words
 from gearengine.gate.remedies.compute import remedies
 from gearengine.gate.remedies.levers import iso1328_class
@@ -270,6 +270,30 @@ def test_iso1328_class_that_delivers_a_transmission_error() -> None:
         iso1328_class(Design.model_validate(json.loads(EXAMPLE.read_text())["design"]), 1e-5)
         is None
     )
+
+
+def test_the_remedy_found_passes_the_check_on_a_2x_finer_grid() -> None:
+    """The z = 23/67 class-7 pair at 5 N*m over 4,250-5,250 rpm on 3 speeds: the TE that makes
+    these 3 speeds pass (7.81 µm, main's answer) is chaotic at 4,500 rpm from 19 % of starts,
+    which the 2x finer grid holds; the remedy is verified there and passes it, and says so."""
+    doc = json.loads((ROOT / "examples" / "remedies-z23-67.json").read_text())
+    request = RemediesRequest.model_validate({
+        "design": doc["design"], "fail_on": ["chaotic"],
+        "envelope": {"speed": "4250:5250", "speed_points": 3, "torque": "5:5", "torque_points": 1},
+        "levers": [{"lever": ACCURACY_FIELD, "bounds": ["0 um", "11.3 um"]}],
+    })  # fmt: skip
+    result = remedies(request)
+    (found,) = [r for r in result.remedies if r.bound == "numerical"]
+    assert found.check.passed and found.check.resolution is not None
+    assert found.check.resolution.speed_points == 5 and found.check.resolution.depth == 1
+    assert "2x finer grid" in found.summary and "5 speeds (250 rpm)" in found.summary
+    finer = RemediesRequest.model_validate({
+        "design": with_value(doc, ACCURACY_FIELD, float(f"{found.to:.4g}"), "um")["design"],
+        "fail_on": ["chaotic"],
+        "envelope": {"speed": "4250:5250", "speed_points": 5, "torque": "5:5", "torque_points": 1},
+    })  # fmt: skip
+    assert check_envelope(finer.sweep(), finer.rules()).passed
+    assert found.to < 7.0  # main's 7.813 µm fails at 4,500 rpm on the finer grid
 
 
 def test_melnikov_guarantee_only_where_the_criterion_applies() -> None:
