@@ -46,21 +46,17 @@ class Resolution(BaseModel):
     finest_speed_step_rpm: float | None = Field(description="Finest speed spacing [rpm].")
     finest_torque_step_nm: float | None = Field(None, description="Finest torque spacing [N*m].")
     refined_points: int = Field(0, description="Points inserted between grid points.")
-    stopped_early: bool = Field(
-        False, description="The check stopped at its first failing point (only pass or fail "
-        "was needed): points and failing points count what ran.",
-    )  # fmt: skip
 
     def text(self) -> str:
         """ "23 x 5 grid (227 rpm x 13.8 N*m), 16 starts a point; refined ... 7 points added"."""
         grid = f"{self.speed_points} x {self.torque_points} grid" if self.torque_points > 1 \
             else f"{self.speed_points} speeds"  # fmt: skip
-        steps = [f"{s:.3g} {u}" for s, u in ((self.speed_step_rpm, "rpm"),
+        steps = [f"{s:.4g} {u}" for s, u in ((self.speed_step_rpm, "rpm"),
                  (self.torque_step_nm, "N*m")) if s is not None]  # fmt: skip
         out = f"{grid} ({' x '.join(steps) or 'one point'}), {self.starts} starts a point"
         if self.depth == 0:
             return out + "; not refined between grid points"
-        fine = [f"{s:.3g} {u}" for s, u in ((self.finest_speed_step_rpm, "rpm"),
+        fine = [f"{s:.4g} {u}" for s, u in ((self.finest_speed_step_rpm, "rpm"),
                 (self.finest_torque_step_nm, "N*m")) if s is not None]  # fmt: skip
         return (f"{out}; refined to {' x '.join(fine)} where neighbours differ or a point is "
                 f"near a limit: {self.refined_points} points added")  # fmt: skip
