@@ -95,10 +95,12 @@ def test_each_value_passes_the_gate_and_ten_percent_short_fails(
             report = tmp_path / "report.json"
             run = gearengine("check", str(path), *ENVELOPE, "--json", str(report))
             assert run.returncode == code, (r.lever, value, run.stdout)
-    # the attached report is the gate's own report at the value (same points, same verdicts)
+    # the attached report is the gate's own report at the value on the 2x finer grid (same
+    # points, same verdicts): 9 x 3 for the envelope's 5 x 2
     r = next(r for r in answer.remedies if r.lever == "mesh.damping_ratio")
     path.write_text(json.dumps(with_value(doc, r.lever, r.to, r.unit)))
-    gearengine("check", str(path), *ENVELOPE, "--json", str(report))
+    finer = [{"5": "9", "2": "3"}.get(a, a) if k in (3, 7) else a for k, a in enumerate(ENVELOPE)]
+    gearengine("check", str(path), *finer, "--json", str(report))
     checked = json.loads(report.read_text())
     assert [(p["values"], p["classification"]) for p in checked["sweep"]["points"]] == [
         (p.values, p.classification) for p in r.check.sweep.points
