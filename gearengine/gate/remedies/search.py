@@ -54,6 +54,7 @@ from gearengine.model.design import Design
 from gearengine.model.reduction import convert_design
 from gearengine.studies.sweep.axes import design_with, si_value
 from gearengine.studies.sweep.compute import points_at
+from gearengine.studies.sweep.points import SweepPoint
 from gearengine.studies.sweep.request import SweepRequest
 
 
@@ -212,29 +213,32 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
     rules = request.rules()
     check = check or (lambda sweep: shared_check(request, sweep))
     reports: dict[tuple[float, bool], EnvelopeReport] = {(lever.start, False): baseline}
-    failed = [p for p in baseline.sweep.points if attractor_failures(p, rules)]
+    failed: dict[bool, list[SweepPoint]] = {  # per grid (finer or not): its failing points
+        False: [p for p in baseline.sweep.points if attractor_failures(p, rules)],
+        True: [],
+    }
 
     def run(value: float, finer: bool = False) -> EnvelopeReport:
         if (value, finer) not in reports:
             design = design_with(request.design, {lever.path: value})
             reports[(value, finer)] = report = check(request.sweep(design, finer))
-            if not report.passed and not finer:  # grid points: a pass there is the grid's
-                failed[:] = [p for p in report.sweep.points if attractor_failures(p, rules)]
+            if not report.passed:  # its grid points: a failure there is the grid's
+                failed[finer] = [p for p in report.sweep.points if attractor_failures(p, rules)]
         return reports[(value, finer)]
 
     def numerical(value: float) -> tuple[bool, int]:
         report = run(value)
         return report.passed, report.failing_points
 
-    def passes_at(value: float) -> bool:
+    def passes_at(value: float, finer: bool = False) -> bool:
         """Pass or fail at ``value``: the grid points that failed last run first (``HINTS``);
         one failing there fails the grid, the answer the full check would give."""
-        sweep = request.sweep(design_with(request.design, {lever.path: value}))
+        sweep = request.sweep(design_with(request.design, {lever.path: value}), finer)
         names = [a.parameter for a in sweep.axes]
-        hints = [{n: p.values[n] for n in names} for p in failed[:HINTS]]
+        hints = [{n: p.values[n] for n in names} for p in failed[finer][:HINTS]]
         if hints and any(attractor_failures(p, rules) for p in points_at(sweep, hints)):
             return False
-        return run(value).passed
+        return run(value, finer).passed
 
     def snapped(value: float) -> float:
         """``value`` as the answer prints it (``SHOWN_DIGITS``, rounded toward the far end),
@@ -264,7 +268,7 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
         shown, monotone, bracket = _search(
             test, lever, samples, _narrow(rtol, lever), steps,
             passes_at=passes_at if bound == "numerical" else None,
-            verify=(lambda v: run(snapped(v), finer=True).passed) if bound == "numerical"
+            verify=(lambda v: passes_at(snapped(v), finer=True)) if bound == "numerical"
             else None,
         )  # fmt: skip
         if bracket is None:
