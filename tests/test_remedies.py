@@ -20,12 +20,14 @@ import httpx
 import pytest
 from pydantic import ValidationError
 
+from gearengine.gate.envelope import EnvelopeReport, check_envelope
+from gearengine.gate.remedies.compute import answer as answer_words
 from gearengine.gate.remedies.compute import remedies
 from gearengine.gate.remedies.levers import iso1328_class
 from gearengine.gate.remedies.request import Lever, RemediesRequest
-from gearengine.gate.remedies.results import RemediesResult
+from gearengine.gate.remedies.results import RemediesResult, Remedy
 from gearengine.gate.remedies.search import _narrow, _search, envelope_points
-from gearengine.model.design import Design
+from gearengine.model.design import ACCURACY_FIELD, Design
 from gearengine.model.standards import iso1328
 from gearengine.model.units import in_display_unit
 from tests.conftest import ROOT, Server
@@ -93,10 +95,12 @@ def test_each_value_passes_the_gate_and_ten_percent_short_fails(
             report = tmp_path / "report.json"
             run = gearengine("check", str(path), *ENVELOPE, "--json", str(report))
             assert run.returncode == code, (r.lever, value, run.stdout)
-    # the attached report is the gate's own report at the value (same points, same verdicts)
+    # the attached report is the gate's own report at the value on the 2x finer grid (same
+    # points, same verdicts): 9 x 3 for the envelope's 5 x 2
     r = next(r for r in answer.remedies if r.lever == "mesh.damping_ratio")
     path.write_text(json.dumps(with_value(doc, r.lever, r.to, r.unit)))
-    gearengine("check", str(path), *ENVELOPE, "--json", str(report))
+    finer = [{"5": "9", "2": "3"}.get(a, a) if k in (3, 7) else a for k, a in enumerate(ENVELOPE)]
+    gearengine("check", str(path), *finer, "--json", str(report))
     checked = json.loads(report.read_text())
     assert [(p["values"], p["classification"]) for p in checked["sweep"]["points"]] == [
         (p.values, p.classification) for p in r.check.sweep.points
@@ -268,6 +272,58 @@ def test_iso1328_class_that_delivers_a_transmission_error() -> None:
         iso1328_class(Design.model_validate(json.loads(EXAMPLE.read_text())["design"]), 1e-5)
         is None
     )
+
+
+def test_the_remedy_found_passes_the_check_on_a_2x_finer_grid() -> None:
+    """The z = 23/67 class-7 pair at 5 N*m over 4,250-5,250 rpm on 3 speeds: the TE that makes
+    these 3 speeds pass (7.81 µm, main's answer) is chaotic at 4,500 rpm from 19 % of starts,
+    which the 2x finer grid holds; the remedy is verified there and passes it, and says so."""
+    doc = json.loads((ROOT / "examples" / "remedies-z23-67.json").read_text())
+    request = RemediesRequest.model_validate({
+        "design": doc["design"], "fail_on": ["chaotic"],
+        "envelope": {"speed": "4250:5250", "speed_points": 3, "torque": "5:5", "torque_points": 1},
+        "levers": [{"lever": ACCURACY_FIELD, "bounds": ["0 um", "11.3 um"]}],
+    })  # fmt: skip
+    result = remedies(request)
+    (found,) = [r for r in result.remedies if r.bound == "numerical"]
+    assert found.check.passed and found.check.resolution is not None
+    assert found.check.resolution.speed_points == 5 and found.check.resolution.depth == 1
+    assert "2x finer grid" in found.summary and "5 speeds (250 rpm)" in found.summary
+    finer = RemediesRequest.model_validate({
+        "design": with_value(doc, ACCURACY_FIELD, float(f"{found.to:.4g}"), "um")["design"],
+        "fail_on": ["chaotic"],
+        "envelope": {"speed": "4250:5250", "speed_points": 5, "torque": "5:5", "torque_points": 1},
+    })  # fmt: skip
+    assert check_envelope(finer.sweep(), finer.rules()).passed
+    assert found.to < 7.0  # main's 7.813 µm fails at 4,500 rpm on the finer grid
+
+
+def test_melnikov_guarantee_only_where_the_criterion_applies() -> None:
+    """A Melnikov bound whose criterion applies at none of the envelope's points guarantees
+    nothing and the answer says so; applying at some, it says at how many."""
+    check = EnvelopeReport.model_construct(passed=False, points=115, failing_points=3)
+
+    def said(blind: int) -> str:
+        mel = Remedy.model_construct(lever=ACCURACY_FIELD, from_=11.3, to=4.0, unit="um",
+                                     bound="melnikov", monotone=True, iso1328_class=None,
+                                     not_applicable_points=blind, melnikov_points=115,
+                                     check=check)  # fmt: skip
+        return answer_words([mel], [], None)
+
+    assert "guarantee against" not in said(115) and "applies at none of the 115" in said(115)
+    assert "guarantee against homoclinic chaos at the 40 of 115 points" in said(75)
+    assert "(Melnikov guarantee against homoclinic chaos;" in said(0)
+
+
+def test_a_class_bound_written_rounded_is_that_class() -> None:
+    """The z = 23/67 pair's class-7 bound is 11.31 µm; the 11.3 µm a designer writes for it is
+    class 7 (within ISO_ROUNDING), not class 6; 1 % below the bound is class 6."""
+    design = Design.model_validate(json.loads((ROOT / "examples" / "remedies-z23-67.json")
+                                              .read_text())["design"])  # fmt: skip
+    bound = iso1328.pair_te_bound(7, design.driver, design.driven)
+    assert 11.3e-6 < bound < 11.32e-6
+    assert iso1328_class(design, 11.3e-6) == 7
+    assert iso1328_class(design, 0.99 * bound) == 6
 
 
 def test_two_levers_together_when_neither_alone_clears_the_envelope(tmp_path: Path) -> None:

@@ -35,14 +35,15 @@ from gearengine.cli.documents import (
 from gearengine.cli.junit import envelope_junit
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import (
+    REFINE_DEPTH,
     EnvelopeReport,
     Rules,
     check_envelope,
     envelope_axis,
-    envelope_report,
     envelope_sweep,
     gate_settings,
     level_text,
+    refined_report,
     window_text,
 )
 from gearengine.jsonio import dumps
@@ -169,6 +170,8 @@ def print_report(report: EnvelopeReport) -> None:
     if "melnikov" in report.rules.fail_on and report.melnikov_not_judged:
         print(f"  Melnikov could not judge {report.melnikov_not_judged} of {report.points} points "
               "(the criterion does not apply above the critical torque)")  # fmt: skip
+    if report.resolution is not None:
+        print(f"  resolution: {report.resolution.text()}")
     for w in report.failures:
         print(f"  {window_text(w)}")
     for line in windows_summary(report.windows):
@@ -225,11 +228,13 @@ def cmd_envelope(args: argparse.Namespace) -> int:
     rules = rules_of(args)
     print(settings_text(request.settings), file=sys.stderr)
     tick = progress(time.monotonic(), "envelope")
+    depth = REFINE_DEPTH if args.refine is None else args.refine
     if args.server:
         key = os.environ.get("GEARCHAOS_API_KEY")
-        report = envelope_report(run_on_server(args.server, request, key, tick), rules)
+        result = run_on_server(args.server, request, key, tick)  # refined here, as locally
+        report = refined_report(request, result, rules, depth, workers=os.cpu_count() or 1)
     else:
-        report = check_envelope(request, rules, tick, workers=os.cpu_count() or 1)
+        report = check_envelope(request, rules, tick, workers=os.cpu_count() or 1, refine=depth)
     if getattr(args, "runup", None) is not None:  # run-ups through the range (gate.runup)
         from gearengine.gate.runup import gate_envelope
 

@@ -35,6 +35,8 @@ def remedies_request(args: argparse.Namespace) -> RemediesRequest:
         raise InvalidInputError([f'{args.file}: remedies need {{"design": {{...}}}}'])
     envelope: dict[str, object] = {"speed": args.speed, "speed_points": args.speed_points,
                                    "torque_points": args.torque_points}  # fmt: skip
+    if args.refine is not None:
+        envelope["refine"] = args.refine
     if args.torque:
         envelope["torque"] = args.torque
     body = {"design": doc["design"], "envelope": envelope,
@@ -51,11 +53,14 @@ def remedies_request(args: argparse.Namespace) -> RemediesRequest:
 def print_result(result: RemediesResult) -> None:
     """The answer in words, then one line per remedy and per unreachable lever."""
     print(result.answer[0].upper() + result.answer[1:] + ".")
+    if result.check is not None and result.check.resolution is not None:
+        print(f"  the design's check: {result.check.resolution.text()}")
     for r in result.remedies:
         unit = "" if r.unit == "1" else f" {r.unit}"
+        grid = "" if r.check.resolution is None else f" on {r.check.resolution.text()}"
         print(f"  {r.bound:9s} {r.lever}: {r.from_:g} -> {r.to:.4g}{unit} "
               f"({'monotone' if r.monotone else 'NOT monotone: not unique'}; check "
-              f"{'PASS' if r.check.passed else 'FAIL'})")  # fmt: skip
+              f"{'PASS' if r.check.passed else 'FAIL'}{grid})")  # fmt: skip
     for u in result.unreachable:
         print(f"  {u.bound:9s} {u.lever}: none in {u.searched[0]} to {u.searched[1]}")
     if result.combination is not None:

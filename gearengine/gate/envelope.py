@@ -18,12 +18,14 @@ the attractors that broke it with their fractions.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from typing import Literal
 from xml.etree import ElementTree
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from gearengine.gate.resolution import REFINE_DEPTH, Resolution, resolution
+from gearengine.gate.resolution import refine as refine_points
 from gearengine.model.units import OUTPUTS, RESPONSES
 from gearengine.signals.classify import SEVERITY
 from gearengine.studies.sweep.compute import run_local
@@ -119,6 +121,51 @@ def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
     return out
 
 
+NEAR_LLE = 0.6
+"""An attractor whose LLE is above -NEAR_LLE x mu is near the chaos limit: a periodic attractor
+contracting at under 60 % of the linear rate is close to a bifurcation (the period-2 orbits
+beside a chaotic window of the z = 23/67 pair have -0.011 at mu = 0.05)."""
+NEAR_LIMIT = 0.1
+"""A DTE or dynamic factor within this fraction of its limit is near it."""
+ESTIMATE_Z = 2.0
+"""Standard errors added to an LLE before comparing it with a limit."""
+
+
+def near_limit(p: SweepPoint, rules: Rules) -> bool:
+    """Whether point ``p`` is near a limit of ``rules``, for any attractor found, whatever its
+    basin fraction: its LLE (plus ``ESTIMATE_Z`` standard errors) above -``NEAR_LLE`` x mu (mu
+    the damping ratio: a linear response's LLE per unit tau) under a chaotic or quasi-periodic
+    rule, or above ``max_lle`` - ``NEAR_LLE`` x mu; a rule broken from a basin at or under
+    ``min_basin`` (not counted, but a neighbour's basin may be larger); its DTE or dynamic
+    factor within ``NEAR_LIMIT`` of that limit."""
+    mu = (p.dimensionless or {}).get("mu")
+    margin = NEAR_LLE * mu if mu else 0.0
+    chaos = any(r in ("chaotic", "quasi_periodic") for r in rules.fail_on)
+    found = [(p.lle, p.lle_stderr, _physical(p, "dte"), _physical(p, "dynamic_factor"))]
+    if p.attractors:
+        found = [(a.lle, a.lle_stderr, a.dte_um, a.dynamic_factor) for a in p.attractors]
+    max_lle, max_dte, max_factor = rules.max_lle, rules.max_dte_um, rules.max_dynamic_factor
+    for lle, stderr, dte, factor in found:
+        high = None if lle is None else lle + ESTIMATE_Z * (stderr or 0.0)
+        if high is not None and chaos and high > -margin:
+            return True
+        if high is not None and max_lle is not None and high > max_lle - margin:
+            return True
+        if max_dte is not None and dte is not None and dte > (1 - NEAR_LIMIT) * max_dte:
+            return True
+        if max_factor is not None and factor is not None and factor > (1 - NEAR_LIMIT) * max_factor:
+            return True
+    if p.attractors and rules.min_basin is not None:
+        ignored = rules.model_copy(update={"min_basin": None})
+        return len(attractor_failures(p, ignored)) > len(attractor_failures(p, rules))
+    return False
+
+
+def _physical(p: SweepPoint, key: str) -> float | None:
+    value = (p.physical or {}).get(key)
+    return None if value is None else value.value
+
+
 ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
 """Light integration settings of an envelope check; a design file's ``settings`` are merged
 over them (adding ``random_initial_states`` keeps the 60 + 60 periods)."""
@@ -170,12 +217,31 @@ def check_envelope(
     rules: Rules,
     progress_callback: Callable[[int, int], None] | None = None,
     workers: int = 1,
+    refine: int = REFINE_DEPTH,
+    refine_failing: bool = True,
 ) -> EnvelopeReport:
     """The gate's report of one envelope sweep, computed in this process (``workers`` threads,
-    ``balanced_chunk_points`` down to one point per chunk, as the CLI gate runs it)."""
+    ``balanced_chunk_points`` down to one point per chunk, as the CLI gate runs it), refined
+    ``refine`` times between grid points where neighbours differ or a point is near a limit
+    (``gate.resolution.refine``); ``refine_failing`` False skips the refinement when the grid
+    fails already (only pass or fail needed: refining cannot make it pass)."""
     chunk = balanced_chunk_points(request.n_points(), workers, smallest=1)
     result = run_local(request, progress_callback, chunk_points=chunk, workers=workers)
-    return envelope_report(result, rules)
+    return refined_report(request, result, rules, refine, refine_failing, workers)
+
+
+def refined_report(request: SweepRequest, result: SweepResult, rules: Rules,
+                   refine: int = REFINE_DEPTH, refine_failing: bool = True, workers: int = 1
+                   ) -> EnvelopeReport:  # fmt: skip
+    """The report of an envelope sweep's ``result`` (computed here or on a server), refined
+    between its grid points in this process as ``check_envelope`` says."""
+    report = envelope_report(result, rules, resolution=resolution(request, 0))
+    if refine <= 0 or (not refine_failing and not report.passed):
+        return report
+    added = refine_points(request, [p for p in result.points if p.branch != "down"],
+                          lambda p: bool(attractor_failures(p, rules)),
+                          lambda p: near_limit(p, rules), refine, workers)  # fmt: skip
+    return envelope_report(result, rules, added, resolution(request, refine, len(added)))
 
 
 class FailingWindow(BaseModel):
@@ -209,7 +275,15 @@ class EnvelopeReport(BaseModel):
     )
     failures: list[FailingWindow]
     windows: list[SpeedWindows] = Field(description="All response windows, failing or not.")
+    resolution: Resolution | None = Field(
+        None, description="What was checked: grid spacing, starts, and the points inserted "
+        "between grid points (null: a report read back without it).",
+    )  # fmt: skip
     sweep: SweepResult = Field(description="The sweep result (the API's document).")
+    refined: list[SweepPoint] = Field(
+        [], description="The points inserted between the grid points (gate.resolution), "
+        "checked by the same rules; their failures are in failures.",
+    )  # fmt: skip
 
 
 def _level_key(p: SweepPoint) -> tuple:
@@ -217,10 +291,12 @@ def _level_key(p: SweepPoint) -> tuple:
                         (SPEED, *RESPONSES)))  # fmt: skip
 
 
-def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
-    """Failing windows of a sweep over the driver speed (and another axis) under ``rules``."""
+def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPoint] = (),
+                    resolution: Resolution | None = None) -> EnvelopeReport:  # fmt: skip
+    """Failing windows of a sweep over the driver speed (and another axis) under ``rules``,
+    with the points ``refined`` between its grid points beside them."""
     rows: dict[tuple, list[SweepPoint]] = {}
-    for p in result.points:
+    for p in [*result.points, *refined]:
         if p.branch != "down":
             rows.setdefault(_level_key(p), []).append(p)
     failures: list[FailingWindow] = []
@@ -249,7 +325,9 @@ def envelope_report(result: SweepResult, rules: Rules) -> EnvelopeReport:
         ),
         failures=failures,
         windows=result.windows or [],
+        resolution=resolution,
         sweep=result,
+        refined=list(refined),
     )
 
 
@@ -267,7 +345,10 @@ def window_text(w: FailingWindow) -> str:
 
 
 def junit_xml(report: EnvelopeReport, name: str, levels: Sequence[dict[str, PhysicalValue]]) -> str:
-    """JUnit XML: one test case per torque level, one failure element per failing window."""
+    """JUnit XML: one test case per torque level, one failure element per failing window (a
+    level refined between the grid's, with failures, is a case too)."""
+    levels = [*levels, *(lv for lv in _distinct(w.level for w in report.failures)
+                         if lv not in levels)]  # fmt: skip
     suites = ElementTree.Element("testsuites", name="gearchaos envelope")
     suite = ElementTree.SubElement(suites, "testsuite", name=name)
     failed = 0
@@ -285,3 +366,12 @@ def junit_xml(report: EnvelopeReport, name: str, levels: Sequence[dict[str, Phys
         node.set("failures", str(failed))
         node.set("errors", "0")
     return ElementTree.tostring(suites, encoding="unicode", xml_declaration=True) + "\n"
+
+
+def _distinct(levels: Iterable[dict[str, PhysicalValue]]) -> list[dict[str, PhysicalValue]]:
+    """``levels`` without repeats, in order (dicts: not hashable)."""
+    out: list[dict[str, PhysicalValue]] = []
+    for level in levels:
+        if level not in out:
+            out.append(level)
+    return out

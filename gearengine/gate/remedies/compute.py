@@ -5,9 +5,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from gearengine.gate.envelope import (
-    check_envelope,
-)
 from gearengine.gate.remedies.request import (
     COMBINATION_GRID,
     MAX_BISECTIONS,
@@ -30,6 +27,7 @@ from gearengine.gate.remedies.search import (
     lever_outcome,
     lever_words,
     melnikov_failures,
+    shared_check,
 )
 from gearengine.numerics.batch import threads_may_share_kernels
 from gearengine.studies import jobs
@@ -41,7 +39,7 @@ def _chunk(request: RemediesRequest, index: int, chunk_points: int = 1) -> str:
     """Chunk ``index``: lever ``index`` (both bounds), or the combination (the last chunk);
     chunk 0 also carries the design's own report."""
     levers = request_levers(request)
-    baseline = check_envelope(request.sweep(), request.rules())
+    baseline = shared_check(request, request.sweep(), finish=True)
     out = ChunkOutcome(baseline=baseline if index == 0 else None, passed_already=baseline.passed)
     if baseline.passed:
         return out.model_dump_json()
@@ -57,11 +55,10 @@ def combination(request: RemediesRequest, levers: list[Lever]) -> Combination | 
     """Two levers together, when none clears the envelope alone at its far end: the two with
     the fewest failing points there (distinct fields), tried on a 3 x 3 grid of fractions of
     their ranges in order of total fraction; the first grid point that passes (None if none)."""
-    rules = request.rules()
     far: list[tuple[int, Lever]] = []
     for lever in levers:
-        report = check_envelope(request.sweep(design_with(request.design,
-                                {lever.path: lever.end})), rules)  # fmt: skip
+        report = shared_check(request, request.sweep(design_with(request.design,
+                              {lever.path: lever.end})))  # fmt: skip
         if report.passed:
             return None
         far.append((report.failing_points, lever))
@@ -73,7 +70,7 @@ def combination(request: RemediesRequest, levers: list[Lever]) -> Combination | 
                   key=lambda st: (st[0] + st[1], st[0]))  # fmt: skip
     for s, t in grid:
         values = {pair[0].path: pair[0].at(s), pair[1].path: pair[1].at(t)}
-        report = check_envelope(request.sweep(design_with(request.design, values)), rules)
+        report = shared_check(request, request.sweep(design_with(request.design, values)))
         if report.passed:
             settings = [LeverSetting(lever=lev.path, from_=lev.shown(lev.start),
                                      to=lev.shown(values[lev.path]), unit=lev.unit)
@@ -147,8 +144,18 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
             text += ")" if num.monotone else "; not unique: the response is not monotone)"
         if mel is not None:
             outcome = "passes" if mel.check.passed else "still fails"
-            text += (f"{' or' if num else ' to'} {mel.to:.4g}{unit} (Melnikov guarantee against "
-                     f"homoclinic chaos; the envelope check {outcome} there)")  # fmt: skip
+            points = mel.melnikov_points or 0
+            applies = points - (mel.not_applicable_points or 0)
+            if applies == points:
+                what = "Melnikov guarantee against homoclinic chaos"
+            elif applies:
+                what = (f"Melnikov guarantee against homoclinic chaos at the {applies} of "
+                        f"{points} points where the criterion applies")  # fmt: skip
+            else:
+                what = (f"the Melnikov criterion allows chaos nowhere but applies at none of "
+                        f"the {points} points: no guarantee")  # fmt: skip
+            text += (f"{' or' if num else ' to'} {mel.to:.4g}{unit} ({what}; the envelope check "
+                     f"{outcome} there)")  # fmt: skip
         parts.append(text)
     words = "; or ".join(parts) if parts else "no single lever clears the envelope"
     for u in unreachable:
@@ -160,11 +167,17 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
     return words
 
 
+FINER_RUNS = 2
+"""Runs on the 2x finer grid (about 4x the points) a numerical remedy's verification takes in
+the budget: its value, and one more when it fails there."""
+
+
 def _work(request: RemediesRequest) -> int:
-    """RK4 steps at most: per lever its samples, bisections and the Melnikov bound's run; the
-    combination's far ends and grid; one baseline per chunk."""
+    """RK4 steps, about: per lever its samples, bisections, the Melnikov bound's run and the
+    verification on the finer grid; the combination's far ends and grid; the baseline."""
     n = len(request_levers(request))
-    runs = n * (1 + SAMPLES + MAX_BISECTIONS + 1) + 1 + n + len(COMBINATION_GRID) ** 2
+    runs = n * (1 + SAMPLES + MAX_BISECTIONS + 1 + 4 * FINER_RUNS) + 1 + n
+    runs += len(COMBINATION_GRID) ** 2
     return runs * sweep_work(request.sweep())
 
 

@@ -23,6 +23,7 @@ from gearengine.gate.envelope import (
     envelope_sweep,
     gate_settings,
 )
+from gearengine.gate.resolution import MAX_REFINE_DEPTH, REFINE_DEPTH
 from gearengine.jsonio import message
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.errors import Problems
@@ -66,6 +67,12 @@ class Envelope(BaseModel):
                                examples=["2:40"])  # fmt: skip
     speed_points: int = Field(23, ge=1, le=200, description="Grid speeds (as the gate).")
     torque_points: int = Field(5, ge=1, le=50, description="Grid torques (as the gate).")
+    refine: int = Field(
+        REFINE_DEPTH, ge=0, le=MAX_REFINE_DEPTH,
+        description="Halvings of the grid spacing where neighbours differ or a point is near a "
+        "limit (as the gate's --refine); a remedy's value is verified on a 2x finer grid, "
+        "refined the same way.",
+    )  # fmt: skip
 
 
 class LeverRange(BaseModel):
@@ -130,12 +137,17 @@ class RemediesRequest(Rules):
         """The gate's rules of this request."""
         return Rules.model_validate(self.model_dump(include=set(Rules.model_fields)))
 
-    def sweep(self, design: Design | None = None) -> SweepRequest:
-        """The envelope's sweep of ``design`` (default: the request's)."""
+    def sweep(self, design: Design | None = None, finer: bool = False) -> SweepRequest:
+        """The envelope's sweep of ``design`` (default: the request's); ``finer``: on the grid
+        with half its spacing (2n - 1 points an axis), where a remedy is verified."""
         env = self.envelope
-        axes = [envelope_axis("speed", env.speed, "rpm", env.speed_points)]
+
+        def num(n: int) -> int:
+            return 2 * n - 1 if finer else n
+
+        axes = [envelope_axis("speed", env.speed, "rpm", num(env.speed_points))]
         if env.torque is not None:
-            axes.append(envelope_axis("torque", env.torque, "N*m", env.torque_points))
+            axes.append(envelope_axis("torque", env.torque, "N*m", num(env.torque_points)))
         settings = gate_settings(self.settings.model_dump(exclude_none=True), self.starts)
         doc = envelope_sweep((design or self.design).model_dump(), settings, axes, "remedies")
         return SweepRequest.model_validate(doc)

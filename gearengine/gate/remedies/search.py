@@ -30,10 +30,13 @@ for the combination; a chunk depends only on (request, index).
 
 from __future__ import annotations
 
+import math
+import threading
 from collections.abc import Callable
 
 from gearengine.gate.envelope import (
     EnvelopeReport,
+    attractor_failures,
     check_envelope,
 )
 from gearengine.gate.remedies.levers import accuracy_classes, contact_ratio
@@ -49,7 +52,10 @@ from gearengine.gate.remedies.results import Remedy, Sample, Unreachable
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.homoclinic.train_reduction import melnikov_point
 from gearengine.model.design import Design
-from gearengine.studies.sweep.axes import design_with
+from gearengine.studies.sweep.axes import design_with, si_value
+from gearengine.studies.sweep.compute import points_at
+from gearengine.studies.sweep.points import SweepPoint
+from gearengine.studies.sweep.request import SweepRequest
 from gearengine.systems.designs import design_model
 
 
@@ -75,10 +81,16 @@ def melnikov_failures(design: Design, points: list[dict[str, float]],
 
 
 def _search(test: Callable[[float], tuple[bool, int]], lever: Lever, samples: int,
-            width: Callable[[float, float], bool], max_steps: int
+            width: Callable[[float, float], bool], max_steps: int,
+            passes_at: Callable[[float], bool] | None = None,
+            verify: Callable[[float], bool] | None = None,
             ) -> tuple[list[Sample], bool, tuple[float, float] | None]:  # fmt: skip
     """Bracket samples of v(t), monotone on them?, and [last failing, first passing] value (SI)
-    after bisection (None when no sample passes). ``test(v) -> (passed, failing points)``."""
+    after bisection (None when no sample passes, or none passes ``verify``).
+    ``test(v) -> (passed, failing points)`` runs the samples; ``passes_at(v)`` (default: the
+    test's pass) each bisection step, where only pass or fail is needed. With ``verify`` the
+    value found must pass it too (a finer grid): if not, the search goes on from it toward the
+    far end with ``verify`` as its test, and the bracket returned is ``verify``'s."""
     ts = [k / (samples - 1) for k in range(samples)]
     results = [test(lever.at(t)) for t in ts]
     shown = [Sample(value=lever.shown(lever.at(t)), passed=r[0], failing_points=r[1])
@@ -89,17 +101,32 @@ def _search(test: Callable[[float], tuple[bool, int]], lever: Lever, samples: in
     j = passes.index(True)
     monotone = j > 0 and all(passes[j:])
     if j == 0:
-        return shown, monotone, (lever.at(0.0), lever.at(0.0))
-    fail, good = lever.at(ts[j - 1]), lever.at(ts[j])
+        fail, good = lever.at(0.0), lever.at(0.0)
+    else:
+        step = passes_at or (lambda v: test(v)[0])
+        fail, good = _bisect(step, lever.at(ts[j - 1]), lever.at(ts[j]), width, max_steps)
+    if verify is None or verify(good):
+        return shown, monotone, (fail, good)
+    later = [lever.at(t) for t, ok in zip(ts[j:], passes[j:], strict=True) if ok]
+    fail, good = good, next((v for v in later if v != good and verify(v)), None)
+    if good is None:
+        return shown, monotone, None
+    return shown, monotone, _bisect(verify, fail, good, width, max_steps)
+
+
+def _bisect(passes: Callable[[float], bool], fail: float, good: float,
+            width: Callable[[float, float], bool], max_steps: int
+            ) -> tuple[float, float]:  # fmt: skip
+    """[fail, good] narrowed by bisection with ``passes`` until ``width`` says it is narrow."""
     for _ in range(max_steps):
         if width(fail, good):
             break
         mid = 0.5 * (fail + good)
-        if test(mid)[0]:
+        if passes(mid):
             good = mid
         else:
             fail = mid
-    return shown, monotone, (fail, good)
+    return fail, good
 
 
 def _narrow(rtol: float, lever: Lever) -> Callable[[float, float], bool]:
@@ -144,21 +171,89 @@ def _uniqueness(monotone: bool) -> str:
             "this is one switch from the design's value, not a unique bound")  # fmt: skip
 
 
-def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeReport
-                  ) -> tuple[list[Remedy], list[Unreachable]]:  # fmt: skip
-    """Both bounds of one lever."""
-    rules = request.rules()
-    reports: dict[float, EnvelopeReport] = {lever.start: baseline}
+MEMO_SIZE = 32
+"""Envelope reports kept in this process (``shared_check``)."""
+_memo: dict[str, EnvelopeReport] = {}
+_memo_locks: dict[str, threading.Lock] = {}
+_memo_lock = threading.Lock()
 
-    def run(value: float) -> EnvelopeReport:
-        if value not in reports:
+
+def shared_check(request: RemediesRequest, sweep: SweepRequest, finish: bool = False
+                 ) -> EnvelopeReport:  # fmt: skip
+    """``check_envelope`` of ``sweep`` under the request's rules and refinement, computed once
+    per process: the design's own check that every chunk needs, and a lever's far end that the
+    combination checks again, are run once however many chunks ask (threads asking for the same
+    sweep wait for the first). ``finish``: refine a grid that fails too (the design's own report,
+    shown to the user); else a failing grid is not refined (only pass or fail is needed)."""
+    rules = request.rules()
+    key = "\n".join((sweep.model_dump_json(), rules.model_dump_json(),
+                      str(request.envelope.refine), str(finish)))  # fmt: skip
+    with _memo_lock:
+        lock = _memo_locks.setdefault(key, threading.Lock())
+    with lock:
+        if key not in _memo:
+            report = check_envelope(sweep, rules, refine=request.envelope.refine,
+                                    refine_failing=finish)  # fmt: skip
+            with _memo_lock:
+                while len(_memo) >= MEMO_SIZE:
+                    _memo_locks.pop(next(iter(_memo)), None)
+                    _memo.pop(next(iter(_memo)))
+                _memo[key] = report
+        return _memo[key]
+
+
+SHOWN_DIGITS = 4
+"""Significant digits of a numerical remedy's value, as the answer prints it (``.4g``)."""
+HINTS = 4
+"""Points that failed at the last failing value, run first at the next bisection value: one of
+them failing there decides the step (the envelope fails) without the rest of the grid."""
+
+
+def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeReport,
+                  check: Callable[[SweepRequest], EnvelopeReport] | None = None,
+                  ) -> tuple[list[Remedy], list[Unreachable]]:  # fmt: skip
+    """Both bounds of one lever; ``check`` runs an envelope sweep (default ``shared_check``)."""
+    rules = request.rules()
+    check = check or (lambda sweep: shared_check(request, sweep))
+    reports: dict[tuple[float, bool], EnvelopeReport] = {(lever.start, False): baseline}
+    failed: dict[bool, list[SweepPoint]] = {  # per grid (finer or not): its failing points
+        False: [p for p in baseline.sweep.points if attractor_failures(p, rules)],
+        True: [],
+    }
+
+    def run(value: float, finer: bool = False) -> EnvelopeReport:
+        if (value, finer) not in reports:
             design = design_with(request.design, {lever.path: value})
-            reports[value] = check_envelope(request.sweep(design), rules)
-        return reports[value]
+            reports[(value, finer)] = report = check(request.sweep(design, finer))
+            if not report.passed:  # its grid points: a failure there is the grid's
+                failed[finer] = [p for p in report.sweep.points if attractor_failures(p, rules)]
+        return reports[(value, finer)]
 
     def numerical(value: float) -> tuple[bool, int]:
         report = run(value)
         return report.passed, report.failing_points
+
+    def passes_at(value: float, finer: bool = False) -> bool:
+        """Pass or fail at ``value``: the grid points that failed last run first (``HINTS``);
+        one failing there fails the grid, the answer the full check would give."""
+        sweep = request.sweep(design_with(request.design, {lever.path: value}), finer)
+        names = [a.parameter for a in sweep.axes]
+        hints = [{n: p.values[n] for n in names} for p in failed[finer][:HINTS]]
+        if hints and any(attractor_failures(p, rules) for p in points_at(sweep, hints)):
+            return False
+        return run(value, finer).passed
+
+    def snapped(value: float) -> float:
+        """``value`` as the answer prints it (``SHOWN_DIGITS``, rounded toward the far end),
+        read back as a design file reads it: the value verified is the one a user types."""
+        shown = lever.shown(value)
+        digits = SHOWN_DIGITS - 1 - math.floor(math.log10(abs(shown))) if shown else 0
+        toward = math.ceil if lever.end > lever.start else math.floor
+        near = toward(round(shown * 10**digits, 6)) / 10**digits
+        if (near - lever.shown(lever.end)) * (lever.end - lever.start) > 0:
+            return lever.end
+        return si_value(request.design, lever.path, near if lever.unit == "1"
+                        else f"{near!r} {lever.unit}")  # fmt: skip
 
     points = envelope_points(request)
 
@@ -173,17 +268,25 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
         ("numerical", numerical, SAMPLES, request.tolerance, MAX_BISECTIONS),
         ("melnikov", melnikov, MELNIKOV_SAMPLES, MELNIKOV_RTOL, 60),
     ):
-        shown, monotone, bracket = _search(test, lever, samples, _narrow(rtol, lever), steps)
+        shown, monotone, bracket = _search(
+            test, lever, samples, _narrow(rtol, lever), steps,
+            passes_at=passes_at if bound == "numerical" else None,
+            verify=(lambda v: passes_at(snapped(v), finer=True)) if bound == "numerical"
+            else None,
+        )  # fmt: skip
         if bracket is None:
+            far = run(lever.end) if bound == "numerical" else None
             unreachable.append(Unreachable(
                 lever=lever.path, bound=bound, searched=searched, samples=shown,
-                why=_why(bound, lever, shown, run(lever.end) if bound == "numerical" else None),
+                why=_why(bound, lever, shown, far, run(lever.end, finer=True) if far is not None
+                         and far.passed else None),
             ))  # fmt: skip
             continue
         fail, to = bracket
+        to = snapped(to) if bound == "numerical" else to
         if bound == "melnikov" and to == lever.start:
             continue  # the criterion rules chaos out already: no change needed for it
-        report = run(to)
+        report = run(to, finer=bound == "numerical")
         blind = None
         if bound == "melnikov":
             blind = melnikov_failures(request.design, points, {lever.path: to})[1]
@@ -192,32 +295,51 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
             unit=lever.unit, bound=bound, monotone=monotone,
             bracket=[lever.shown(fail), lever.shown(to)], samples=shown,
             not_applicable_points=blind, check=report,
+            melnikov_points=len(points) if bound == "melnikov" else None,
             contact_ratio=contact_ratio(design_with(request.design, {lever.path: to})),
             iso1328_class=accuracy_classes(request.design, lever, to),
-            summary=_summary(bound, lever, to, monotone, report, blind),
+            summary=_summary(bound, lever, to, monotone, report, blind, len(points)),
         ))  # fmt: skip
     return remedies, unreachable
 
 
+def melnikov_words(applies: int, points: int) -> str:
+    """What the Melnikov criterion guarantees at a value where it allows chaos nowhere:
+    ``applies`` of ``points`` envelope grid points are judged (the rest have no saddle under
+    their load), and the guarantee is stated only where it applies."""
+    if applies == 0:
+        return (f"the Melnikov criterion applies at none of the {points} envelope points (no "
+                "saddle under their load), so it guarantees nothing there")  # fmt: skip
+    where = ("every envelope point" if applies == points else
+             f"the {applies} of {points} envelope points where it applies (no saddle under the "
+             "load at the others: not judged)")  # fmt: skip
+    return f"the Melnikov criterion rules out homoclinic chaos at {where}"
+
+
 def _summary(bound: str, lever: Lever, to: float, monotone: bool, report: EnvelopeReport,
-             blind: int | None) -> str:  # fmt: skip
-    run = (f"the envelope check passes there ({report.points} points run)" if report.passed
-           else f"the envelope check still fails there at {report.failing_points} of "
-           f"{report.points} points")  # fmt: skip
+             blind: int | None, points: int) -> str:  # fmt: skip
+    grid = f"; {report.resolution.text()}" if report.resolution is not None else ""
+    finer = " on the 2x finer grid" if bound == "numerical" else ""
+    run = (f"the envelope check passes there{finer} ({report.points} points run{grid})"
+           if report.passed else f"the envelope check still fails there at "
+           f"{report.failing_points} of {report.points} points{grid}")  # fmt: skip
     if bound == "numerical":
         return f"{change_words(lever, to)}: {run}{_uniqueness(monotone)}"
-    na = (f"; the criterion does not apply at {blind} of {report.points} points (no saddle "
-          "under that load: not judged there)" if blind else "")  # fmt: skip
-    return (f"{change_words(lever, to)}: the Melnikov criterion rules out homoclinic chaos at "
-            f"every envelope point{na}; {run}{_uniqueness(monotone)}")  # fmt: skip
+    words = melnikov_words(points - (blind or 0), points)
+    return f"{change_words(lever, to)}: {words}; {run}{_uniqueness(monotone)}"
 
 
-def _why(bound: str, lever: Lever, samples: list[Sample], far: EnvelopeReport | None) -> str:
+def _why(bound: str, lever: Lever, samples: list[Sample], far: EnvelopeReport | None,
+         finer: EnvelopeReport | None = None) -> str:  # fmt: skip
     values = ", ".join(f"{s.value:g}" for s in samples)
     if bound == "melnikov":
         return (f"the Melnikov criterion allows chaos somewhere in the envelope at every sampled "
                 f"{lever_words(lever.path)} ({values}{lever.suffix})")  # fmt: skip
     assert far is not None
+    if finer is not None:
+        return (f"sampled {lever_words(lever.path)} values pass the envelope's grid but none "
+                f"passes its 2x finer grid; at {lever.shown(lever.end):g}{lever.suffix} "
+                f"{finer.failing_points} of {finer.points} points fail there")  # fmt: skip
     return (f"no sampled {lever_words(lever.path)} ({values}{lever.suffix}) clears the envelope; "
             f"at {lever.shown(lever.end):g}{lever.suffix} {far.failing_points} of {far.points} "
             "points still fail")  # fmt: skip

@@ -113,23 +113,40 @@ def _compute(
     scaled = [request.scaled_point(v) for v in values]
     designs = [params for params, _ in scaled]
     if not request.continuation:
-        verdicts = simulate_batch(designs, request.settings)
-    else:
-        verdicts = []
-        settings = request.settings
-        for design in designs:
-            (bp,) = simulate_batch([design], settings)
-            verdicts.append(bp)
-            settings = _carried(request.settings, bp)
-    ensembles = _basins(request, scaled, verdicts)
-    points = [
-        _point(v, chunk.branch, params, scales, bp, e)
-        for v, (params, scales), bp, e in zip(values, scaled, verdicts, ensembles, strict=True)
-    ]
-    if not request.continuation or len(axes) != 1 or len(values) < 2:
+        return _points(request, values, chunk.branch, scaled,
+                       simulate_batch(designs, request.settings)), None  # fmt: skip
+    verdicts = []
+    settings = request.settings
+    for design in designs:
+        (bp,) = simulate_batch([design], settings)
+        verdicts.append(bp)
+        settings = _carried(request.settings, bp)
+    points = _points(request, values, chunk.branch, scaled, verdicts)
+    if len(axes) != 1 or len(values) < 2:
         return points, None
     line = [v[axes[0].parameter] for v in values]
     return points, _line_bifurcations(request, line, designs, verdicts)
+
+
+def points_at(request: SweepRequest, values: list[dict[str, float]]) -> list[SweepPoint]:
+    """The points of a sweep without continuation at any ``values`` of its axes (SI, as a
+    point's ``values``), not only its grid's: each computed as a grid point is (the same
+    settings, starts and verdict), e.g. the gate's refinement between grid points."""
+    assert not request.continuation, "a continuation line's points depend on their order"
+    scaled = [request.scaled_point(v) for v in values]
+    verdicts = simulate_batch([params for params, _ in scaled], request.settings)
+    return _points(request, values, None, scaled, verdicts)
+
+
+def _points(request: SweepRequest, values: list[dict[str, float]], branch: SweepBranch | None,
+            scaled: list[tuple[GearParams, Scales | None]], verdicts: list[BatchPoint]
+            ) -> list[SweepPoint]:  # fmt: skip
+    """The sweep's points from the engine's verdicts at ``values``, with their ensembles."""
+    ensembles = _basins(request, scaled, verdicts)
+    return [
+        _point(v, branch, params, scales, bp, e)
+        for v, (params, scales), bp, e in zip(values, scaled, verdicts, ensembles, strict=True)
+    ]
 
 
 def _basins(

@@ -1,0 +1,66 @@
+"""The gate states the resolution it checked and refines between grid points: chaos in a narrow
+window between two passing grid points next to a point near the chaos limit is found, as a
+finer grid finds it (issue 30.4).
+
+The case is the z = 23/67 class-7 pair of ``examples/remedies-z23-67.json`` with the
+transmission error lowered to 4.591 µm (the remedy the default 23 x 5 grid accepted): at 5 N*m,
+4,500 and 5,000 rpm are periodic, 4,750 rpm is chaotic from about 40 % of the 16 starts, and the
+period-2 attractor at 4,500 rpm contracts at half the linear rate (LLE -0.024 at mu = 0.05).
+"""
+
+from __future__ import annotations
+
+import json
+
+from gearengine.gate.envelope import (
+    Rules,
+    envelope_axis,
+    envelope_sweep,
+    gate_settings,
+    junit_xml,
+    near_limit,
+    refined_report,
+)
+from gearengine.studies.sweep import run_local, validated
+from tests.conftest import ROOT
+
+DESIGN = ROOT / "examples" / "remedies-z23-67.json"
+
+
+def sweep(te_um: float, speed: str, num: int) -> object:
+    design = json.loads(DESIGN.read_text())["design"]
+    design["transmission_error"]["harmonics"][0]["amplitude"] = f"{te_um} um"
+    axes = [envelope_axis("speed", speed, "rpm", num), envelope_axis("torque", "5:5", "N*m", 1)]
+    return validated(envelope_sweep(design, gate_settings({}, None), axes, "resolution test"))
+
+
+def test_refinement_finds_chaos_between_passing_grid_points() -> None:
+    request = sweep(4.591, "4500:5000", 2)
+    result = run_local(request, chunk_points=1)
+    rules = Rules()
+    coarse = refined_report(request, result, rules, refine=0)
+    assert coarse.passed and coarse.points == 2
+    assert coarse.resolution is not None and coarse.resolution.starts == 16
+    assert coarse.resolution.speed_step_rpm == 500.0
+    assert "not refined between grid points" in coarse.resolution.text()
+    assert any(near_limit(p, rules) for p in result.points)
+
+    fine = refined_report(request, result, rules, refine=1)
+    assert not fine.passed and fine.points == 3 and fine.failing_points == 1
+    assert fine.resolution is not None and fine.resolution.refined_points == 1
+    assert fine.resolution.finest_speed_step_rpm == 250.0
+    assert "refined to 250 rpm" in fine.resolution.text()
+    (window,) = fine.failures
+    assert window.rule == "chaotic" and window.speeds_rpm == [4750.0, 4750.0]
+    assert window.attractors and "% of starts" in window.attractors[0]
+    assert "<failure " in junit_xml(fine, "envelope", [w.level for w in fine.windows])
+
+
+def test_a_point_far_from_every_limit_is_not_refined() -> None:
+    """Two passing grid points, both contracting near the linear rate: nothing is inserted."""
+    request = sweep(4.591, "4500:4625", 2)
+    result = run_local(request, chunk_points=1)
+    rules = Rules(fail_on=["diverged"])  # the chaos limit is not a rule: LLEs are not near it
+    report = refined_report(request, result, rules, refine=2)
+    assert report.passed and report.resolution is not None
+    assert report.resolution.refined_points == 0 and report.points == 2
