@@ -117,10 +117,10 @@ def test_the_envelope_gate_checks_a_train() -> None:
         {"parameter": "torque", "start": "20 N*m", "stop": "40 N*m", "num": 2},
     ]
     request = validated(sweep(axes))
-    report = check_envelope(request, Rules(max_dte_um=1.0))
+    report = check_envelope(request, Rules(max_dte_um=1.0), refine=0)
     dtes = [p.physical["dte"].value for p in report.sweep.points]
     limit = sorted(dtes)[1] * 1.0001
-    report = check_envelope(request, Rules(max_dte_um=limit))
+    report = check_envelope(request, Rules(max_dte_um=limit), refine=0)  # the grid's points
     assert report.points == 4
     assert report.failing_points == sum(d > limit for d in dtes) == 2
     assert not report.passed and all("DTE" in w.rule for w in report.failures)
