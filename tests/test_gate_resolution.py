@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import json
 
+from gearengine.cli.junit import envelope_junit
 from gearengine.gate.envelope import (
     Rules,
     envelope_axis,
     envelope_sweep,
     gate_settings,
-    junit_xml,
     near_limit,
     refined_report,
 )
@@ -53,7 +53,7 @@ def test_refinement_finds_chaos_between_passing_grid_points() -> None:
     (window,) = fine.failures
     assert window.rule == "chaotic" and window.speeds_rpm == [4750.0, 4750.0]
     assert window.attractors and "% of starts" in window.attractors[0]
-    assert "<failure " in junit_xml(fine, "envelope", [w.level for w in fine.windows])
+    assert "<failure " in envelope_junit(fine, "envelope")
 
 
 def test_a_point_far_from_every_limit_is_not_refined() -> None:

@@ -18,9 +18,8 @@ the attractors that broke it with their fractions.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from typing import Literal
-from xml.etree import ElementTree
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -342,36 +341,3 @@ def window_text(w: FailingWindow) -> str:
     span = f"{lo:g} rpm" if lo == hi else f"{lo:g}-{hi:g} rpm"
     who = "" if not w.attractors else f" ({'; '.join(w.attractors)})"
     return f"{level_text(w.level)}: {w.rule} at {span}{who}"
-
-
-def junit_xml(report: EnvelopeReport, name: str, levels: Sequence[dict[str, PhysicalValue]]) -> str:
-    """JUnit XML: one test case per torque level, one failure element per failing window (a
-    level refined between the grid's, with failures, is a case too)."""
-    levels = [*levels, *(lv for lv in _distinct(w.level for w in report.failures)
-                         if lv not in levels)]  # fmt: skip
-    suites = ElementTree.Element("testsuites", name="gearchaos envelope")
-    suite = ElementTree.SubElement(suites, "testsuite", name=name)
-    failed = 0
-    for level in levels:
-        case = ElementTree.SubElement(
-            suite, "testcase", classname="gearchaos.envelope", name=level_text(level), time="0"
-        )
-        mine = [w for w in report.failures if w.level == level]
-        failed += bool(mine)
-        for w in mine:
-            node = ElementTree.SubElement(case, "failure", message=window_text(w), type=w.rule)
-            node.text = window_text(w)
-    for node in (suites, suite):
-        node.set("tests", str(len(levels)))
-        node.set("failures", str(failed))
-        node.set("errors", "0")
-    return ElementTree.tostring(suites, encoding="unicode", xml_declaration=True) + "\n"
-
-
-def _distinct(levels: Iterable[dict[str, PhysicalValue]]) -> list[dict[str, PhysicalValue]]:
-    """``levels`` without repeats, in order (dicts: not hashable)."""
-    out: list[dict[str, PhysicalValue]] = []
-    for level in levels:
-        if level not in out:
-            out.append(level)
-    return out
