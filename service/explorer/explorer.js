@@ -442,8 +442,6 @@ async function analyse() {
 }
 
 // ---------------------------------------------------------------- the envelope
-let polling = null; // {id, timer}
-
 const recentJobs = () => JSON.parse(localStorage.getItem(JOBS_STORE) || "[]");
 function rememberJob(job) {
   const jobs = [job, ...recentJobs().filter((j) => j.id !== job.id)].slice(0, 10);
@@ -500,8 +498,6 @@ async function mapRange() {
 }
 
 function watchJob(id) {
-  if (polling) clearTimeout(polling.timer);
-  polling = { id, timer: null };
   $("welcome").hidden = true;
   $("envelope").hidden = false;
   $("envelope-progress-row").hidden = false;
@@ -509,48 +505,76 @@ function watchJob(id) {
   $("envelope-map").replaceChildren();
   $("windows").replaceChildren();
   $("envelope").scrollIntoView({ block: "start" });
-  poll(id);
+  envelopeJob.start(id);
 }
 
-async function poll(id) {
-  if (!polling || polling.id !== id) return;
-  let res;
-  try {
-    res = await api("GET", `/v1/sweeps/${id}`);
-  } catch (err) { // the server is restarting, say: the job is durable, keep asking
-    $("envelope-progress-text").textContent = "server not answering, retrying…";
-    polling.timer = setTimeout(() => poll(id), 3000);
-    return;
+// One durable job watched in its panel (the envelope, a robustness study, a run-up): its status
+// and progress in <prefix>-status, <prefix>-progress and <prefix>-progress-text, polled every
+// second (every 3 s while the server does not answer: the job is durable, keep asking), the
+// cancel button shown while it is queued or running, and its result handed to onResult.
+class JobWatcher {
+  constructor({ route, prefix, cancel, unit, onResult, onStatus = () => {} }) {
+    Object.assign(this, { route, prefix, cancel, unit, onResult, onStatus });
+    this.job = null; // {id, timer, result}
   }
-  if (!res.ok) {
-    $("envelope-status").textContent = "unavailable";
-    $("envelope-progress-text").textContent = (await problemOf(res)).detail;
-    updateJob(id, { status: res.status === 404 ? "gone" : "unavailable" });
-    return;
+
+  start(id) {
+    if (this.job) clearTimeout(this.job.timer);
+    this.job = { id, timer: null };
+    this.poll(id);
   }
-  const job = await res.json();
-  const { done, total } = job.progress;
-  $("envelope-status").textContent = job.status;
-  $("envelope-progress").max = total || 1;
-  $("envelope-progress").value = done;
-  $("envelope-progress-text").textContent = `${done} / ${total} points`;
-  $("cancel-sweep").hidden = !["queued", "running"].includes(job.status);
-  updateJob(id, { status: job.status });
-  if (job.status === "queued" || job.status === "running") {
-    polling.timer = setTimeout(() => poll(id), 1000);
-  } else if (job.status === "succeeded") {
-    const result = await api("GET", `/v1/sweeps/${id}/result`);
-    if (result.ok) drawEnvelope(id, await result.json());
-  } else {
-    $("envelope-progress-text").textContent += job.error ? ` · ${job.error}` : "";
+
+  text(t) { $(`${this.prefix}-progress-text`).textContent = t; }
+
+  async poll(id) {
+    if (!this.job || this.job.id !== id) return;
+    let res;
+    try {
+      res = await api("GET", `/v1/${this.route}/${id}`);
+    } catch (err) {
+      this.text("server not answering, retrying…");
+      this.job.timer = setTimeout(() => this.poll(id), 3000);
+      return;
+    }
+    if (!res.ok) {
+      $(`${this.prefix}-status`).textContent = "unavailable";
+      this.text((await problemOf(res)).detail);
+      this.onStatus(id, res.status === 404 ? "gone" : "unavailable");
+      return;
+    }
+    const job = await res.json();
+    const { done, total } = job.progress;
+    $(`${this.prefix}-status`).textContent = job.status;
+    $(`${this.prefix}-progress`).max = total || 1;
+    $(`${this.prefix}-progress`).value = done;
+    this.text(`${done} / ${total} ${this.unit}`);
+    $(this.cancel).hidden = !["queued", "running"].includes(job.status);
+    this.onStatus(id, job.status);
+    if (job.status === "queued" || job.status === "running") {
+      this.job.timer = setTimeout(() => this.poll(id), 1000);
+    } else if (job.status === "succeeded") {
+      const result = await api("GET", `/v1/${this.route}/${id}/result`);
+      if (result.ok) {
+        this.job.result = await result.json();
+        this.onResult(id, this.job.result);
+      }
+    } else {
+      this.text(`${done} / ${total} ${this.unit}` + (job.error ? ` · ${job.error}` : ""));
+    }
+  }
+
+  async stop() {
+    if (!this.job) return;
+    await api("DELETE", `/v1/${this.route}/${this.job.id}`);
+    this.poll(this.job.id);
   }
 }
 
-async function cancelSweep() {
-  if (!polling) return;
-  await api("DELETE", `/v1/sweeps/${polling.id}`);
-  poll(polling.id);
-}
+const envelopeJob = new JobWatcher({
+  route: "sweeps", prefix: "envelope", cancel: "cancel-sweep", unit: "points",
+  onResult: (id, result) => drawEnvelope(id, result),
+  onStatus: (id, status) => updateJob(id, { status }),
+});
 
 let plotlyLoading = null;
 function loadPlotly() {
@@ -799,7 +823,7 @@ async function start() {
   $("train-example").addEventListener("click", () => { $("train").value = JSON.stringify(defaults.train, null, 1); });
   $("design-form").addEventListener("submit", (e) => { e.preventDefault(); analyse(); });
   $("envelope-form").addEventListener("submit", (e) => { e.preventDefault(); mapRange(); });
-  $("cancel-sweep").addEventListener("click", cancelSweep);
+  $("cancel-sweep").addEventListener("click", () => envelopeJob.stop());
   $("fix-it").addEventListener("click", fixIt);
   $("threshold-parameter").addEventListener("change", loadThresholds);
   document.querySelectorAll("figure img, #campbell-figure").forEach((img) => img.addEventListener("click", () => enlarge(img)));

@@ -13,7 +13,10 @@ const ROBUSTNESS_FIELDS = [
 const PROBABILITIES = [
   ["chaotic", "P(chaotic)"], ["impacts", "P(tooth separation)"], ["back_flank", "P(back-flank impacts)"],
 ];
-let studying = null; // {id, timer}
+const studyJob = new JobWatcher({
+  route: "robustness", prefix: "robustness", cancel: "cancel-study", unit: "runs (samples × points)",
+  onResult: (id, result) => drawProbabilities(result),
+});
 
 function buildRobustnessForm() {
   for (const [p, label, kind, value] of ROBUSTNESS_FIELDS) {
@@ -23,8 +26,8 @@ function buildRobustnessForm() {
   }
   for (const [name, label] of PROBABILITIES) $("robustness-output").append(el("option", { value: name, text: label }));
   $("robustness-form").addEventListener("submit", (ev) => { ev.preventDefault(); studyRange(); });
-  $("cancel-study").addEventListener("click", cancelStudy);
-  $("robustness-output").addEventListener("change", () => studying && studying.result && drawProbabilities(studying.result));
+  $("cancel-study").addEventListener("click", () => studyJob.stop());
+  $("robustness-output").addEventListener("change", () => studyJob.job && studyJob.job.result && drawProbabilities(studyJob.job.result));
 }
 
 function studyBody() {
@@ -66,55 +69,12 @@ async function studyRange() {
     return;
   }
   const job = await res.json();
-  if (studying) clearTimeout(studying.timer);
-  studying = { id: job.id, timer: null };
   $("welcome").hidden = true;
   $("robustness").hidden = false;
   $("robustness-progress-row").hidden = false;
   $("robustness-map").replaceChildren();
   $("robustness").scrollIntoView({ block: "start" });
-  pollStudy(job.id);
-}
-
-async function pollStudy(id) {
-  if (!studying || studying.id !== id) return;
-  let res;
-  try {
-    res = await api("GET", `/v1/robustness/${id}`);
-  } catch (err) {
-    $("robustness-progress-text").textContent = "server not answering, retrying…";
-    studying.timer = setTimeout(() => pollStudy(id), 3000);
-    return;
-  }
-  if (!res.ok) {
-    $("robustness-status").textContent = "unavailable";
-    $("robustness-progress-text").textContent = (await problemOf(res)).detail;
-    return;
-  }
-  const job = await res.json();
-  const { done, total } = job.progress;
-  $("robustness-status").textContent = job.status;
-  $("robustness-progress").max = total || 1;
-  $("robustness-progress").value = done;
-  $("robustness-progress-text").textContent = `${done} / ${total} runs (samples × points)`;
-  $("cancel-study").hidden = !["queued", "running"].includes(job.status);
-  if (job.status === "queued" || job.status === "running") {
-    studying.timer = setTimeout(() => pollStudy(id), 1000);
-  } else if (job.status === "succeeded") {
-    const result = await api("GET", `/v1/robustness/${id}/result`);
-    if (result.ok) {
-      studying.result = await result.json();
-      drawProbabilities(studying.result);
-    }
-  } else {
-    $("robustness-progress-text").textContent += job.error ? ` · ${job.error}` : "";
-  }
-}
-
-async function cancelStudy() {
-  if (!studying) return;
-  await api("DELETE", `/v1/robustness/${studying.id}`);
-  pollStudy(studying.id);
+  studyJob.start(job.id);
 }
 
 async function drawProbabilities(result) {

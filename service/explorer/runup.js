@@ -12,7 +12,10 @@ const RUNUP_FIELDS = [
   ["direction", "direction", ["up", "down", "up_down"], "up"],
   ["bin_rpm", "bin width [rpm]", "num", "100"],
 ];
-let ramping = null; // {id, timer}
+const runupJob = new JobWatcher({
+  route: "runups", prefix: "runup", cancel: "cancel-runup", unit: "ramp segments",
+  onResult: (id, result) => showRunup(id, result),
+});
 
 function buildRunupForm() {
   for (const [p, label, kind, value] of RUNUP_FIELDS) {
@@ -21,7 +24,7 @@ function buildRunupForm() {
     $("runup-fields").append(f);
   }
   $("runup-form").addEventListener("submit", (ev) => { ev.preventDefault(); runUp(); });
-  $("cancel-runup").addEventListener("click", cancelRunup);
+  $("cancel-runup").addEventListener("click", () => runupJob.stop());
   $("runup-figure").addEventListener("click", () => enlarge($("runup-figure")));
 }
 
@@ -52,8 +55,6 @@ async function runUp() {
     return;
   }
   const job = await res.json();
-  if (ramping) clearTimeout(ramping.timer);
-  ramping = { id: job.id, timer: null };
   $("welcome").hidden = true;
   $("runup").hidden = false;
   $("runup-progress-row").hidden = false;
@@ -61,45 +62,7 @@ async function runUp() {
   $("runup-figure").dataset.state = "waiting";
   $("runup-summary").replaceChildren();
   $("runup").scrollIntoView({ block: "start" });
-  pollRunup(job.id);
-}
-
-async function pollRunup(id) {
-  if (!ramping || ramping.id !== id) return;
-  let res;
-  try {
-    res = await api("GET", `/v1/runups/${id}`);
-  } catch (err) {
-    $("runup-progress-text").textContent = "server not answering, retrying…";
-    ramping.timer = setTimeout(() => pollRunup(id), 3000);
-    return;
-  }
-  if (!res.ok) {
-    $("runup-status").textContent = "unavailable";
-    $("runup-progress-text").textContent = (await problemOf(res)).detail;
-    return;
-  }
-  const job = await res.json();
-  const { done, total } = job.progress;
-  $("runup-status").textContent = job.status;
-  $("runup-progress").max = total || 1;
-  $("runup-progress").value = done;
-  $("runup-progress-text").textContent = `${done} / ${total} ramp segments`;
-  $("cancel-runup").hidden = !["queued", "running"].includes(job.status);
-  if (job.status === "queued" || job.status === "running") {
-    ramping.timer = setTimeout(() => pollRunup(id), 1000);
-  } else if (job.status === "succeeded") {
-    const result = await api("GET", `/v1/runups/${id}/result`);
-    if (result.ok) showRunup(id, await result.json());
-  } else {
-    $("runup-progress-text").textContent += job.error ? ` · ${job.error}` : "";
-  }
-}
-
-async function cancelRunup() {
-  if (!ramping) return;
-  await api("DELETE", `/v1/runups/${ramping.id}`);
-  pollRunup(ramping.id);
+  runupJob.start(job.id);
 }
 
 // runs of neighbouring bins where pick(bin) holds, as "1,200-1,800 rpm"
