@@ -140,6 +140,9 @@ def request_errors(request: RobustnessRequest) -> list[InitErrorDetails]:
         problems.add(("samples",), "give a power of 2 (the Sobol points' balance)", 0)
     try:  # the pair itself, before its axes: a geometry that does not mesh is the design's
         convert_design(request.design)
+    except InputError as exc:  # naming its field (design.driven.base_radius, ...)
+        problems.add_error(exc, None)
+        return problems.details
     except ValueError as exc:
         problems.add(("design",), str(exc), 0)
         return problems.details
