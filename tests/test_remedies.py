@@ -311,6 +311,9 @@ def test_melnikov_guarantee_only_where_the_criterion_applies() -> None:
         return answer_words([mel], [], None)
 
     assert "guarantee against" not in said(115) and "applies at none of the 115" in said(115)
+    # judging no point and with no numerical value, it is not offered as a remedy (the answer
+    # said "or lower ... to 4 um (... no guarantee ...)" beside "no value ... clears")
+    assert said(115).startswith("no single lever clears the envelope; ")
     assert "guarantee against homoclinic chaos at the 40 of 115 points" in said(75)
     assert "(Melnikov guarantee against homoclinic chaos;" in said(0)
 

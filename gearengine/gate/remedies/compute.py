@@ -127,12 +127,19 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
     by_lever: dict[tuple[str, bool], dict[str, Remedy]] = {}
     for r in remedies:
         by_lever.setdefault((r.lever, r.to > r.from_), {})[r.bound] = r
-    parts = []
+    parts, blind = [], []
     for found in by_lever.values():
         num, mel = found.get("numerical"), found.get("melnikov")
         first = num or mel
         assert first is not None
         unit = "" if first.unit == "1" else f" {first.unit}"
+        if num is None and mel is not None and _judged(mel) == 0:
+            # no numerical value and a criterion that judges no point: not a remedy to offer
+            blind.append(f"{lever_words(mel.lever)} at {mel.to:.4g}{unit}: the Melnikov "
+                         "criterion allows chaos nowhere but applies at none of the "
+                         f"{mel.melnikov_points or 0} points, so it guarantees "
+                         "nothing")  # fmt: skip
+            continue
         words = lever_words(first.lever)
         verb = "raise" if first.to > first.from_ else "lower"
         text = f"{verb} the {words} from {first.from_:.4g}"
@@ -144,8 +151,7 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
             text += ")" if num.monotone else "; not unique: the response is not monotone)"
         if mel is not None:
             outcome = "passes" if mel.check.passed else "still fails"
-            points = mel.melnikov_points or 0
-            applies = points - (mel.not_applicable_points or 0)
+            points, applies = mel.melnikov_points or 0, _judged(mel)
             if applies == points:
                 what = "Melnikov guarantee against homoclinic chaos"
             elif applies:
@@ -162,9 +168,16 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
         if u.bound == "numerical":
             words += (f"; {lever_words(u.lever)} has no value in {u.searched[0]} to "
                       f"{u.searched[1]} that clears the envelope")  # fmt: skip
+    for b in blind:
+        words += f"; {b}"
     if combo is not None:
         words += f"; together: {combo.summary}"
     return words
+
+
+def _judged(mel: Remedy) -> int:
+    """Envelope points where a Melnikov value's criterion applies (has a saddle to judge)."""
+    return (mel.melnikov_points or 0) - (mel.not_applicable_points or 0)
 
 
 FINER_RUNS = 2
