@@ -114,9 +114,13 @@ def main() -> None:
         "work left by adaptive stopping (periods run over the fixed length's 1,000 per point) "
         "shared by 2 cores, at gear_ref's own cost per point-step (the cubic lanes cost about "
         "the same, `kink-lanes` above): what the service would take with no Python and no job "
-        "queue at all. The chaotic points (35 % of the map) run at least 700 periods (500 "
-        "transient, then 200 recorded before the LLE rule may stop them) and are most of the "
-        "work, so 0.2x needs shorter transients or records, not a faster kernel.\n\n"
+        "queue at all. With physical time (issue 31, `numerics/physical.py`; T0 is one mesh "
+        "period here) a chaotic point (35 % of the map) keeps the whole 500-period transient "
+        "and records 400 periods, then 500 again from the same state when the LLE's error is "
+        "not yet met (one uninterrupted record): up to 1,400 periods, where the kernels' own "
+        "LLE rule stopped the record from 200. That is why the periods run rose from 0.425 to "
+        "0.56 of the fixed length on this map, and 0.2x needs shorter records of chaos, not a "
+        "faster kernel.\n\n"
         + "\n".join(table)
         + f"\n\nLoad average (1 min) at the end of the run: {load:.1f} on 2 cores.\n"
     )
