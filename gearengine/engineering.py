@@ -3,22 +3,19 @@
 From the design's conversion (``model.design``) and the dimensionless verdicts this module
 gives what a gearbox engineer asks:
 
-* ``speed_windows_rpm``: the driver speeds at which the Melnikov criterion allows chaos at the
-  design's torque. A change of running speed scales every excitation frequency together (their
-  ratios fixed; amplitudes F~_er = e_r / b and F~_pr do not depend on speed), so the windows are
-  the sign changes of the sign-change strength along that scaling, located by brentq; the scan
-  runs on past the requested range until the last window closes, or to ``WINDOW_BOUND`` times
-  the design speed, where an open window is reported as open-ended;
+* ``speed_windows_rpm``: the driver speeds where the Melnikov criterion allows chaos at the
+  design's torque: the sign changes of the sign-change strength as a change of speed scales every
+  excitation frequency together (F~_er = e_r / b and F~_pr do not depend on speed), by brentq,
+  scanned past the requested range to ``WINDOW_BOUND`` times the design speed (then open-ended);
 * ``critical_torque_nm``: the mean driver torque T_crit at which the static mesh force reaches
   F_crit of the cubic fit; above it the unperturbed system has no saddle and the criterion does
   not apply (``docs/melnikov-under-load.md``);
 * the critical value of each control parameter in its unit, and ``margin_to_chaos``: the
   threshold's margin in that unit, positive on the safe side, negative inside the
   chaos-possible region (Eqs. 23, 24 generalised);
-* for analyses, the response: dynamic transmission error b (x_max - x_min), the dynamic mesh
-  force b k_m [K(t) f_h(x) + 2 mu~ x'] and the dynamic factor (max force / static force F^_m),
-  the fractions of time with the teeth apart (|x| <= 1) and on the back flank (x < -1), the
-  response period and the dominant response frequency;
+* for analyses, the response: DTE b (x_max - x_min), the dynamic mesh force b k_m [K(t) f_h(x)
+  + 2 mu~ x'] and the dynamic factor (max force / static force F^_m), the fractions of time
+  apart (|x| <= 1) and on the back flank (x < -1), the period and dominant response frequency;
 * ``summary``: plain sentences for a design review.
 
 Every dimensionless number crosses to gear units through ``model.units.to_physical`` (the
@@ -347,8 +344,8 @@ def summary(
 ) -> str:
     """Two or three sentences an engineer can paste into a design review; with basins the
     response named is the worst attractor's above the basin threshold (``decided``, with its
-    fraction), and the contact, DTE and dynamic factor those of the recorded run, said so when
-    that run settled elsewhere."""
+    fraction and LLE), and the contact, DTE, dynamic factor and the LLE that follow are the
+    recorded run's when that run settled elsewhere (said so)."""
     t_crit = critical_torque(conv, mel)
     if over_critical(conv, mel) and t_crit is not None and mel.critical_mean_force:
         words = load_words(conv, mel.critical_mean_force, t_crit)
@@ -359,28 +356,25 @@ def summary(
             f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion {here}; at this torque it "
             f"{_windows_text(windows, rng)}."
         )
-        if (
-            t_crit is not None
-            and mel.mean_load == "perturbation"
-            and abs(conv.params.mean_force) >= (mel.critical_mean_force or math.inf)
-        ):
-            text += (
-                f" This is the paper's first-order answer outside its domain: above the critical "
-                f"torque {t_crit:,.3g} N*m the loaded system has no saddle."
-            )
+        outside = abs(conv.params.mean_force) >= (mel.critical_mean_force or math.inf)
+        if t_crit is not None and mel.mean_load == "perturbation" and outside:
+            text += (f" This is the paper's first-order answer outside its domain: above the "
+                     f"critical torque {t_crit:,.3g} N*m the loaded system has no "
+                     "saddle.")  # fmt: skip
         elif t_crit is not None:
             text += f" It applies below the critical torque {t_crit:,.3g} N*m."
     if num is not None and resp is not None:
         kind = f"periodic ({num.period}T)" if num.period else num.classification.replace("_", "-")
+        other = decided is not None and decided.kind != kind  # the worst attractor is not the run
         if decided is None:
             text += f" The simulated response is {kind}"
-        elif decided.kind == kind:
+        elif not other:
             text += f" The simulated response is {kind} ({decided.decided_by})"
-        else:
-            text += (
-                f" The simulated response is {decided.kind} ({decided.decided_by}, the worst "
-                f"attractor); the recorded run from the settings' start is {kind}"
-            )
+        else:  # its LLE here; contact, DTE, dynamic factor and LLE below are the recorded run's
+            lle = decided.attractor.lle if decided.attractor else None
+            text += (f" The simulated response is {decided.kind} ({decided.decided_by}, the worst "
+                     f"attractor{lle_words(lle, conv)}); the recorded run from the settings' "
+                     f"start is {kind}")  # fmt: skip
         if resp.contact is not None:
             text += f" with {IMPACT_WORDS.get(resp.contact.regime or '', 'no verdict on impacts')}"
             if resp.contact.separation_fraction > 0.0:
@@ -389,12 +383,17 @@ def summary(
             text += f", dynamic transmission error {resp.dte_peak_to_peak_um:.3g} µm peak to peak"
         if resp.dynamic_factor is not None:
             text += f", dynamic factor {resp.dynamic_factor:.3g}"
-        a = None if decided is None else decided.attractor  # the response named's LLE, in 1/s
-        if (lle := num.lle if decided is None else a and a.lle) is not None:  # tau = omega_n t
-            per_s = float(f"{lle / conv.time_scale_s:.3g}")  # 3 digits, no exponent below 1e6
-            text += f", largest Lyapunov exponent {per_s:+,g} 1/s ({lle:+.3g} per unit tau)"
-        text += "."
+        a = None if decided is None or other else decided.attractor  # tau = omega_n t
+        text += lle_words(num.lle if a is None else a.lle, conv) + "."
     return text
+
+
+def lle_words(lle: float | None, conv: DesignConversion) -> str:
+    """The LLE in words, ", largest Lyapunov exponent ... 1/s (... per unit tau)", or ""."""
+    if lle is None:
+        return ""
+    per_s = float(f"{lle / conv.time_scale_s:.3g}")  # 3 digits, no exponent below 1e6
+    return f", largest Lyapunov exponent {per_s:+,g} 1/s ({lle:+.3g} per unit tau)"
 
 
 def engineering(

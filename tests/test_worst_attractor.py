@@ -49,6 +49,12 @@ def test_summaries_name_the_worst_attractor(analysis):
     summary = analysis.engineering.summary
     assert "The simulated response is chaotic (chaotic, double-sided impacts from 56 %" in summary
     assert "the recorded run from the settings' start is periodic (1T)" in summary
+    # each LLE beside the response it belongs to: the chaotic attractor's in its parenthesis,
+    # the recorded periodic run's with that run's contact, DTE and dynamic factor
+    worst, run = analysis.numerics.attractors[0].lle, analysis.numerics.lle
+    assert worst > 0.0 > run
+    head, tail = summary.split("the recorded run from the settings' start")
+    assert f"({worst:+.3g} per unit tau)" in head and f"({run:+.3g} per unit tau)" in tail
     line = analysis.summary()
     assert line.startswith("chaotic (chaotic, double-sided impacts from 56 % of starts)")
 
