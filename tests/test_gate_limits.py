@@ -110,3 +110,21 @@ def test_envelope_settings_merge_over_the_light_defaults(tmp_path: Path) -> None
     path.write_text(json.dumps({**doc, "settings": [1]}))
     with pytest.raises(InvalidInputError, match="settings must be an object"):
         envelope_request(args)
+
+
+@pytest.mark.parametrize(
+    ("options", "named"),
+    [
+        (["--speed", "4000:nan"], "--speed (its high end): 'nan' is not a finite shaft speed"),
+        (["--speed", "4000:5000", "--speed-points", "0"], "--speed-points: "),
+        (["--speed", "4000:5000", "--torque", "5N:10N"], "--torque (its low end): '5N' has"),
+    ],
+)
+def test_a_bad_option_is_named_by_the_option(
+    options: list[str], named: str, capsys: pytest.CaptureFixture
+) -> None:
+    """What the options build (the sweep's axes) is refused naming the option the user typed,
+    not the internal path (axes[0].stop), found by a new-user review."""
+    assert main(["check", str(ROOT / "examples" / "ci" / "design.json"), *options]) == 2
+    err = capsys.readouterr().err
+    assert named in err and "axes[" not in err
