@@ -155,7 +155,7 @@ def test_gate_exit_codes_and_junit(tmp_path: Path) -> None:
                      "--max-dte", "1um")  # fmt: skip
     assert out.returncode == 1 and "DTE > 1 µm" in out.stdout
     out = gearengine("check", str(good), "--speed", "500mm:6000")
-    assert out.returncode == 2 and "axes[0].start" in out.stderr
+    assert out.returncode == 2 and "--speed (its low end)" in out.stderr
 
 
 def test_server_gives_the_same_report(tmp_path: Path) -> None:
