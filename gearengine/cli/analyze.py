@@ -21,13 +21,18 @@ from gearengine.studies.sweep.points import PhysicalValue, SweepPoint
 
 
 def cmd_analyze(args: argparse.Namespace) -> int:
-    result = analyze(read_request(args.file, AnalysisRequest))
+    request = read_request(args.file, AnalysisRequest)
+    result = analyze(request)
     if args.json:
         print(dumps(result))
     else:
         print(render_melnikov(result.melnikov))
         print(f"Numerical verdict: {result.summary()}")
         print(f"  {result.verdict.summary}")
+        if request.settings.basins is None:  # say what one or a few starts cannot see
+            n = len(request.settings.starts())
+            print(f"  from {n} start{'s' if n > 1 else ''} of the settings: other attractors "
+                  f"of this design are not searched (gearengine basins {args.file})")  # fmt: skip
         print(f"  forcing period T0 = {fmt_value(result.numerics.forcing_period)}")
         print(f"  {lengths_line(result)}")
         line = floquet_line(result)
