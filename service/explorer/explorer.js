@@ -570,6 +570,32 @@ class JobWatcher {
   }
 }
 
+// POST a job from its form (its button disabled meanwhile): the accepted job's document, or
+// null with the refusal shown, errors mine(e) in this form as "path: message" lines and the
+// design's in the design form.
+async function postJob(form, button, path, body, mine = (e) => !e.path.startsWith("design")) {
+  clearErrors(form);
+  let res;
+  $(button).disabled = true;
+  try {
+    res = await api("POST", path, body);
+  } catch (err) {
+    showProblem(form, { detail: "the server did not answer: " + err.message });
+    return null;
+  } finally {
+    $(button).disabled = false;
+  }
+  if (res.ok) return res.json();
+  const problem = await problemOf(res);
+  const own = problem.errors.filter(mine);
+  const theirs = problem.errors.filter((e) => !own.includes(e));
+  if (theirs.length) showProblem($("design-form"), { ...problem, errors: theirs });
+  if (own.length || !theirs.length) {
+    showProblem(form, { detail: own.map((e) => `${e.path}: ${e.message}`).join("\n") || problem.detail });
+  }
+  return null;
+}
+
 const envelopeJob = new JobWatcher({
   route: "sweeps", prefix: "envelope", cancel: "cancel-sweep", unit: "points",
   onResult: (id, result) => drawEnvelope(id, result),

@@ -43,32 +43,12 @@ function studyBody() {
 }
 
 async function studyRange() {
-  const form = $("robustness-form");
-  clearErrors(form);
-  let res;
-  $("study-range").disabled = true;
-  try {
-    res = await api("POST", "/v1/robustness", studyBody());
-  } catch (err) {
-    return showProblem(form, { detail: "the server did not answer: " + err.message });
-  } finally {
-    $("study-range").disabled = false;
-  }
-  if (!res.ok) {
-    const problem = await problemOf(res);
-    // the tolerances' errors (by path, or a design-level check naming them) are this form's;
-    // the rest belong to the design form
-    const mine = (e) => e.path.startsWith("design.tolerances") || e.message.includes("tolerances.")
-      || !e.path.startsWith("design");
-    const own = problem.errors.filter(mine);
-    const theirs = problem.errors.filter((e) => !own.includes(e));
-    if (theirs.length) showProblem($("design-form"), { ...problem, errors: theirs });
-    if (own.length || !theirs.length) {
-      showProblem(form, { detail: own.map((e) => `${e.path}: ${e.message}`).join("\n") || problem.detail });
-    }
-    return;
-  }
-  const job = await res.json();
+  // the tolerances' errors (by path, or a design-level check naming them) are this form's;
+  // the rest belong to the design form
+  const mine = (e) => e.path.startsWith("design.tolerances") || e.message.includes("tolerances.")
+    || !e.path.startsWith("design");
+  const job = await postJob($("robustness-form"), "study-range", "/v1/robustness", studyBody(), mine);
+  if (!job) return;
   $("welcome").hidden = true;
   $("robustness").hidden = false;
   $("robustness-progress-row").hidden = false;

@@ -33,28 +33,8 @@ function runupBody() {
 }
 
 async function runUp() {
-  const form = $("runup-form");
-  clearErrors(form);
-  let res;
-  $("start-runup").disabled = true;
-  try {
-    res = await api("POST", "/v1/runups", runupBody());
-  } catch (err) {
-    return showProblem(form, { detail: "the server did not answer: " + err.message });
-  } finally {
-    $("start-runup").disabled = false;
-  }
-  if (!res.ok) {
-    const problem = await problemOf(res);
-    const theirs = problem.errors.filter((e) => e.path.startsWith("design"));
-    const own = problem.errors.filter((e) => !theirs.includes(e));
-    if (theirs.length) showProblem($("design-form"), { ...problem, errors: theirs });
-    if (own.length || !theirs.length) {
-      showProblem(form, { detail: own.map((e) => `${e.path}: ${e.message}`).join("\n") || problem.detail });
-    }
-    return;
-  }
-  const job = await res.json();
+  const job = await postJob($("runup-form"), "start-runup", "/v1/runups", runupBody());
+  if (!job) return;
   $("welcome").hidden = true;
   $("runup").hidden = false;
   $("runup-progress-row").hidden = false;
