@@ -39,9 +39,9 @@ class SweepPoint(BaseModel):
         None,
         description="periodic | chaotic | quasi_periodic | diverged; with settings.basins the "
         "worst attractor's above basins.min_fraction (decided_by names it; period, lle, "
-        "lle_stderr and impact_regime are its too). This and every field "
-        "below are left out of the stored and returned points that a sweep's outputs do not "
-        "name (null when read back into this model).",
+        "lle_stderr, impact_regime and physical's dte and dynamic_factor are its too). This "
+        "and every field below are left out of the stored and returned points that a "
+        "sweep's outputs do not name (null when read back into this model).",
     )
     period: int | None = Field(None, description="Period in units of T0, null if none found.")
     lle: float | None = Field(None, description="Largest Lyapunov exponent per unit tau.")
@@ -89,9 +89,10 @@ class SweepPoint(BaseModel):
         None,
         description="With settings.basins: the attractors reached from the point's basin "
         "starts, worst first (as numerics.attractors of an analysis). The verdict fields "
-        "(classification, period, lle, lle_stderr, impact_regime) are the worst attractor's "
-        "above basins.min_fraction; the record fields (poincare_x, x_peak_to_peak, forces, "
-        "physical) describe the worst of settings' own starts.",
+        "(classification, period, lle, lle_stderr, impact_regime) and physical's dte and "
+        "dynamic_factor are the worst attractor's above basins.min_fraction (decided_by names "
+        "it); the record fields (poincare_x, x_peak_to_peak, force_max, force_min) describe "
+        "the worst of settings' own starts.",
     )
     basins: BasinCounts | None = Field(
         None, description="With settings.basins: how the point's basin starts ended."
