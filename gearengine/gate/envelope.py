@@ -32,7 +32,7 @@ from gearengine.studies.sweep.plan import balanced_chunk_points
 from gearengine.studies.sweep.points import PhysicalValue, SpeedWindows, SweepPoint
 from gearengine.studies.sweep.request import SweepRequest
 from gearengine.studies.sweep.results import SweepResult
-from gearengine.studies.sweep.windows import SPEED, runs
+from gearengine.studies.sweep.windows import SPEED, runs, speed_windows
 
 FailOn = Literal[
     "chaotic", "quasi_periodic", "diverged", "melnikov", "back_flank", "impacts", "separation"
@@ -273,7 +273,11 @@ class EnvelopeReport(BaseModel):
         "torque, or no saddle): --fail-on melnikov never fails them.",
     )
     failures: list[FailingWindow]
-    windows: list[SpeedWindows] = Field(description="All response windows, failing or not.")
+    windows: list[SpeedWindows] = Field(
+        description="All response windows, failing or not, over the grid points and the refined "
+        "points between them (the points failures come from; sweep.windows has the grid's "
+        "alone), by torque level ascending."
+    )
     resolution: Resolution | None = Field(
         None, description="What was checked: grid spacing, starts, and the points inserted "
         "between grid points (null: a report read back without it).",
@@ -300,7 +304,7 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
             rows.setdefault(_level_key(p), []).append(p)
     failures: list[FailingWindow] = []
     failing = 0
-    for row in rows.values():
+    for _, row in sorted(rows.items()):
         row.sort(key=lambda p: p.values[SPEED])
         level = {k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, *RESPONSES)}
         speeds = [p.physical[SPEED].value for p in row]  # type: ignore[index]
@@ -323,7 +327,7 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
             1 for r in rows.values() for p in r if p.melnikov_chaos_possible is None
         ),
         failures=failures,
-        windows=result.windows or [],
+        windows=speed_windows(result, [*result.points, *refined]) or [],
         resolution=resolution,
         sweep=result,
         refined=list(refined),
