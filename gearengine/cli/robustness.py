@@ -24,7 +24,7 @@ from gearengine.cli.documents import (
 from gearengine.cli.envelope import axis
 from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
-from gearengine.gate.envelope import ENVELOPE_SETTINGS
+from gearengine.gate.envelope import ENVELOPE_SETTINGS, gate_settings
 from gearengine.model.units import display_unit
 from gearengine.studies import jobs
 from gearengine.studies.robustness.study import (
@@ -54,6 +54,8 @@ def robustness_request(args: argparse.Namespace) -> RobustnessRequest:
     settings = doc.get("settings", {})
     if not isinstance(settings, dict):
         raise InvalidInputError([f"{args.file}: settings must be an object"])
+    if getattr(args, "starts", None) is not None:  # check --starts: starts per sample too
+        settings = gate_settings(settings, args.starts)
     body = {**{k: v for k, v in doc.items() if k not in ("params",)},
             "settings": {**ENVELOPE_SETTINGS, **settings}, "axes": axes or doc.get("axes", []),
             "samples": args.samples, "seed": args.seed}  # fmt: skip
@@ -131,7 +133,7 @@ def cmd_robustness(args: argparse.Namespace) -> int:
             f"{k} {pr[k].value:.3f} [{pr[k].interval[0]:.3f}, {pr[k].interval[1]:.3f}]"
             for k in ("chaotic", "separation", "back_flank")
         )
-        print(f"{point_name(p.shown)}: {words} ({p.samples} samples)")
+        print(f"{point_name(p.shown)}: {words} ({p.samples} samples, {result.starts_text()})")
         for line in p.ranking or []:
             print(f"  {line}")
     if args.json:
@@ -218,6 +220,7 @@ def cmd_probability_gate(args: argparse.Namespace) -> int:
     else:
         _, result = study(args)
     why = failures(result, limits)
+    print(f"probabilities from {result.samples} samples, {result.starts_text()}")
     for p, reasons in zip(result.points, why, strict=True):
         verdict = "FAIL" if reasons else "PASS"
         print(f"{verdict}: {point_name(p.shown)}" + (f" [{'; '.join(reasons)}]" if reasons else ""))

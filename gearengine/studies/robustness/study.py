@@ -282,6 +282,17 @@ class RobustnessResult(BaseModel):
     variables: list[RobustnessVariable] = Field(description="The toleranced fields.")
     partial: bool = Field(False, description="True when chunks are missing.")
     model: list[str] = Field(description="What the sampling and the TE model assume.")
+    starts_per_sample: int = Field(
+        1, description="Initial states each sample ran: settings.basins' starts (the sample "
+        "counts as its worst attractor above basins.min_fraction), else the settings' own "
+        "starts (the worst of them)."
+    )  # fmt: skip
+
+    def starts_text(self) -> str:
+        """ "16 starts a sample (settings.basins)", "1 start a sample": what decided a sample."""
+        n = self.starts_per_sample
+        basins = " (settings.basins)" if any("settings.basins" in m for m in self.model) else ""
+        return f"{n} start{'s' if n != 1 else ''} a sample{basins}"
 
 
 ASSUMPTIONS = [
@@ -362,6 +373,7 @@ def assemble(request: RobustnessRequest, chunks: list[str]) -> RobustnessResult:
         variables=[RobustnessVariable(path=v.path, distribution=v.words) for v in variables_],
         partial=not complete,
         model=ASSUMPTIONS + ([] if basins is None else [basin_assumption(basins)]),
+        starts_per_sample=len(request.settings.starts()) if basins is None else basins.starts,
     )
 
 
