@@ -81,3 +81,41 @@ def test_analysis_reports_both_transmission_errors_and_the_contact_force() -> No
     assert r.dynamic_mesh_force_min_n <= r.contact_force_min_n <= r.contact_force_max_n
     assert r.contact_force_max_n <= r.dynamic_mesh_force_max_n
     assert r.contact_force_max_n == pytest.approx(r.dynamic_mesh_force_max_n, rel=1e-3)
+
+
+def test_the_old_word_impacts_is_read_with_a_note_where_it_is_given() -> None:
+    """'impacts' meant back-flank contact in ``check --fail-on`` and any separation in
+    ``--max-probability``: it keeps each meaning as an alias of back_flank and separation, and
+    the answer says how it was read (it was read silently; issue 30 item 6, new-user review)."""
+    from gearengine.cli.envelope import print_report
+    from gearengine.cli.robustness import limits_of
+    from gearengine.gate.envelope import EnvelopeReport, envelope_report
+    from tests.conftest import ROOT
+
+    golden = EnvelopeReport.model_validate_json((ROOT / "tests/golden/check-envelope.json")
+                                                .read_text())  # fmt: skip
+    report = envelope_report(golden.sweep, Rules(fail_on=["chaotic", "impacts"]))
+    (note,) = report.notes
+    assert "--fail-on impacts is read as back_flank" in note and "separation" in note
+    assert envelope_report(golden.sweep, Rules(fail_on=["back_flank"])).notes == []
+    limits, notes = limits_of(["impacts=0.05", "chaotic=0.01"])
+    assert limits == {"separation": 0.05, "chaotic": 0.01}
+    (note,) = notes
+    assert "--max-probability impacts is read as separation" in note and "back_flank" in note
+    import contextlib
+    import io
+
+    shown = io.StringIO()
+    with contextlib.redirect_stdout(shown):
+        print_report(report)
+    assert "--fail-on impacts is read as back_flank" in shown.getvalue()
+
+
+def test_robustness_outputs_and_panels_say_separation() -> None:
+    """The robustness figure's panel and the Sobol output of tooth separation are named
+    separation, as P(separation) and --fail-on separation (they said impacts)."""
+    from gearengine.plots.robustness import PANELS
+    from gearengine.studies.robustness.study import OUTPUTS
+
+    assert "separation" in PANELS and "impacts" not in PANELS
+    assert "separation" in OUTPUTS and "impacts" not in OUTPUTS

@@ -37,7 +37,7 @@ from gearengine.studies.robustness.tolerances import samples_to_prove
 
 GATED = ("chaotic", "quasi_periodic", "diverged", "separation", "impacts", "back_flank",
          "dynamic_factor_above_limit", "melnikov_chaos_possible")  # fmt: skip
-"""Probabilities a gate may limit."""
+"""Probabilities a gate may limit (``impacts``: the older name of ``separation``, noted)."""
 
 
 def robustness_request(args: argparse.Namespace) -> RobustnessRequest:
@@ -86,9 +86,18 @@ def point_name(values: dict[str, float]) -> str:
     return ", ".join(parts) or "operating point"
 
 
-def limits_of(texts: list[str]) -> dict[str, float]:
-    """``["chaotic=0.01", ...]`` as {name: limit}; InvalidInputError naming a bad one."""
-    out = {}
+OLD_IMPACTS_LIMIT = (
+    "--max-probability impacts is read as separation (the teeth separate, on either flank), "
+    "its older name; write separation, or back_flank for back-flank impacts (as --fail-on "
+    "back_flank)"
+)
+"""The note of a probability gate given the older name ``impacts``."""
+
+
+def limits_of(texts: list[str]) -> tuple[dict[str, float], list[str]]:
+    """``["chaotic=0.01", ...]`` as {name: limit}, the older name ``impacts`` read as
+    ``separation``, and the notes saying so; InvalidInputError naming a bad one."""
+    out, notes = {}, []
     for text in texts:
         name, _, value = text.partition("=")
         try:
@@ -98,8 +107,11 @@ def limits_of(texts: list[str]) -> dict[str, float]:
         if name not in GATED or not 0.0 <= limit <= 1.0:
             raise InvalidInputError([f"--max-probability {text}: give NAME=P with P in [0, 1] "
                                      f"and NAME one of {', '.join(GATED)}"])  # fmt: skip
+        if name == "impacts":
+            name = "separation"
+            notes += [] if OLD_IMPACTS_LIMIT in notes else [OLD_IMPACTS_LIMIT]
         out[name] = limit
-    return out
+    return out, notes
 
 
 def failures(result: RobustnessResult, limits: dict[str, float]) -> list[list[str]]:
@@ -213,7 +225,9 @@ def sequential_study(
 def cmd_probability_gate(args: argparse.Namespace) -> int:
     """``check --max-probability``: exit 1 where an upper bound exceeds its limit; a sample
     count that cannot prove a limit is refused before computing (``samples_needed``)."""
-    limits = limits_of(args.max_probability)
+    limits, notes = limits_of(args.max_probability)
+    for note in notes:
+        print(f"note: {note}")
     least = samples_needed(limits, args.samples)
     if args.samples == "auto":
         result = sequential_study(args, limits, least)

@@ -39,6 +39,11 @@ FailOn = Literal[
 ]
 BACK_FLANK = ("back_flank", "impacts")
 """The rule names of back-flank impacts (``impacts`` the older one, kept: the same rule)."""
+OLD_IMPACTS_RULE = (
+    "--fail-on impacts is read as back_flank (back-flank impacts), its older name; write "
+    "back_flank, or separation to fail wherever the teeth separate (as P(separation))"
+)
+"""The note of a report whose rules give the older rule name ``impacts``."""
 
 
 class Rules(BaseModel):
@@ -287,6 +292,10 @@ class EnvelopeReport(BaseModel):
         [], description="The points inserted between the grid points (gate.resolution), "
         "checked by the same rules; their failures are in failures.",
     )  # fmt: skip
+    notes: list[str] = Field(
+        [], description="How the rules were read: an older rule name (impacts, read as "
+        "back_flank) is named with its reading."
+    )  # fmt: skip
 
 
 def _level_key(p: SweepPoint) -> tuple:
@@ -331,6 +340,7 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
         resolution=resolution,
         sweep=result,
         refined=list(refined),
+        notes=[OLD_IMPACTS_RULE] if "impacts" in rules.fail_on else [],
     )
 
 

@@ -68,8 +68,9 @@ EVENTS = (
     "dynamic_factor_above_limit",
     "melnikov_chaos_possible",
 )
-OUTPUTS = ("chaotic", "impacts", "back_flank", "dte", "dynamic_factor")
-"""The outputs whose Sobol indices are reported."""
+OUTPUTS = ("chaotic", "separation", "back_flank", "dte", "dynamic_factor")
+"""The outputs whose Sobol indices are reported (``sensitivity`` also holds separation's
+under ``impacts``, its older name)."""
 DEFAULT_CHUNK_ROWS = 16
 MAX_SAMPLES = 4096
 
@@ -256,14 +257,16 @@ class RobustnessPoint(BaseModel):
     probabilities: dict[str, Probability] = Field(
         description="Of each class (periodic, quasi_periodic, chaotic, diverged) and event "
         "(separation: the teeth separate, drive-flank or back-flank impacts, as the gate's "
-        "--fail-on separation; impacts: its older name, the same count; back_flank: back-flank "
+        "--fail-on separation; impacts: its older name, the same count (deprecated: "
+        "--fail-on impacts is back_flank); back_flank: back-flank "
         "impacts, as --fail-on back_flank; "
         "dynamic_factor_above_limit; melnikov_chaos_possible)."
     )
     dte_um: dict[str, float | None] = Field(description="DTE over the samples: mean, p5, p95.")
     sensitivity: dict[str, dict[str, dict[str, float | None]] | None] | None = Field(
-        None, description="Sobol indices by output (chaotic, impacts, back_flank, dte, "
-        "dynamic_factor) and field: first, total, and their 95 % half-widths.",
+        None, description="Sobol indices by output (chaotic, separation, back_flank, dte, "
+        "dynamic_factor; impacts: separation's under its older name) and field: first, total, "
+        "and their 95 % half-widths.",
     )  # fmt: skip
     ranking: list[str] | None = Field(None, description="The indices in plain words.")
 
@@ -338,16 +341,17 @@ def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[
     if request.sensitivity and complete:
         ys = {
             "chaotic": [r[0] == 2 for r in runs],
-            "impacts": [r[1] in (1, 2) for r in runs],
+            "separation": [r[1] in (1, 2) for r in runs],
             "back_flank": [r[1] == 2 for r in runs],
             "dte": [math.nan if r[3] is None else r[3] for r in runs],
             "dynamic_factor": [math.nan if r[4] is None else r[4] for r in runs],
         }
+        assert tuple(ys) == OUTPUTS
         table = {k: sensitivity.indices(names, np.array(y, float), request.seed)
                  for k, y in ys.items()}  # fmt: skip
-        out["sensitivity"] = table
         labels = {v.path: v.name for v in variables_}
         out["ranking"] = [sensitivity.ranked(k, t, labels) for k, t in table.items()]
+        out["sensitivity"] = {**table, "impacts": table["separation"]}  # its older name
     return out
 
 
