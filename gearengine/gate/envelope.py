@@ -25,7 +25,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.gate.resolution import REFINE_DEPTH, Resolution, resolution
 from gearengine.gate.resolution import refine as refine_points
-from gearengine.model.units import OUTPUTS, RESPONSES
+from gearengine.model.units import OUTPUTS, POINT_OUTPUTS
 from gearengine.signals.classify import SEVERITY
 from gearengine.studies.sweep.compute import run_local
 from gearengine.studies.sweep.plan import balanced_chunk_points
@@ -300,7 +300,7 @@ class EnvelopeReport(BaseModel):
 
 def _level_key(p: SweepPoint) -> tuple:
     return tuple(sorted((k, v.value) for k, v in (p.physical or {}).items() if k not in
-                        (SPEED, *RESPONSES)))  # fmt: skip
+                        (SPEED, *POINT_OUTPUTS)))  # fmt: skip
 
 
 def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPoint] = (),
@@ -315,7 +315,8 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
     failing = 0
     for _, row in sorted(rows.items()):
         row.sort(key=lambda p: p.values[SPEED])
-        level = {k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, *RESPONSES)}
+        level = {k: v for k, v in (row[0].physical or {}).items()
+                 if k not in (SPEED, *POINT_OUTPUTS)}  # fmt: skip
         speeds = [p.physical[SPEED].value for p in row]  # type: ignore[index]
         found = [attractor_failures(p, rules) for p in row]
         broken = [[rule for rule, _ in f] for f in found]

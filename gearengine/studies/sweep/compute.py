@@ -14,11 +14,14 @@ from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
 from gearengine.model.units import (
     OUTPUTS,
+    RECORD_FORCES,
     RESPONSES,
     Scales,
     display_unit,
     in_display_unit,
     response_values,
+    shown,
+    to_physical,
 )
 from gearengine.numerics.attractors import coexisting, headline, points_attractors
 from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
@@ -51,23 +54,27 @@ def _physical(
     responses: dict[str, float | None] | None = None,
 ) -> dict[str, Any]:
     """With a design (its ``scales``): the axes in display units, the responses (DTE in µm,
-    dynamic factor) and the point's aliases. The responses are the deciding attractor's with
-    basins (``responses``, from ``_decided``), else ``model.units.response_values`` of the
-    settings' own run ``bp``."""
+    dynamic factor), the record's mesh forces in N and the point's aliases. The responses are
+    the deciding attractor's with basins (``responses``, from ``_decided``), else
+    ``model.units.response_values`` of the settings' own run ``bp``; the forces are always the
+    record's (``RECORD_FORCES``, as ``force_max`` and ``force_min``)."""
     if scales is None:
         return {}
-    shown = {
+    out = {
         name: PhysicalValue(value=in_display_unit(name, si), unit=display_unit(name)[0])
         for name, si in values.items()
         if not is_dimensionless(name)
     }
-    if responses is None:
-        responses = response_values(bp.x_peak_to_peak, bp.force_max, scales)
-    for key, value in responses.items():
+    record = response_values(bp.x_peak_to_peak, bp.force_max, scales)
+    forces = {
+        key: None if f is None else shown(to_physical("mesh_force", f, scales))
+        for key, f in zip(RECORD_FORCES, (bp.force_max, bp.force_min), strict=True)
+    }
+    for key, value in {**record, **(responses or {}), **forces}.items():
         if value is not None:
-            shown[key] = PhysicalValue(value=value, unit=OUTPUTS[key].unit)
+            out[key] = PhysicalValue(value=value, unit=OUTPUTS[key].unit)
     aliases = {a: get_alias(params, a) for a in ALIASES}
-    return {"physical": shown, "dimensionless": {k: v for k, v in aliases.items() if v is not None}}
+    return {"physical": out, "dimensionless": {k: v for k, v in aliases.items() if v is not None}}
 
 
 def _point(
@@ -201,7 +208,7 @@ def _decided(found: list[Attractor], counts: BasinCounts, min_fraction: float) -
     a = head.attractor
     if a is None:  # diverged: no LLE, no impact verdict, no response
         verdict.update(lle=None, lle_stderr=None, impact_regime=None)
-        responses: dict[str, float | None] = dict.fromkeys(RESPONSES)
+        responses: dict[str, float | None] = dict.fromkeys(RESPONSES)  # none of them
     else:
         verdict.update(lle=a.lle, lle_stderr=a.lle_stderr, impact_regime=a.impact_regime)
         responses = {"dte": a.dte_um, "dynamic_factor": a.dynamic_factor}

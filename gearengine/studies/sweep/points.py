@@ -30,7 +30,10 @@ class SweepPoint(BaseModel):
     model_config = ConfigDict(frozen=True, allow_inf_nan=False)
 
     values: dict[str, float] = Field(
-        description="The axes' parameter values at this point.", examples=[{"F_e1": 0.2}]
+        description="The axes' parameter values at this point: a design's fields in SI "
+        "(speed in rad/s, torque in N*m; the result's values_units names each, physical has "
+        "them in display units), dimensionless aliases as they are.",
+        examples=[{"F_e1": 0.2}],
     )
     branch: SweepBranch | None = Field(
         description="With continuation: up (forward) or down (backward) branch; else null."
@@ -66,8 +69,8 @@ class SweepPoint(BaseModel):
     )
     force_max: float | None = Field(
         None,
-        description="Largest dimensionless mesh force K(t) f_h(x) + 2 mu x' over the record; "
-        "null if diverged.",
+        description="Largest dimensionless mesh force K(t) f_h(x) + 2 mu x' over the record, "
+        "in units of b k_m (with a design physical.force_max has it in N); null if diverged.",
     )
     force_min: float | None = Field(
         None, description="Smallest dimensionless mesh force over the record; null if diverged."
@@ -75,8 +78,9 @@ class SweepPoint(BaseModel):
     physical: dict[str, PhysicalValue] | None = Field(
         None,
         description="With a design: the physical axes' values in display units (rpm, N*m, "
-        "µm, ...), the dynamic transmission error dte (µm peak to peak) and the "
-        "dynamic_factor (largest mesh force / static force F~_m).",
+        "µm, ...), the dynamic transmission error dte (µm peak to peak), the "
+        "dynamic_factor (largest mesh force / static force F~_m), and force_max and force_min "
+        "in N (the record's, as the fields force_max and force_min x b k_m).",
         examples=[{"speed": {"value": 1500.0, "unit": "rpm"}, "torque": {"value": 40.0,
                    "unit": "N*m"}, "dte": {"value": 3.4, "unit": "um"}}],
     )  # fmt: skip
