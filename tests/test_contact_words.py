@@ -119,3 +119,26 @@ def test_robustness_outputs_and_panels_say_separation() -> None:
 
     assert "separation" in PANELS and "impacts" not in PANELS
     assert "separation" in OUTPUTS and "impacts" not in OUTPUTS
+
+
+def test_runup_bins_give_the_contact_force_beside_the_models() -> None:
+    """A run-up through the separating branch of examples/ci/design.json (4300-4500 rpm): the
+    model's smallest force is negative in every bin (its damping acts in the clearance: -254 N
+    was read as a pull of the teeth), the contact force is 0 there (apart, no back flank), and
+    never exceeds the model's largest force (issue 30 item 6, new-user review)."""
+    import json
+
+    from gearengine.studies.runup import run_local
+    from gearengine.studies.runup.profile import validated
+    from tests.conftest import ROOT
+
+    design = json.loads((ROOT / "examples" / "ci" / "design.json").read_text())["design"]
+    r = validated({"design": design, "from_speed": "4300 rpm", "to_speed": "4500 rpm",
+                   "rate": "4000 rpm/s", "direction": "up", "settle_periods": 0,
+                   "ensemble": {"size": 1}})  # fmt: skip
+    bins = run_local(r).up.bins  # type: ignore[union-attr]
+    assert bins and all(b.separation_fraction > 0 and b.back_flank_fraction == 0 for b in bins)
+    for b in bins:
+        assert b.force_min_n < 0.0
+        assert b.contact_force_min_n == 0.0
+        assert 0.0 < b.contact_force_max_n <= b.force_max_n
