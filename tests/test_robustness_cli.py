@@ -112,3 +112,14 @@ def test_the_answers_say_how_many_starts_decided_each_sample(
     args = [str(design_file), "--speed", "5000:5000", "--speed-points", "1", "--samples", "8"]
     assert main(["robustness", *args]) == 0
     assert "(8 samples, 1 start a sample)" in capsys.readouterr().out
+
+
+def test_the_result_names_the_units_of_its_points_values(design_file: Path, tmp_path: Path) -> None:
+    """A robustness point's values are SI and its shown values in gear units: the result names
+    both (values.speed read as rpm by a new user is rad/s; issue 30 item 2)."""
+    out = tmp_path / "r.json"
+    args = [str(design_file), "--speed", "5000:5000", "--speed-points", "1", "--samples", "2"]
+    assert main(["robustness", *args, "--json", str(out)]) == 0
+    document = json.loads(out.read_text())
+    assert document["values_units"] == {"speed": "rad/s"}
+    assert document["shown_units"] == {"speed": "rpm"}

@@ -38,7 +38,7 @@ from gearengine.model.design import Design
 from gearengine.model.errors import InputError, Problems
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
-from gearengine.model.units import Scales, in_display_unit, response_values
+from gearengine.model.units import Scales, display_unit, in_display_unit, response_values
 from gearengine.numerics.attractors import headline, points_attractors
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.settings import SimulationSettings, work
@@ -53,7 +53,12 @@ from gearengine.studies.robustness.tolerances import (
     sobol_points,
     variables,
 )
-from gearengine.studies.sweep.axes import axis_problem, design_with, is_dimensionless
+from gearengine.studies.sweep.axes import (
+    axis_problem,
+    axis_unit,
+    design_with,
+    is_dimensionless,
+)
 from gearengine.studies.sweep.request import SweepAxis
 from gearengine.systems.designs import design_model
 
@@ -285,6 +290,14 @@ class RobustnessResult(BaseModel):
     variables: list[RobustnessVariable] = Field(description="The toleranced fields.")
     partial: bool = Field(False, description="True when chunks are missing.")
     model: list[str] = Field(description="What the sampling and the TE model assume.")
+    values_units: dict[str, str] | None = Field(
+        None, description="The unit of each axis in the points' values (SI: speed rad/s).",
+        examples=[{"speed": "rad/s", "torque": "N*m"}],
+    )  # fmt: skip
+    shown_units: dict[str, str] | None = Field(
+        None, description="The unit of each axis in the points' shown values (speed rpm).",
+        examples=[{"speed": "rpm", "torque": "N*m"}],
+    )  # fmt: skip
     starts_per_sample: int = Field(
         1, description="Initial states each sample ran: settings.basins' starts (the sample "
         "counts as its worst attractor above basins.min_fraction), else the settings' own "
@@ -378,6 +391,8 @@ def assemble(request: RobustnessRequest, chunks: list[str]) -> RobustnessResult:
         partial=not complete,
         model=ASSUMPTIONS + ([] if basins is None else [basin_assumption(basins)]),
         starts_per_sample=len(request.settings.starts()) if basins is None else basins.starts,
+        values_units={a.parameter: axis_unit(a.parameter) for a in request.axes},
+        shown_units={a.parameter: display_unit(a.parameter)[0] for a in request.axes},
     )
 
 

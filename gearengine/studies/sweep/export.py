@@ -13,7 +13,7 @@ import numpy as np
 from pydantic import BaseModel, Field, TypeAdapter
 
 from gearengine.model.units import POINT_OUTPUTS, display_label, field_unit, in_display_unit
-from gearengine.studies.sweep.axes import is_dimensionless
+from gearengine.studies.sweep.axes import axis_unit, is_dimensionless
 from gearengine.studies.sweep.points import SweepBifurcation, SweepPoint
 from gearengine.studies.sweep.request import SweepAxis
 
@@ -206,12 +206,6 @@ def _physical_columns(
         return axes
     response = [(key, display_label(key), False) for key in POINT_OUTPUTS]
     return [*axes, *response]
-
-
-def axis_unit(name: str) -> str:
-    """The unit of an axis' values in a point's ``values``: a design field's SI unit (speed
-    rad/s), "1" for a dimensionless alias."""
-    return "1" if is_dimensionless(name) else field_unit(name).si
 
 
 def _axis_title(name: str) -> str:
