@@ -86,3 +86,18 @@ def test_windows_are_the_failures_points_and_levels_ascend() -> None:
         lo, hi = f.speeds_rpm
         assert any(a <= lo and hi <= b for a, b in w.response[f.rule]), (f, w.response)
     assert len(windows_summary(report.windows)) == 3
+
+
+def test_junit_cases_come_in_ascending_torque() -> None:
+    """The JUnit report lists its torque levels as the text does, ascending: a refined level
+    with failures (6.75 N*m) stands between the grid's 2 and 11.5 N*m, not after them."""
+    from xml.etree import ElementTree
+
+    from gearengine.gate.envelope import EnvelopeReport, envelope_report
+
+    golden = EnvelopeReport.model_validate_json((ROOT / "tests/golden/check-envelope.json")
+                                                .read_text())  # fmt: skip
+    report = envelope_report(golden.sweep, golden.rules, golden.refined, golden.resolution)
+    root = ElementTree.fromstring(envelope_junit(report, "envelope"))
+    names = [c.get("name") for c in root.iter("testcase")]
+    assert names == ["torque 2 N*m", "torque 6.75 N*m", "torque 11.5 N*m"]
