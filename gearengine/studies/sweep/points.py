@@ -50,7 +50,11 @@ class SweepPoint(BaseModel):
     lle: float | None = Field(None, description="Largest Lyapunov exponent per unit tau.")
     lle_stderr: float | None = Field(None, description="Standard error of lle.")
     impact_regime: str | None = Field(
-        None, description="no_impact | single_sided | double_sided, null when not reported."
+        None,
+        description="no_impact (contact throughout) | single_sided (separation: the teeth "
+        "separate, not reaching the back flank) | double_sided (back_flank: back-flank "
+        "impacts), the words of --fail-on and P(...) (docs/units.md, Contact words); null when "
+        "not reported.",
     )
     melnikov_chaos_possible: bool | None = Field(
         None,
