@@ -81,3 +81,64 @@ def test_analysis_reports_both_transmission_errors_and_the_contact_force() -> No
     assert r.dynamic_mesh_force_min_n <= r.contact_force_min_n <= r.contact_force_max_n
     assert r.contact_force_max_n <= r.dynamic_mesh_force_max_n
     assert r.contact_force_max_n == pytest.approx(r.dynamic_mesh_force_max_n, rel=1e-3)
+
+
+def test_the_old_word_impacts_is_read_with_a_note_where_it_is_given() -> None:
+    """'impacts' meant back-flank contact in ``check --fail-on`` and any separation in
+    ``--max-probability``: it keeps each meaning as an alias of back_flank and separation, and
+    the answer says how it was read (it was read silently; issue 30 item 6, new-user review)."""
+    from gearengine.cli.envelope import print_report
+    from gearengine.cli.robustness import limits_of
+    from gearengine.gate.envelope import EnvelopeReport, envelope_report
+    from tests.conftest import ROOT
+
+    golden = EnvelopeReport.model_validate_json((ROOT / "tests/golden/check-envelope.json")
+                                                .read_text())  # fmt: skip
+    report = envelope_report(golden.sweep, Rules(fail_on=["chaotic", "impacts"]))
+    (note,) = report.notes
+    assert "--fail-on impacts is read as back_flank" in note and "separation" in note
+    assert envelope_report(golden.sweep, Rules(fail_on=["back_flank"])).notes == []
+    limits, notes = limits_of(["impacts=0.05", "chaotic=0.01"])
+    assert limits == {"separation": 0.05, "chaotic": 0.01}
+    (note,) = notes
+    assert "--max-probability impacts is read as separation" in note and "back_flank" in note
+    import contextlib
+    import io
+
+    shown = io.StringIO()
+    with contextlib.redirect_stdout(shown):
+        print_report(report)
+    assert "--fail-on impacts is read as back_flank" in shown.getvalue()
+
+
+def test_robustness_outputs_and_panels_say_separation() -> None:
+    """The robustness figure's panel and the Sobol output of tooth separation are named
+    separation, as P(separation) and --fail-on separation (they said impacts)."""
+    from gearengine.plots.robustness import PANELS
+    from gearengine.studies.robustness.study import OUTPUTS
+
+    assert "separation" in PANELS and "impacts" not in PANELS
+    assert "separation" in OUTPUTS and "impacts" not in OUTPUTS
+
+
+def test_runup_bins_give_the_contact_force_beside_the_models() -> None:
+    """A run-up through the separating branch of examples/ci/design.json (4300-4500 rpm): the
+    model's smallest force is negative in every bin (its damping acts in the clearance: -254 N
+    was read as a pull of the teeth), the contact force is 0 there (apart, no back flank), and
+    never exceeds the model's largest force (issue 30 item 6, new-user review)."""
+    import json
+
+    from gearengine.studies.runup import run_local
+    from gearengine.studies.runup.profile import validated
+    from tests.conftest import ROOT
+
+    design = json.loads((ROOT / "examples" / "ci" / "design.json").read_text())["design"]
+    r = validated({"design": design, "from_speed": "4300 rpm", "to_speed": "4500 rpm",
+                   "rate": "4000 rpm/s", "direction": "up", "settle_periods": 0,
+                   "ensemble": {"size": 1}})  # fmt: skip
+    bins = run_local(r).up.bins  # type: ignore[union-attr]
+    assert bins and all(b.separation_fraction > 0 and b.back_flank_fraction == 0 for b in bins)
+    for b in bins:
+        assert b.force_min_n < 0.0
+        assert b.contact_force_min_n == 0.0
+        assert 0.0 < b.contact_force_max_n <= b.force_max_n

@@ -64,3 +64,40 @@ def test_a_point_far_from_every_limit_is_not_refined() -> None:
     report = refined_report(request, result, rules, refine=2)
     assert report.passed and report.resolution is not None
     assert report.resolution.refined_points == 0 and report.points == 2
+
+
+def test_windows_are_the_failures_points_and_levels_ascend() -> None:
+    """One source for the check's windows: the report's windows (text and JSON) are drawn from
+    the grid and the refined points its failures come from, at every torque level, ascending
+    (the windows said chaotic 4500-5000 rpm at 2 N*m beside a failure at 4500-5250 rpm, left out
+    the refined 6.75 N*m level, and the failures listed 2, 11.5, then 6.75 N*m)."""
+    from gearengine.cli.envelope import windows_summary
+    from gearengine.gate.envelope import EnvelopeReport, envelope_report
+
+    golden = EnvelopeReport.model_validate_json((ROOT / "tests/golden/check-envelope.json")
+                                                .read_text())  # fmt: skip
+    report = envelope_report(golden.sweep, golden.rules, golden.refined, golden.resolution)
+    torques = [w.level["torque"].value for w in report.windows]
+    assert torques == sorted(torques) == [2.0, 6.75, 11.5]
+    failing = [f.level["torque"].value for f in report.failures]
+    assert failing == sorted(failing)
+    for f in report.failures:
+        (w,) = [w for w in report.windows if w.level == f.level]
+        lo, hi = f.speeds_rpm
+        assert any(a <= lo and hi <= b for a, b in w.response[f.rule]), (f, w.response)
+    assert len(windows_summary(report.windows)) == 3
+
+
+def test_junit_cases_come_in_ascending_torque() -> None:
+    """The JUnit report lists its torque levels as the text does, ascending: a refined level
+    with failures (6.75 N*m) stands between the grid's 2 and 11.5 N*m, not after them."""
+    from xml.etree import ElementTree
+
+    from gearengine.gate.envelope import EnvelopeReport, envelope_report
+
+    golden = EnvelopeReport.model_validate_json((ROOT / "tests/golden/check-envelope.json")
+                                                .read_text())  # fmt: skip
+    report = envelope_report(golden.sweep, golden.rules, golden.refined, golden.resolution)
+    root = ElementTree.fromstring(envelope_junit(report, "envelope"))
+    names = [c.get("name") for c in root.iter("testcase")]
+    assert names == ["torque 2 N*m", "torque 6.75 N*m", "torque 11.5 N*m"]

@@ -27,6 +27,7 @@ from gearengine.gate.remedies.levers import iso1328_class
 from gearengine.gate.remedies.request import Lever, RemediesRequest
 from gearengine.gate.remedies.results import RemediesResult, Remedy
 from gearengine.gate.remedies.search import _narrow, _search, envelope_points
+from gearengine.gate.resolution import Resolution
 from gearengine.model.design import ACCURACY_FIELD, Design
 from gearengine.model.standards import iso1328
 from gearengine.model.units import in_display_unit
@@ -298,24 +299,46 @@ def test_the_remedy_found_passes_the_check_on_a_2x_finer_grid() -> None:
     assert found.to < 7.0  # main's 7.813 µm fails at 4,500 rpm on the finer grid
 
 
+def _melnikov_said(blind: int, passed: bool) -> str:
+    """The answer of a lone Melnikov value judging 115 - ``blind`` of 115 points, where the
+    envelope check on a 23 x 5 grid passes or fails at 3 points."""
+    grid = Resolution(speed_points=23, torque_points=5, speed_step_rpm=227.3,
+                      torque_step_nm=13.75, starts=16, depth=0,
+                      finest_speed_step_rpm=227.3)  # fmt: skip
+    check = EnvelopeReport.model_construct(passed=passed, points=115,
+                                           failing_points=0 if passed else 3, resolution=grid)
+    mel = Remedy.model_construct(lever=ACCURACY_FIELD, from_=11.3, to=4.0, unit="um",
+                                 bound="melnikov", monotone=True, iso1328_class=None,
+                                 not_applicable_points=blind, melnikov_points=115,
+                                 check=check)  # fmt: skip
+    return answer_words([mel], [], None)
+
+
 def test_melnikov_guarantee_only_where_the_criterion_applies() -> None:
     """A Melnikov bound whose criterion applies at none of the envelope's points guarantees
     nothing and the answer says so; applying at some, it says at how many."""
-    check = EnvelopeReport.model_construct(passed=False, points=115, failing_points=3)
 
     def said(blind: int) -> str:
-        mel = Remedy.model_construct(lever=ACCURACY_FIELD, from_=11.3, to=4.0, unit="um",
-                                     bound="melnikov", monotone=True, iso1328_class=None,
-                                     not_applicable_points=blind, melnikov_points=115,
-                                     check=check)  # fmt: skip
-        return answer_words([mel], [], None)
+        return _melnikov_said(blind, passed=True)
 
     assert "guarantee against" not in said(115) and "applies at none of the 115" in said(115)
     # judging no point and with no numerical value, it is not offered as a remedy (the answer
     # said "or lower ... to 4 um (... no guarantee ...)" beside "no value ... clears")
     assert said(115).startswith("no single lever clears the envelope; ")
     assert "guarantee against homoclinic chaos at the 40 of 115 points" in said(75)
-    assert "(Melnikov guarantee against homoclinic chaos;" in said(0)
+    assert "(Melnikov guarantee against homoclinic chaos; the envelope check passes there " \
+        "(checked on 23 x 5 grid (227.3 rpm x 13.75 N*m), 16 starts a point;" in said(0)
+
+
+def test_no_melnikov_guarantee_where_the_check_fails() -> None:
+    """Where the envelope check still fails at a Melnikov value, the answer offers no
+    guarantee (it read 'Melnikov guarantee against homoclinic chaos; the envelope check still
+    fails there'): it says the check fails there, at how many points and on what grid."""
+    said = _melnikov_said(0, passed=False)
+    assert "guarantee against" not in said
+    assert said.startswith("no single lever clears the envelope; ")
+    assert "still fails there at 3 of 115 points (checked on 23 x 5 grid" in said
+    assert "guarantees no pass" in said
 
 
 def test_a_class_bound_written_rounded_is_that_class() -> None:

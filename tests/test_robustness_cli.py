@@ -91,3 +91,35 @@ def test_samples_auto_samples_until_every_point_is_decided(
     captured = capsys.readouterr()
     assert "--samples auto: decided at 64 samples" in captured.err
     assert "PASS: speed 2000 rpm" in captured.out and "FAIL: speed 5000 rpm" in captured.out
+
+
+def test_the_answers_say_how_many_starts_decided_each_sample(
+    design_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The probability gate and the study say how many starts each sample ran (one, the
+    settings' start, unless settings.basins or --starts give more), in the text and the JSON:
+    the gate's envelope check runs 16 starts a point, and nothing said that P(chaotic) came
+    from one (issue 30 item 5, a new-user review)."""
+    out = tmp_path / "p.json"
+    base = ["check", str(design_file), "--speed", "5000:5000", "--speed-points", "1",
+            "--samples", "8", "--max-probability", "back_flank=0.5"]  # fmt: skip
+    assert main([*base, "--json", str(out)]) == 0
+    assert json.loads(out.read_text())["starts_per_sample"] == 1
+    assert "8 samples, 1 start a sample" in capsys.readouterr().out
+    assert main([*base, "--starts", "4", "--json", str(out)]) == 0
+    assert json.loads(out.read_text())["starts_per_sample"] == 4
+    assert "8 samples, 4 starts a sample (settings.basins)" in capsys.readouterr().out
+    args = [str(design_file), "--speed", "5000:5000", "--speed-points", "1", "--samples", "8"]
+    assert main(["robustness", *args]) == 0
+    assert "(8 samples, 1 start a sample)" in capsys.readouterr().out
+
+
+def test_the_result_names_the_units_of_its_points_values(design_file: Path, tmp_path: Path) -> None:
+    """A robustness point's values are SI and its shown values in gear units: the result names
+    both (values.speed read as rpm by a new user is rad/s; issue 30 item 2)."""
+    out = tmp_path / "r.json"
+    args = [str(design_file), "--speed", "5000:5000", "--speed-points", "1", "--samples", "2"]
+    assert main(["robustness", *args, "--json", str(out)]) == 0
+    document = json.loads(out.read_text())
+    assert document["values_units"] == {"speed": "rad/s"}
+    assert document["shown_units"] == {"speed": "rpm"}

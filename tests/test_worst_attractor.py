@@ -83,3 +83,15 @@ def test_csv_and_dataframe_rows_have_the_verdict_and_every_attractor(sweep):
     assert [(label, float(f)) for label, f in listed] == [
         (a.label, pytest.approx(a.fraction)) for a in sweep.points[0].attractors
     ]
+
+
+def test_csv_and_dataframe_dte_and_dynamic_factor_are_the_worst_attractors(sweep):
+    """The DTE and dynamic-factor columns belong to the attractor whose verdict heads the row
+    (decided_by), not to the settings' own periodic start (a new-user review of issue 30)."""
+    (p,) = sweep.points
+    worst = p.attractors[0]
+    assert p.physical["dte"].value == pytest.approx(worst.dte_um)
+    assert p.physical["dynamic_factor"].value == pytest.approx(worst.dynamic_factor)
+    row = sweep.to_pandas().iloc[0]
+    assert row["dte [um]"] == pytest.approx(worst.dte_um)
+    assert row["dynamic_factor"] == pytest.approx(worst.dynamic_factor)

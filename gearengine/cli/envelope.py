@@ -188,6 +188,8 @@ def print_report(report: EnvelopeReport) -> None:
     if "melnikov" in report.rules.fail_on and report.melnikov_not_judged:
         print(f"  Melnikov could not judge {report.melnikov_not_judged} of {report.points} points "
               "(the criterion does not apply above the critical torque)")  # fmt: skip
+    for note in report.notes:
+        print(f"  note: {note}")
     if report.resolution is not None:
         print(f"  resolution: {report.resolution.text()}")
     for w in report.failures:

@@ -114,7 +114,8 @@ def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -
             "impacts",
             "separation",
         ],
-        help="repeatable",
+        help="repeatable; back_flank: back-flank impacts, separation: the teeth separate "
+        "(impacts: the older name of back_flank, read with a note)",
     )
     p.add_argument("--speed", metavar="LOW:HIGH", required=speed_required,
                    help="driver speeds: rpm, or with units")  # fmt: skip
@@ -202,7 +203,8 @@ def build_parser() -> argparse.ArgumentParser:
         action="append",
         metavar="NAME=P",
         help="fail where the 95 %% upper bound of P(NAME) over the design's "
-        "tolerances exceeds P (chaotic, separation, back_flank; repeatable)",
+        "tolerances exceeds P (chaotic, separation, back_flank; impacts: the older name of "
+        "separation, read with a note; repeatable)",
     )
     p.add_argument("--samples", type=samples_count, default=64,
                    help="with --max-probability: N, a power of 2 (64), refused when too few "

@@ -24,7 +24,7 @@ from gearengine.cli.documents import (
 from gearengine.cli.envelope import axis
 from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
-from gearengine.gate.envelope import ENVELOPE_SETTINGS
+from gearengine.gate.envelope import ENVELOPE_SETTINGS, gate_settings
 from gearengine.model.units import display_unit
 from gearengine.studies import jobs
 from gearengine.studies.robustness.study import (
@@ -37,7 +37,7 @@ from gearengine.studies.robustness.tolerances import samples_to_prove
 
 GATED = ("chaotic", "quasi_periodic", "diverged", "separation", "impacts", "back_flank",
          "dynamic_factor_above_limit", "melnikov_chaos_possible")  # fmt: skip
-"""Probabilities a gate may limit."""
+"""Probabilities a gate may limit (``impacts``: the older name of ``separation``, noted)."""
 
 
 def robustness_request(args: argparse.Namespace) -> RobustnessRequest:
@@ -54,6 +54,8 @@ def robustness_request(args: argparse.Namespace) -> RobustnessRequest:
     settings = doc.get("settings", {})
     if not isinstance(settings, dict):
         raise InvalidInputError([f"{args.file}: settings must be an object"])
+    if getattr(args, "starts", None) is not None:  # check --starts: starts per sample too
+        settings = gate_settings(settings, args.starts)
     body = {**{k: v for k, v in doc.items() if k not in ("params",)},
             "settings": {**ENVELOPE_SETTINGS, **settings}, "axes": axes or doc.get("axes", []),
             "samples": args.samples, "seed": args.seed}  # fmt: skip
@@ -84,9 +86,18 @@ def point_name(values: dict[str, float]) -> str:
     return ", ".join(parts) or "operating point"
 
 
-def limits_of(texts: list[str]) -> dict[str, float]:
-    """``["chaotic=0.01", ...]`` as {name: limit}; InvalidInputError naming a bad one."""
-    out = {}
+OLD_IMPACTS_LIMIT = (
+    "--max-probability impacts is read as separation (the teeth separate, on either flank), "
+    "its older name; write separation, or back_flank for back-flank impacts (as --fail-on "
+    "back_flank)"
+)
+"""The note of a probability gate given the older name ``impacts``."""
+
+
+def limits_of(texts: list[str]) -> tuple[dict[str, float], list[str]]:
+    """``["chaotic=0.01", ...]`` as {name: limit}, the older name ``impacts`` read as
+    ``separation``, and the notes saying so; InvalidInputError naming a bad one."""
+    out, notes = {}, []
     for text in texts:
         name, _, value = text.partition("=")
         try:
@@ -96,8 +107,11 @@ def limits_of(texts: list[str]) -> dict[str, float]:
         if name not in GATED or not 0.0 <= limit <= 1.0:
             raise InvalidInputError([f"--max-probability {text}: give NAME=P with P in [0, 1] "
                                      f"and NAME one of {', '.join(GATED)}"])  # fmt: skip
+        if name == "impacts":
+            name = "separation"
+            notes += [] if OLD_IMPACTS_LIMIT in notes else [OLD_IMPACTS_LIMIT]
         out[name] = limit
-    return out
+    return out, notes
 
 
 def failures(result: RobustnessResult, limits: dict[str, float]) -> list[list[str]]:
@@ -131,7 +145,7 @@ def cmd_robustness(args: argparse.Namespace) -> int:
             f"{k} {pr[k].value:.3f} [{pr[k].interval[0]:.3f}, {pr[k].interval[1]:.3f}]"
             for k in ("chaotic", "separation", "back_flank")
         )
-        print(f"{point_name(p.shown)}: {words} ({p.samples} samples)")
+        print(f"{point_name(p.shown)}: {words} ({p.samples} samples, {result.starts_text()})")
         for line in p.ranking or []:
             print(f"  {line}")
     if args.json:
@@ -211,13 +225,16 @@ def sequential_study(
 def cmd_probability_gate(args: argparse.Namespace) -> int:
     """``check --max-probability``: exit 1 where an upper bound exceeds its limit; a sample
     count that cannot prove a limit is refused before computing (``samples_needed``)."""
-    limits = limits_of(args.max_probability)
+    limits, notes = limits_of(args.max_probability)
+    for note in notes:
+        print(f"note: {note}")
     least = samples_needed(limits, args.samples)
     if args.samples == "auto":
         result = sequential_study(args, limits, least)
     else:
         _, result = study(args)
     why = failures(result, limits)
+    print(f"probabilities from {result.samples} samples, {result.starts_text()}")
     for p, reasons in zip(result.points, why, strict=True):
         verdict = "FAIL" if reasons else "PASS"
         print(f"{verdict}: {point_name(p.shown)}" + (f" [{'; '.join(reasons)}]" if reasons else ""))

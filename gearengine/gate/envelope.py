@@ -25,20 +25,25 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.gate.resolution import REFINE_DEPTH, Resolution, resolution
 from gearengine.gate.resolution import refine as refine_points
-from gearengine.model.units import OUTPUTS, RESPONSES
+from gearengine.model.units import OUTPUTS, POINT_OUTPUTS
 from gearengine.signals.classify import SEVERITY
 from gearengine.studies.sweep.compute import run_local
 from gearengine.studies.sweep.plan import balanced_chunk_points
 from gearengine.studies.sweep.points import PhysicalValue, SpeedWindows, SweepPoint
 from gearengine.studies.sweep.request import SweepRequest
 from gearengine.studies.sweep.results import SweepResult
-from gearengine.studies.sweep.windows import SPEED, runs
+from gearengine.studies.sweep.windows import SPEED, runs, speed_windows
 
 FailOn = Literal[
     "chaotic", "quasi_periodic", "diverged", "melnikov", "back_flank", "impacts", "separation"
 ]
 BACK_FLANK = ("back_flank", "impacts")
 """The rule names of back-flank impacts (``impacts`` the older one, kept: the same rule)."""
+OLD_IMPACTS_RULE = (
+    "--fail-on impacts is read as back_flank (back-flank impacts), its older name; write "
+    "back_flank, or separation to fail wherever the teeth separate (as P(separation))"
+)
+"""The note of a report whose rules give the older rule name ``impacts``."""
 
 
 class Rules(BaseModel):
@@ -273,7 +278,11 @@ class EnvelopeReport(BaseModel):
         "torque, or no saddle): --fail-on melnikov never fails them.",
     )
     failures: list[FailingWindow]
-    windows: list[SpeedWindows] = Field(description="All response windows, failing or not.")
+    windows: list[SpeedWindows] = Field(
+        description="All response windows, failing or not, over the grid points and the refined "
+        "points between them (the points failures come from; sweep.windows has the grid's "
+        "alone), by torque level ascending."
+    )
     resolution: Resolution | None = Field(
         None, description="What was checked: grid spacing, starts, and the points inserted "
         "between grid points (null: a report read back without it).",
@@ -283,11 +292,15 @@ class EnvelopeReport(BaseModel):
         [], description="The points inserted between the grid points (gate.resolution), "
         "checked by the same rules; their failures are in failures.",
     )  # fmt: skip
+    notes: list[str] = Field(
+        [], description="How the rules were read: an older rule name (impacts, read as "
+        "back_flank) is named with its reading."
+    )  # fmt: skip
 
 
 def _level_key(p: SweepPoint) -> tuple:
     return tuple(sorted((k, v.value) for k, v in (p.physical or {}).items() if k not in
-                        (SPEED, *RESPONSES)))  # fmt: skip
+                        (SPEED, *POINT_OUTPUTS)))  # fmt: skip
 
 
 def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPoint] = (),
@@ -300,9 +313,10 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
             rows.setdefault(_level_key(p), []).append(p)
     failures: list[FailingWindow] = []
     failing = 0
-    for row in rows.values():
+    for _, row in sorted(rows.items()):
         row.sort(key=lambda p: p.values[SPEED])
-        level = {k: v for k, v in (row[0].physical or {}).items() if k not in (SPEED, *RESPONSES)}
+        level = {k: v for k, v in (row[0].physical or {}).items()
+                 if k not in (SPEED, *POINT_OUTPUTS)}  # fmt: skip
         speeds = [p.physical[SPEED].value for p in row]  # type: ignore[index]
         found = [attractor_failures(p, rules) for p in row]
         broken = [[rule for rule, _ in f] for f in found]
@@ -323,10 +337,11 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
             1 for r in rows.values() for p in r if p.melnikov_chaos_possible is None
         ),
         failures=failures,
-        windows=result.windows or [],
+        windows=speed_windows(result, [*result.points, *refined]) or [],
         resolution=resolution,
         sweep=result,
         refined=list(refined),
+        notes=[OLD_IMPACTS_RULE] if "impacts" in rules.fail_on else [],
     )
 
 

@@ -98,7 +98,7 @@ def gate_envelope(
     lo, hi = grid[0] / RPM, grid[-1] / RPM
     if axis.num < 2 or not lo < hi:
         raise ValueError("--runup: give the envelope a speed range, --speed LOW:HIGH")
-    levels = [w.level for w in report.windows] or [{}]
+    levels = [w.level for w in report.sweep.windows or []] or [{}]
     design = sweep.design.model_dump()
     failures = list(report.failures)
     for k, level in enumerate(levels):

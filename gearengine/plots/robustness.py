@@ -12,10 +12,10 @@ from gearengine.model.units import display_unit
 from gearengine.plots.style import ImageFormat, figure_bytes
 from gearengine.studies.robustness.study import RobustnessRequest, RobustnessResult
 
-PANELS = ("chaotic", "impacts", "back_flank", "dynamic_factor_above_limit")
+PANELS = ("chaotic", "separation", "back_flank", "dynamic_factor_above_limit")
 TITLES = {
     "chaotic": "P(chaotic)",
-    "impacts": "P(tooth separation)",
+    "separation": "P(tooth separation)",
     "back_flank": "P(back-flank impacts)",
     "dynamic_factor_above_limit": "P(dynamic factor > {limit:g})",
 }

@@ -659,11 +659,13 @@ async function drawMap(map, result, height) {
         p.melnikov_chaos_possible === null ? "not applicable (above T_crit)"
           : p.melnikov_chaos_possible ? "chaos possible" : "chaos ruled out",
         physicalText(p, "dynamic_factor", 3, ""), physicalText(p, "dte", 3, " µm"),
+        // with basins every number above is the worst attractor's: name it and its fraction
+        p.decided_by ? `<br>decided by ${p.decided_by}` : "",
       ]),
       hovertemplate: "speed %{x:,.0f} rpm<br>torque %{y:,.1f} N·m"
         + "<br>class %{customdata[0]}, period %{customdata[1]}<br>LLE %{customdata[2]} ± %{customdata[3]} per unit τ"
         + "<br>%{customdata[4]}<br>dynamic factor %{customdata[6]}, DTE %{customdata[7]}"
-        + "<br>Melnikov: %{customdata[5]}<extra></extra>",
+        + "<br>Melnikov: %{customdata[5]}%{customdata[8]}<extra></extra>",
       marker: {
         color: CLASS_COLORS[cls], symbol: sel.map((p) => IMPACT_SYMBOLS[p.impact_regime] || "square"),
         size: sel.map((p) => factorSize(p)), line: { color: "white", width: 1 },

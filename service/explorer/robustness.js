@@ -11,7 +11,7 @@ const ROBUSTNESS_FIELDS = [
   ["samples", "samples (power of 2)", "int", "32"],
 ];
 const PROBABILITIES = [
-  ["chaotic", "P(chaotic)"], ["impacts", "P(tooth separation)"], ["back_flank", "P(back-flank impacts)"],
+  ["chaotic", "P(chaotic)"], ["separation", "P(tooth separation)"], ["back_flank", "P(back-flank impacts)"],
 ];
 const studyJob = new JobWatcher({
   route: "robustness", prefix: "robustness", cancel: "cancel-study", unit: "runs (samples × points)",

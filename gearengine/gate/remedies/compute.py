@@ -123,7 +123,9 @@ def _cost(r: Remedy) -> tuple[int, float]:
 def answer(remedies: list[Remedy], unreachable: list[Unreachable],
            combo: Combination | None) -> str:  # fmt: skip
     """The ranked answer in words: each lever's numerical value, its Melnikov guarantee beside
-    it, then what no value in range clears."""
+    it where the criterion judges envelope points and the envelope check passes there (with
+    what was checked: the resolution), then what no value in range clears, and the Melnikov
+    values that guarantee nothing (judging no point, or where the check still fails)."""
     by_lever: dict[tuple[str, bool], dict[str, Remedy]] = {}
     for r in remedies:
         by_lever.setdefault((r.lever, r.to > r.from_), {})[r.bound] = r
@@ -133,13 +135,11 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
         first = num or mel
         assert first is not None
         unit = "" if first.unit == "1" else f" {first.unit}"
-        if num is None and mel is not None and _judged(mel) == 0:
-            # no numerical value and a criterion that judges no point: not a remedy to offer
-            blind.append(f"{lever_words(mel.lever)} at {mel.to:.4g}{unit}: the Melnikov "
-                         "criterion allows chaos nowhere but applies at none of the "
-                         f"{mel.melnikov_points or 0} points, so it guarantees "
-                         "nothing")  # fmt: skip
-            continue
+        if mel is not None and not _guarantees(mel):
+            blind.append(f"{lever_words(mel.lever)} at {mel.to:.4g}{unit}: {_no_guarantee(mel)}")
+            mel = None
+            if num is None:  # not a remedy to offer
+                continue
         words = lever_words(first.lever)
         verb = "raise" if first.to > first.from_ else "lower"
         text = f"{verb} the {words} from {first.from_:.4g}"
@@ -150,18 +150,12 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
                 text += f"; ISO 1328 class {grades[0]} -> {grades[1]}"
             text += ")" if num.monotone else "; not unique: the response is not monotone)"
         if mel is not None:
-            outcome = "passes" if mel.check.passed else "still fails"
             points, applies = mel.melnikov_points or 0, _judged(mel)
-            if applies == points:
-                what = "Melnikov guarantee against homoclinic chaos"
-            elif applies:
-                what = (f"Melnikov guarantee against homoclinic chaos at the {applies} of "
-                        f"{points} points where the criterion applies")  # fmt: skip
-            else:
-                what = (f"the Melnikov criterion allows chaos nowhere but applies at none of "
-                        f"the {points} points: no guarantee")  # fmt: skip
+            what = "Melnikov guarantee against homoclinic chaos"
+            if applies < points:
+                what += f" at the {applies} of {points} points where the criterion applies"
             text += (f"{' or' if num else ' to'} {mel.to:.4g}{unit} ({what}; the envelope check "
-                     f"{outcome} there)")  # fmt: skip
+                     f"passes there{_checked(mel)})")  # fmt: skip
         parts.append(text)
     words = "; or ".join(parts) if parts else "no single lever clears the envelope"
     for u in unreachable:
@@ -173,6 +167,30 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
     if combo is not None:
         words += f"; together: {combo.summary}"
     return words
+
+
+def _guarantees(mel: Remedy) -> bool:
+    """A Melnikov value is offered with its guarantee only where its criterion judges some
+    envelope point and the envelope check passes there."""
+    return _judged(mel) > 0 and mel.check.passed
+
+
+def _no_guarantee(mel: Remedy) -> str:
+    """Why a Melnikov value guarantees nothing, with what was checked."""
+    points = mel.melnikov_points or 0
+    if _judged(mel) == 0:
+        return (f"the Melnikov criterion allows chaos nowhere but applies at none of the "
+                f"{points} points, so it guarantees nothing")  # fmt: skip
+    return (f"the Melnikov criterion allows homoclinic chaos at none of the {_judged(mel)} of "
+            f"{points} points it judges, but the envelope check still fails there at "
+            f"{mel.check.failing_points} of {mel.check.points} points{_checked(mel)}, so it "
+            "guarantees no pass")  # fmt: skip
+
+
+def _checked(mel: Remedy) -> str:
+    """The resolution the envelope check at a Melnikov value ran at (empty without one)."""
+    resolution = mel.check.resolution
+    return "" if resolution is None else f" (checked on {resolution.text()})"
 
 
 def _judged(mel: Remedy) -> int:

@@ -7,7 +7,9 @@ output table). Everything else imports units from here.
 
 from gearengine.model.units.outputs import (
     OUTPUTS,
+    POINT_OUTPUTS,
     RADIUS_RATIO_TOLERANCE,
+    RECORD_FORCES,
     RESPONSES,
     RPM,
     TORQUE_BALANCE_TOLERANCE,
@@ -53,8 +55,10 @@ from gearengine.model.units.quantities import (
 
 __all__ = [
     "OUTPUTS",
+    "POINT_OUTPUTS",
     "QUANTITIES",
     "RADIUS_RATIO_TOLERANCE",
+    "RECORD_FORCES",
     "RESPONSES",
     "RPM",
     "TORQUE_BALANCE_TOLERANCE",

@@ -85,6 +85,15 @@ OUTPUTS: dict[str, OutputKind] = {
     "mesh_force": OutputKind(
         "dynamic mesh force", "N", "N", lambda f, s: f * s.half_backlash * s.mesh_stiffness
     ),
+    "force_max": OutputKind(
+        "largest mesh force of the model over the record, k_m b (K(t) f_h(x) + 2 mu x')", "N",
+        "N", lambda f, s: f * s.half_backlash * s.mesh_stiffness,
+    ),
+    "force_min": OutputKind(
+        "smallest mesh force of the model over the record (its damping term acts in the "
+        "clearance too: negative while apart or on the back flank)", "N", "N",
+        lambda f, s: f * s.half_backlash * s.mesh_stiffness,
+    ),
     "transmission_error_amplitude": OutputKind(
         "transmission-error amplitude e_1 = F~_e1 b", "m", "um",
         lambda v, s: v * s.half_backlash, 1e6,
@@ -114,6 +123,11 @@ OUTPUTS: dict[str, OutputKind] = {
 RESPONSES = ("dte", "dynamic_factor")
 """The response quantities of a design's simulated point (a sweep point's ``physical`` entries
 beside its axes, the CSV's response columns, the gate's limits)."""
+RECORD_FORCES = ("force_max", "force_min")
+"""A design's sweep point's mesh forces in N (``physical`` entries after ``RESPONSES``, the CSV's
+``force_max [N]``, ``force_min [N]``): the record's ``force_max`` and ``force_min`` x b k_m."""
+POINT_OUTPUTS = (*RESPONSES, *RECORD_FORCES)
+"""Every ``physical`` entry of a sweep point that is an output, not an axis."""
 
 
 def in_si(name: str, value: float, scales: Scales) -> float:

@@ -38,7 +38,7 @@ from gearengine.model.design import Design
 from gearengine.model.errors import InputError, Problems
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
-from gearengine.model.units import Scales, in_display_unit, response_values
+from gearengine.model.units import Scales, display_unit, in_display_unit, response_values
 from gearengine.numerics.attractors import headline, points_attractors
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.settings import SimulationSettings, work
@@ -53,7 +53,12 @@ from gearengine.studies.robustness.tolerances import (
     sobol_points,
     variables,
 )
-from gearengine.studies.sweep.axes import axis_problem, design_with, is_dimensionless
+from gearengine.studies.sweep.axes import (
+    axis_problem,
+    axis_unit,
+    design_with,
+    is_dimensionless,
+)
 from gearengine.studies.sweep.request import SweepAxis
 from gearengine.systems.designs import design_model
 
@@ -68,8 +73,9 @@ EVENTS = (
     "dynamic_factor_above_limit",
     "melnikov_chaos_possible",
 )
-OUTPUTS = ("chaotic", "impacts", "back_flank", "dte", "dynamic_factor")
-"""The outputs whose Sobol indices are reported."""
+OUTPUTS = ("chaotic", "separation", "back_flank", "dte", "dynamic_factor")
+"""The outputs whose Sobol indices are reported (``sensitivity`` also holds separation's
+under ``impacts``, its older name)."""
 DEFAULT_CHUNK_ROWS = 16
 MAX_SAMPLES = 4096
 
@@ -256,14 +262,16 @@ class RobustnessPoint(BaseModel):
     probabilities: dict[str, Probability] = Field(
         description="Of each class (periodic, quasi_periodic, chaotic, diverged) and event "
         "(separation: the teeth separate, drive-flank or back-flank impacts, as the gate's "
-        "--fail-on separation; impacts: its older name, the same count; back_flank: back-flank "
+        "--fail-on separation; impacts: its older name, the same count (deprecated: "
+        "--fail-on impacts is back_flank); back_flank: back-flank "
         "impacts, as --fail-on back_flank; "
         "dynamic_factor_above_limit; melnikov_chaos_possible)."
     )
     dte_um: dict[str, float | None] = Field(description="DTE over the samples: mean, p5, p95.")
     sensitivity: dict[str, dict[str, dict[str, float | None]] | None] | None = Field(
-        None, description="Sobol indices by output (chaotic, impacts, back_flank, dte, "
-        "dynamic_factor) and field: first, total, and their 95 % half-widths.",
+        None, description="Sobol indices by output (chaotic, separation, back_flank, dte, "
+        "dynamic_factor; impacts: separation's under its older name) and field: first, total, "
+        "and their 95 % half-widths.",
     )  # fmt: skip
     ranking: list[str] | None = Field(None, description="The indices in plain words.")
 
@@ -282,6 +290,25 @@ class RobustnessResult(BaseModel):
     variables: list[RobustnessVariable] = Field(description="The toleranced fields.")
     partial: bool = Field(False, description="True when chunks are missing.")
     model: list[str] = Field(description="What the sampling and the TE model assume.")
+    values_units: dict[str, str] | None = Field(
+        None, description="The unit of each axis in the points' values (SI: speed rad/s).",
+        examples=[{"speed": "rad/s", "torque": "N*m"}],
+    )  # fmt: skip
+    shown_units: dict[str, str] | None = Field(
+        None, description="The unit of each axis in the points' shown values (speed rpm).",
+        examples=[{"speed": "rpm", "torque": "N*m"}],
+    )  # fmt: skip
+    starts_per_sample: int = Field(
+        1, description="Initial states each sample ran: settings.basins' starts (the sample "
+        "counts as its worst attractor above basins.min_fraction), else the settings' own "
+        "starts (the worst of them)."
+    )  # fmt: skip
+
+    def starts_text(self) -> str:
+        """ "16 starts a sample (settings.basins)", "1 start a sample": what decided a sample."""
+        n = self.starts_per_sample
+        basins = " (settings.basins)" if any("settings.basins" in m for m in self.model) else ""
+        return f"{n} start{'s' if n != 1 else ''} a sample{basins}"
 
 
 ASSUMPTIONS = [
@@ -327,16 +354,17 @@ def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[
     if request.sensitivity and complete:
         ys = {
             "chaotic": [r[0] == 2 for r in runs],
-            "impacts": [r[1] in (1, 2) for r in runs],
+            "separation": [r[1] in (1, 2) for r in runs],
             "back_flank": [r[1] == 2 for r in runs],
             "dte": [math.nan if r[3] is None else r[3] for r in runs],
             "dynamic_factor": [math.nan if r[4] is None else r[4] for r in runs],
         }
+        assert tuple(ys) == OUTPUTS
         table = {k: sensitivity.indices(names, np.array(y, float), request.seed)
                  for k, y in ys.items()}  # fmt: skip
-        out["sensitivity"] = table
         labels = {v.path: v.name for v in variables_}
         out["ranking"] = [sensitivity.ranked(k, t, labels) for k, t in table.items()]
+        out["sensitivity"] = {**table, "impacts": table["separation"]}  # its older name
     return out
 
 
@@ -362,6 +390,9 @@ def assemble(request: RobustnessRequest, chunks: list[str]) -> RobustnessResult:
         variables=[RobustnessVariable(path=v.path, distribution=v.words) for v in variables_],
         partial=not complete,
         model=ASSUMPTIONS + ([] if basins is None else [basin_assumption(basins)]),
+        starts_per_sample=len(request.settings.starts()) if basins is None else basins.starts,
+        values_units={a.parameter: axis_unit(a.parameter) for a in request.axes},
+        shown_units={a.parameter: display_unit(a.parameter)[0] for a in request.axes},
     )
 
 

@@ -54,6 +54,9 @@ JUMP_MIN_B = 0.1
 BRANCH, T0, T1, SPEED, FM, STEPS, XMIN, XMAX, FMIN, FMAX, SEP, BACK, BACK_IN, DRIVE_IN, LOG = range(
     15
 )
+CMIN, CMAX = 15, 16
+"""The contact force's extremes (``kernels.ramp.BLOCK_COLUMNS``; absent from a table stored
+before they were added: the bin's contact force is then null)."""
 
 
 def jumps(speeds: Sequence[float], dte: Sequence[float | None], b_um: float) -> list[RunupJump]:
@@ -143,6 +146,7 @@ def _bins(request: RunupRequest, tables: list[np.ndarray], branch: Branch, lo: f
             blocks = zip(mine[:, FMAX].tolist(), mine[:, FM].tolist(), strict=True)
             factor = shown(max(to_physical("dynamic_factor", f, scales.at(fm)) for f, fm in blocks))
         dte = float(mine[:, XMAX].max() - mine[:, XMIN].min())
+        contact_kept = mine.shape[1] > CMAX
         out.append((k, RunupBin(
             speed_rpm=[shown(span[0]), shown(span[1])],
             time_s=[shown(float(mine[:, T0].min())), shown(float(mine[:, T1].max()))],
@@ -151,6 +155,10 @@ def _bins(request: RunupRequest, tables: list[np.ndarray], branch: Branch, lo: f
             if ok else None,
             force_min_n=shown(to_physical("mesh_force", float(mine[:, FMIN].min()), scales))
             if ok else None,
+            contact_force_max_n=shown(to_physical("mesh_force", float(mine[:, CMAX].max()),
+                                                  scales)) if ok and contact_kept else None,
+            contact_force_min_n=shown(to_physical("mesh_force", float(mine[:, CMIN].min()),
+                                                  scales)) if ok and contact_kept else None,
             dynamic_factor=factor,
             separation_fraction=None if sep is None else shown(sep),
             back_flank_fraction=None if back is None else shown(back),
@@ -193,7 +201,8 @@ def read_runup(
     """The run-up's document from the members' block tables and the quasi-static sweep."""
     design, conv, params = request.design, request.conversion, request.params
     assert design is not None and conv is not None and params is not None
-    arrays = [np.array(t, dtype=float).reshape(-1, 15) for t in tables]
+    arrays = [np.array(t, dtype=float).reshape(-1, len(t[0]) if t else CMAX + 1)
+              for t in tables]  # fmt: skip
     lo, hi = (w / RPM for w in request.speed_range())
     scales = conv.scales
     b_um = to_physical("dte", 1.0, scales)  # one half backlash b in the DTE's unit

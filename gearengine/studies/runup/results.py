@@ -17,8 +17,24 @@ class RunupBin(_Result):
     dte_peak_to_peak_um: float | None = Field(
         description="Dynamic transmission error b (x_max - x_min) over the bin [µm]."
     )
-    force_max_n: float | None = Field(description="Largest dynamic mesh force [N].")
-    force_min_n: float | None = Field(description="Smallest dynamic mesh force [N].")
+    force_max_n: float | None = Field(
+        description="Largest mesh force of the model [N]: k_m b (K f_h(x) + 2 mu x') at step "
+        "ends, whose damping term acts in the clearance too."
+    )
+    force_min_n: float | None = Field(
+        description="Smallest mesh force of the model [N] (negative: back-flank contact, or "
+        "the damping term while the teeth are apart)."
+    )
+    contact_force_max_n: float | None = Field(
+        None,
+        description="Largest tooth contact force [N]: the model's force where a flank touches "
+        "(|x| > 1; drive flank >= 0, back flank <= 0), zero while the teeth are apart.",
+    )
+    contact_force_min_n: float | None = Field(
+        None,
+        description="Smallest tooth contact force [N]: 0 in a bin where the teeth separate "
+        "without reaching the back flank, negative only with back-flank contact.",
+    )
     dynamic_factor: float | None = Field(
         description="Largest mesh force over the mean force F^_m of the moment (torque ramp "
         "and acceleration included)."

@@ -22,7 +22,7 @@ from pydantic import ValidationError
 from gearengine.model.aliases import ALIASES, with_aliases, with_speed_factor
 from gearengine.model.design import Design
 from gearengine.model.params import GearParams
-from gearengine.model.units import Scales, si_numbers
+from gearengine.model.units import Scales, field_unit, si_numbers
 from gearengine.systems.base import System
 from gearengine.systems.designs import design_model, params_of
 from gearengine.systems.spur_pair.forcing import packed_forcing
@@ -34,6 +34,12 @@ OMEGA = "Omega"
 def is_dimensionless(parameter: str) -> bool:
     """True for an alias of Eq. (9) or ``Omega``; False for a field of a design."""
     return parameter in ALIASES or parameter == OMEGA
+
+
+def axis_unit(parameter: str) -> str:
+    """The unit of an axis' values in a point's ``values``: a design field's SI unit (speed
+    rad/s), "1" for a dimensionless alias."""
+    return "1" if is_dimensionless(parameter) else field_unit(parameter).si
 
 
 def _set(tree: dict[str, Any], path: str, value: object) -> None:

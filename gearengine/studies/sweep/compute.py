@@ -12,7 +12,17 @@ from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.homoclinic.train_reduction import melnikov_point
 from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
-from gearengine.model.units import OUTPUTS, Scales, display_unit, in_display_unit, response_values
+from gearengine.model.units import (
+    OUTPUTS,
+    RECORD_FORCES,
+    RESPONSES,
+    Scales,
+    display_unit,
+    in_display_unit,
+    response_values,
+    shown,
+    to_physical,
+)
 from gearengine.numerics.attractors import coexisting, headline, points_attractors
 from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
 from gearengine.numerics.bifurcations import PointResponse, locate_bifurcations
@@ -37,22 +47,34 @@ from gearengine.systems.spur_pair.forcing import step_plan
 
 
 def _physical(
-    values: dict[str, float], params: GearParams, scales: Scales | None, bp: BatchPoint
+    values: dict[str, float],
+    params: GearParams,
+    scales: Scales | None,
+    bp: BatchPoint,
+    responses: dict[str, float | None] | None = None,
 ) -> dict[str, Any]:
-    """With a design (its ``scales``): the axes in display units, the responses of
-    ``model.units.response_values`` (DTE in µm, dynamic factor) and the point's aliases."""
+    """With a design (its ``scales``): the axes in display units, the responses (DTE in µm,
+    dynamic factor), the record's mesh forces in N and the point's aliases. The responses are
+    the deciding attractor's with basins (``responses``, from ``_decided``), else
+    ``model.units.response_values`` of the settings' own run ``bp``; the forces are always the
+    record's (``RECORD_FORCES``, as ``force_max`` and ``force_min``)."""
     if scales is None:
         return {}
-    shown = {
+    out = {
         name: PhysicalValue(value=in_display_unit(name, si), unit=display_unit(name)[0])
         for name, si in values.items()
         if not is_dimensionless(name)
     }
-    for key, value in response_values(bp.x_peak_to_peak, bp.force_max, scales).items():
+    record = response_values(bp.x_peak_to_peak, bp.force_max, scales)
+    forces = {
+        key: None if f is None else shown(to_physical("mesh_force", f, scales))
+        for key, f in zip(RECORD_FORCES, (bp.force_max, bp.force_min), strict=True)
+    }
+    for key, value in {**record, **(responses or {}), **forces}.items():
         if value is not None:
-            shown[key] = PhysicalValue(value=value, unit=OUTPUTS[key].unit)
+            out[key] = PhysicalValue(value=value, unit=OUTPUTS[key].unit)
     aliases = {a: get_alias(params, a) for a in ALIASES}
-    return {"physical": shown, "dimensionless": {k: v for k, v in aliases.items() if v is not None}}
+    return {"physical": out, "dimensionless": {k: v for k, v in aliases.items() if v is not None}}
 
 
 def _point(
@@ -89,7 +111,7 @@ def _point(
         periods_run=bp.periods_run,
         force_max=bp.force_max,
         force_min=bp.force_min,
-        **_physical(values, params, scales, bp),
+        **_physical(values, params, scales, bp, basins.pop("responses", None)),
         **basins,
     )
 
@@ -175,18 +197,23 @@ def _basins(
 def _decided(found: list[Attractor], counts: BasinCounts, min_fraction: float) -> dict[str, Any]:
     """The point's verdict from its ensemble (docs/basins.md): the worst attractor (or the
     divergence) whose basin fraction is above ``min_fraction`` (``numerics.attractors.headline``),
-    its classification, period, LLE and impacts, named with its fraction in ``decided_by``; empty
-    when no basin is above it (the settings' own starts decide)."""
+    its classification, period, LLE and impacts, named with its fraction in ``decided_by``, and
+    its responses (DTE, dynamic factor: the point's ``physical`` entries, so the CSV's and the
+    DataFrame's columns are that attractor's too); empty when no basin is above it (the
+    settings' own starts decide)."""
     head = headline(found, counts, min_fraction)
     if head is None:
         return {}
     verdict: dict[str, Any] = {"classification": head.classification, "period": head.period}
     a = head.attractor
-    if a is None:  # diverged: no LLE, no impact verdict
+    if a is None:  # diverged: no LLE, no impact verdict, no response
         verdict.update(lle=None, lle_stderr=None, impact_regime=None)
+        responses: dict[str, float | None] = dict.fromkeys(RESPONSES)  # none of them
     else:
         verdict.update(lle=a.lle, lle_stderr=a.lle_stderr, impact_regime=a.impact_regime)
-    return {"verdict": verdict, "decided_by": head.decided_by, "decided_fraction": head.fraction}
+        responses = {"dte": a.dte_um, "dynamic_factor": a.dynamic_factor}
+    return {"verdict": verdict, "responses": responses, "decided_by": head.decided_by,
+            "decided_fraction": head.fraction}  # fmt: skip
 
 
 def _line_bifurcations(

@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel, Field, TypeAdapter
 
-from gearengine.model.units import RESPONSES, display_label, field_unit, in_display_unit
-from gearengine.studies.sweep.axes import is_dimensionless
+from gearengine.model.units import POINT_OUTPUTS, display_label, field_unit, in_display_unit
+from gearengine.studies.sweep.axes import axis_unit, is_dimensionless
 from gearengine.studies.sweep.points import SweepBifurcation, SweepPoint
 from gearengine.studies.sweep.request import SweepAxis
 
@@ -66,7 +66,11 @@ def result_json(
     order): the points streamed as they are, the lines' bifurcations gathered at the end.
     ``partial``: some chunks are missing (a job that did not succeed); ``windows``: the speed
     windows (``studies.sweep.windows``) of a sweep over the driver speed."""
-    yield '{"axes":[' + ",".join(a.model_dump_json() for a in axes) + '],"points":['
+    units = {a.parameter: axis_unit(a.parameter) for a in axes}
+    yield (
+        '{"axes":[' + ",".join(a.model_dump_json() for a in axes) + '],"values_units":'
+        + json.dumps(units) + ',"points":['
+    )  # fmt: skip
     first = True
     located: list[dict[str, object]] | None = None
     for array in chunk_arrays:
@@ -117,8 +121,10 @@ def csv_rows(
     """CSV rows (header first): one column per axis, a design's field in SI units and titled
     with its unit (``speed [rad/s]``, ``torque [N*m]``); with a ``design`` (a sweep of a design
     in physical units) the axes whose display unit differs also in that unit (``speed [rpm]``)
-    and, unless ``outputs`` leaves ``physical`` out, the DTE and the dynamic factor
-    (``dte [um]``, ``dynamic_factor``, from the point's ``physical``); then the verdicts, and
+    and, unless ``outputs`` leaves ``physical`` out, the DTE, the dynamic factor and the mesh
+    forces in N (``dte [um]``, ``dynamic_factor``, ``force_max [N]``, ``force_min [N]``, from the
+    point's ``physical``; ``force_max`` and ``force_min`` are the same in units of b k_m); then
+    the verdicts, and
     poincare_x as space-separated numbers. Empty cells are nulls; booleans are true/false. Axis
     cells are plain decimals (``_axis_cell``: 500, 0.000001, never 500.0 beside 1e-6), rounded
     to the 15 significant digits they were given with (``_grid_value``); every other number is
@@ -188,8 +194,9 @@ def _physical_columns(
     names: list[str], outputs: Sequence[str] | None
 ) -> list[tuple[str, str, bool]]:
     """(key, column title, is an axis) of a design's sweep: each physical axis in its display
-    unit (from the point's ``values``), then the responses of ``model.units.RESPONSES`` (from
-    its ``physical``, unless ``outputs`` leaves that out)."""
+    unit (from the point's ``values``), then the responses and the record's mesh forces of
+    ``model.units.POINT_OUTPUTS`` (``dte [um]``, ``dynamic_factor``, ``force_max [N]``,
+    ``force_min [N]``, from its ``physical``, unless ``outputs`` leaves that out)."""
     axes = [
         (n, f"{n} [{field_unit(n).display}]", True)
         for n in names
@@ -197,15 +204,15 @@ def _physical_columns(
     ]
     if outputs is not None and "physical" not in outputs:
         return axes
-    response = [(key, display_label(key), False) for key in RESPONSES]
+    response = [(key, display_label(key), False) for key in POINT_OUTPUTS]
     return [*axes, *response]
 
 
 def _axis_title(name: str) -> str:
     """An axis column's title: the alias, or a design field with its SI unit."""
-    if is_dimensionless(name) or field_unit(name).si == "1":
+    if axis_unit(name) == "1":
         return name
-    return f"{name} [{field_unit(name).si}]"
+    return f"{name} [{axis_unit(name)}]"
 
 
 @lru_cache(maxsize=1 << 16)

@@ -30,7 +30,10 @@ class SweepPoint(BaseModel):
     model_config = ConfigDict(frozen=True, allow_inf_nan=False)
 
     values: dict[str, float] = Field(
-        description="The axes' parameter values at this point.", examples=[{"F_e1": 0.2}]
+        description="The axes' parameter values at this point: a design's fields in SI "
+        "(speed in rad/s, torque in N*m; the result's values_units names each, physical has "
+        "them in display units), dimensionless aliases as they are.",
+        examples=[{"F_e1": 0.2}],
     )
     branch: SweepBranch | None = Field(
         description="With continuation: up (forward) or down (backward) branch; else null."
@@ -39,15 +42,19 @@ class SweepPoint(BaseModel):
         None,
         description="periodic | chaotic | quasi_periodic | diverged; with settings.basins the "
         "worst attractor's above basins.min_fraction (decided_by names it; period, lle, "
-        "lle_stderr and impact_regime are its too). This and every field "
-        "below are left out of the stored and returned points that a sweep's outputs do not "
-        "name (null when read back into this model).",
+        "lle_stderr, impact_regime and physical's dte and dynamic_factor are its too). This "
+        "and every field below are left out of the stored and returned points that a "
+        "sweep's outputs do not name (null when read back into this model).",
     )
     period: int | None = Field(None, description="Period in units of T0, null if none found.")
     lle: float | None = Field(None, description="Largest Lyapunov exponent per unit tau.")
     lle_stderr: float | None = Field(None, description="Standard error of lle.")
     impact_regime: str | None = Field(
-        None, description="no_impact | single_sided | double_sided, null when not reported."
+        None,
+        description="no_impact (contact throughout) | single_sided (separation: the teeth "
+        "separate, not reaching the back flank) | double_sided (back_flank: back-flank "
+        "impacts), the words of --fail-on and P(...) (docs/units.md, Contact words); null when "
+        "not reported.",
     )
     melnikov_chaos_possible: bool | None = Field(
         None,
@@ -66,8 +73,8 @@ class SweepPoint(BaseModel):
     )
     force_max: float | None = Field(
         None,
-        description="Largest dimensionless mesh force K(t) f_h(x) + 2 mu x' over the record; "
-        "null if diverged.",
+        description="Largest dimensionless mesh force K(t) f_h(x) + 2 mu x' over the record, "
+        "in units of b k_m (with a design physical.force_max has it in N); null if diverged.",
     )
     force_min: float | None = Field(
         None, description="Smallest dimensionless mesh force over the record; null if diverged."
@@ -75,8 +82,9 @@ class SweepPoint(BaseModel):
     physical: dict[str, PhysicalValue] | None = Field(
         None,
         description="With a design: the physical axes' values in display units (rpm, N*m, "
-        "µm, ...), the dynamic transmission error dte (µm peak to peak) and the "
-        "dynamic_factor (largest mesh force / static force F~_m).",
+        "µm, ...), the dynamic transmission error dte (µm peak to peak), the "
+        "dynamic_factor (largest mesh force / static force F~_m), and force_max and force_min "
+        "in N (the record's, as the fields force_max and force_min x b k_m).",
         examples=[{"speed": {"value": 1500.0, "unit": "rpm"}, "torque": {"value": 40.0,
                    "unit": "N*m"}, "dte": {"value": 3.4, "unit": "um"}}],
     )  # fmt: skip
@@ -89,9 +97,10 @@ class SweepPoint(BaseModel):
         None,
         description="With settings.basins: the attractors reached from the point's basin "
         "starts, worst first (as numerics.attractors of an analysis). The verdict fields "
-        "(classification, period, lle, lle_stderr, impact_regime) are the worst attractor's "
-        "above basins.min_fraction; the record fields (poincare_x, x_peak_to_peak, forces, "
-        "physical) describe the worst of settings' own starts.",
+        "(classification, period, lle, lle_stderr, impact_regime) and physical's dte and "
+        "dynamic_factor are the worst attractor's above basins.min_fraction (decided_by names "
+        "it); the record fields (poincare_x, x_peak_to_peak, force_max, force_min) describe "
+        "the worst of settings' own starts.",
     )
     basins: BasinCounts | None = Field(
         None, description="With settings.basins: how the point's basin starts ended."

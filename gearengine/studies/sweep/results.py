@@ -25,6 +25,13 @@ class SweepResult(BaseModel):
     model_config = ConfigDict(frozen=True)
 
     axes: list[SweepAxis] = Field(description="The axes of the request.")
+    values_units: dict[str, str] | None = Field(
+        None,
+        description="The unit of each axis' numbers in the points' values: a design field in "
+        "SI (speed: rad/s, torque: N*m; each point's physical has it in its display unit, "
+        "rpm), a dimensionless alias 1.",
+        examples=[{"speed": "rad/s", "torque": "N*m"}],
+    )
     points: list[SweepPoint] = Field(description="One entry per point and branch.")
     bifurcations: list[SweepBifurcation] | None = Field(
         None,

@@ -9,11 +9,12 @@ verdict held at 500, 600, ..., 1100 rpm and differed at 400 and 1200 rpm (when o
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Protocol
 
 from gearengine.model.units import display_unit
 from gearengine.model.units import shown as rounded
 from gearengine.studies.sweep.points import PhysicalValue, SpeedWindows, SweepPoint
-from gearengine.studies.sweep.request import SweepRequest
+from gearengine.studies.sweep.request import SweepAxis
 
 SPEED = "speed"
 
@@ -37,9 +38,17 @@ def runs(speeds: Sequence[float], flags: Sequence[str | None]) -> dict[str, list
     return out
 
 
-def speed_windows(request: SweepRequest, points: Sequence[SweepPoint]) -> list[SpeedWindows] | None:
-    """The windows of a sweep with a ``speed`` axis (None for other sweeps); rows follow the
-    other axis' grid, the down branch of a continuation sweep is left out."""
+class _Axes(Protocol):
+    """A sweep's request or result: what names its axes."""
+
+    @property
+    def axes(self) -> list[SweepAxis]: ...
+
+
+def speed_windows(request: _Axes, points: Sequence[SweepPoint]) -> list[SpeedWindows] | None:
+    """The windows of a sweep with a ``speed`` axis (None for other sweeps) over ``points``
+    (its grid's, or with the gate's refined points between them); rows by the other axis'
+    level, ascending; the down branch of a continuation sweep is left out."""
     names = [a.parameter for a in request.axes]
     if SPEED not in names:
         return None
@@ -50,7 +59,7 @@ def speed_windows(request: SweepRequest, points: Sequence[SweepPoint]) -> list[S
         if p.branch != "down":
             rows.setdefault(None if other is None else p.values[other], []).append(p)
     out = []
-    for level, row in rows.items():
+    for level, row in sorted(rows.items(), key=lambda item: item[0] or 0.0):
         row.sort(key=lambda p: p.values[SPEED])
         speeds = [rounded(p.values[SPEED] * factor) for p in row]
         impacts = [p.impact_regime if p.impact_regime != "no_impact" else None for p in row]

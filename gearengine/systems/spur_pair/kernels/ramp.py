@@ -27,12 +27,16 @@ every later FTLE reads NaN."""
 
 BLOCK_COLUMNS = (
     "x_min", "x_max", "force_min", "force_max", "steps_separated", "steps_back_flank",
-    "back_flank_impacts", "drive_flank_impacts", "log_growth",
+    "back_flank_impacts", "drive_flank_impacts", "log_growth", "contact_force_min",
+    "contact_force_max",
 )  # fmt: skip
 """Columns of ``run_ramp``'s block table: extremes of x and of the dimensionless mesh force
-K f_h(x) + 2 mu x' at step ends; steps ending inside the clearance (|x| <= 1) and on the back
-flank (x < -1); entries into the back flank and re-engagements of the drive flank (0 -> x > 1)
-at step ends; log of the tangent norm over the block."""
+K f_h(x) + 2 mu x' at step ends (the model's force: its damping term acts in the clearance
+too); steps ending inside the clearance (|x| <= 1) and on the back flank (x < -1); entries into
+the back flank and re-engagements of the drive flank (0 -> x > 1) at step ends; log of the
+tangent norm over the block; extremes of the tooth contact force at step ends (the model's
+force where a flank touches, clipped to that flank's sign, 0 while apart: as
+``forcing.contact_force_of``)."""
 
 
 @njit(**JIT_OPTIONS)
@@ -61,11 +65,12 @@ def run_ramp(
         blocks completed.
     """
     twomu = 2.0 * mu
-    out = np.full((n_blocks, 9), np.nan)
+    out = np.full((n_blocks, 11), np.nan)
     x, v, dx, dv = state[0], state[1], state[2], state[3]
     reg = region(x)
     for n in range(n_blocks):
         xmin, xmax, fmin, fmax = np.inf, -np.inf, np.inf, -np.inf
+        cmin, cmax = np.inf, -np.inf
         sep, back, back_in, drive_in = 0, 0, 0, 0
         grown = 0.0  # log of the tangent's norm taken out within the block
         t0 = n * steps * h
@@ -85,14 +90,20 @@ def run_ramp(
             xmax = max(xmax, x)
             fmin = min(fmin, force)
             fmax = max(fmax, force)
+            contact = 0.0  # apart: no contact force, whatever the model's damping term
             if reg == 0:
                 sep += 1
             elif reg < 0:
                 back += 1
+                contact = min(force, 0.0)  # a flank pushes, never pulls
                 if prev >= 0:
                     back_in += 1
-            elif prev == 0:
-                drive_in += 1
+            else:
+                contact = max(force, 0.0)
+                if prev == 0:
+                    drive_in += 1
+            cmin = min(cmin, contact)
+            cmax = max(cmax, contact)
         nrm = math.sqrt(dx * dx + dv * dv)
         dx /= nrm
         dv /= nrm
@@ -103,5 +114,6 @@ def run_ramp(
         row[0], row[1], row[2], row[3] = xmin, xmax, fmin, fmax
         row[4], row[5], row[6], row[7] = sep, back, back_in, drive_in
         row[8] = grown + math.log(nrm)
+        row[9], row[10] = cmin, cmax
     state[0], state[1], state[2], state[3] = x, v, dx, dv
     return out, n_blocks
