@@ -25,6 +25,7 @@ from gearengine.model.params import GearParams
 from gearengine.model.reduction import DesignConversion
 from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.systems.base import Run, StepPlan, StroboscopicFlow, System
+from gearengine.systems.gear_train import ramp as train_ramp
 from gearengine.systems.gear_train.kernel import flow_train, run_train, train_forcing
 from gearengine.systems.gear_train.model import (
     RELATIVE,
@@ -60,6 +61,8 @@ class TrainSystem(System):
     kc: np.ndarray
     ec: np.ndarray
     tc: np.ndarray
+    load: np.ndarray
+    """A^-1 f~ per unit of the pair's mean force F~_m (``model.Dimensionless.load_direction``)."""
     omega_max: float
     torque_ratio: float
     """T_p / (r_p b k_m) per unit of the pair's F~_p: I_a / (m_e r_a^2)."""
@@ -82,6 +85,48 @@ class TrainSystem(System):
 
     name = "gear_train"
     step_cost = TRAIN_STEP_COST
+    mesh_column = RELATIVE.index("mesh_rotation")  # delta = w~ . u~ - e with w~_mesh = 1
+    ramp_method = (
+        "RK4 of the gear train stepped straight across the backlash edges "
+        f"(systems.gear_train.ramp), h omega_max <= {H_OMEGA} for its fastest mode"
+    )
+
+    def step_limit(self) -> float:
+        """h omega_max <= ``H_OMEGA`` (module docstring)."""
+        return H_OMEGA / self.omega_max
+
+    def ramp_start(self, x: float, v: float) -> np.ndarray:
+        """(u, v) of ``start`` and the tangent with equal components, shape (4, n / 2)."""
+        u0, v0 = self.start(x, v)
+        tangent = np.full(u0.size, 1.0 / math.sqrt(self.n))
+        return np.vstack([u0, v0, tangent, tangent])
+
+    def run_ramp(
+        self, state: np.ndarray, kc: np.ndarray, fc: np.ndarray, ramp: np.ndarray,
+        inertia: float, h: float, n_blocks: int, steps: int,
+    ) -> tuple[np.ndarray, int]:  # fmt: skip
+        """One segment by ``ramp.run_ramp``. The pair's forcing by order maps to the train's as
+        ``train_system`` maps the stationary one: transmission-error terms (kind 1, amplitude
+        e_r / b) displace delta, torque terms act on the motor (x ``torque_ratio``). The mean
+        force F~_m - ``inertia`` is the torque's (driver and balancing brake, ``load``);
+        ``inertia``, the pair's force that accelerates the driven inertia, is here the motor
+        torque m_0 (d w_p / dt) that accelerates the whole train (``torque_ratio`` x it, the
+        free rotation's inertia m_0 = phi_0^T M phi_0): its relative part P e_motor m_0 a is
+        the d'Alembert load -M phi_0 a, which P annihilates, plus that torque."""
+        te = fc[3] == 1.0
+        ec = np.ascontiguousarray(fc[:3, te])
+        tc = np.ascontiguousarray(fc[:3, ~te])
+        tc[0] *= self.torque_ratio
+        means = np.vstack([
+            self.load * (ramp[0] - inertia) + self.p * (self.torque_ratio * inertia),
+            self.load * ramp[1],
+        ])  # fmt: skip
+        lw = law(self.params)
+        return train_ramp.run_ramp(
+            lw.code, lw.a, lw.c, lw.alpha, self.params.damping, self.AK, self.AC, self.g, self.w,
+            self.p, kc, ec, tc, means, np.ascontiguousarray(ramp[2:]), state, h, n_blocks, steps,
+            DIVERGENCE_BOUND,
+        )  # fmt: skip
 
     def dynamics_key(self) -> tuple:
         """The kernel's arguments (matrices, forcing terms, law and mesh damping) as bytes."""
@@ -179,7 +224,8 @@ def train_system(model: TrainModel, pair: DesignConversion) -> TrainSystem:
         model=model, form=form, params=params,
         AK=inv @ form.stiffness, AC=inv @ form.damping, g=inv @ w, w=w,
         f=inv @ form.mean_force, p=inv @ form.torque_direction,
-        kc=kc, ec=ec, tc=tc, omega_max=float(np.sqrt(np.max(np.abs(linear)))),
+        kc=kc, ec=ec, tc=tc, load=inv @ form.load_direction,
+        omega_max=float(np.sqrt(np.max(np.abs(linear)))),
         torque_ratio=scale,
     )  # fmt: skip
 
