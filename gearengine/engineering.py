@@ -350,6 +350,9 @@ def summary(
     if over_critical(conv, mel) and t_crit is not None and mel.critical_mean_force:
         words = load_words(conv, mel.critical_mean_force, t_crit)
         text = f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion does not apply: {words}."
+    elif not mel.applicable:  # for another reason than the load (a train without a reduction)
+        why = mel.notes[0] if mel.notes else "it has no saddle loop to judge"
+        text = f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion does not apply: {why}."
     else:
         here = "allows chaos" if mel.chaos_possible else "rules chaos out"
         text = (
