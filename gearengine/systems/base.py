@@ -23,7 +23,9 @@ How to add a system (the contract, as ``scipy.integrate.OdeSolver`` states its o
 6. For the studies (sweeps, the gate): ``params``, the parameter point of Eq. (9) whose scales
    and forcing the system shares; ``step_cost``, its RK4 step in steps of the pair's (compute
    budgets); ``dynamics_key()``, equal for two systems with equal dynamics (None: unknown).
-7. For run-ups (``studies.runup``, a driver speed that changes): ``ramp_start(x, v)``, the
+7. For ensembles (optional): ``lane_group`` and ``run_lanes``, many runs in one lock-step
+   kernel with the numbers of their own runs.
+8. For run-ups (``studies.runup``, a driver speed that changes): ``ramp_start(x, v)``, the
    state (positions, rates and their tangents, shape (4, n / 2)) with ``mesh_column`` the
    column whose position and rate move x and v one for one; ``run_ramp``, one linear segment
    of the speed profile with the excitations at the integrated driver angle, by blocks
@@ -180,6 +182,22 @@ class System(ABC):
         (``spur_pair.kernels.phase``), of whose mean force ``inertia`` is the part that
         accelerates the train. Returns the block table (n_blocks, 9) and the blocks done."""
         raise NotImplementedError(f"{self.name} has no run-up kernel")
+
+    def lane_group(self, plan: StepPlan) -> tuple | None:
+        """The key of the lock-step group whose lanes this system's runs on ``plan`` join
+        (``run_lanes``); None: they run one by one (``integrate``)."""
+        return None
+
+    def run_lanes(
+        self, points: Sequence[System], owner: np.ndarray, starts: np.ndarray,
+        plans: Sequence[StepPlan], n_trans: int, n_rec: int, stride: int,
+    ) -> tuple:  # fmt: skip
+        """Every lane of one group (``lane_group``) in lock-step: ``points`` (P) of the group
+        (this one among them), the point of each lane ``owner`` (L,), their full starts
+        (``start_state``, (L, n)) and plans; the arrays of ``numerics.lanes`` (xs, vs, logs,
+        xmin, xmax, fmin, fmax, done, recorded, diverged, final x, final v), each lane's
+        numbers those of its ``integrate`` with history ``stride``."""
+        raise NotImplementedError(f"{self.name} has no lock-step kernel")
 
     def dynamics_key(self) -> tuple | None:
         """Equal for two systems that integrate the same equations (a sweep axis that leaves it

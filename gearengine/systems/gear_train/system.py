@@ -27,6 +27,7 @@ from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.systems.base import Run, StepPlan, StroboscopicFlow, System
 from gearengine.systems.gear_train import ramp as train_ramp
 from gearengine.systems.gear_train.kernel import flow_train, run_train, train_forcing
+from gearengine.systems.gear_train.lanes import forcing_table, run_train_lanes
 from gearengine.systems.gear_train.model import (
     RELATIVE,
     Dimensionless,
@@ -126,6 +127,37 @@ class TrainSystem(System):
             lw.code, lw.a, lw.c, lw.alpha, self.params.damping, self.AK, self.AC, self.g, self.w,
             self.p, kc, ec, tc, means, np.ascontiguousarray(ramp[2:]), state, h, n_blocks, steps,
             DIVERGENCE_BOUND,
+        )  # fmt: skip
+
+    def lane_group(self, plan: StepPlan) -> tuple | None:
+        """Trains of one state dimension, law and N under periodic forcing step together."""
+        if plan.omega0 is None:
+            return None
+        lw = law(self.params)
+        return (self.name, self.n, lw.code, lw.a, lw.c, lw.alpha, plan.steps)
+
+    def run_lanes(
+        self, points: Sequence[System], owner: np.ndarray, starts: np.ndarray,
+        plans: Sequence[StepPlan], n_trans: int, n_rec: int, stride: int,
+    ) -> tuple:  # fmt: skip
+        """``lanes.run_train_lanes`` of the group (``System.run_lanes``)."""
+        trains = [t for t in points if isinstance(t, TrainSystem)]
+        assert len(trains) == len(points)
+        N = plans[0].steps
+        lw = law(self.params)
+
+        def stack(name: str) -> np.ndarray:
+            return np.ascontiguousarray(np.stack([getattr(t, name) for t in trains]))
+
+        tables = np.stack([forcing_table(t.kc, t.ec, t.tc, pl.period, N)
+                           for t, pl in zip(trains, plans, strict=True)])  # fmt: skip
+        half = starts.shape[1] // 2
+        return run_train_lanes(
+            lw.code, lw.a, lw.c, lw.alpha, np.array([t.params.damping for t in trains]),
+            stack("AK"), stack("AC"), stack("g"), stack("w"), stack("f"), stack("p"), tables,
+            owner, np.array([pl.period for pl in plans]),
+            np.ascontiguousarray(starts[:, :half]), np.ascontiguousarray(starts[:, half:]),
+            N, n_trans, n_rec, (n_rec * N // stride) * stride, DIVERGENCE_BOUND,
         )  # fmt: skip
 
     def dynamics_key(self) -> tuple:
