@@ -3,8 +3,10 @@
 Points with commensurate forcing are grouped by backlash law and steps per T0 and advanced in
 lock-step by the SIMD kernels ``kernels.run_batch`` (cubic law) and ``kernels.run_kink_batch``
 (piecewise law, split at the kinks lane by lane), parallel over chunks of lanes, and their
-verdicts are taken array-wise (``numerics.lanes``); other points (incommensurate forcing) run
-one by one in the single kernels (``numerics.runs``). Numbers equal those of ``simulate``.
+verdicts are taken array-wise (``numerics.lanes``); a ``System`` with a lock-step kernel of its
+own (``System.lane_group``: a gear train's) runs its groups there; other points (incommensurate
+forcing) run one by one in the single kernels (``numerics.runs``). Numbers equal those of
+``simulate``.
 """
 
 from __future__ import annotations
@@ -101,8 +103,9 @@ def run_lanes(
     Every run of a request (point x start x sample) is a lane ``(i, (x0, v0))``: parameter
     point ``points[i]`` from the initial state (x0, v0). Lanes of points with commensurate
     forcing are grouped by backlash law and steps per T0 and advanced together in the lock-step
-    SIMD kernels (``kernels.run_batch``, cubic; ``kernels.run_kink_batch``, piecewise); the
-    others run one by one in the single kernels (``runs.integrate``). With
+    SIMD kernels (``kernels.run_batch``, cubic; ``kernels.run_kink_batch``, piecewise), those
+    of systems with a lock-step kernel (``System.lane_group``) in theirs over the settings'
+    fixed lengths; the others run one by one in the single kernels (``runs.integrate``). With
     ``settings.adaptive`` a lane may stop early (``kernels.adaptive``: settled periodic orbits,
     and chaotic or quasi-periodic ones once their LLE's stderr is within the settings'
     tolerances); otherwise, and in the single kernels, the numbers equal those of ``simulate``
