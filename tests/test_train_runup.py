@@ -10,13 +10,14 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
 from gearengine.model.design import Design
 from gearengine.model.train import EXAMPLE_TRAIN
 from gearengine.studies.runup import run_local
-from gearengine.studies.runup.profile import validated
+from gearengine.studies.runup.profile import ramp_forcing, validated
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.systems.gear_train.model import equivalent_design, train_of
 from gearengine.systems.gear_train.system import train_system
@@ -84,3 +85,27 @@ def test_train_runup_is_accepted_by_the_api(tmp_path: Path) -> None:
     with TestClient(app) as client:
         r = client.post("/v1/runups", json=body)
     assert r.status_code in (200, 202), r.text
+
+
+def test_a_train_ramp_without_acceleration_is_its_stationary_run() -> None:
+    """beta = 0, no torque ramp: the ramp kernel over 20 periods T0 from a state gives the
+    stationary kernel's extremes of delta and of the mesh force, block by block (one block a
+    period), to rounding: the forcing by order of the driver angle (TE in delta, torque
+    fluctuation on the motor) and the mean force through ``load`` are the stationary ones."""
+    design = Design.model_validate({**TRAIN_DESIGN, "torque_fluctuation": {
+        "order": 2, "harmonics": [{"amplitude": "4 N*m"}]}})  # fmt: skip
+    system, conv = RunupRequest.model_validate({"design": design}).model()
+    plan = system.plan(128)
+    wn = 1.0 / conv.time_scale_s
+    forcing = ramp_forcing(conv.params, design.speed, wn)
+    record = np.array([conv.params.mean_force, 0.0, design.speed / wn, 0.0, 0.0])
+    state = system.ramp_start(0.5, 0.1)
+    start = np.concatenate([state[0], state[1]])
+    run = system.integrate(plan, start, 0, 20, 1)
+    table, done = system.run_ramp(state, forcing.kc, forcing.fc, record, 0.0, plan.h, 20,
+                                  plan.steps)  # fmt: skip
+    assert done == 20
+    steps = run.hx.reshape(20, plan.steps)
+    assert np.allclose(table[:, 0], steps.min(axis=1), rtol=0, atol=1e-9)
+    assert np.allclose(table[:, 1], steps.max(axis=1), rtol=0, atol=1e-9)
+    assert table[:, 3].max() == pytest.approx(run.fmax, rel=1e-9)
