@@ -292,7 +292,11 @@ def analyze_train(request: AnalysisRequest) -> AnalysisResult:
         conv = pair.model_copy(update={"params": reduced.params})
     else:
         a, c, _ = melnikov_cubic(system.params.backlash)
-        mel = not_applicable(a, c, "closed_form", [reduced.reason])
+        # no critical load either: the equivalent pair's F_crit judges no train without a
+        # reduction (its T_crit read "the criterion applies below it")
+        mel = not_applicable(a, c, "closed_form", [reduced.reason]).model_copy(
+            update={"critical_mean_force": None}
+        )
         conv = pair
     eng = engineering(conv, request.speed_rpm_range(), mel, num, decision(num, request.settings))
     if not reduced.applicable:

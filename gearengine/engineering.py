@@ -347,9 +347,10 @@ def summary(
     fraction and LLE), and the contact, DTE, dynamic factor and the LLE that follow are the
     recorded run's when that run settled elsewhere (said so)."""
     t_crit = critical_torque(conv, mel)
-    if over_critical(conv, mel) and t_crit is not None and mel.critical_mean_force:
-        words = load_words(conv, mel.critical_mean_force, t_crit)
-        text = f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion does not apply: {words}."
+    f_crit = mel.critical_mean_force if over_critical(conv, mel) and t_crit is not None else None
+    if f_crit or not mel.applicable:  # its load, or its notes' reason (a train, no reduction)
+        why = load_words(conv, f_crit, t_crit) if f_crit and t_crit else mel.notes[0]
+        text = f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion does not apply: {why}."
     else:
         here = "allows chaos" if mel.chaos_possible else "rules chaos out"
         text = (

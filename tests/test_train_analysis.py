@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 import gearengine
+from gearengine.cli.melnikov import render_engineering
 from gearengine.model.design import Design
 from gearengine.model.train import EXAMPLE_TRAIN
 from gearengine.numerics.settings import SimulationSettings
@@ -38,3 +39,20 @@ def test_analysis_of_a_train_is_the_trains() -> None:
     text = pair.model_dump_json()
     assert '"modes"' not in text and '"train"' not in text
     assert pair.numerics.lle != num.lle
+
+
+def test_a_train_without_a_reduction_gets_no_single_dof_words() -> None:
+    """The example train (56.5 % of the mesh mode's strain energy in the mesh, no one-mode
+    reduction) was told the equivalent pair's critical torque ("T_crit = 9.623 N*m (the
+    criterion applies below it)") and that the criterion does not apply because its torque is
+    above it, and its gear-units header named the stiff limit's f_n as its natural frequency.
+    Now: no critical torque, the summary says why the criterion does not apply, and the header
+    names the train's mesh mode."""
+    design = Design.model_validate({**PAIR, "train": EXAMPLE_TRAIN})
+    eng = gearengine.analyze(design, SETTINGS).engineering
+    assert eng.critical_torque_nm is None
+    assert "the Melnikov criterion does not apply: the mesh mode holds 56.5%" in eng.summary
+    assert "critical torque" not in eng.summary and "rules chaos out" not in eng.summary
+    text = render_engineering(eng)
+    assert "T_crit" not in text and "nearest critical" not in text
+    assert "the train's mesh mode 2799.88 Hz, 57% of its strain energy in the mesh" in text

@@ -16,6 +16,7 @@ from pydantic import ValidationError
 
 import gearengine
 from gearengine.analysis import AnalysisRequest
+from gearengine.cli.envelope import not_judged_reason, windows_summary
 from gearengine.gate.envelope import Rules, check_envelope
 from gearengine.gate.remedies.compute import remedies
 from gearengine.gate.remedies.request import RemediesRequest as RemediesRequest_
@@ -29,6 +30,7 @@ from gearengine.studies.robustness.study import checked as checked_robustness
 from gearengine.studies.robustness.study import run_local as run_robustness
 from gearengine.studies.sweep import run_local, validated
 from gearengine.studies.sweep.plan import sweep_work
+from gearengine.studies.sweep.points import SpeedWindows
 from gearengine.systems.designs import design_model
 from service.core.config import Settings
 from service.main import create_app
@@ -218,3 +220,29 @@ def test_the_api_takes_a_train_sweep_and_refuses_what_it_cannot_do(client: TestC
     r = client.post("/v1/sweeps", json={**doc, "continuation": True})
     assert r.status_code == 422, r.text
     assert [e["path"] for e in r.json()["errors"]] == ["continuation"]
+
+
+def test_the_gates_text_says_why_melnikov_judges_no_point_of_a_train() -> None:
+    """``gearengine check``'s windows said "(above T_crit)" for a train whose mesh no single
+    mode carries (56 % of the mesh strain energy in the example's mesh mode): there the
+    criterion judges no point at any torque. It names the reason now; a train with stiff
+    shafts and bearings (the reduction holds, 99.96 %) names the reduction's T_crit, and the
+    pair keeps its words."""
+    row = SpeedWindows(level={}, response={}, impacts={}, melnikov=[],
+                       melnikov_not_applicable=[[1000.0, 3000.0]])  # fmt: skip
+    stiff = json.loads(json.dumps(EXAMPLE_TRAIN))
+    for shaft in ("input_shaft", "output_shaft"):
+        stiff[shaft]["torsional_stiffness"] = "1e9 N*m/rad"
+    for side in ("driver", "driven"):
+        stiff["bearings"][side]["stiffness"] = "1e12 N/m"
+    cases = [
+        (TRAIN, "no single mode of the train holds 90% of the mesh strain energy"),
+        ({**PAIR, "train": stiff}, "above the mesh-mode reduction's T_crit"),
+        (PAIR, "above T_crit"),
+    ]
+    for design, words in cases:
+        short, _ = not_judged_reason(Design.model_validate(design))
+        assert short == words
+        (line,) = windows_summary([row], short)
+        assert line.endswith(f"Melnikov: not applicable at 1000-3000 rpm ({words})"), line
+    assert "reduction" in not_judged_reason(Design.model_validate(TRAIN))[1]

@@ -23,6 +23,7 @@ import urllib.error
 import urllib.request
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from gearengine.cli.documents import (
     EXIT_FAIL,
@@ -52,6 +53,9 @@ from gearengine.studies import jobs
 from gearengine.studies.sweep.points import SpeedWindows
 from gearengine.studies.sweep.request import SweepRequest, validated
 from gearengine.studies.sweep.results import SweepResult
+
+if TYPE_CHECKING:
+    from gearengine.model.design import Design
 
 POLL_SECONDS = 1.0
 
@@ -180,21 +184,42 @@ def rules_text(rules: Rules) -> str:
     return ", ".join(parts)
 
 
-def print_report(report: EnvelopeReport) -> None:
-    """PASS or FAIL, then one line per failing window (rpm and N m)."""
+def not_judged_reason(design: Design | None) -> tuple[str, str]:
+    """Why the Melnikov criterion judges no point of ``design``'s envelope where it does not,
+    (in a window's words, in the report's): above the critical torque of the pair, or of a
+    train's mesh-mode reduction (``homoclinic.train_reduction``), or, for a train whose mesh no
+    single mode carries, at every point (no one-mode reduction). The gate's axes (speed and
+    torque) leave a train's modes as they are, so the design decides it."""
+    if design is None or design.train is None:
+        return "above T_crit", "the criterion does not apply above the critical torque"
+    from gearengine.homoclinic.train_reduction import SHARE_THRESHOLD, melnikov_point
+    from gearengine.systems.designs import design_model
+
+    if melnikov_point(design_model(design)[0]) is not None:
+        return ("above the mesh-mode reduction's T_crit",
+                "the criterion of the train's mesh-mode reduction does not apply above its "
+                "critical torque")  # fmt: skip
+    share = f"no single mode of the train holds {SHARE_THRESHOLD:.0%} of the mesh strain energy"
+    return share, f"{share}: the one-degree-of-freedom criterion has no reduction to judge"
+
+
+def print_report(report: EnvelopeReport, design: Design | None = None) -> None:
+    """PASS or FAIL, then one line per failing window (rpm and N m); ``design`` says why
+    Melnikov judges no point where it does not (``not_judged_reason``)."""
     verdict = "PASS" if report.passed else "FAIL"
+    short, reason = not_judged_reason(design)
     print(f"{verdict}: {report.failing_points} of {report.points} operating points break "
           f"the rules ({rules_text(report.rules)})")  # fmt: skip
     if "melnikov" in report.rules.fail_on and report.melnikov_not_judged:
         print(f"  Melnikov could not judge {report.melnikov_not_judged} of {report.points} points "
-              "(the criterion does not apply above the critical torque)")  # fmt: skip
+              f"({reason})")  # fmt: skip
     for note in report.notes:
         print(f"  note: {note}")
     if report.resolution is not None:
         print(f"  resolution: {report.resolution.text()}")
     for w in report.failures:
         print(f"  {window_text(w)}")
-    for line in windows_summary(report.windows):
+    for line in windows_summary(report.windows, short):
         print(f"  {line}")
 
 
@@ -206,16 +231,17 @@ def settings_text(settings: SimulationSettings) -> str:
             f"{settings.steps_per_period} steps per period{starts}")  # fmt: skip
 
 
-def windows_summary(windows: list[SpeedWindows]) -> list[str]:
+def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit") -> list[str]:
     """Per level of the other axis, the impact and Melnikov windows in rpm, pass or fail:
     "windows at torque 40 N*m: tooth separation (drive-flank impacts) 500-1100 rpm; Melnikov:
-    chaos possible nowhere"."""
+    chaos possible nowhere"; ``reason`` says why Melnikov does not apply where it does not
+    (``not_judged_reason``)."""
     out = []
     for w in windows:
         impacts = "; ".join(f"{IMPACT_LABELS[k]} {spans_text(v)}" for k, v in w.impacts.items())
         melnikov = f"chaos possible {spans_text(w.melnikov) if w.melnikov else 'nowhere'}"
-        if w.melnikov_not_applicable:  # above the critical torque
-            na = f"not applicable at {spans_text(w.melnikov_not_applicable)} (above T_crit)"
+        if w.melnikov_not_applicable:
+            na = f"not applicable at {spans_text(w.melnikov_not_applicable)} ({reason})"
             melnikov = f"{melnikov}, {na}" if w.melnikov else na
         where = f" at {level_text(w.level)}" if w.level else ""
         out.append(f"windows{where}: {impacts or 'teeth always in contact'}; "
@@ -259,7 +285,7 @@ def cmd_envelope(args: argparse.Namespace) -> int:
         from gearengine.gate.runup import gate_envelope
 
         report = validated_input(lambda r: gate_envelope(report, request, r), args.runup, "--runup")
-    print_report(report)
+    print_report(report, request.design)
     if args.json:
         Path(args.json).write_text(dumps(report))
     if args.junit:

@@ -54,12 +54,20 @@ def render_engineering(eng: Engineering) -> str:
     if eng.speed_windows_note:
         windows += f" ({eng.speed_windows_note})"
     lo, hi = eng.speed_range_rpm
+    natural = f"f_n = {eng.natural_frequency_hz:.6g} Hz"
+    if eng.modes is not None:  # a train: its mesh mode; f_n is its stiff limit's
+        mesh = eng.modes.modes[eng.modes.mesh_mode]
+        share = f"{mesh.mesh_energy_share:.0%}"
+        natural = (f"the train's mesh mode {mesh.frequency_hz:.6g} Hz, {share} of its strain "
+                   f"energy in the mesh; {natural} of its stiff limit")  # fmt: skip
     lines = [
-        f"In gear units (f_n = {eng.natural_frequency_hz:.6g} Hz, mesh "
-        f"{eng.mesh_frequency_hz:.6g} Hz at {eng.speed_rpm:,.0f} rpm):",
+        f"In gear units ({natural}, mesh {eng.mesh_frequency_hz:.6g} Hz at "
+        f"{eng.speed_rpm:,.0f} rpm):",
         f"  Melnikov speed windows [rpm] (scanned {lo:,.0f}-{hi:,.0f}): {windows}",
-        f"  {'parameter':<36} {'value':>12} {'nearest critical':>17} {'margin to chaos':>16}",
     ]
+    if eng.critical:
+        lines.append(f"  {'parameter':<36} {'value':>12} {'nearest critical':>17} "
+                     f"{'margin to chaos':>16}")  # fmt: skip
     if eng.critical_torque_nm is not None:
         lines.insert(
             2, f"  critical torque T_crit = {eng.critical_torque_nm:,.4g} N*m (the criterion "

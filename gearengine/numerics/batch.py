@@ -3,8 +3,10 @@
 Points with commensurate forcing are grouped by backlash law and steps per T0 and advanced in
 lock-step by the SIMD kernels ``kernels.run_batch`` (cubic law) and ``kernels.run_kink_batch``
 (piecewise law, split at the kinks lane by lane), parallel over chunks of lanes, and their
-verdicts are taken array-wise (``numerics.lanes``); other points (incommensurate forcing) run
-one by one in the single kernels (``numerics.runs``). Numbers equal those of ``simulate``.
+verdicts are taken array-wise (``numerics.lanes``); a ``System`` with a lock-step kernel of its
+own (``System.lane_group``: a gear train's) runs its groups there; other points (incommensurate
+forcing) run one by one in the single kernels (``numerics.runs``). Numbers equal those of
+``simulate``.
 """
 
 from __future__ import annotations
@@ -19,7 +21,14 @@ from gearengine.model.params import GearParams
 from gearengine.numerics import physical
 from gearengine.numerics.lanes import lane_point, lane_verdicts, last_strobes
 from gearengine.numerics.results import BATCH_POINCARE, BatchPoint
-from gearengine.numerics.runs import Run, as_system, finite_or_none, integrate, start_verdict
+from gearengine.numerics.runs import (
+    Run,
+    as_system,
+    finite_or_none,
+    history_stride,
+    integrate,
+    start_verdict,
+)
 from gearengine.numerics.settings import SimulationSettings, check_work
 from gearengine.signals.classify import DIVERGENCE_BOUND, severity
 from gearengine.systems.base import System
@@ -94,8 +103,9 @@ def run_lanes(
     Every run of a request (point x start x sample) is a lane ``(i, (x0, v0))``: parameter
     point ``points[i]`` from the initial state (x0, v0). Lanes of points with commensurate
     forcing are grouped by backlash law and steps per T0 and advanced together in the lock-step
-    SIMD kernels (``kernels.run_batch``, cubic; ``kernels.run_kink_batch``, piecewise); the
-    others run one by one in the single kernels (``runs.integrate``). With
+    SIMD kernels (``kernels.run_batch``, cubic; ``kernels.run_kink_batch``, piecewise), those
+    of systems with a lock-step kernel (``System.lane_group``) in theirs over the settings'
+    fixed lengths; the others run one by one in the single kernels (``runs.integrate``). With
     ``settings.adaptive`` a lane may stop early (``kernels.adaptive``: settled periodic orbits,
     and chaotic or quasi-periodic ones once their LLE's stderr is within the settings'
     tolerances); otherwise, and in the single kernels, the numbers equal those of ``simulate``
@@ -123,14 +133,22 @@ def _run_lanes(
 ) -> list[BatchPoint]:
     results: list[BatchPoint | None] = [None] * len(lanes)
     groups: dict[tuple[str, int], list[int]] = {}
+    systems: dict[tuple, list[int]] = {}
     for k, (i, s) in enumerate(lanes):
         plan, point = plans[i], points[i]
         name = point.backlash.model if isinstance(point, GearParams) else ""
+        key = point.lane_group(plan) if isinstance(point, System) else None
         if name and LAWS[name].lanes is not None and plan.omega0 is not None:
             groups.setdefault((name, plan.steps), []).append(k)
+        elif key is not None:
+            systems.setdefault(key, []).append(k)
         else:
             start = as_system(point).start_state(*s)
             results[k] = run_verdict(integrate(point, settings, start), s, plan, k)
+    for ks in systems.values():
+        for k, point in zip(ks, system_lanes(points, plans, [lanes[k] for k in ks], settings),
+                            strict=True):  # fmt: skip
+            results[k] = point.model_copy(update={"start_index": k})
     for (name, N), ks in groups.items():
         owner = np.array([lanes[k][0] for k in ks], dtype=np.int64)
         members, inverse = np.unique(owner, return_inverse=True)
@@ -163,6 +181,31 @@ def _run_lanes(
         for j, k in enumerate(ks):
             results[k] = lane_point(out, j, k, verdicts[j], strobes[j])
     return results  # type: ignore[return-value]
+
+
+def system_lanes(
+    points: Sequence[Point], plans: list[StepPlan], group: list[Lane],
+    settings: SimulationSettings,
+) -> list[BatchPoint]:  # fmt: skip
+    """The ``BatchPoint`` of every lane of one lock-step group of systems (``System.lane_group``:
+    a train's), run by its ``System.run_lanes`` over the settings' fixed lengths, as their own
+    runs (``integrate``) would give them."""
+    owner = np.array([i for i, _ in group], dtype=np.int64)
+    members, inverse = np.unique(owner, return_inverse=True)
+    chosen = [points[i] for i in members.tolist()]
+    assert all(isinstance(p, System) for p in chosen)
+    head = chosen[0]
+    assert isinstance(head, System)
+    starts = np.array([as_system(points[i]).start_state(*s) for i, s in group],
+                      dtype=np.float64)  # fmt: skip
+    mine = [plans[i] for i in members.tolist()]
+    stride = history_stride(settings, mine[0].steps)
+    out = head.run_lanes(chosen, inverse.astype(np.int64), starts, mine,  # type: ignore[arg-type]
+                         settings.transient_periods, settings.record_periods, stride)  # fmt: skip
+    per = np.array([pl.period for pl in mine])[inverse]
+    verdicts = lane_verdicts(out, per)
+    strobes = last_strobes(out, list(range(len(group))))
+    return [lane_point(out, j, j, verdicts[j], strobes[j]) for j in range(len(group))]
 
 
 def physical_lanes(

@@ -23,6 +23,14 @@ How to add a system (the contract, as ``scipy.integrate.OdeSolver`` states its o
 6. For the studies (sweeps, the gate): ``params``, the parameter point of Eq. (9) whose scales
    and forcing the system shares; ``step_cost``, its RK4 step in steps of the pair's (compute
    budgets); ``dynamics_key()``, equal for two systems with equal dynamics (None: unknown).
+7. For ensembles (optional): ``lane_group`` and ``run_lanes``, many runs in one lock-step
+   kernel with the numbers of their own runs.
+8. For run-ups (``studies.runup``, a driver speed that changes): ``ramp_start(x, v)``, the
+   state (positions, rates and their tangents, shape (4, n / 2)) with ``mesh_column`` the
+   column whose position and rate move x and v one for one; ``run_ramp``, one linear segment
+   of the speed profile with the excitations at the integrated driver angle, by blocks
+   (``spur_pair.kernels.ramp.BLOCK_COLUMNS`` of the mesh coordinate); ``step_limit()``, the
+   largest RK4 step its own fast modes allow.
 
 The spur pair of the paper (Eq. 9, ``spur_pair``) is the first system.
 """
@@ -147,6 +155,49 @@ class System(ABC):
     def start_state(self, x: float, v: float) -> tuple[float, ...]:
         """A full start from (x, v) of the mesh coordinate, every other coordinate at rest."""
         return (x, v) + (0.0,) * (self.n - 2)
+
+    ramp_method: str = "no run-up kernel"
+    """How ``run_ramp`` integrates, in words."""
+    mesh_column: int = 0
+    """Column of the run-up state (``ramp_start``) whose position and rate are x and v, or move
+    them one for one."""
+
+    def step_limit(self) -> float:
+        """Largest RK4 step [tau] this system's own modes allow (inf: the natural frequency
+        1 and the excitations alone set the step)."""
+        return math.inf
+
+    def ramp_start(self, x: float, v: float) -> np.ndarray:
+        """The run-up state from (x, v) of the mesh coordinate (``start_state``), with its
+        tangent: rows positions, rates, their tangent components; shape (4, n / 2)."""
+        raise NotImplementedError(f"{self.name} has no run-up kernel")
+
+    def run_ramp(
+        self, state: np.ndarray, kc: np.ndarray, fc: np.ndarray, ramp: np.ndarray,
+        inertia: float, h: float, n_blocks: int, steps: int,
+    ) -> tuple[np.ndarray, int]:  # fmt: skip
+        """One segment of a speed profile from ``state`` (``ramp_start``'s layout, updated in
+        place): n_blocks x steps RK4 steps of h. ``kc``, ``fc``, ``ramp``: the pair's forcing by
+        order of the driver angle and the segment's record (F~_m0, F~_m1, Omega_0, beta, psi_0)
+        (``spur_pair.kernels.phase``), of whose mean force ``inertia`` is the part that
+        accelerates the train. Returns the block table (n_blocks, 9) and the blocks done."""
+        raise NotImplementedError(f"{self.name} has no run-up kernel")
+
+    def lane_group(self, plan: StepPlan) -> tuple | None:
+        """The key of the lock-step group whose lanes this system's runs on ``plan`` join
+        (``run_lanes``); None: they run one by one (``integrate``)."""
+        return None
+
+    def run_lanes(
+        self, points: Sequence[System], owner: np.ndarray, starts: np.ndarray,
+        plans: Sequence[StepPlan], n_trans: int, n_rec: int, stride: int,
+    ) -> tuple:  # fmt: skip
+        """Every lane of one group (``lane_group``) in lock-step: ``points`` (P) of the group
+        (this one among them), the point of each lane ``owner`` (L,), their full starts
+        (``start_state``, (L, n)) and plans; the arrays of ``numerics.lanes`` (xs, vs, logs,
+        xmin, xmax, fmin, fmax, done, recorded, diverged, final x, final v), each lane's
+        numbers those of its ``integrate`` with history ``stride``."""
+        raise NotImplementedError(f"{self.name} has no lock-step kernel")
 
     def dynamics_key(self) -> tuple | None:
         """Equal for two systems that integrate the same equations (a sweep axis that leaves it

@@ -1,11 +1,13 @@
-"""Computing a run-up as a job: one chunk per ensemble member (the whole profile, kink-accurate
-RK4 on the integrated driver angle, ``systems.spur_pair.kernels.ramp``), and the two lines of the
-quasi-static continuation sweep (up and down, ``studies.sweep.compute``, on the bin centres); the
-assembly reads them into bins, jumps and lags (``studies.runup.reading``).
+"""Computing a run-up as a job: one chunk per ensemble member (the whole profile on the
+integrated driver angle through the system's ``run_ramp``: the pair's kink-accurate RK4,
+``systems.spur_pair.kernels.ramp``, or a train's, ``systems.gear_train.ramp``), and the two
+lines of the quasi-static continuation sweep (up and down, ``studies.sweep.compute``, on the bin
+centres); the assembly reads them into bins, jumps and lags (``studies.runup.reading``).
 
 Member m starts from the state of the settling (``settle_periods`` mesh periods at the start
-speed from the static contact x = 1 + F~_m, v = 0), member 0 as it is, the others perturbed by
-``ensemble.perturbation`` (normal, ``numpy.random.default_rng([seed, m])``). A chunk depends only
+speed from the static contact x = 1 + F~_m, v = 0; a train's shafts and bearings at their static
+deflection), member 0 as it is, the others' x and v perturbed by ``ensemble.perturbation``
+(normal, ``numpy.random.default_rng([seed, m])``). A chunk depends only
 on (request, index), so a resumed job gives the same bytes.
 """
 
@@ -17,9 +19,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from gearengine.model.params import PiecewiseBacklash
 from gearengine.model.units import RPM
-from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.studies import jobs
 from gearengine.studies.runup.profile import RunupPlan, mid_speeds_rpm, runup_plan, segment_angle
 from gearengine.studies.runup.reading import read_runup
@@ -27,8 +27,6 @@ from gearengine.studies.runup.request import RunupRequest, n_bins
 from gearengine.studies.runup.results import RunupResult
 from gearengine.studies.sweep.plan import sweep_work
 from gearengine.studies.sweep.request import SweepRequest
-from gearengine.systems.spur_pair.kernels.ramp import run_ramp
-from gearengine.systems.spur_pair.kernels.smooth import SQRT1_2
 
 QUASI_STATIC_CHUNKS = 2
 """Chunks after the members: the up and the down line of the continuation sweep."""
@@ -40,20 +38,18 @@ def member_blocks(request: RunupRequest, plan: RunupPlan, member: int) -> list[l
     Rows: branch (+1 up, -1 down), t0 [s], t1 [s], speed [rpm] at the block's middle, F~_m of
     the block, steps, then ``kernels.ramp.BLOCK_COLUMNS`` (None where the run diverged).
     """
-    params = request.params
-    assert params is not None and isinstance(params.backlash, PiecewiseBacklash)
-    alpha, mu = float(params.backlash.alpha), float(params.damping)
-    f = plan.forcing
-    state = np.array([1.0 + plan.mean_force[0], 0.0, SQRT1_2, SQRT1_2])
+    system, f = plan.system, plan.forcing
+    state = system.ramp_start(1.0 + plan.mean_force[0], 0.0)
+    mesh = system.mesh_column
     psi = 0.0
     rows: list[list[float | None]] = []
     for seg in plan.segments:
         if seg.branch is not None and member > 0 and not rows:
             rng = np.random.default_rng([request.ensemble.seed, member])
-            state[:2] += request.ensemble.perturbation * rng.standard_normal(2)
+            state[:2, mesh] += request.ensemble.perturbation * rng.standard_normal(2)
         ramp = plan.ramp_record(seg, psi)
-        table, _ = run_ramp(alpha, mu, state, f.kc, ramp, f.fc, seg.h, seg.n_blocks, seg.steps,
-                            DIVERGENCE_BOUND)  # fmt: skip
+        table, _ = system.run_ramp(state, f.kc, f.fc, ramp, plan.inertia(seg), seg.h,
+                                   seg.n_blocks, seg.steps)  # fmt: skip
         psi += segment_angle(seg)
         if seg.branch is None:
             continue

@@ -11,7 +11,10 @@ angle is psi_a = psi_0 + Omega_0 tau + beta tau^2 / 2 exactly, Omega = w / w_n, 
 Mean force: the driver follows the profile (speed-controlled) against the braking torque that
 balances the design's torque, so the tooth force also accelerates the driven inertia:
 F^_m = T_a / r_a + I_b (d w_b / dt) / r_b (the driven gear's free body; w_b = w_a r_a / r_b).
-At 1000 rpm/s on ``examples/ci/design.json`` the second term is 0.1 % of the first.
+At 1000 rpm/s on ``examples/ci/design.json`` the second term is 0.1 % of the first. A train
+(its equivalent pair's scales, I_b = I_g + I_l) takes that force as the motor torque that
+accelerates it (``TrainSystem.run_ramp``), and its fast modes bound the step
+(``System.step_limit``).
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from gearengine.model.params import GearParams
 from gearengine.model.units import RPM, in_si
 from gearengine.studies.runup.request import MAX_RUNUP_STEPS, RunupRequest, request_errors
 from gearengine.studies.sweep.axes import point_params
+from gearengine.systems.base import System
 from gearengine.systems.spur_pair.forcing import packed_forcing
 
 BLOCKS_PER_BIN = 4
@@ -93,6 +97,8 @@ def ramp_forcing(params: GearParams, speed: float, omega_n: float) -> RampForcin
 class RunupPlan:
     """Everything a member's integration needs, from the request alone (deterministic)."""
 
+    system: System
+    """What the members integrate (``RunupRequest.model``)."""
     segments: list[Segment]
     forcing: RampForcing
     mean_force: tuple[float, float]
@@ -119,18 +125,26 @@ class RunupPlan:
             f0, f1 = self.mean_force_at(0.0, 0.0), 0.0
         return np.array([f0, f1, seg.w0 / wn, accel / wn**2, psi0])
 
+    def inertia(self, seg: Segment) -> float:
+        """The part of ``ramp_record``'s F~_m0 that accelerates the driven side (0 while
+        settling)."""
+        if seg.branch is None:
+            return 0.0
+        return self.inertia_force * (seg.w1 - seg.w0) / (seg.t1 - seg.t0)
+
     def work(self, members: int) -> int:
-        """RK4 steps of ``members`` runs of the whole plan."""
-        return members * sum(s.n_blocks * s.steps for s in self.segments)
+        """RK4 steps of ``members`` runs of the whole plan, in the pair's steps
+        (``System.step_cost``)."""
+        return members * self.system.step_cost * sum(s.n_blocks * s.steps for s in self.segments)
 
 
 def _segment(
-    request: RunupRequest, forcing: RampForcing, t0: float, t1: float, w0: float, w1: float,
-    branch: Branch | None,
+    request: RunupRequest, forcing: RampForcing, limit: float, t0: float, t1: float, w0: float,
+    w1: float, branch: Branch | None,
 ) -> Segment:  # fmt: skip
     wn = forcing.omega_n
     fastest = max(1.0, forcing.fastest_order * max(w0, w1) / wn)  # natural frequency is 1
-    h_max = 2.0 * math.pi / fastest / request.steps_per_period
+    h_max = min(2.0 * math.pi / fastest / request.steps_per_period, limit)
     span = abs(w1 - w0) / RPM
     if span > 0.0 and branch is not None:
         n_blocks = max(1, math.ceil(span / (request.bin_rpm / BLOCKS_PER_BIN) - 1e-9))
@@ -149,8 +163,9 @@ def runup_plan(request: RunupRequest) -> RunupPlan:
     Raises ValueError (message starting with the field) when a torque ramp changes more than
     the mean force (a load-dependent ISO 6336 stiffness).
     """
-    design, conv, params = request.design, request.conversion, request.params
-    assert design is not None and conv is not None and params is not None
+    design, (system, conv) = request.design, request.model()
+    assert design is not None
+    params = conv.params
     omega_n = 1.0 / conv.time_scale_s
     forcing = ramp_forcing(params, design.speed, omega_n)
     f0 = params.mean_force
@@ -166,16 +181,18 @@ def runup_plan(request: RunupRequest) -> RunupPlan:
     ib = float(conv.derived["inertia_driven"].value)  # type: ignore[arg-type]
     force_scale = in_si("mesh_force", 1.0, conv.scales)  # N per unit force, b k_m
     knots = request.knots()
+    limit = system.step_limit()
     segments: list[Segment] = []
     if request.settle_periods > 0:
         w = knots[0][1]
         settle = request.settle_periods * 2.0 * math.pi / (design.driver.teeth * w)
-        segments.append(_segment(request, forcing, -settle, 0.0, w, w, None))
+        segments.append(_segment(request, forcing, limit, -settle, 0.0, w, w, None))
     branch: Branch = "up" if knots[-1][1] >= knots[0][1] else "down"
     for (t0, w0), (t1, w1) in itertools.pairwise(knots):
         branch = "up" if w1 > w0 else ("down" if w1 < w0 else branch)
-        segments.append(_segment(request, forcing, t0, t1, w0, w1, branch))
+        segments.append(_segment(request, forcing, limit, t0, t1, w0, w1, branch))
     return RunupPlan(
+        system=system,
         segments=segments,
         forcing=forcing,
         mean_force=(f0, f1),

@@ -28,6 +28,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from gearengine.engineering import speed_windows
+from gearengine.homoclinic.train_reduction import melnikov_point
 from gearengine.model.units import RPM, Scales, shown, to_physical
 from gearengine.signals.classify import LLE_FLOOR
 from gearengine.studies.runup.profile import Branch, RunupPlan
@@ -199,8 +200,8 @@ def read_runup(
     request: RunupRequest, plan: RunupPlan, tables: list[list], quasi: SweepResult
 ) -> RunupResult:
     """The run-up's document from the members' block tables and the quasi-static sweep."""
-    design, conv, params = request.design, request.conversion, request.params
-    assert design is not None and conv is not None and params is not None
+    design, (system, conv) = request.design, request.model()
+    assert design is not None
     arrays = [np.array(t, dtype=float).reshape(-1, len(t[0]) if t else CMAX + 1)
               for t in tables]  # fmt: skip
     lo, hi = (w / RPM for w in request.speed_range())
@@ -230,17 +231,25 @@ def read_runup(
     ]
     if request.to_torque is not None:
         notes.append(f"the torque ramps linearly in time to {request.to_torque:g} N m")
+    judged = melnikov_point(system)  # a train's mesh-mode reduction, when it holds
+    windows = [] if judged is None else speed_windows(judged, conv.speed_rpm, lo, hi)
+    if system.n > 2:
+        notes.append(
+            f"gear train ({system.n} states): numerics of the train, scales of its equivalent "
+            "pair (I_a = I_m + I_p, I_b = I_g + I_l); Melnikov windows "
+            + ("of its mesh-mode reduction (a reduction)" if judged is not None else
+               "not given: no single mode carries the mesh")
+        )  # fmt: skip
     return RunupResult(
         up=branches["up"],
         down=branches["down"],
         quasi_static=qs,
-        melnikov_windows_rpm=speed_windows(params, conv.speed_rpm, lo, hi),
+        melnikov_windows_rpm=windows,
         time_scale_s=conv.time_scale_s,
         duration_s=plan.duration,
         method=RunupMethod(
-            integration="RK4 split at every backlash edge |x| = 1 (kink-accurate, "
-            f"systems.spur_pair.kernels.kink), {request.steps_per_period} steps per period of the "
-            "fastest of the natural frequency and the excitations at each segment's top "
+            integration=f"{system.ramp_method}, {request.steps_per_period} steps per period of "
+            "the fastest of the natural frequency and the excitations at each segment's top "
             "speed; excitations at the integrated driver angle (systems.spur_pair.kernels.phase)",
             lyapunov="ensemble-averaged finite-time Lyapunov exponent over each bin's window: "
             "tangent equation renormalised every block (Benettin 1980), averaged over "

@@ -11,6 +11,9 @@ Refused before any compute (422 naming the field): a rate that is zero or negati
 outside the plausible range of a shaft (``model.units``), a profile whose integration is over
 the work budget (``MAX_RUNUP_STEPS``), a params-only request (a run-up needs the design's time
 scale), the cubic-fit law (the run-up kernel is the kink-accurate piecewise one).
+
+A design with a ``train`` runs as its ``System`` (``systems.designs.design_model``) on the
+scales of its equivalent pair: ``RunupRequest.model`` is the one door of the run-up room.
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ from pydantic_core import InitErrorDetails
 from gearengine.model.design import EXAMPLE_DESIGN
 from gearengine.model.errors import Problems
 from gearengine.model.params import request_config
-from gearengine.model.reduction import ParamsOrDesign
+from gearengine.model.reduction import DesignConversion, ParamsOrDesign
 from gearengine.model.units import (
     QUANTITIES,
     Duration,
@@ -36,6 +39,9 @@ from gearengine.model.units import (
     registry,
 )
 from gearengine.numerics.settings import SimulationSettings
+from gearengine.systems.base import System
+from gearengine.systems.designs import design_model
+from gearengine.systems.spur_pair.system import SpurPair
 
 MAX_RUNUP_STEPS = 200_000_000
 """Cap on the RK4 steps of one run-up (every ensemble member, the quasi-static sweep aside)."""
@@ -148,6 +154,16 @@ class RunupRequest(ParamsOrDesign):
         description="Settings of each point of the quasi-static continuation sweep (bin centres).",
     )
     label: str | None = Field(None, max_length=200, description="The client's name for it.")
+
+    TRAINS = True  # a train design runs as its System (model)
+
+    def model(self) -> tuple[System, DesignConversion]:
+        """(the system the members integrate, the conversion whose scales read them): the
+        pair of Eq. (9) and the design's conversion, or a train's ``TrainSystem`` and its
+        equivalent pair's (I_a = I_m + I_p, I_b = I_g + I_l)."""
+        assert self.design is not None
+        model, conversion = design_model(self.design)
+        return (model if isinstance(model, System) else SpurPair(model)), conversion
 
     def leg_seconds(self) -> float:
         """Duration of one leg of a linear ramp [s]."""

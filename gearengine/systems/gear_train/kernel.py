@@ -72,12 +72,14 @@ def _field(
     e: float,
     ed: float,
     T: float,
+    q: int,
     s: np.ndarray,
     k: np.ndarray,
     stage: int,
 ) -> None:  # pragma: no cover - compiled
     """The train's field and its tangent at the state s = (u, v, du, dv), shape (4, n), into
-    k[stage] (indices, not row views: a view costs reference counting every call)."""  # fmt: skip
+    k[stage], with the mean force f[q] of the stage time q (indices, not row views: a view
+    costs reference counting every call)."""  # fmt: skip
     n = s.shape[1]
     delta = -e
     deltad = -ed
@@ -92,7 +94,7 @@ def _field(
     W = K * fh + twomu * deltad
     dW = K * dfh * wdu + twomu * wdv
     for i in range(n):
-        acc = f[i] + p[i] * T - g[i] * W
+        acc = f[q, i] + p[i] * T - g[i] * W
         dacc = -g[i] * dW
         for j in range(n):
             acc -= AK[i, j] * s[0, j] + AC[i, j] * s[1, j]
@@ -101,6 +103,47 @@ def _field(
         k[stage, 1, i] = acc
         k[stage, 2, i] = s[3, i]
         k[stage, 3, i] = dacc
+
+
+@njit(**JIT_OPTIONS)
+def train_step(
+    law: int,
+    a: float,
+    c: float,
+    alpha: float,
+    twomu: float,
+    AK: np.ndarray,
+    AC: np.ndarray,
+    g: np.ndarray,
+    w: np.ndarray,
+    f: np.ndarray,
+    p: np.ndarray,
+    forcing: np.ndarray,
+    y: np.ndarray,
+    k: np.ndarray,
+    s: np.ndarray,
+    h: float,
+) -> None:  # pragma: no cover - compiled
+    """One classical RK4 step h of the train and its tangent, y = (u, v, du, dv) of shape
+    (4, n) in place. ``forcing`` rows (K, e, e', T) and ``f`` rows (the mean force, (n,)) at
+    the stage times tau, tau + h/2, tau + h, shapes (3, 4) and (3, n); k (4, 4, n) and s
+    (4, n) are scratch. The one step of ``run_train`` and of the run-up's ``ramp.run_ramp``."""
+    n = y.shape[1]
+    h2 = 0.5 * h
+    h6 = h / 6.0
+    for stage in range(4):
+        step = 0.0 if stage == 0 else (h if stage == 3 else h2)
+        for r in range(4):
+            for i in range(n):
+                s[r, i] = y[r, i] + step * k[stage - 1, r, i] if stage else y[r, i]
+        q = 0 if stage == 0 else (2 if stage == 3 else 1)
+        _field(
+            law, a, c, alpha, twomu, AK, AC, g, w, f, p,
+            forcing[q, 0], forcing[q, 1], forcing[q, 2], forcing[q, 3], q, s, k, stage,
+        )  # fmt: skip
+    for r in range(4):
+        for i in range(n):
+            y[r, i] += h6 * (k[0, r, i] + 2.0 * (k[1, r, i] + k[2, r, i]) + k[3, r, i])
 
 
 @njit(**JIT_OPTIONS)
@@ -152,8 +195,10 @@ def run_train(
     n = u0.size
     h = T / N
     h2 = 0.5 * h
-    h6 = h / 6.0
     twomu = 2.0 * mu
+    means = np.empty((3, n))  # the mean force at the three stage times: constant here
+    for q in range(3):
+        means[q] = f
     if use_table:
         table = np.empty((2 * N + 1, 4))
         for s in range(2 * N + 1):
@@ -192,21 +237,9 @@ def run_train(
                     forcing[q, 0], forcing[q, 1], forcing[q, 2], forcing[q, 3] = train_forcing(
                         tn + j * h + q * h2, kc, ec, tc
                     )
-            for stage in range(4):
-                step = 0.0 if stage == 0 else (h if stage == 3 else h2)
-                for r in range(4):
-                    for i in range(n):
-                        s[r, i] = y[r, i] + step * k[stage - 1, r, i] if stage else y[r, i]
-                q = 0 if stage == 0 else (2 if stage == 3 else 1)
-                _field(
-                    law, a, c, alpha, twomu, AK, AC, g, w, f, p,
-                    forcing[q, 0], forcing[q, 1], forcing[q, 2], forcing[q, 3], s, k, stage,
-                )  # fmt: skip
+            train_step(law, a, c, alpha, twomu, AK, AC, g, w, means, p, forcing, y, k, s, h)
             delta = -forcing[2, 1]
             deltad = -forcing[2, 2]
-            for r in range(4):
-                for i in range(n):
-                    y[r, i] += h6 * (k[0, r, i] + 2.0 * (k[1, r, i] + k[2, r, i]) + k[3, r, i])
             for i in range(n):
                 delta += w[i] * y[0, i]
                 deltad += w[i] * y[1, i]

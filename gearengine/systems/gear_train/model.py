@@ -238,7 +238,9 @@ class Dimensionless:
 
     A = D^-1 M_r D^-1 / m_e, K~ = D^-1 K_r D^-1 / k_m, C~ = D^-1 C_r D^-1 / (m_e omega_n),
     w~ = D^-1 w_r, delta = w~ . u~ - e(tau) / b, f~ = D^-1 P F_mean / (b k_m) and p~ the
-    motor-torque direction D^-1 P e_motor r_p, T~ = T_p / (r_p b k_m).
+    motor-torque direction D^-1 P e_motor r_p, T~ = T_p / (r_p b k_m). ``load_direction``:
+    f~ per unit of the pair's mean force F~_m = T / (r_p b k_m), D^-1 P (r_p e_motor - r_g
+    e_load) (the driver torque and the braking torque that balances it; a torque ramp).
     """
 
     mass: np.ndarray
@@ -247,6 +249,7 @@ class Dimensionless:
     mesh_direction: np.ndarray
     mean_force: np.ndarray
     torque_direction: np.ndarray
+    load_direction: np.ndarray
     scale: np.ndarray
     conversion: DesignConversion
 
@@ -267,6 +270,8 @@ def dimensionless(model: TrainModel, pair: DesignConversion) -> Dimensionless:
     force[0], force[3] = model.torque, -model.braking_torque
     motor = np.zeros(model.size)
     motor[0] = rp
+    load = motor.copy()
+    load[3] = -rg
     return Dimensionless(
         mass=inv[:, None] * red.mass * inv[None, :] / m_e,
         stiffness=inv[:, None] * red.stiffness * inv[None, :] / k_m,
@@ -274,6 +279,7 @@ def dimensionless(model: TrainModel, pair: DesignConversion) -> Dimensionless:
         mesh_direction=inv * red.mesh_direction,
         mean_force=inv * (red.projection @ force) / (b * k_m),
         torque_direction=inv * (red.projection @ motor),
+        load_direction=inv * (red.projection @ load),
         scale=scale,
         conversion=pair,
     )

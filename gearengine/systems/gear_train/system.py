@@ -25,7 +25,9 @@ from gearengine.model.params import GearParams
 from gearengine.model.reduction import DesignConversion
 from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.systems.base import Run, StepPlan, StroboscopicFlow, System
+from gearengine.systems.gear_train import ramp as train_ramp
 from gearengine.systems.gear_train.kernel import flow_train, run_train, train_forcing
+from gearengine.systems.gear_train.lanes import forcing_table, run_train_lanes
 from gearengine.systems.gear_train.model import (
     RELATIVE,
     Dimensionless,
@@ -60,6 +62,8 @@ class TrainSystem(System):
     kc: np.ndarray
     ec: np.ndarray
     tc: np.ndarray
+    load: np.ndarray
+    """A^-1 f~ per unit of the pair's mean force F~_m (``model.Dimensionless.load_direction``)."""
     omega_max: float
     torque_ratio: float
     """T_p / (r_p b k_m) per unit of the pair's F~_p: I_a / (m_e r_a^2)."""
@@ -82,6 +86,79 @@ class TrainSystem(System):
 
     name = "gear_train"
     step_cost = TRAIN_STEP_COST
+    mesh_column = RELATIVE.index("mesh_rotation")  # delta = w~ . u~ - e with w~_mesh = 1
+    ramp_method = (
+        "RK4 of the gear train stepped straight across the backlash edges "
+        f"(systems.gear_train.ramp), h omega_max <= {H_OMEGA} for its fastest mode"
+    )
+
+    def step_limit(self) -> float:
+        """h omega_max <= ``H_OMEGA`` (module docstring)."""
+        return H_OMEGA / self.omega_max
+
+    def ramp_start(self, x: float, v: float) -> np.ndarray:
+        """(u, v) of ``start`` and the tangent with equal components, shape (4, n / 2)."""
+        u0, v0 = self.start(x, v)
+        tangent = np.full(u0.size, 1.0 / math.sqrt(self.n))
+        return np.vstack([u0, v0, tangent, tangent])
+
+    def run_ramp(
+        self, state: np.ndarray, kc: np.ndarray, fc: np.ndarray, ramp: np.ndarray,
+        inertia: float, h: float, n_blocks: int, steps: int,
+    ) -> tuple[np.ndarray, int]:  # fmt: skip
+        """One segment by ``ramp.run_ramp``. The pair's forcing by order maps to the train's as
+        ``train_system`` maps the stationary one: transmission-error terms (kind 1, amplitude
+        e_r / b) displace delta, torque terms act on the motor (x ``torque_ratio``). The mean
+        force F~_m - ``inertia`` is the torque's (driver and balancing brake, ``load``);
+        ``inertia``, the pair's force that accelerates the driven inertia, is here the motor
+        torque m_0 (d w_p / dt) that accelerates the whole train (``torque_ratio`` x it, the
+        free rotation's inertia m_0 = phi_0^T M phi_0): its relative part P e_motor m_0 a is
+        the d'Alembert load -M phi_0 a, which P annihilates, plus that torque."""
+        te = fc[3] == 1.0
+        ec = np.ascontiguousarray(fc[:3, te])
+        tc = np.ascontiguousarray(fc[:3, ~te])
+        tc[0] *= self.torque_ratio
+        means = np.vstack([
+            self.load * (ramp[0] - inertia) + self.p * (self.torque_ratio * inertia),
+            self.load * ramp[1],
+        ])  # fmt: skip
+        lw = law(self.params)
+        return train_ramp.run_ramp(
+            lw.code, lw.a, lw.c, lw.alpha, self.params.damping, self.AK, self.AC, self.g, self.w,
+            self.p, kc, ec, tc, means, np.ascontiguousarray(ramp[2:]), state, h, n_blocks, steps,
+            DIVERGENCE_BOUND,
+        )  # fmt: skip
+
+    def lane_group(self, plan: StepPlan) -> tuple | None:
+        """Trains of one state dimension, law and N under periodic forcing step together."""
+        if plan.omega0 is None:
+            return None
+        lw = law(self.params)
+        return (self.name, self.n, lw.code, lw.a, lw.c, lw.alpha, plan.steps)
+
+    def run_lanes(
+        self, points: Sequence[System], owner: np.ndarray, starts: np.ndarray,
+        plans: Sequence[StepPlan], n_trans: int, n_rec: int, stride: int,
+    ) -> tuple:  # fmt: skip
+        """``lanes.run_train_lanes`` of the group (``System.run_lanes``)."""
+        trains = [t for t in points if isinstance(t, TrainSystem)]
+        assert len(trains) == len(points)
+        N = plans[0].steps
+        lw = law(self.params)
+
+        def stack(name: str) -> np.ndarray:
+            return np.ascontiguousarray(np.stack([getattr(t, name) for t in trains]))
+
+        tables = np.stack([forcing_table(t.kc, t.ec, t.tc, pl.period, N)
+                           for t, pl in zip(trains, plans, strict=True)])  # fmt: skip
+        half = starts.shape[1] // 2
+        return run_train_lanes(
+            lw.code, lw.a, lw.c, lw.alpha, np.array([t.params.damping for t in trains]),
+            stack("AK"), stack("AC"), stack("g"), stack("w"), stack("f"), stack("p"), tables,
+            owner, np.array([pl.period for pl in plans]),
+            np.ascontiguousarray(starts[:, :half]), np.ascontiguousarray(starts[:, half:]),
+            N, n_trans, n_rec, (n_rec * N // stride) * stride, DIVERGENCE_BOUND,
+        )  # fmt: skip
 
     def dynamics_key(self) -> tuple:
         """The kernel's arguments (matrices, forcing terms, law and mesh damping) as bytes."""
@@ -179,7 +256,8 @@ def train_system(model: TrainModel, pair: DesignConversion) -> TrainSystem:
         model=model, form=form, params=params,
         AK=inv @ form.stiffness, AC=inv @ form.damping, g=inv @ w, w=w,
         f=inv @ form.mean_force, p=inv @ form.torque_direction,
-        kc=kc, ec=ec, tc=tc, omega_max=float(np.sqrt(np.max(np.abs(linear)))),
+        kc=kc, ec=ec, tc=tc, load=inv @ form.load_direction,
+        omega_max=float(np.sqrt(np.max(np.abs(linear)))),
         torque_ratio=scale,
     )  # fmt: skip
 

@@ -14,10 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gearengine.model.params import GearParams
+from gearengine.model.params import GearParams, PiecewiseBacklash
+from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.systems.base import Run, StepPlan, System
 from gearengine.systems.spur_pair import kernels
 from gearengine.systems.spur_pair.forcing import packed_forcing, step_plan
+from gearengine.systems.spur_pair.kernels.ramp import run_ramp
+from gearengine.systems.spur_pair.kernels.smooth import SQRT1_2
 from gearengine.systems.spur_pair.laws import LAWS, Law, law
 
 
@@ -56,6 +59,9 @@ class SpurPair(System):
     name = "spur_pair"
     n = 2
     coordinates = ("x", "v")
+    ramp_method = (
+        "RK4 split at every backlash edge |x| = 1 (kink-accurate, systems.spur_pair.kernels.kink)"
+    )
 
     def __init__(self, params: GearParams) -> None:
         self.params = params
@@ -85,6 +91,21 @@ class SpurPair(System):
 
     def damping_rate(self) -> float:
         return self.params.damping
+
+    def ramp_start(self, x: float, v: float) -> np.ndarray:
+        return np.array([[x], [v], [SQRT1_2], [SQRT1_2]])
+
+    def run_ramp(
+        self, state: np.ndarray, kc: np.ndarray, fc: np.ndarray, ramp: np.ndarray,
+        inertia: float, h: float, n_blocks: int, steps: int,
+    ) -> tuple[np.ndarray, int]:  # fmt: skip
+        """The kink-splitting ramp kernel of the piecewise law (``kernels.ramp``); the mean
+        force of ``ramp`` includes ``inertia`` already."""
+        backlash = self.params.backlash
+        assert isinstance(backlash, PiecewiseBacklash)
+        flat = state.reshape(-1)  # (x, v, dx, dv), a view: the kernel updates it in place
+        return run_ramp(float(backlash.alpha), float(self.params.damping), flat, kc, ramp, fc, h,
+                        n_blocks, steps, DIVERGENCE_BOUND)  # fmt: skip
 
     def method(self, plan: StepPlan) -> str:
         name = self.params.backlash.model
