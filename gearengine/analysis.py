@@ -92,9 +92,10 @@ class AnalysisResult(BaseModel):
     )
 
     def summary(self) -> str:
-        """The verdicts in one line: response, LLE (with a design also in 1/s), contact (with
-        basins the deciding attractor's), Melnikov, and with a design the DTE, dynamic factor and
-        Melnikov speed windows (the gate's PASS or FAIL line)."""
+        """The verdicts in one line: response, LLE (with a design also in 1/s), contact,
+        Melnikov, and with a design the DTE, dynamic factor and Melnikov speed windows (the
+        gate's PASS or FAIL line). With basins the LLE, contact, DTE and dynamic factor are the
+        deciding attractor's."""
         num = self.numerics
         decided = decision(num, self.settings) or num  # with basins the worst attractor's
         kind = f"periodic {decided.period}T" if decided.period else decided.classification
@@ -114,10 +115,14 @@ class AnalysisResult(BaseModel):
         eng = self.engineering
         if eng is not None:
             resp = eng.response
-            if resp is not None and resp.dte_peak_to_peak_um is not None:
-                line += f"; DTE {resp.dte_peak_to_peak_um:.3g} µm"
-            if resp is not None and resp.dynamic_factor is not None:
-                line += f", dynamic factor {resp.dynamic_factor:.3g}"
+            dte = None if resp is None else resp.dte_peak_to_peak_um
+            factor = None if resp is None else resp.dynamic_factor
+            if decided is not num and who is not None:  # the worst attractor's, as its LLE
+                dte, factor = who.dte_um, who.dynamic_factor
+            if dte is not None:
+                line += f"; DTE {dte:.3g} µm"
+            if factor is not None:
+                line += f", dynamic factor {factor:.3g}"
             lo, hi = eng.speed_range_rpm
             spans = ", ".join(f"{a:,.0f}-{b:,.0f}" for a, b in eng.speed_windows_rpm) or "nowhere"
             scanned = f"{spans} rpm (scanned {lo:,.0f}-{hi:,.0f} rpm)"

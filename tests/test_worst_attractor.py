@@ -59,6 +59,15 @@ def test_summaries_name_the_worst_attractor(analysis):
     assert line.startswith("chaotic (chaotic, double-sided impacts from 56 % of starts)")
 
 
+def test_the_one_line_summary_gives_the_worst_attractors_dte_and_dynamic_factor(analysis):
+    """The headline's DTE and dynamic factor sit beside the chaotic attractor's LLE: they are
+    that attractor's, not the periodic settings' start's (which read 'chaotic ... DTE 62 um')"""
+    worst, run = analysis.numerics.attractors[0], analysis.engineering.response
+    assert f"{worst.dte_um:.3g}" != f"{run.dte_peak_to_peak_um:.3g}"  # the premise
+    line = analysis.summary()
+    assert f"; DTE {worst.dte_um:.3g} µm, dynamic factor {worst.dynamic_factor:.3g}" in line
+
+
 def test_sweep_point_and_windows_follow_the_worst_attractor(sweep):
     (p,) = sweep.points
     worst = p.attractors[0]
