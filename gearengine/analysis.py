@@ -232,10 +232,11 @@ def analyze(
         ts = conv.time_scale_s
         num = num.model_copy(update={"transient": in_seconds(num.transient, ts),
                                      "record": in_seconds(num.record, ts)})  # fmt: skip
-    if request.settings.basins is not None:
+    decided, basins = None, request.settings.basins
+    if basins is not None:  # the worst attractor above min_fraction decides (one headline)
         found, counts = attractors(system, request.settings, None if conv is None else conv.scales)
         num = num.model_copy(update={"attractors": found, "basins": counts})
-    decided = decision(num, request.settings)
+        decided = headline(found, counts, basins.min_fraction)
     result = AnalysisResult(melnikov=mel, numerics=num, settings=request.settings,
                             verdict=verdict(mel, num, decided))  # fmt: skip
     if conv is None:
@@ -294,10 +295,11 @@ def analyze_train(request: AnalysisRequest, system: TrainSystem) -> AnalysisResu
     a reduction there are none, and the note says why."""
     pair = system.conversion
     num = simulate(system, request.settings)
-    if request.settings.basins is not None:  # starts over (delta, delta'), the rest static
+    decided, basins = None, request.settings.basins
+    if basins is not None:  # starts over (delta, delta'), the rest static
         found, counts = attractors(system, request.settings, pair.scales)
         num = num.model_copy(update={"attractors": found, "basins": counts})
-    decided = decision(num, request.settings)
+        decided = headline(found, counts, basins.min_fraction)
     reduced = train_melnikov(system)
     if reduced.applicable:
         assert reduced.melnikov is not None and reduced.params is not None
