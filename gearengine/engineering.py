@@ -388,7 +388,7 @@ def engineering(
         elif windows and windows[-1][1] >= hi:
             note = f"the window from {windows[-1][0]:,.0f} rpm reaches the end of the scan"
     if no_windows is not None:
-        note, decided = no_windows, None  # its summary has never named the deciding attractor
+        note = no_windows
     crit = {
         CONTROLS[name]: critical(name, t, conv.scales)
         for name, t in mel.thresholds.items()

@@ -151,7 +151,8 @@ def test_gearengine_check_of_a_train_file(tmp_path: Path) -> None:
 
 def test_basins_of_a_train() -> None:
     """Basins over the mesh coordinate (the rest at its static deflection, at rest): every
-    start of a periodic point settles on one 1T orbit whose DTE is the train's verdict's."""
+    start of a periodic point settles on one 1T orbit whose DTE is the train's verdict's, and
+    the engineering summary names it with its fraction (issue 30)."""
     settings = {**LIGHT, "transient_periods": 200, "basins": {"starts": 4}}
     result = gearengine.analyze(AnalysisRequest(design=TRAIN, settings=settings))
     found, counts = result.numerics.attractors, result.numerics.basins
@@ -160,6 +161,9 @@ def test_basins_of_a_train() -> None:
     train = simulate_train(Design.model_validate(TRAIN), SimulationSettings(**settings))
     assert found[0].dte_um == pytest.approx(train.dte_um, rel=1e-3)
     assert result.verdict.decided_by == "periodic 1T, no impacts from 100 % of starts"
+    # issue 30: the summary names the deciding attractor, though this train has no reduction
+    assert not result.melnikov.applicable
+    assert f"({result.verdict.decided_by})" in result.engineering.summary
 
 
 def test_robustness_of_a_train_is_the_trains() -> None:
