@@ -215,34 +215,63 @@ def analyze(
     ``request`` is a whole request, or (the facade's short form) a ``Design`` in physical units
     or dimensionless ``GearParams``, integrated with ``settings`` (default: the defaults of
     ``SimulationSettings``); ``settings`` with a whole request is refused (it has its own).
-    The request's system decides once: the pair here, a train in ``analyze_train``.
+    One pipeline for the request's system: its Melnikov answer (the pair's, or a train's
+    reduction, ``train_answer``), its numerics (with ``settings.basins`` its attractors and
+    the worst one's headline, computed once), the verdict, and with a design the engineering
+    block from the values handed to it (a train's with its modes).
     """
     if not isinstance(request, AnalysisRequest):
         key = "design" if isinstance(request, Design) else "params"
         request = AnalysisRequest(**{key: request}, settings=settings or SimulationSettings())
     elif settings is not None:
         raise TypeError("analyze: an AnalysisRequest carries its settings; give one or the other")
-    system = request.system
-    if isinstance(system, TrainSystem):
-        return analyze_train(request, system)
-    mel = melnikov(system)
-    num = simulate(system, request.settings)
-    conv = request.conversion
-    if conv is not None:
+    system, settings = request.system, request.settings
+    train = system if isinstance(system, TrainSystem) else None
+    if train is None:
+        mel, conv, no_windows = melnikov(system), request.conversion, None
+    else:
+        mel, conv, no_windows = train_answer(train)
+    num = simulate(system, settings)
+    if conv is not None and train is None:  # the pair's run lengths in seconds too
         ts = conv.time_scale_s
         num = num.model_copy(update={"transient": in_seconds(num.transient, ts),
                                      "record": in_seconds(num.record, ts)})  # fmt: skip
-    decided, basins = None, request.settings.basins
-    if basins is not None:  # the worst attractor above min_fraction decides (one headline)
-        found, counts = attractors(system, request.settings, None if conv is None else conv.scales)
+    decided = None
+    if settings.basins is not None:  # the worst attractor above min_fraction decides
+        found, counts = attractors(system, settings, None if conv is None else conv.scales)
         num = num.model_copy(update={"attractors": found, "basins": counts})
-        decided = headline(found, counts, basins.min_fraction)
-    result = AnalysisResult(melnikov=mel, numerics=num, settings=request.settings,
+        decided = headline(found, counts, settings.basins.min_fraction)
+    result = AnalysisResult(melnikov=mel, numerics=num, settings=settings,
                             verdict=verdict(mel, num, decided))  # fmt: skip
     if conv is None:
         return result
-    eng = engineering(conv, request.speed_rpm_range(), mel, num, decided)
-    return result.model_copy(update={"params": conv.params, "engineering": eng})
+    eng = engineering(conv, request.speed_rpm_range(), mel, num, decided, no_windows)
+    if train is None:
+        return result.model_copy(update={"params": conv.params, "engineering": eng})
+    notes = [f"gear train: {train.model.size} coordinates; numerics of the train, scales of "
+             "its equivalent pair (I_a = I_m + I_p, I_b = I_g + I_l)"]  # fmt: skip
+    found_modes = modes(train.model, conv.natural_frequency_hz)
+    eng = eng.model_copy(update={"notes": [*eng.notes, *notes], "modes": found_modes})
+    return result.model_copy(update={"params": train.params, "engineering": eng})
+
+
+def train_answer(system: TrainSystem) -> tuple[MelnikovResult, DesignConversion, str | None]:
+    """A train's Melnikov answer (that of its mesh-mode reduction, or not applicable with the
+    reason, ``homoclinic.train_reduction``), the conversion its engineering block uses (the
+    scales of its equivalent pair, ``model.equivalent_design``, with the reduction's params),
+    and why there are no Melnikov speed windows (None with a reduction: the windows are the
+    reduction's, its frequencies scale with the speed like the pair's)."""
+    pair = system.conversion
+    reduced = train_melnikov(system)
+    if reduced.applicable:
+        assert reduced.melnikov is not None and reduced.params is not None
+        mel = reduced.melnikov.model_copy(
+            update={"notes": [reduced.reason, reduced.reduction, *reduced.melnikov.notes]}
+        )
+        return mel, pair.model_copy(update={"params": reduced.params}), None
+    a, c, _ = melnikov_cubic(system.params.backlash)
+    mel = not_applicable(a, c, "closed_form", [reduced.reason])
+    return mel, pair, "no Melnikov reduction: " + reduced.reason
 
 
 def answer_melnikov(request: MelnikovRequest) -> MelnikovResult:
@@ -282,45 +311,4 @@ def convert(request: DesignRequest) -> DesignReport:
     mel = melnikov(conv.params)
     return DesignReport(
         conversion=conv, engineering=engineering(conv, request.speed_rpm_range(), mel)
-    )
-
-
-def analyze_train(request: AnalysisRequest, system: TrainSystem) -> AnalysisResult:
-    """``analyze`` for a design with a ``train``, its ``system``: the numerical verdict from the
-    train's kernel (``systems.gear_train``; with ``settings.basins`` the attractors of its
-    starts over the mesh coordinate), the Melnikov verdict of its mesh-mode reduction (or not
-    applicable with the reason, ``homoclinic.train_reduction``), and the engineering block on
-    the scales of its equivalent pair (``model.equivalent_design``). The Melnikov speed windows
-    are those of the reduction (its frequencies scale with the speed like the pair's); without
-    a reduction there are none, and the note says why."""
-    pair = system.conversion
-    num = simulate(system, request.settings)
-    decided, basins = None, request.settings.basins
-    if basins is not None:  # starts over (delta, delta'), the rest static
-        found, counts = attractors(system, request.settings, pair.scales)
-        num = num.model_copy(update={"attractors": found, "basins": counts})
-        decided = headline(found, counts, basins.min_fraction)
-    reduced = train_melnikov(system)
-    if reduced.applicable:
-        assert reduced.melnikov is not None and reduced.params is not None
-        mel = reduced.melnikov.model_copy(
-            update={"notes": [reduced.reason, reduced.reduction, *reduced.melnikov.notes]}
-        )
-        conv, no_windows = pair.model_copy(update={"params": reduced.params}), None
-    else:
-        a, c, _ = melnikov_cubic(system.params.backlash)
-        mel = not_applicable(a, c, "closed_form", [reduced.reason])
-        conv, no_windows = pair, "no Melnikov reduction: " + reduced.reason
-    eng = engineering(conv, request.speed_rpm_range(), mel, num, decided, no_windows)
-    notes = [f"gear train: {system.model.size} coordinates; numerics of the train, scales of "
-             "its equivalent pair (I_a = I_m + I_p, I_b = I_g + I_l)"]  # fmt: skip
-    found = modes(system.model, pair.natural_frequency_hz)
-    eng = eng.model_copy(update={"notes": [*eng.notes, *notes], "modes": found})
-    return AnalysisResult(
-        melnikov=mel,
-        numerics=num,
-        settings=request.settings,
-        verdict=verdict(mel, num, decided),
-        params=system.params,
-        engineering=eng,
     )
