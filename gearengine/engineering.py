@@ -369,11 +369,17 @@ def engineering(
     ``decided`` the worst attractor of its basins, ``numerics.attractors.headline``).
     ``no_windows``: why the speed windows are not looked for (a train without a Melnikov
     reduction), said in their note; the range stays the scan's."""
-    params = conv.params
-    t_crit = critical_torque(conv, mel)
+    params = conv.params  # the values of this file first, then the rooms below
+    t_crit, over = critical_torque(conv, mel), over_critical(conv, mel)
+    crit = {
+        CONTROLS[name]: critical(name, t, conv.scales)
+        for name, t in mel.thresholds.items()
+        if name in CONTROLS and t.value is not None and (t.critical_values or t.note is None)
+    }
+    resp = None if num is None else response(params, num, conv)
     note = None
     lo, hi = rpm_range
-    if over_critical(conv, mel) and t_crit is not None:
+    if over and t_crit is not None:
         windows: list[list[float]] = []
         note = f"not applicable above T_crit = {t_crit:,.3g} N*m"
     else:
@@ -389,12 +395,6 @@ def engineering(
             note = f"the window from {windows[-1][0]:,.0f} rpm reaches the end of the scan"
     if no_windows is not None:
         note = no_windows
-    crit = {
-        CONTROLS[name]: critical(name, t, conv.scales)
-        for name, t in mel.thresholds.items()
-        if name in CONTROLS and t.value is not None and (t.critical_values or t.note is None)
-    }
-    resp = None if num is None else response(params, num, conv)
     return Engineering(
         natural_frequency_hz=conv.natural_frequency_hz,
         time_scale_s=conv.time_scale_s,
