@@ -13,10 +13,9 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
 
 from gearengine.engineering import IMPACT_WORDS, Engineering, engineering
-from gearengine.engineering import summary as engineering_summary
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
 from gearengine.homoclinic.train_reduction import train_melnikov
 from gearengine.homoclinic.verdict import melnikov, not_applicable
@@ -30,9 +29,10 @@ from gearengine.numerics.physical import in_seconds
 from gearengine.numerics.results import NumericsResult
 from gearengine.numerics.settings import RequestSettings, SimulationSettings
 from gearengine.numerics.simulation import simulate
-from gearengine.systems.gear_train.model import train_of
+from gearengine.systems.base import System
+from gearengine.systems.designs import design_model
 from gearengine.systems.gear_train.modes import modes
-from gearengine.systems.gear_train.system import train_system
+from gearengine.systems.gear_train.system import TrainSystem
 from gearengine.systems.spur_pair.laws import melnikov_cubic
 
 Agreement = Literal["both_chaotic", "both_regular", "melnikov_only", "numerics_only", "undecided"]
@@ -49,6 +49,25 @@ class AnalysisRequest(ParamsOrDesign):
         description="Integration settings (defaults: 500 + 500 periods, 200 steps, x0 = "
         "(0.01, 0.01)).",
     )
+    _system: GearParams | System | None = PrivateAttr(None)
+
+    @model_validator(mode="after")
+    def _carry_system(self) -> AnalysisRequest:
+        """Build what the numerics run once, when the request is validated: its params, or
+        for a design with a ``train`` its ``TrainSystem`` (``systems.designs.design_model``);
+        the budget check, the analysis and the basins job all read it from here."""
+        design = self.design
+        if design is not None and design.train is not None:
+            self._system = design_model(design)[0]
+        else:
+            self._system = self.params
+        return self
+
+    @property
+    def system(self) -> GearParams | System:
+        """What the numerics run: the pair's params, or the train's ``TrainSystem``."""
+        assert self._system is not None
+        return self._system
 
 
 class Verdict(BaseModel):
@@ -149,15 +168,15 @@ class MelnikovAnswer(MelnikovResult):
     )
 
 
-def verdict(mel: MelnikovResult, num: NumericsResult, min_fraction: float = 0.0) -> Verdict:
+def verdict(mel: MelnikovResult, num: NumericsResult, decided: Headline | None = None) -> Verdict:
     """Compare the Melnikov verdict with the numerical classification: that of the worst
-    start, or with basins of the worst attractor above ``min_fraction`` (``ensembles``)."""
+    start, or with basins of the worst attractor that decides (``decision``)."""
     classification, period_n, decided_by, basins = num.classification, num.period, None, ""
     if num.attractors is not None and num.basins is not None:
-        head = headline(num.attractors, num.basins, min_fraction)
         basins = f" ({coexistence(num.attractors, num.basins)})"
-        if head is not None:
-            classification, period_n, decided_by = head.classification, head.period, head.decided_by
+        if decided is not None:
+            classification, period_n = decided.classification, decided.period
+            decided_by = decided.decided_by
     chaotic = classification == "chaotic"
     period = f" ({period_n}T)" if period_n else ""
     numerics = f"numerics: {classification}{period}{basins}"
@@ -201,33 +220,67 @@ def analyze(
     ``request`` is a whole request, or (the facade's short form) a ``Design`` in physical units
     or dimensionless ``GearParams``, integrated with ``settings`` (default: the defaults of
     ``SimulationSettings``); ``settings`` with a whole request is refused (it has its own).
+    One pipeline for the request's system: its Melnikov answer (the pair's, or a train's
+    reduction, ``train_answer``), its numerics (with ``settings.basins`` its attractors and
+    the worst one's headline, computed once), the verdict, and with a design the engineering
+    block from the values handed to it (a train's with its modes).
     """
     if not isinstance(request, AnalysisRequest):
         key = "design" if isinstance(request, Design) else "params"
         request = AnalysisRequest(**{key: request}, settings=settings or SimulationSettings())
     elif settings is not None:
         raise TypeError("analyze: an AnalysisRequest carries its settings; give one or the other")
-    if request.design is not None and request.design.train is not None:
-        return analyze_train(request)
-    mel = melnikov(request.params)
-    num = simulate(request.params, request.settings)
-    conv = request.conversion
-    if conv is not None:
+    system, settings = request.system, request.settings
+    train = system if isinstance(system, TrainSystem) else None
+    if train is None:
+        mel, conv, no_windows = melnikov(system), request.conversion, None
+    else:
+        mel, conv, no_windows = train_answer(train)
+    num = simulate(system, settings)
+    if conv is not None and train is None:  # the pair's run lengths in seconds too
         ts = conv.time_scale_s
         num = num.model_copy(update={"transient": in_seconds(num.transient, ts),
                                      "record": in_seconds(num.record, ts)})  # fmt: skip
-    basins = request.settings.basins
-    if basins is not None:
-        scales = None if conv is None else conv.scales
-        found, counts = attractors(request.params, request.settings, scales)
+    decided = None
+    if settings.basins is not None:  # the worst attractor above min_fraction decides
+        found, counts = attractors(system, settings, None if conv is None else conv.scales)
         num = num.model_copy(update={"attractors": found, "basins": counts})
-    min_fraction = 0.0 if basins is None else basins.min_fraction
-    result = AnalysisResult(melnikov=mel, numerics=num, settings=request.settings,
-                            verdict=verdict(mel, num, min_fraction))  # fmt: skip
+        decided = headline(found, counts, settings.basins.min_fraction)
+    result = AnalysisResult(melnikov=mel, numerics=num, settings=settings,
+                            verdict=verdict(mel, num, decided))  # fmt: skip
     if conv is None:
         return result
-    eng = engineering(conv, request.speed_rpm_range(), mel, num, decision(num, request.settings))
-    return result.model_copy(update={"params": conv.params, "engineering": eng})
+    eng = engineering(conv, request.speed_rpm_range(), mel, num, decided, no_windows)
+    if train is None:
+        return result.model_copy(update={"params": conv.params, "engineering": eng})
+    notes = [f"gear train: {train.model.size} coordinates; numerics of the train, scales of "
+             "its equivalent pair (I_a = I_m + I_p, I_b = I_g + I_l)"]  # fmt: skip
+    found_modes = modes(train.model, conv.natural_frequency_hz)
+    eng = eng.model_copy(update={"notes": [*eng.notes, *notes], "modes": found_modes})
+    return result.model_copy(update={"params": train.params, "engineering": eng})
+
+
+def train_answer(system: TrainSystem) -> tuple[MelnikovResult, DesignConversion, str | None]:
+    """A train's Melnikov answer (that of its mesh-mode reduction, or not applicable with the
+    reason, ``homoclinic.train_reduction``), the conversion its engineering block uses (the
+    scales of its equivalent pair, ``model.equivalent_design``, with the reduction's params),
+    and why there are no Melnikov speed windows (None with a reduction: the windows are the
+    reduction's, its frequencies scale with the speed like the pair's)."""
+    pair = system.conversion
+    reduced = train_melnikov(system)
+    if reduced.applicable:
+        assert reduced.melnikov is not None and reduced.params is not None
+        mel = reduced.melnikov.model_copy(
+            update={"notes": [reduced.reason, reduced.reduction, *reduced.melnikov.notes]}
+        )
+        return mel, pair.model_copy(update={"params": reduced.params}), None
+    a, c, _ = melnikov_cubic(system.params.backlash)
+    # no critical load either: the equivalent pair's F_crit judges no train without a
+    # reduction (its T_crit read "the criterion applies below it")
+    mel = not_applicable(a, c, "closed_form", [reduced.reason]).model_copy(
+        update={"critical_mean_force": None}
+    )
+    return mel, pair, "no Melnikov reduction: " + reduced.reason
 
 
 def answer_melnikov(request: MelnikovRequest) -> MelnikovResult:
@@ -267,61 +320,4 @@ def convert(request: DesignRequest) -> DesignReport:
     mel = melnikov(conv.params)
     return DesignReport(
         conversion=conv, engineering=engineering(conv, request.speed_rpm_range(), mel)
-    )
-
-
-def analyze_train(request: AnalysisRequest) -> AnalysisResult:
-    """``analyze`` for a design with a ``train``: the numerical verdict from the train's kernel
-    (``systems.gear_train``; with ``settings.basins`` the attractors of its starts over the mesh
-    coordinate), the Melnikov verdict of its mesh-mode reduction (or not applicable
-    with the reason, ``homoclinic.train_reduction``), and the engineering block on the scales of
-    its equivalent pair (``model.equivalent_design``). The Melnikov speed windows are those of
-    the reduction (its frequencies scale with the speed like the pair's); without a reduction
-    there are none, and the note says why."""
-
-    design = request.design
-    assert design is not None and design.train is not None
-    model, pair = train_of(design)
-    system = train_system(model, pair)
-    num = simulate(system, request.settings)
-    basins = request.settings.basins
-    if basins is not None:  # starts over (delta, delta'), the rest at its static deflection
-        found, counts = attractors(system, request.settings, pair.scales)
-        num = num.model_copy(update={"attractors": found, "basins": counts})
-    reduced = train_melnikov(system)
-    if reduced.applicable:
-        assert reduced.melnikov is not None and reduced.params is not None
-        mel = reduced.melnikov.model_copy(
-            update={"notes": [reduced.reason, reduced.reduction, *reduced.melnikov.notes]}
-        )
-        conv = pair.model_copy(update={"params": reduced.params})
-    else:
-        a, c, _ = melnikov_cubic(system.params.backlash)
-        # no critical load either: the equivalent pair's F_crit judges no train without a
-        # reduction (its T_crit read "the criterion applies below it")
-        mel = not_applicable(a, c, "closed_form", [reduced.reason]).model_copy(
-            update={"critical_mean_force": None}
-        )
-        conv = pair
-    eng = engineering(conv, request.speed_rpm_range(), mel, num, decision(num, request.settings))
-    if not reduced.applicable:
-        lo, hi = eng.speed_range_rpm
-        eng = eng.model_copy(
-            update={
-                "speed_windows_rpm": [],
-                "speed_windows_note": "no Melnikov reduction: " + reduced.reason,
-                "summary": engineering_summary(conv, mel, [], (lo, hi), eng.response, num),
-            }
-        )
-    notes = [f"gear train: {model.size} coordinates; numerics of the train, scales of its "
-             "equivalent pair (I_a = I_m + I_p, I_b = I_g + I_l)"]  # fmt: skip
-    found = modes(model, pair.natural_frequency_hz)
-    eng = eng.model_copy(update={"notes": [*eng.notes, *notes], "modes": found})
-    return AnalysisResult(
-        melnikov=mel,
-        numerics=num,
-        settings=request.settings,
-        verdict=verdict(mel, num, 0.0 if basins is None else basins.min_fraction),
-        params=system.params,
-        engineering=eng,
     )

@@ -4,9 +4,9 @@ From the design's conversion (``model.design``) and the dimensionless verdicts t
 gives what a gearbox engineer asks:
 
 * ``speed_windows_rpm``: the driver speeds where the Melnikov criterion allows chaos at the
-  design's torque: the sign changes of the sign-change strength as a change of speed scales every
-  excitation frequency together (F~_er = e_r / b and F~_pr do not depend on speed), by brentq,
-  scanned past the requested range to ``WINDOW_BOUND`` times the design speed (then open-ended);
+  design's torque (``homoclinic.boundary.speed_window_scan``: a change of speed scales every
+  excitation frequency together), scanned past the requested range to ``WINDOW_BOUND`` times
+  the design speed (then open-ended);
 * ``critical_torque_nm``: the mean driver torque T_crit at which the static mesh force reaches
   F_crit of the cubic fit; above it the unperturbed system has no saddle and the criterion does
   not apply (``docs/melnikov-under-load.md``);
@@ -30,11 +30,9 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from gearengine.homoclinic.boundary import chaos_intervals
-from gearengine.homoclinic.coefficients import MeanLoad
+from gearengine.homoclinic.boundary import WINDOW_BOUND, speed_window_scan
 from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
-from gearengine.homoclinic.thresholds import strength_at
-from gearengine.model.aliases import get_alias, with_speed_factor
+from gearengine.model.aliases import get_alias
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import Derived, DesignConversion
 from gearengine.model.units import (
@@ -50,13 +48,6 @@ from gearengine.numerics.attractors import Headline
 from gearengine.numerics.results import NumericsResult
 from gearengine.systems.gear_train.modes import Modes
 from gearengine.systems.spur_pair.forcing import contact_force_of, static_error
-
-WINDOW_SCAN = 240
-"""Speeds sampled in the Melnikov window scan before brentq refines each edge."""
-WINDOW_BOUND = 10.0
-"""The window scan goes on past the requested range, while the last window is open, up to this
-multiple of the design speed (beyond which no gear pair of the design runs): a window still
-open there is reported open-ended."""
 
 
 class _Doc(BaseModel):
@@ -160,37 +151,6 @@ class Engineering(_Doc):
         exclude_if=lambda modes: modes is None,  # a pair's JSON stays the pair's
         description="With a train: its modes linearised in contact (docs/gear-trains.md).",
     )
-
-
-def _speed_path(params: GearParams, speed_rpm: float):
-    """The design at ``speed_rpm`` moved to each speed [rpm] (every frequency scaled)."""
-    return lambda rpm: with_speed_factor(params, rpm / speed_rpm)
-
-
-def speed_windows(
-    params: GearParams,
-    speed_rpm: float,
-    lo: float,
-    hi: float,
-    mean_load: MeanLoad = "unperturbed",
-    num: int = WINDOW_SCAN,
-) -> list[list[float]]:
-    """Driver speeds [rpm] in [lo, hi] where some Melnikov branch changes sign: the design at
-    ``speed_rpm`` moved to each speed by scaling every excitation frequency together."""
-    return chaos_intervals(_speed_path(params, speed_rpm), lo, hi, num, mean_load)
-
-
-def window_scan_end(
-    params: GearParams, speed_rpm: float, hi: float, mean_load: MeanLoad = "unperturbed"
-) -> float:
-    """The end [rpm] of the window scan: ``hi``, doubled while the criterion still allows chaos
-    there, up to ``WINDOW_BOUND`` times the design speed."""
-    path = _speed_path(params, speed_rpm)
-    bound = max(hi, WINDOW_BOUND * speed_rpm)
-    top = hi
-    while top < bound and strength_at(path(top), mean_load=mean_load) > 0.0:
-        top = min(2.0 * top, bound)
-    return top
 
 
 IMPACT_WORDS = {
@@ -340,13 +300,14 @@ def summary(
     rng: tuple[float, float],
     resp: Response | None,
     num: NumericsResult | None,
-    decided: Headline | None = None,
+    decided: Headline | None,
+    t_crit: float | None,
 ) -> str:
     """Two or three sentences an engineer can paste into a design review; with basins the
     response named is the worst attractor's above the basin threshold (``decided``, with its
     fraction and LLE), and the contact, DTE, dynamic factor and the LLE that follow are the
-    recorded run's when that run settled elsewhere (said so)."""
-    t_crit = critical_torque(conv, mel)
+    recorded run's when that run settled elsewhere (said so); ``t_crit`` the critical torque
+    (``critical_torque``)."""
     f_crit = mel.critical_mean_force if over_critical(conv, mel) and t_crit is not None else None
     if f_crit or not mel.applicable:  # its load, or its notes' reason (a train, no reduction)
         why = load_words(conv, f_crit, t_crit) if f_crit and t_crit else mel.notes[0]
@@ -403,35 +364,38 @@ def engineering(
     mel: MelnikovResult,
     num: NumericsResult | None = None,
     decided: Headline | None = None,
+    no_windows: str | None = None,
 ) -> Engineering:
     """The engineering block of a design's Melnikov verdict (and analysis, given ``num``;
-    ``decided`` the worst attractor of its basins, ``numerics.attractors.headline``)."""
-    params = conv.params
-    t_crit = critical_torque(conv, mel)
-    note = None
-    lo, hi = rpm_range
-    if over_critical(conv, mel) and t_crit is not None:
-        windows: list[list[float]] = []
-        note = f"not applicable above T_crit = {t_crit:,.3g} N*m"
-    else:
-        top = window_scan_end(params, conv.speed_rpm, hi, mel.mean_load)
-        scan = WINDOW_SCAN if top == hi else math.ceil(WINDOW_SCAN * (top - lo) / (hi - lo))
-        windows = speed_windows(params, conv.speed_rpm, lo, top, mel.mean_load, scan)
-        hi = top
-        if windows and windows[-1][1] >= top and top > rpm_range[1]:
-            note = (
-                f"the window from {windows[-1][0]:,.0f} rpm is open-ended: chaos is still "
-                f"possible at {top:,.0f} rpm, {WINDOW_BOUND:g} x the design speed, where the "
-                "scan stops"
-            )
-        elif windows and windows[-1][1] >= top:
-            note = f"the window from {windows[-1][0]:,.0f} rpm reaches the end of the scan"
+    ``decided`` the worst attractor of its basins, ``numerics.attractors.headline``).
+    ``no_windows``: why the speed windows are not looked for (a train without a Melnikov
+    reduction), said in their note; the range stays the scan's."""
+    params = conv.params  # the values of this file first, then the rooms below
+    t_crit, over = critical_torque(conv, mel), over_critical(conv, mel)
     crit = {
         CONTROLS[name]: critical(name, t, conv.scales)
         for name, t in mel.thresholds.items()
         if name in CONTROLS and t.value is not None and (t.critical_values or t.note is None)
     }
     resp = None if num is None else response(params, num, conv)
+    note = None
+    lo, hi = rpm_range
+    if over and t_crit is not None:
+        windows: list[list[float]] = []
+        note = f"not applicable above T_crit = {t_crit:,.3g} N*m"
+    else:
+        find = no_windows is None
+        windows, hi = speed_window_scan(params, conv.speed_rpm, lo, hi, mel.mean_load, find)
+        if windows and windows[-1][1] >= hi and hi > rpm_range[1]:
+            note = (
+                f"the window from {windows[-1][0]:,.0f} rpm is open-ended: chaos is still "
+                f"possible at {hi:,.0f} rpm, {WINDOW_BOUND:g} x the design speed, where the "
+                "scan stops"
+            )
+        elif windows and windows[-1][1] >= hi:
+            note = f"the window from {windows[-1][0]:,.0f} rpm reaches the end of the scan"
+    if no_windows is not None:
+        note = no_windows
     return Engineering(
         natural_frequency_hz=conv.natural_frequency_hz,
         time_scale_s=conv.time_scale_s,
@@ -445,6 +409,6 @@ def engineering(
         critical=crit,
         derived=conv.derived,
         response=resp,
-        summary=summary(conv, mel, windows, (lo, hi), resp, num, decided),
+        summary=summary(conv, mel, windows, (lo, hi), resp, num, decided, t_crit),
         notes=conv.notes,
     )

@@ -14,8 +14,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from gearengine.analysis import AnalysisRequest, analyze, answer_melnikov, convert
-from gearengine.engineering import response, speed_windows
+from gearengine.engineering import response
 from gearengine.homoclinic import melnikov
+from gearengine.homoclinic.boundary import speed_windows
 from gearengine.homoclinic.schemas import MelnikovRequest
 from gearengine.model.aliases import with_speed_factor
 from gearengine.model.conversion import to_dimensionless

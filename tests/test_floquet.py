@@ -23,6 +23,7 @@ from gearengine.cli import main
 from gearengine.model.params import GearParams
 from gearengine.numerics.bifurcations import feigenbaum_ratios, locate_bifurcations
 from gearengine.numerics.floquet import NEWTON_MAX_STEPS, floquet, floquet_of
+from gearengine.numerics.runs import as_system
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate
 from gearengine.plots.sweep import bifurcation_label, sweep_figure
@@ -343,7 +344,10 @@ def test_down_sweep_and_coarse_grid_find_the_same_points(cascade: list[dict]) ->
 def test_analysis_field_is_null_with_a_reason_when_not_periodic() -> None:
     chaotic = simulate(paper(0.25))
     assert chaotic.floquet is None and "chaotic" in chaotic.floquet_note
-    assert floquet_of(paper(0.25), SimulationSettings(), chaotic) == (None, chaotic.floquet_note)
+    assert floquet_of(as_system(paper(0.25)), SimulationSettings(), chaotic) == (
+        None,
+        chaotic.floquet_note,
+    )
     periodic = simulate(paper(0.2))
     assert periodic.floquet is not None and periodic.floquet_note is None
     assert periodic.floquet.period == 1 and periodic.floquet.converged

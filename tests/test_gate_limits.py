@@ -12,8 +12,8 @@ import pytest
 from gearengine.cli.documents import InvalidInputError
 from gearengine.cli.envelope import envelope_request
 from gearengine.cli.main import build_parser, main
-from gearengine.gate.envelope import Rules, point_failures
-from gearengine.studies.sweep.points import SweepPoint
+from gearengine.gate.envelope import Rules, point_failures, verdict_failures
+from gearengine.studies.sweep.points import PhysicalValue, SweepPoint
 from tests.conftest import PAPER_PARAMS, ROOT
 
 LIGHT = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
@@ -75,6 +75,27 @@ def test_separation_fails_drive_flank_impacts() -> None:
     assert point_failures(point("single_sided"), impacts) == []
     args = build_parser().parse_args(["check", "x.json", "--fail-on", "separation"])
     assert args.fail_on == ["separation"]
+
+
+def test_one_verdict_is_judged_by_the_rules_of_a_point() -> None:
+    """One analysis is judged by the gate's rule for one verdict (``verdict_failures``), with no
+    sweep point made for it; a sweep point is judged by the same rule."""
+    rules = Rules(fail_on=["chaotic", "melnikov"], max_lle=0.0, max_dte_um=20.0,
+                  max_dynamic_factor=1.5)  # fmt: skip
+    verdict = ("chaotic", 0.05, "double_sided", True)
+    expected = ["chaotic", "Melnikov: chaos possible", "LLE > 0", "DTE > 20 µm"]
+    assert verdict_failures(rules, *verdict, dte_um=25.0, dynamic_factor=1.2) == expected
+    # a limit on a value the verdict does not have (dimensionless, diverged) fails
+    assert verdict_failures(rules, "periodic", -0.1, "no_impact", False)[-2:] == [
+        "DTE > 20 µm",
+        "dynamic factor > 1.5",
+    ]
+    physical = {"dte": PhysicalValue(value=25.0, unit="um"),
+                "dynamic_factor": PhysicalValue(value=1.2, unit="1")}  # fmt: skip
+    point = SweepPoint(values={}, branch=None, classification="chaotic", lle=0.05,
+                       impact_regime="double_sided", melnikov_chaos_possible=True,
+                       physical=physical)  # fmt: skip
+    assert point_failures(point, rules) == expected
 
 
 def test_envelope_pass_line_names_impact_and_melnikov_windows(

@@ -22,8 +22,8 @@ from gearengine.gate.remedies.compute import remedies
 from gearengine.gate.remedies.request import RemediesRequest as RemediesRequest_
 from gearengine.model.design import Design
 from gearengine.model.train import EXAMPLE_TRAIN
-from gearengine.numerics.settings import SimulationSettings, work
-from gearengine.numerics.trains import simulate_train, train_work
+from gearengine.numerics.settings import SimulationSettings, run_steps, work
+from gearengine.numerics.trains import simulate_train
 from gearengine.studies.basins import basins_work
 from gearengine.studies.robustness.study import RobustnessRequest
 from gearengine.studies.robustness.study import checked as checked_robustness
@@ -32,6 +32,7 @@ from gearengine.studies.sweep import run_local, validated
 from gearengine.studies.sweep.plan import sweep_work
 from gearengine.studies.sweep.points import SpeedWindows
 from gearengine.systems.designs import design_model
+from gearengine.systems.gear_train.system import TRAIN_STEP_COST
 from service.core.config import Settings
 from service.main import create_app
 from tests.conftest import started
@@ -100,15 +101,17 @@ def test_what_a_train_cannot_sweep_yet_is_refused_naming_the_field(doc: dict, pa
 
 def test_the_budget_counts_the_trains_steps() -> None:
     """A train's steps (raised for stiff shafts and bearings) count at its step cost, in sweeps
-    and in basin jobs as in an analysis (``train_work``)."""
+    and in basin jobs as in an analysis (the system its request carries)."""
     settings = SimulationSettings.model_validate(LIGHT)
     model, _ = design_model(at(1500))
-    assert work(model, settings) == train_work(at(1500), settings)
+    steps = run_steps(settings, model.plan(settings.steps_per_period).steps)
+    analysis = AnalysisRequest(design=at(1500), settings=LIGHT)
+    assert work(analysis.system, settings) == work(model, settings) == TRAIN_STEP_COST * steps
     doc = sweep([{"parameter": "speed", "start": "1000 rpm", "stop": "3000 rpm", "num": 4}])
     pair = sweep_work(validated({**doc, "design": PAIR}))
     assert sweep_work(validated(doc)) == 3 * pair  # same steps per T0 here, step cost 3
     request = AnalysisRequest(design=TRAIN, settings={**LIGHT, "basins": {"starts": 4}})
-    assert basins_work(request) == train_work(request.design, request.settings)
+    assert basins_work(request) == work(request.system, request.settings)
 
 
 def test_the_envelope_gate_checks_a_train() -> None:
@@ -150,7 +153,8 @@ def test_gearengine_check_of_a_train_file(tmp_path: Path) -> None:
 
 def test_basins_of_a_train() -> None:
     """Basins over the mesh coordinate (the rest at its static deflection, at rest): every
-    start of a periodic point settles on one 1T orbit whose DTE is the train's verdict's."""
+    start of a periodic point settles on one 1T orbit whose DTE is the train's verdict's, and
+    the engineering summary names it with its fraction (issue 30)."""
     settings = {**LIGHT, "transient_periods": 200, "basins": {"starts": 4}}
     result = gearengine.analyze(AnalysisRequest(design=TRAIN, settings=settings))
     found, counts = result.numerics.attractors, result.numerics.basins
@@ -159,6 +163,9 @@ def test_basins_of_a_train() -> None:
     train = simulate_train(Design.model_validate(TRAIN), SimulationSettings(**settings))
     assert found[0].dte_um == pytest.approx(train.dte_um, rel=1e-3)
     assert result.verdict.decided_by == "periodic 1T, no impacts from 100 % of starts"
+    # issue 30: the summary names the deciding attractor, though this train has no reduction
+    assert not result.melnikov.applicable
+    assert f"({result.verdict.decided_by})" in result.engineering.summary
 
 
 def test_robustness_of_a_train_is_the_trains() -> None:

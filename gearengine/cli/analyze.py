@@ -14,10 +14,8 @@ from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.cli.documents import EXIT_FAIL, EXIT_OK, InvalidInputError, read_request
 from gearengine.cli.envelope import cmd_envelope, physical_limits, rules_of
 from gearengine.cli.melnikov import fmt_value, render_engineering, render_melnikov
-from gearengine.gate.envelope import Rules, point_failures
+from gearengine.gate.envelope import Rules, verdict_failures
 from gearengine.jsonio import dumps
-from gearengine.model.units import OUTPUTS, RESPONSES
-from gearengine.studies.sweep.points import PhysicalValue, SweepPoint
 
 
 def cmd_analyze(args: argparse.Namespace) -> int:
@@ -87,28 +85,15 @@ def margin_failure(r: AnalysisResult, min_margin: float) -> str | None:
     return None
 
 
-def gate_point(r: AnalysisResult) -> SweepPoint:
-    """The analysis as one operating point of the envelope gate (its worst start, its DTE and
-    dynamic factor in µm and 1), so one design and an envelope are judged by one set of rules,
-    ``gate.envelope.point_failures``."""
+def failures(r: AnalysisResult, rules: Rules, min_margin: float | None = None) -> list[str]:
+    """Reasons the design fails the gate (empty: pass): the envelope's rules judging its one
+    verdict (its worst start, its DTE and dynamic factor in µm and 1:
+    ``gate.envelope.verdict_failures``), and the Floquet stability margin (one design only)."""
     worst = r.numerics.worst_case
     resp = None if r.engineering is None else r.engineering.response
-    values = (None, None) if resp is None else (resp.dte_peak_to_peak_um, resp.dynamic_factor)
-    physical = {
-        key: PhysicalValue(value=value, unit=OUTPUTS[key].unit)
-        for key, value in zip(RESPONSES, values, strict=True)
-        if value is not None
-    }
-    return SweepPoint(values={}, branch=None, classification=worst.classification,
-                      period=worst.period, lle=worst.lle, impact_regime=r.numerics.impact_regime,
-                      melnikov_chaos_possible=r.melnikov.chaos_possible,
-                      physical=physical or None)  # fmt: skip
-
-
-def failures(r: AnalysisResult, rules: Rules, min_margin: float | None = None) -> list[str]:
-    """Reasons the design fails the gate (empty: pass): the envelope's rules at its one point,
-    and the Floquet stability margin (one design only)."""
-    reasons = point_failures(gate_point(r), rules)
+    dte, factor = (None, None) if resp is None else (resp.dte_peak_to_peak_um, resp.dynamic_factor)
+    reasons = verdict_failures(rules, worst.classification, worst.lle, r.numerics.impact_regime,
+                               r.melnikov.chaos_possible, dte, factor)  # fmt: skip
     margin = None if min_margin is None else margin_failure(r, min_margin)
     if margin is not None:
         reasons.append(margin)

@@ -60,12 +60,25 @@ if TYPE_CHECKING:
 POLL_SECONDS = 1.0
 
 
-def axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
-    """``gate.envelope.envelope_axis``, its error naming the option."""
-    try:
-        return envelope_axis(name, text, unit, num)
-    except ValueError as exc:
-        raise InvalidInputError([f"--{name}: {exc}"]) from None
+OPTION_UNITS = {"speed": "rpm", "torque": "N*m"}
+"""The unit of a bare number in --speed and --torque."""
+
+
+def option_axes(args: argparse.Namespace, design: dict | None = None) -> list[dict[str, object]]:
+    """The axes that --speed and --torque give (``gate.envelope.envelope_axis``), an error
+    naming its option; with a ``design`` and no --speed, the design's own speed as one point."""
+    given = {name: getattr(args, name) for name in OPTION_UNITS}
+    here = design is not None and not args.speed
+    if here:
+        given["speed"] = _here(design, "speed")
+    axes = []
+    for name, text in ((n, t) for n, t in given.items() if t):
+        num = 1 if here and name == "speed" else getattr(args, f"{name}_points")
+        try:
+            axes.append(envelope_axis(name, text, OPTION_UNITS[name], num))
+        except ValueError as exc:
+            raise InvalidInputError([f"--{name}: {exc}"]) from None
+    return axes
 
 
 def envelope_request(args: argparse.Namespace) -> SweepRequest:
@@ -74,13 +87,7 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
     if not isinstance(doc, dict) or "design" not in doc:
         raise InvalidInputError([f'{args.file}: an envelope check needs {{"design": {{...}}}}'])
     design = doc["design"]
-    axes = [
-        axis("speed", args.speed, "rpm", args.speed_points)
-        if args.speed
-        else axis("speed", _here(design, "speed"), "rpm", 1)
-    ]
-    if args.torque:
-        axes.append(axis("torque", args.torque, "N*m", args.torque_points))
+    axes = option_axes(args, design)
     settings = doc.get("settings", {})
     if not isinstance(settings, dict):
         raise InvalidInputError([f"{args.file}: settings must be an object"])

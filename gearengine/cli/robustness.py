@@ -21,7 +21,7 @@ from gearengine.cli.documents import (
     read_document,
     validated_input,
 )
-from gearengine.cli.envelope import axis
+from gearengine.cli.envelope import option_axes
 from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import ENVELOPE_SETTINGS, gate_settings
@@ -46,11 +46,7 @@ def robustness_request(args: argparse.Namespace) -> RobustnessRequest:
     doc = read_document(args.file)
     if not isinstance(doc, dict) or "design" not in doc:
         raise InvalidInputError([f'{args.file}: a robustness study needs {{"design": {{...}}}}'])
-    axes = []
-    if args.speed:
-        axes.append(axis("speed", args.speed, "rpm", args.speed_points))
-    if args.torque:
-        axes.append(axis("torque", args.torque, "N*m", args.torque_points))
+    axes = option_axes(args)
     settings = doc.get("settings", {})
     if not isinstance(settings, dict):
         raise InvalidInputError([f"{args.file}: settings must be an object"])

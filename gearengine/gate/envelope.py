@@ -76,26 +76,49 @@ SEPARATING = ("single_sided", "double_sided")
 
 
 def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
-    """The rules one point breaks, as short labels ("chaotic", "DTE > 20 µm", ...)."""
+    """The rules one point of a sweep breaks (``verdict_failures`` of its verdict)."""
+    physical = p.physical or {}
+    dte, factor = physical.get("dte"), physical.get("dynamic_factor")
+    return verdict_failures(
+        rules,
+        p.classification,
+        p.lle,
+        p.impact_regime,
+        p.melnikov_chaos_possible,
+        dte_um=None if dte is None else dte.value,
+        dynamic_factor=None if factor is None else factor.value,
+    )
+
+
+def verdict_failures(
+    rules: Rules,
+    classification: str,
+    lle: float | None,
+    impact_regime: str | None,
+    melnikov_chaos_possible: bool | None,
+    dte_um: float | None = None,
+    dynamic_factor: float | None = None,
+) -> list[str]:
+    """The rules one verdict breaks, as short labels ("chaotic", "DTE > 20 µm", ...): a sweep
+    point's (``point_failures``) or one analysis's (``gearengine check``); a limit on a value
+    that is missing (no design, diverged) fails."""
     out = []
     for name in rules.fail_on:
-        if name in SEVERITY and SEVERITY[p.classification] >= SEVERITY[name]:
-            out.append(p.classification.replace("_", "-"))
+        if name in SEVERITY and SEVERITY[classification] >= SEVERITY[name]:
+            out.append(classification.replace("_", "-"))
             break
-    if "melnikov" in rules.fail_on and p.melnikov_chaos_possible:
+    if "melnikov" in rules.fail_on and melnikov_chaos_possible:
         out.append("Melnikov: chaos possible")
-    if any(r in rules.fail_on for r in BACK_FLANK) and p.impact_regime == "double_sided":
+    if any(r in rules.fail_on for r in BACK_FLANK) and impact_regime == "double_sided":
         out.append("back-flank impacts")
-    if "separation" in rules.fail_on and p.impact_regime in SEPARATING:
+    if "separation" in rules.fail_on and impact_regime in SEPARATING:
         out.append("tooth separation")
-    if rules.max_lle is not None and (p.lle is None or p.lle > rules.max_lle):
+    if rules.max_lle is not None and (lle is None or lle > rules.max_lle):
         out.append(f"LLE > {rules.max_lle:g}")
-    dte = (p.physical or {}).get("dte")
-    if rules.max_dte_um is not None and (dte is None or dte.value > rules.max_dte_um):
+    if rules.max_dte_um is not None and (dte_um is None or dte_um > rules.max_dte_um):
         out.append(f"DTE > {rules.max_dte_um:g} µm")
-    factor = (p.physical or {}).get("dynamic_factor")
     if rules.max_dynamic_factor is not None and (
-        factor is None or factor.value > rules.max_dynamic_factor
+        dynamic_factor is None or dynamic_factor > rules.max_dynamic_factor
     ):
         out.append(f"dynamic factor > {rules.max_dynamic_factor:g}")
     return out

@@ -6,21 +6,34 @@ field of a design converted at each value. The verdict flips where the sign-chan
 (``thresholds.sign_change_strength``: > 0 iff some homoclinic branch changes sign) crosses zero;
 a scan of ``num`` values brackets each crossing and brentq locates it. Sweep plots, speed
 windows and ``/v1/melnikov`` thus draw one boundary: the verdict of each point of the path.
+
+The speed windows of a design (``speed_window_scan``) follow the speed path: the design at its
+speed moved to each driver speed [rpm] by scaling every excitation frequency together
+(``model.aliases.with_speed_factor``; F~_er = e_r / b and F~_pr do not depend on speed).
 """
 
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Callable
 
 import numpy as np
 
 from gearengine.homoclinic.coefficients import MeanLoad
 from gearengine.homoclinic.thresholds import strength_at
+from gearengine.model.aliases import with_speed_factor
 from gearengine.model.params import GearParams
 
 Path = Callable[[float], GearParams]
 """A path through parameter space: value -> dimensionless parameters."""
+
+WINDOW_SCAN = 240
+"""Speeds sampled in the Melnikov window scan before brentq refines each edge."""
+WINDOW_BOUND = 10.0
+"""The window scan goes on past the requested range, while the last window is open, up to this
+multiple of the design speed (beyond which no gear pair of the design runs): a window still
+open there is reported open-ended."""
 
 
 def flips(
@@ -66,3 +79,44 @@ def chaos_intervals(
     """[a, b] intervals of [lo, hi] where the Melnikov criterion allows chaos along ``path``."""
     edges = [min(lo, hi), *flips(path, lo, hi, num, mean_load=mean_load), max(lo, hi)]
     return chaos_intervals_from(path, edges, mean_load)
+
+
+def speed_path(params: GearParams, speed_rpm: float) -> Path:
+    """The design at ``speed_rpm`` moved to each speed [rpm] (every frequency scaled)."""
+    return lambda rpm: with_speed_factor(params, rpm / speed_rpm)
+
+
+def speed_windows(
+    params: GearParams,
+    speed_rpm: float,
+    lo: float,
+    hi: float,
+    mean_load: MeanLoad = "unperturbed",
+    num: int = WINDOW_SCAN,
+) -> list[list[float]]:
+    """Driver speeds [rpm] in [lo, hi] where some Melnikov branch changes sign: the design at
+    ``speed_rpm`` moved to each speed by scaling every excitation frequency together."""
+    return chaos_intervals(speed_path(params, speed_rpm), lo, hi, num, mean_load)
+
+
+def speed_window_scan(
+    params: GearParams,
+    speed_rpm: float,
+    lo: float,
+    hi: float,
+    mean_load: MeanLoad = "unperturbed",
+    find: bool = True,
+) -> tuple[list[list[float]], float]:
+    """(the speed windows [rpm], the end of the scan [rpm]) of the design at ``speed_rpm``: the
+    scan ends at ``hi``, doubled while the criterion still allows chaos there, up to
+    ``WINDOW_BOUND`` times the design speed; ``WINDOW_SCAN`` speeds sample [lo, hi] and as
+    many per rpm the scan beyond it. ``find=False``: the end alone, no windows."""
+    path = speed_path(params, speed_rpm)
+    bound = max(hi, WINDOW_BOUND * speed_rpm)
+    top = hi
+    while top < bound and strength_at(path(top), mean_load=mean_load) > 0.0:
+        top = min(2.0 * top, bound)
+    if not find:
+        return [], top
+    scan = WINDOW_SCAN if top == hi else math.ceil(WINDOW_SCAN * (top - lo) / (hi - lo))
+    return chaos_intervals(path, lo, top, scan, mean_load), top

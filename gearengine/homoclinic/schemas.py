@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from gearengine.homoclinic.coefficients import (
     BranchCoefficients,
@@ -13,6 +13,7 @@ from gearengine.homoclinic.coefficients import (
     MeanLoad,
     Method,
 )
+from gearengine.model.answers import Answer
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import MIN_FREQUENCY, WholeNumber, request_config
 from gearengine.model.reduction import ParamsOrDesign
@@ -22,11 +23,7 @@ Bounds = Annotated[list[float | None], Field(min_length=2, max_length=2)]
 nested tuples give an invalid OpenAPI schema.)"""
 
 
-class _Result(BaseModel):
-    model_config = ConfigDict(frozen=True)
-
-
-class BranchVerdict(_Result):
+class BranchVerdict(Answer):
     """Extrema of M over tau0 on one homoclinic branch."""
 
     sign_change: bool = Field(description="min M < 0 < max M: M has a simple zero.")
@@ -46,7 +43,7 @@ class BranchVerdict(_Result):
     )
 
 
-class BranchThreshold(_Result):
+class BranchThreshold(Answer):
     """Where one branch stops changing sign as the parameter varies."""
 
     critical_values: list[float] = Field(description="Ends of the no-sign-change intervals.")
@@ -56,7 +53,7 @@ class BranchThreshold(_Result):
     )
 
 
-class ParameterThreshold(_Result):
+class ParameterThreshold(Answer):
     """Thresholds of one control parameter, the others fixed, and the design's margin."""
 
     value: float | None = Field(description="The parameter's value in the given design.")
@@ -91,7 +88,7 @@ class ParameterThreshold(_Result):
     note: str | None = Field(None, description="Why a threshold is missing, if it is.")
 
 
-class MelnikovResult(_Result):
+class MelnikovResult(Answer):
     """The Melnikov verdict of a design (the /v1/melnikov contract)."""
 
     applicable: bool = Field(
@@ -142,7 +139,7 @@ class MelnikovResult(_Result):
     )
 
 
-class ThresholdCurve(_Result):
+class ThresholdCurve(Answer):
     """Critical values of a control parameter over a frequency range (paper Figs. 5, 12, 18)."""
 
     parameter: str = Field(description="The control parameter: F_e1, mu, k_p1 or F_p1.")

@@ -238,8 +238,8 @@ def points_attractors(
     basins = settings.basins or BasinSettings()
     starts = [basin_starts(basins, sc) for sc in scales]
     lanes = [(i, s) for i, ss in enumerate(starts) for s in ss]
-    runs = run_lanes(points, lanes, settings)
     plans = step_plans(points, settings.steps_per_period)
+    runs = run_lanes(points, lanes, settings, plans)
     out = []
     for i, (plan, sc) in enumerate(zip(plans, scales, strict=True)):
         mine = runs[i * len(starts[i]) : (i + 1) * len(starts[i])]

@@ -97,6 +97,7 @@ def run_lanes(
     points: Sequence[Point],
     lanes: Sequence[Lane],
     settings: SimulationSettings | None = None,
+    plans: list[StepPlan] | None = None,
 ) -> list[BatchPoint]:
     """The verdict of every lane: the one door of ensembles into the kernels.
 
@@ -116,13 +117,15 @@ def run_lanes(
         lanes: the runs, shape (L,); a point may appear in any number of lanes.
         settings: periods, steps and adaptive stopping shared by all lanes (their starts are
             ignored: each lane carries its own).
+        plans: the points' ``step_plans`` when the caller has them (made here otherwise).
 
     Returns:
         One ``BatchPoint`` per lane, in order, shape (L,); its ``start_index`` is the lane's
         index in ``lanes``.
     """
     settings = settings or SimulationSettings()
-    return _run_lanes(points, step_plans(points, settings.steps_per_period), lanes, settings)
+    plans = step_plans(points, settings.steps_per_period) if plans is None else plans
+    return _run_lanes(points, plans, lanes, settings)
 
 
 def _run_lanes(

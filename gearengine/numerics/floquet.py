@@ -231,22 +231,23 @@ def floquet(
 
 
 def floquet_of(
-    params: GearParams | System,
+    system: System,
     settings: SimulationSettings,
     result: NumericsResult,
     state: Sequence[float] | None = None,
 ) -> tuple[FloquetResult | None, str | None]:
-    """The ``floquet`` and ``floquet_note`` fields of ``simulate(params, settings)``'s result:
-    the Floquet result of its (worst start's) periodic response, or None and the reason.
-    ``state``: the full last strobe of a system with more than (x, v) (the pair's is the last
-    Poincare point)."""
+    """The ``floquet`` and ``floquet_note`` fields of ``simulate(system, settings)``'s result:
+    the Floquet result of its (worst start's) periodic response (``refine`` on the system's own
+    stroboscopic flow, as ``floquet``), or None and the reason. ``state``: the full last strobe
+    of a system with more than (x, v) (the pair's is the last Poincare point)."""
     if result.classification != "periodic" or result.period is None or not result.poincare:
         return None, f"the response is {result.classification}: no periodic orbit to linearise"
     if result.forcing_period is None:
         return None, "incommensurate forcing: no Poincare period, hence no Floquet multipliers"
     try:
         last = result.poincare[-1] if state is None else state
-        fl = floquet(params, settings, last, result.period)
+        flow = system.stroboscopic_flow(settings.steps_per_period)
+        fl = refine(flow, np.array(last, dtype=np.float64), result.period)
     except ValueError as exc:
         return None, f"Floquet analysis failed: {exc}"
     if not fl.converged:

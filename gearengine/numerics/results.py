@@ -5,19 +5,16 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
+from gearengine.model.answers import FiniteAnswer
 from gearengine.signals.nolds_check import NoldsResult
 
 BATCH_POINCARE = 64
 """Strobes returned per point by ``simulate_batch``."""
 
 
-class _Result(BaseModel):
-    model_config = ConfigDict(frozen=True, allow_inf_nan=False)
-
-
-class SpectrumPeak(_Result):
+class SpectrumPeak(FiniteAnswer):
     """One peak of the amplitude spectrum of x."""
 
     frequency: float = Field(description="Angular frequency, rad per unit tau.")
@@ -27,7 +24,7 @@ class SpectrumPeak(_Result):
     )
 
 
-class TimeHistory(_Result):
+class TimeHistory(FiniteAnswer):
     """Decimated samples of the last recorded intervals."""
 
     t: list[float] = Field(description="Dimensionless time tau.")
@@ -35,7 +32,7 @@ class TimeHistory(_Result):
     v: list[float] = Field(description="Velocity x'.")
 
 
-class StartSummary(_Result):
+class StartSummary(FiniteAnswer):
     """Verdict for one initial state."""
 
     initial_state: list[float]
@@ -51,7 +48,7 @@ Bifurcation = Literal["period_doubling", "fold", "neimark_sacker"]
 """How a Floquet multiplier leaves the unit circle: through -1, through +1, or as a complex pair."""
 
 
-class FloquetResult(_Result):
+class FloquetResult(FiniteAnswer):
     """Floquet analysis of one periodic orbit of period n T0, Newton-refined by shooting
     (``numerics.floquet``; docs/floquet.md)."""
 
@@ -80,7 +77,7 @@ class FloquetResult(_Result):
     notes: list[str] = Field(description="Remarks on the result.")
 
 
-class Attractor(_Result):
+class Attractor(FiniteAnswer):
     """One attractor found from the basin starts (``numerics.attractors``, docs/basins.md)."""
 
     label: str = Field(
@@ -115,7 +112,7 @@ class Attractor(_Result):
     )
 
 
-class BasinCounts(_Result):
+class BasinCounts(FiniteAnswer):
     """How the basin starts ended (``settings.basins``)."""
 
     starts: int = Field(description="Initial states run.")
@@ -142,7 +139,7 @@ class BasinCounts(_Result):
     )
 
 
-class RunLength(_Result):
+class RunLength(FiniteAnswer):
     """How long one part of a run (the transient or the record) lasted, and why it stopped."""
 
     periods: int = Field(description="Intervals T0 (Poincare periods).")
@@ -160,7 +157,7 @@ class RunLength(_Result):
     )
 
 
-class NumericsResult(_Result):
+class NumericsResult(FiniteAnswer):
     """Numerical verdict. Detailed fields describe the worst-case start (``worst_case``)."""
 
     classification: str = Field(description="periodic | chaotic | quasi_periodic | diverged.")
@@ -215,7 +212,7 @@ class NumericsResult(_Result):
     )  # fmt: skip
 
 
-class BatchPoint(_Result):
+class BatchPoint(FiniteAnswer):
     """Verdict of ``simulate_batch`` for one parameter point (its worst start)."""
 
     classification: str

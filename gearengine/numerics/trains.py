@@ -1,5 +1,5 @@
 """The numerical verdict of a gear train at its design point, in the train's own words
-(``simulate_train``), and the compute budget of analysing one (``train_work``).
+(``simulate_train``).
 
 A start (x0, v0) of the settings sets the mesh deflection delta and its rate
 (``TrainSystem.start_state``); the verdict of each start is the pair's (``runs.start_verdict``:
@@ -14,7 +14,7 @@ from gearengine.model.design import Design
 from gearengine.model.errors import InputError
 from gearengine.model.units import response_values
 from gearengine.numerics.runs import integrate, start_verdict
-from gearengine.numerics.settings import MAX_TOTAL_STEPS, SimulationSettings, work
+from gearengine.numerics.settings import MAX_TOTAL_STEPS, SimulationSettings
 from gearengine.signals.classify import severity
 from gearengine.signals.diagnostics import ImpactRegime, impact_regime
 from gearengine.systems.gear_train.model import train_of
@@ -88,10 +88,3 @@ def respond(system: TrainSystem, settings: SimulationSettings) -> TrainResponse:
         sampling_interval=plan.period,
         notes=list(plan.notes),
     )
-
-
-def train_work(design: Design, settings: SimulationSettings) -> int:
-    """The compute budget of analysing a train (``numerics.settings.work``'s unit: the pair's RK4
-    steps): its steps (raised for stiff shafts and bearings) times ``TRAIN_STEP_COST``."""
-    model, pair = train_of(design)
-    return work(train_system(model, pair), settings)  # TrainSystem.step_cost = TRAIN_STEP_COST

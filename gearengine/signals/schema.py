@@ -8,16 +8,14 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
+
+from gearengine.model.answers import FiniteAnswer
 
 Verdict = Literal["periodic", "quasi_periodic", "chaotic", "stochastic", "undetermined"]
 
 
-class _Result(BaseModel):
-    model_config = ConfigDict(frozen=True, allow_inf_nan=False)
-
-
-class Record(_Result):
+class Record(FiniteAnswer):
     """What was read."""
 
     samples: int
@@ -29,7 +27,7 @@ class Record(_Result):
     peak_to_peak: float = Field(description="Unit of the values.")
 
 
-class Reference(_Result):
+class Reference(FiniteAnswer):
     """What one cycle is: a mesh period, a revolution, or the series' own fundamental."""
 
     source: Literal["speed", "tach", "spectrum", "none"]
@@ -43,7 +41,7 @@ class Reference(_Result):
     cycles: float | None = Field(description="Cycles in the record.")
 
 
-class SpectrumLine(_Result):
+class SpectrumLine(FiniteAnswer):
     """A line of the amplitude spectrum."""
 
     frequency_hz: float
@@ -53,7 +51,7 @@ class SpectrumLine(_Result):
     label: str = Field(description="e.g. 'mesh order 18', 'shaft order 1', '1/2 mesh'.")
 
 
-class Spectrum(_Result):
+class Spectrum(FiniteAnswer):
     """Lines and a compact spectrum for the picture (orders with a speed, else Hz)."""
 
     axis: Literal["order", "frequency_hz"]
@@ -62,7 +60,7 @@ class Spectrum(_Result):
     lines: list[SpectrumLine]
 
 
-class Periodicity(_Result):
+class Periodicity(FiniteAnswer):
     """The period found by synchronous averaging."""
 
     cycles: int | None = Field(description="Period in cycles (null: none up to 64).")
@@ -79,7 +77,7 @@ class Periodicity(_Result):
     )
 
 
-class EmbeddingReport(_Result):
+class EmbeddingReport(FiniteAnswer):
     """The delay embedding chosen."""
 
     delay_samples: int = Field(description="In the analysed (decimated) series.")
@@ -96,7 +94,7 @@ class EmbeddingReport(_Result):
     )
 
 
-class ZeroOneReport(_Result):
+class ZeroOneReport(FiniteAnswer):
     """The 0-1 test for chaos (correlation method)."""
 
     k: float = Field(description="Median of K_c over the frequencies c: ~0 regular, ~1 chaotic.")
@@ -111,7 +109,7 @@ class ZeroOneReport(_Result):
     q: list[float]
 
 
-class LyapunovReport(_Result):
+class LyapunovReport(FiniteAnswer):
     """Largest Lyapunov exponent (Rosenstein)."""
 
     per_second: float | None
@@ -127,7 +125,7 @@ class LyapunovReport(_Result):
     divergence: list[float] = Field(description="<ln distance> at each time, ln of unit.")
 
 
-class SurrogateReport(_Result):
+class SurrogateReport(FiniteAnswer):
     """IAAFT surrogate test of the 0-1 test's series."""
 
     statistic: str
@@ -141,7 +139,7 @@ class SurrogateReport(_Result):
     method: str
 
 
-class LeverTrial(_Result):
+class LeverTrial(FiniteAnswer):
     """The model with one uncertain quantity of the design scaled."""
 
     quantity: str = Field(description="damping | half_backlash | transmission_error.")
@@ -151,7 +149,7 @@ class LeverTrial(_Result):
     matches_signal: bool
 
 
-class ModelReport(_Result):
+class ModelReport(FiniteAnswer):
     """The model's verdict for the design at the signal's speed."""
 
     speed_rpm: float
@@ -172,7 +170,7 @@ class ModelReport(_Result):
     summary: str
 
 
-class SignalResult(_Result):
+class SignalResult(FiniteAnswer):
     """The reading of a recorded series."""
 
     verdict: Verdict

@@ -14,7 +14,6 @@ from __future__ import annotations
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.numerics.settings import BasinSettings, work
 from gearengine.studies.jobs import one_chunk_kind
-from gearengine.systems.designs import design_model
 
 
 def with_basins(request: AnalysisRequest) -> AnalysisRequest:
@@ -29,8 +28,7 @@ def basins_work(request: AnalysisRequest) -> int:
     """RK4 steps of the analysis with its basin starts (``numerics.settings.work``; a train's
     at its ``System.step_cost``)."""
     full = with_basins(request)
-    model = full.params if full.design is None else design_model(full.design)[0]
-    return work(model, full.settings)
+    return work(full.system, full.settings)
 
 
 BASINS_JOB = one_chunk_kind(

@@ -27,7 +27,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from gearengine.engineering import speed_windows
+from gearengine.homoclinic.boundary import speed_windows
 from gearengine.homoclinic.train_reduction import melnikov_point
 from gearengine.model.units import RPM, Scales, shown, to_physical
 from gearengine.signals.classify import LLE_FLOOR

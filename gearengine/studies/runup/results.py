@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
+
+from gearengine.model.answers import Answer
 
 
-class _Result(BaseModel):
-    model_config = ConfigDict(frozen=True)
-
-
-class RunupBin(_Result):
+class RunupBin(Answer):
     """What the gear did while its speed crossed one bin (on one branch)."""
 
     speed_rpm: list[float] = Field(description="[low, high] driver speed of the bin [rpm].")
@@ -65,7 +63,7 @@ class RunupBin(_Result):
     )
 
 
-class RunupJump(_Result):
+class RunupJump(Answer):
     """A sudden change of the response amplitude between neighbouring bins."""
 
     speed_rpm: float = Field(description="Where it happened: the edge between the two bins.")
@@ -80,14 +78,14 @@ class RunupJump(_Result):
     )  # fmt: skip
 
 
-class RunupBranch(_Result):
+class RunupBranch(Answer):
     """One direction of the profile: its bins in the order travelled, and its jumps."""
 
     bins: list[RunupBin]
     jumps: list[RunupJump]
 
 
-class QuasiStaticPoint(_Result):
+class QuasiStaticPoint(Answer):
     """The steady state of the continuation sweep at one bin centre."""
 
     speed_rpm: float
@@ -98,14 +96,14 @@ class QuasiStaticPoint(_Result):
     lle: float | None = Field(description="Largest Lyapunov exponent per unit tau.")
 
 
-class QuasiStaticBranch(_Result):
+class QuasiStaticBranch(Answer):
     """One branch of the hysteresis loop (continuation up or down, in that order)."""
 
     points: list[QuasiStaticPoint]
     jumps: list[RunupJump]
 
 
-class QuasiStatic(_Result):
+class QuasiStatic(Answer):
     """The quasi-static answer: the continuation sweep on the bin centres, up and down."""
 
     up: QuasiStaticBranch
@@ -114,7 +112,7 @@ class QuasiStatic(_Result):
     torque_nm: float = Field(description="Torque of the sweep (the design's) [N m].")
 
 
-class RunupMethod(_Result):
+class RunupMethod(Answer):
     """How the run-up was integrated and read, in words and numbers."""
 
     integration: str
@@ -125,7 +123,7 @@ class RunupMethod(_Result):
     bin_rpm: float
 
 
-class RunupResult(_Result):
+class RunupResult(Answer):
     """A run-up or run-down of a design: bins against speed, jumps, and the quasi-static loop."""
 
     up: RunupBranch | None

@@ -9,5 +9,5 @@ mesh of Eq. (2) (``docs/gear-trains.md``), the second ``System``.
 
 Above this room: ``numerics.trains`` (the train's verdict in its own words, its budget),
 ``homoclinic.train_reduction`` (the Melnikov verdict of the mesh-mode reduction) and
-``analysis.analyze_train``.
+``analysis.analyze`` (``analysis.train_answer``).
 """

@@ -215,10 +215,11 @@ def train_model(design: Design) -> TrainModel:
     )
 
 
-def equivalent_design(design: Design) -> Design:
+def equivalent_design(design: Design, model: TrainModel | None = None) -> Design:
     """The stiff limit of a train as a pair: I_a = I_m + I_p, I_b = I_g + I_l, the train's
-    mesh damping c_m [N s/m] (the pair's of ``design``), no train."""
-    model = train_model(design)
+    mesh damping c_m [N s/m] (the pair's of ``design``), no train; ``model`` its matrices when
+    the caller has them (``train_model``)."""
+    model = train_model(design) if model is None else model
     assert design.train is not None
     ip, ig = model.mass[1, 1], model.mass[2, 2]
     data = design.model_dump(exclude={"train", "tolerances"})
@@ -287,4 +288,5 @@ def dimensionless(model: TrainModel, pair: DesignConversion) -> Dimensionless:
 
 def train_of(design: Design) -> tuple[TrainModel, DesignConversion]:
     """The matrices of a train and the conversion of its equivalent pair (its scales)."""
-    return train_model(design), convert_design(equivalent_design(design))
+    model = train_model(design)
+    return model, convert_design(equivalent_design(design, model))

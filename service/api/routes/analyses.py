@@ -14,7 +14,6 @@ from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.jsonio import dumps
 from gearengine.numerics import work
 from gearengine.numerics.settings import BasinSettings
-from gearengine.numerics.trains import train_work
 from gearengine.plots import MEDIA_TYPES, analysis_figure, basins_figure, campbell_figure
 from gearengine.systems.gear_train.campbell import Campbell, CampbellRequest, campbell
 from service.api.deps import AppLimits, AppMetrics, cached_compute, require_key
@@ -27,14 +26,13 @@ router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 
 def check_analysis_budget(limits: Limits, body: AnalysisRequest) -> None:
     """422 before any compute when the analysis (its starts and basin starts) is over the
-    synchronous budget; names settings.basins.starts when basins are asked for. A train counts
-    its own steps (raised for stiff shafts and bearings) at their cost (``train_work``)."""
-    if body.design is not None and body.design.train is not None:
-        limits.check_budget(train_work(body.design, body.settings))
-    elif body.settings.basins is None:
-        limits.check_budget(work(body.params, body.settings))
+    synchronous budget; names settings.basins.starts when basins are asked for. The work is
+    that of the request's system (``numerics.settings.work``: a train counts its own steps,
+    raised for stiff shafts and bearings, at their cost)."""
+    steps = work(body.system, body.settings)
+    if body.settings.basins is None:
+        limits.check_budget(steps)
     else:
-        steps = work(body.params, body.settings)
         limits.check_budget(steps, hint=BASINS_HINT, field="settings.basins.starts")
 
 
