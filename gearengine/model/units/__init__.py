@@ -24,6 +24,7 @@ from gearengine.model.units.outputs import (
 )
 from gearengine.model.units.quantities import (
     QUANTITIES,
+    SHARE,
     Angle,
     Backlash,
     BearingStiffness,
@@ -46,6 +47,7 @@ from gearengine.model.units.quantities import (
     TorsionalStiffness,
     note,
     parse_quantity,
+    plain_number,
     readings,
     registry,
     si_numbers,
@@ -57,6 +59,7 @@ __all__ = [
     "RADIUS_RATIO_TOLERANCE",
     "RESPONSES",
     "RPM",
+    "SHARE",
     "TORQUE_BALANCE_TOLERANCE",
     "Angle",
     "Backlash",
@@ -87,6 +90,7 @@ __all__ = [
     "in_si",
     "note",
     "parse_quantity",
+    "plain_number",
     "readings",
     "registry",
     "response_values",
