@@ -31,7 +31,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.homoclinic.boundary import chaos_intervals
-from gearengine.homoclinic.coefficients import MeanLoad
+from gearengine.homoclinic.coefficients import T_CRIT_WHY, MeanLoad
 from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
 from gearengine.homoclinic.thresholds import strength_at
 from gearengine.model.aliases import get_alias, with_speed_factor
@@ -411,7 +411,7 @@ def engineering(
     lo, hi = rpm_range
     if over_critical(conv, mel) and t_crit is not None:
         windows: list[list[float]] = []
-        note = f"not applicable above T_crit = {t_crit:,.3g} N*m"
+        note = f"not applicable above T_crit = {t_crit:,.3g} N*m: {T_CRIT_WHY}"
     else:
         top = window_scan_end(params, conv.speed_rpm, hi, mel.mean_load)
         scan = WINDOW_SCAN if top == hi else math.ceil(WINDOW_SCAN * (top - lo) / (hi - lo))
