@@ -93,9 +93,10 @@ class LeverRange(BaseModel):
 class RemediesRequest(Rules):
     """A failing design, its envelope and the gate's rules: what to change, by how much."""
 
-    model_config = request_config(
-        {"design": EXAMPLE_DESIGN, "envelope": {"speed": "500:6000", "torque": "20:200"},
-         "fail_on": ["chaotic"]}
+    model_config = request_config(  # 7 x 3 points: within a default server's job budget
+        {"design": EXAMPLE_DESIGN, "fail_on": ["chaotic"],
+         "envelope": {"speed": "500:6000", "torque": "20:200", "speed_points": 7,
+                      "torque_points": 3}}
     )  # fmt: skip
 
     design: Design = Field(description="The pair in physical units.")
