@@ -23,6 +23,10 @@ JOB_BUDGET = "the job fits the compute budget of one job (max_job_steps)"
 AXES = "an axis' stop differs from its start and every corner of the grid is a valid design"
 RECORD = "the record holds enough revolutions at the given speed for an order reading"
 DERIVED = "the dimensionless parameters derived from the physical data stay within their bounds"
+UPLOAD = (
+    "the uploaded text holds a series of numbers, and the rate and speed given in the query read "
+    "as quantities (a number with a unit, or a bare number in Hz or rad/s, in its plausible range)"
+)
 
 CROSS_FIELD_RULES: dict[str, tuple[str, ...]] = {
     "post_analysis_v1_analyses_post": (DESIGN, SYNC_BUDGET),
@@ -40,6 +44,8 @@ CROSS_FIELD_RULES: dict[str, tuple[str, ...]] = {
     "post_signal_v1_signals_post": (DESIGN, RECORD),
     "post_signal_v1_signals_jobs_post": (DESIGN, RECORD),
     "post_signal_plot_v1_signals_plot_post": (DESIGN, RECORD),
+    "post_signal_upload_v1_signals_upload_post": (UPLOAD, RECORD),
+    "post_signal_upload_plot_v1_signals_upload_plot_post": (UPLOAD, RECORD),
     "post_sweep_v1_sweeps_post": (DESIGN, AXES, JOB_BUDGET),
     "post_thresholds_v1_thresholds_post": (DESIGN,),
     "post_threshold_plot_v1_thresholds_plot_post": (DESIGN,),
