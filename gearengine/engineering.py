@@ -31,6 +31,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.homoclinic.boundary import WINDOW_BOUND, speed_window_scan
+from gearengine.homoclinic.coefficients import T_CRIT_WHY
 from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
 from gearengine.model.aliases import get_alias
 from gearengine.model.params import GearParams
@@ -382,7 +383,7 @@ def engineering(
     lo, hi = rpm_range
     if over and t_crit is not None:
         windows: list[list[float]] = []
-        note = f"not applicable above T_crit = {t_crit:,.3g} N*m"
+        note = f"not applicable above T_crit = {t_crit:,.3g} N*m: {T_CRIT_WHY}"
     else:
         find = no_windows is None
         windows, hi = speed_window_scan(params, conv.speed_rpm, lo, hi, mel.mean_load, find)

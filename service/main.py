@@ -29,6 +29,7 @@ from service.api.routes import (
     sweeps,
     thresholds,
 )
+from service.api.rules import add_cross_field_rules
 from service.cache import ResponseCache
 from service.core.config import Settings
 from service.jobs.runtime import JobQueue
@@ -93,6 +94,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         if app.openapi_schema is None:
             app.state.limits.document(base_openapi())
             add_job_links(app.openapi_schema)  # submit -> status, result, plot, cancel
+            add_cross_field_rules(app.openapi_schema)  # what the schema cannot say
         return app.openapi_schema
 
     app.openapi = openapi  # type: ignore[method-assign]

@@ -34,6 +34,17 @@ def test_the_readme_design_at_40_nm_is_outside_the_criterion() -> None:
     assert "13.3 µm statically" in eng.summary and "numerical verdict still applies" in eng.summary
 
 
+def test_not_applicable_says_why_t_crit_depends_on_the_load_backlash_and_stiffness() -> None:
+    """Where the answer says "not applicable above T_crit", one sentence says why T_crit is a
+    function of the design (issue 30): the saddle disappears when the mean force exceeds the
+    wells' barrier, which scales with the half backlash, the mesh stiffness and the radius."""
+    note = answer(EXAMPLE_DESIGN).engineering.speed_windows_note
+    assert note.startswith("not applicable above T_crit = 9.62 N*m: ")
+    for words in ("T_crit = F_crit b k_m r_a", "the saddle disappears", "mean mesh force",
+                  "half backlash b", "mesh stiffness k_m", "base radius r_a"):  # fmt: skip
+        assert words in note
+
+
 @pytest.mark.parametrize("factor", [1 - 1e-6, 1 + 1e-6])
 def test_applicability_switches_at_the_critical_torque(factor: float) -> None:
     t_crit = answer(LIGHT).engineering.critical_torque_nm

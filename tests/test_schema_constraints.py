@@ -37,6 +37,10 @@ SIGNAL = {"values": [0.0, 1.0] * 1024, "sample_rate": "2 kHz"}
 
 
 SHAFT = {"torsional_stiffness": "3e4 N*m/rad"}
+INERTIAL = {"inertia": "2e-3 kg*m^2"}
+TRAIN = design(train={"motor": INERTIAL, "input_shaft": SHAFT, "output_shaft": SHAFT,
+                      "load": INERTIAL})  # fmt: skip
+PARAMS = {"damping": 0.05}
 CASES = [  # (schema, accepted body, refused body: the rule)
     ("SimulationSettings", {"initial_states": [[0.1, 0.0]]},
      {"initial_states": [[0.1, 0.0]],
@@ -58,6 +62,13 @@ CASES = [  # (schema, accepted body, refused body: the rule)
     ("Mesh", {"stiffness": "1e8 N/m", "damping_ratio": 0.05, "backlash": "100 um"},
      {"stiffness": "1e8 N/m", "damping_ratio": 0.05, "backlash": "100 um",
       "half_backlash": "50 um"}),
+    # a request that takes a design alone: no params beside it (found by schemathesis)
+    ("CampbellRequest", {"design": TRAIN}, {"design": TRAIN, "params": PARAMS}),
+    ("DesignRequest", {"design": design()}, {"design": design(), "params": PARAMS}),
+    # a request that does not model a gear train refuses design.train (found by schemathesis)
+    ("MelnikovRequest", {"design": design()}, {"design": TRAIN}),
+    ("ThresholdsRequest", {"design": design(), "parameter": "F_e1"},
+     {"design": TRAIN, "parameter": "F_e1"}),
 ]  # fmt: skip
 
 
@@ -72,15 +83,20 @@ def test_the_models_agree(name: str, good: Any, bad: Any) -> None:
     """The same bodies through the service's models: accepted and refused alike."""
     from pydantic import ValidationError
 
+    from gearengine.analysis import DesignRequest
+    from gearengine.homoclinic.schemas import MelnikovRequest, ThresholdsRequest
     from gearengine.model.design import Design, Mesh
     from gearengine.model.train import Shaft
     from gearengine.numerics.settings import BasinSettings, SimulationSettings
     from gearengine.signals.series import SignalRequest
     from gearengine.studies.robustness.study import RobustnessRequest, checked
+    from gearengine.systems.gear_train.campbell import CampbellRequest
 
     models = {"SimulationSettings": SimulationSettings, "BasinSettings": BasinSettings,
               "SignalRequest": SignalRequest, "Shaft": Shaft, "Design": Design,
-              "Mesh": Mesh}  # fmt: skip
+              "Mesh": Mesh, "CampbellRequest": CampbellRequest, "DesignRequest": DesignRequest,
+              "MelnikovRequest": MelnikovRequest,
+              "ThresholdsRequest": ThresholdsRequest}  # fmt: skip
     validate = models[name].model_validate if name in models else (
         lambda b: checked(RobustnessRequest.model_validate(b)))  # fmt: skip
     validate(good)

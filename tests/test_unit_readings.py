@@ -6,10 +6,12 @@ value beside the geometry form used and said so."""
 from __future__ import annotations
 
 import copy
+import json
 
 import pytest
 from pydantic import ValidationError
 
+from gearengine.cli.main import main
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.reduction import convert_design
 from gearengine.studies.sweep.axes import design_with
@@ -64,3 +66,40 @@ def test_given_inertia_beside_the_geometry_is_used_and_said() -> None:
     assert conv.derived["inertia_driver"].value == pytest.approx(2e-3)
     assert conv.derived["inertia_driver"].source == "given"
     assert any(n.startswith("driver.inertia: the given 0.002 kg*m^2 is used") for n in conv.notes)
+
+
+def test_a_bare_speed_over_100000_rpm_is_refused_the_same_way_everywhere(
+    client, tmp_path, capsys
+) -> None:
+    """A bare 20000 is read as rad/s (191,000 rpm): over the plausible 100,000 rpm of a driver,
+    refused with the field, the value and the unit in the API, the library and the CLI (whose
+    bare --speed is rpm, its documented unit)."""
+    answer = client.post("/v1/analyses", json={"design": _design(speed=20000)})
+    assert answer.status_code == 422
+    (error,) = answer.json()["errors"]
+    assert error["path"] == "design.speed"
+    assert "20000 rad/s is outside the plausible range of a shaft speed" in error["message"]
+    assert "100,000 rpm" in error["message"]
+    with pytest.raises(ValidationError, match="20000 rad/s is outside"):
+        Design.model_validate(_design(speed=20000))
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": _design()}))
+    assert main(["robustness", str(path), "--speed", "1000:150000", "--samples", "2"]) == 2
+    assert "--speed (its high end): 150000 rpm is outside the plausible range" in (
+        capsys.readouterr().err
+    )
+
+
+def test_a_damping_ratio_in_percent_is_refused_as_a_plain_number(client) -> None:
+    doc = _design()
+    doc["mesh"]["damping_ratio"] = "5 %"
+    with pytest.raises(ValidationError) as err:
+        Design.model_validate(doc)
+    ((error,),) = [err.value.errors()]
+    assert error["loc"] == ("mesh", "damping_ratio")
+    assert "a damping ratio is a plain number: write 0.05 for 5 %" in error["msg"]
+    answer = client.post("/v1/analyses", json={"design": doc})
+    assert answer.status_code == 422
+    (problem,) = answer.json()["errors"]
+    assert problem["path"] == "design.mesh.damping_ratio"
+    assert "write 0.05 for 5 %" in problem["message"]

@@ -45,14 +45,46 @@ def read_document(path: str) -> object:
         raise InvalidInputError([f"{path}: {exc}"]) from None
 
 
-def validated_input(validate: Callable[[object], R], data: object, path: str) -> R:
-    """``validate(data)``, its ValueErrors (pydantic's included) as InvalidInputError lines."""
+def validated_input(
+    validate: Callable[[object], R], data: object, path: str, options: Options | None = None
+) -> R:
+    """``validate(data)``, its ValueErrors (pydantic's included) as InvalidInputError lines;
+    a line about a field a command-line option gave is named by that option (``options``)."""
     try:
         return validate(data)
     except ValidationError as exc:
-        raise InvalidInputError(error_lines(exc)) from None
+        raise InvalidInputError(by_options(error_lines(exc), options or {})) from None
     except ValueError as exc:
         raise InvalidInputError([f"{path}: {exc}"]) from None
+
+
+Options = dict[str, str]
+"""The option that gave each field of a request the CLI built: {"axes[0].stop": "--speed (its
+high end)", "samples": "--samples"}; a field inside one (``levers[0].bounds[1]``) is named by
+its own entry if it has one, else by its nearest enclosing field's."""
+
+
+def by_options(lines: list[str], options: Options) -> list[str]:
+    """Each error line "path: message" whose path (or an enclosing field) an option gave, as
+    "option: message": the user reads what they typed, not the request's internal path."""
+    named = []
+    for line in lines:
+        path, sep, text = line.partition(": ")
+        fields = [f for f in options if path == f or path.startswith((f"{f}.", f"{f}["))]
+        named.append(f"{options[max(fields, key=len)]}{sep}{text}" if sep and fields else line)
+    return named
+
+
+def axis_options(axes: list[dict[str, object]], given: list[int], name: str = "axes") -> Options:
+    """The options of the axes in ``given`` (those --speed/--torque built): start, stop and num
+    of ``axes[i]`` as "--speed (its low end)", "--speed (its high end)", "--speed-points"."""
+    options = {}
+    for i in given:
+        option = f"--{axes[i]['parameter']}"
+        options |= {f"{name}[{i}].start": f"{option} (its low end)",
+                    f"{name}[{i}].stop": f"{option} (its high end)",
+                    f"{name}[{i}].num": f"{option}-points"}  # fmt: skip
+    return options
 
 
 def read_request(path: str, model: type[R]) -> R:

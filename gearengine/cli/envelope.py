@@ -29,6 +29,7 @@ from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
     InvalidInputError,
+    axis_options,
     points_of,
     read_document,
     validated_input,
@@ -101,29 +102,12 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
     if n > jobs.MAX_JOB_POINTS:  # before the sweep's checks build its grids
         raise InvalidInputError([f"this envelope check has {n} points, the limit is "
                                  f"{jobs.MAX_JOB_POINTS} (max_job_points)"])  # fmt: skip
-    try:
-        request = validated_input(validated, sweep, args.file)
-    except InvalidInputError as exc:  # an axis the options built is named by its option
-        given = [i for i, name in enumerate(["speed", "torque"]) if getattr(args, name)]
-        raise InvalidInputError([by_option(line, axes, given) for line in exc.lines]) from None
+    given = [i for i, name in enumerate(["speed", "torque"]) if getattr(args, name)]
+    request = validated_input(validated, sweep, args.file, axis_options(axes, given))
     why = jobs.over_budget("sweep", request, n, "envelope check")
     if why is not None:
         raise InvalidInputError([f"{why}, or run it on a server (--server URL)"])
     return request
-
-
-AXIS_OPTIONS = {"start": "--{} (its low end)", "stop": "--{} (its high end)", "num": "--{}-points"}
-"""The option that gave each field of an envelope axis."""
-
-
-def by_option(line: str, axes: list[dict[str, object]], given: list[int]) -> str:
-    """An error line of the sweep's ``axes[i].field`` named by the option that gave it
-    ("axes[0].stop: ..." -> "--speed (its high end): ..."), for the axes in ``given``."""
-    for i in given:
-        for field, option in AXIS_OPTIONS.items():
-            if line.startswith(prefix := f"axes[{i}].{field}:"):
-                return option.format(axes[i]["parameter"]) + line[len(prefix) - 1 :]
-    return line
 
 
 def _here(design: dict, name: str) -> str:

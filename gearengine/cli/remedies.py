@@ -47,7 +47,21 @@ def remedies_request(args: argparse.Namespace) -> RemediesRequest:
         body["starts"] = args.starts
     if args.lever:
         body["levers"] = args.lever
-    return validated_input(RemediesRequest.model_validate, body, args.file)
+    options = dict(OPTIONS)
+    for i, lever in enumerate(args.lever or []):
+        options[f"levers[{i}]"] = f"--lever {lever['lever']}"
+        for k, end in enumerate(("low", "high")):
+            options[f"levers[{i}].bounds[{k}]"] = f"--lever {lever['lever']} (its {end} end)"
+    return validated_input(RemediesRequest.model_validate, body, args.file, options)
+
+
+OPTIONS = {"envelope.speed": "--speed", "envelope.torque": "--torque",
+           "envelope.speed_points": "--speed-points", "envelope.torque_points": "--torque-points",
+           "envelope.refine": "--refine", "envelope": "--speed/--torque", "starts": "--starts",
+           "fail_on": "--fail-on", "max_lle": "--max-lle", "max_dte_um": "--max-dte",
+           "max_dynamic_factor": "--max-dynamic-factor", "min_basin": "--min-basin"}  # fmt: skip
+"""The option that gave each field of the request (``documents.by_options``); the design's own
+fields keep their paths in the file."""
 
 
 def print_result(result: RemediesResult) -> None:

@@ -17,6 +17,7 @@ from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
     InvalidInputError,
+    axis_options,
     points_of,
     read_document,
     validated_input,
@@ -61,8 +62,10 @@ def robustness_request(args: argparse.Namespace) -> RobustnessRequest:
     if n > jobs.MAX_JOB_POINTS:  # before the study's checks cost each point's design
         raise InvalidInputError([f"this robustness study has {n} points, the limit is "
                                  f"{jobs.MAX_JOB_POINTS} (max_job_points)"])  # fmt: skip
+    options = {"samples": "--samples", "seed": "--seed",
+               **axis_options(axes, list(range(len(axes))))}  # fmt: skip
     request = validated_input(
-        lambda d: checked(RobustnessRequest.model_validate(d)), body, args.file
+        lambda d: checked(RobustnessRequest.model_validate(d)), body, args.file, options
     )
     why = jobs.over_budget("robustness", request, n, "robustness study")
     if why is not None:

@@ -69,6 +69,16 @@ def critical_mean_force(a: float, c: float) -> float:
     return float(loops.critical_load(a, c))
 
 
+T_CRIT_WHY = (
+    "T_crit = F_crit b k_m r_a is the torque whose mean mesh force T / r_a reaches the barrier "
+    "between the backlash law's two wells, F_crit = (2a/3) sqrt(a/(3c)) in units of b k_m; above "
+    "it the saddle disappears, and with it the homoclinic loop the criterion needs, so T_crit "
+    "grows with the half backlash b, the mesh stiffness k_m and the base radius r_a "
+    "(docs/melnikov-under-load.md)"
+)
+"""Why the critical torque depends on the design, said where an answer gives it."""
+
+
 def saddle_loop(a: float, c: float, fm: float = 0.0) -> bool:
     """True when x'' = a x - c x^3 + F_m has a saddle with homoclinic loops: a > 0, c > 0 and
     |F_m| < F_crit.

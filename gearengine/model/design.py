@@ -17,7 +17,6 @@ frequency unless an ``order`` (multiple of the driver speed) is given; the torqu
 from __future__ import annotations
 
 import math
-import re
 from typing import Annotated, Any, Literal
 
 from pydantic import (
@@ -43,6 +42,7 @@ from gearengine.model.tolerances import Tolerances
 from gearengine.model.train import Train
 from gearengine.model.units import (
     QUANTITIES,
+    SHARE,
     Angle,
     Backlash,
     Bore,
@@ -58,6 +58,7 @@ from gearengine.model.units import (
     Torque,
     note,
     parse_quantity,
+    plain_number,
     readings,
     si_numbers,
 )
@@ -165,9 +166,10 @@ class Mesh(StrictModel):
         description="Stiffness variation at r x mesh frequency. Default: none, or with "
         "'iso6336' the single/double tooth-contact wave of the contact ratio.",
     )
-    damping_ratio: float | None = Field(
-        None, ge=0.0, le=1.0, allow_inf_nan=False, description="Mesh damping ratio zeta."
-    )
+    damping_ratio: Annotated[float, plain_number("damping ratio")] | None = Field(
+        None, ge=0.0, le=1.0, allow_inf_nan=False,
+        description="Mesh damping ratio zeta, a plain number (0.05, not '5 %').",
+    )  # fmt: skip
     damping: Damping | None = Field(None, description="Mesh damping c (instead of zeta).")
     half_backlash: HalfBacklash | None = Field(
         None,
@@ -405,10 +407,6 @@ class Design(StrictModel):
         if tol is not None and tol.backlash is not None and BACKLASH_FIELD in tol.fields():
             raise InputError("tolerances.backlash", f"already sets {BACKLASH_FIELD}")
         return self
-
-
-SHARE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*%\s*")
-"""A share in percent, "3 %"."""
 
 
 def ripple_of_mean_torque(data: Any, notes: list[str]) -> tuple[Any, dict[int, float]]:

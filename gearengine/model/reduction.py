@@ -354,9 +354,22 @@ class ParamsOrDesign(BaseModel):
         cls, core_schema: CoreSchema, handler: GetJsonSchemaHandler
     ) -> JsonSchemaValue:
         """The schema says what validation does: exactly one of params and design, given (a
-        null one counts as absent)."""
+        null one counts as absent), neither field outside ``ONE_OF`` given, and no
+        ``design.train`` unless the request answers for trains (``TRAINS``)."""
         schema = handler.resolve_ref_schema(handler(core_schema))
         schema["oneOf"] = [given(name) for name in cls.ONE_OF]
+        rules = [{"not": given(name)} for name in ("params", "design") if name not in cls.ONE_OF]
+        if not cls.TRAINS:
+            rules.append(
+                {
+                    "not": {
+                        "required": ["design"],
+                        "properties": {"design": {"type": "object", **given("train")}},
+                    }
+                }
+            )
+        if rules:
+            schema["allOf"] = [*schema.get("allOf", []), *rules]
         return schema
 
     TRAINS: ClassVar[bool] = False

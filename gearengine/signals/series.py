@@ -33,6 +33,10 @@ MIN_SAMPLES = 512
 """Shortest series read: the embedding and the 0-1 test need a few hundred points."""
 EXAMPLE_VALUES = [round(math.sin(0.7 * k), 3) for k in range(MIN_SAMPLES)]
 """A series the reading accepts (the shortest, not constant): the schema's example."""
+EXAMPLE_MESH_TONE = [round(math.sin(0.9 * math.pi * k), 3) for k in range(800)]
+"""The request's example: 0.8 s at 1 kHz of an 18-tooth mesh at 1500 rpm (450 Hz), 20
+revolutions, enough for an order reading (``MIN_REVOLUTIONS``); an example the service accepts
+as it stands (an elided one, "...", was refused)."""
 MAX_SAMPLES = 10_000_000
 """Longest series read (80 MB as float64); the service's synchronous budget is lower
 (``SYNC_SAMPLES``)."""
@@ -137,7 +141,7 @@ class SignalRequest(StrictModel):
 
     model_config = request_config(
         {
-            "signal": {"values": [0.0, 1.0, 0.5, "..."], "sample_rate": "20 kHz",
+            "signal": {"values": EXAMPLE_MESH_TONE, "sample_rate": "1 kHz",
                        "quantity": "transmission_error", "unit": "um"},
             "speed": "1500 rpm",
             "teeth": 18,

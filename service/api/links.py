@@ -14,7 +14,7 @@ from typing import Any
 
 SUBMITTED = ("201", "202")
 """Responses of a submit operation that carry the new job."""
-JOB_PATH = re.compile(r"^(?P<base>/v1/[^/{}]+)/\{job_id\}(?P<rest>/[^{}]*)?$")
+JOB_PATH = re.compile(r"^(?P<base>/v1/[^{}]+?)/\{job_id\}(?P<rest>/[^{}]*)?$")
 
 
 def link_name(method: str, rest: str) -> str:

@@ -93,9 +93,10 @@ class LeverRange(BaseModel):
 class RemediesRequest(Rules):
     """A failing design, its envelope and the gate's rules: what to change, by how much."""
 
-    model_config = request_config(
-        {"design": EXAMPLE_DESIGN, "envelope": {"speed": "500:6000", "torque": "20:200"},
-         "fail_on": ["chaotic"]}
+    model_config = request_config(  # 7 x 3 points: within a default server's job budget
+        {"design": EXAMPLE_DESIGN, "fail_on": ["chaotic"],
+         "envelope": {"speed": "500:6000", "torque": "20:200", "speed_points": 7,
+                      "torque_points": 3}}
     )  # fmt: skip
 
     design: Design = Field(description="The pair in physical units.")
@@ -253,33 +254,35 @@ def request_errors(request: RemediesRequest) -> list[InitErrorDetails]:
     for i, given in enumerate(request.levers or []):
         problem = lever_problem(request.design, given)
         if problem is not None:
-            add(("levers", i, problem[0]), problem[1], getattr(given, problem[0]))
+            where, text, value = problem
+            add(("levers", i, *where), text, value)
     return errors
 
 
-def lever_problem(design: Design, given: LeverRange) -> tuple[str, str] | None:
-    """Why a user's lever cannot be searched, as (field, message), or None."""
+def lever_problem(design: Design, given: LeverRange) -> tuple[tuple, str, object] | None:
+    """Why a user's lever cannot be searched, as (location in the lever, message, the value
+    at fault), or None."""
     if given.lever.split(".")[0] in NOT_LEVERS:
-        return "lever", f"{given.lever} is the envelope, not a lever"
+        return ("lever",), f"{given.lever} is the envelope, not a lever", given.lever
     try:
         v0 = _current(design, given.lever)
     except (KeyError, IndexError, TypeError, ValueError):
-        return "lever", f"the design has no numeric field {given.lever}"
+        return ("lever",), f"the design has no numeric field {given.lever}", given.lever
     ends = []
     for k, bound in enumerate(given.bounds):
         try:
             ends.append(si_value(design, given.lever, bound))
         except ValidationError as exc:
             msg = "; ".join(message(e) for e in exc.errors(include_url=False))
-            return "bounds", f"bounds[{k}]: {msg}"
+            return ("bounds", k), msg, bound
     lo, hi = ends
     unit, factor = display_unit(given.lever)
     if not lo < hi:
-        return "bounds", f"give [low, high] with low < high ({lo * factor:g} >= {hi * factor:g} "\
-            f"{unit})"  # fmt: skip
+        return ("bounds",), f"give [low, high] with low < high ({lo * factor:g} >= "\
+            f"{hi * factor:g} {unit})", given.bounds  # fmt: skip
     if not lo <= v0 <= hi:
-        return "bounds", f"the design's {given.lever} = {v0 * factor:g} {unit} lies outside "\
-            f"[{lo * factor:g}, {hi * factor:g}] {unit}"  # fmt: skip
+        return ("bounds",), f"the design's {given.lever} = {v0 * factor:g} {unit} lies "\
+            f"outside [{lo * factor:g}, {hi * factor:g}] {unit}", given.bounds  # fmt: skip
     return None
 
 

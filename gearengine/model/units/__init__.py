@@ -26,6 +26,7 @@ from gearengine.model.units.outputs import (
 )
 from gearengine.model.units.quantities import (
     QUANTITIES,
+    SHARE,
     Angle,
     Backlash,
     BearingStiffness,
@@ -48,6 +49,7 @@ from gearengine.model.units.quantities import (
     TorsionalStiffness,
     note,
     parse_quantity,
+    plain_number,
     readings,
     registry,
     si_numbers,
@@ -61,6 +63,7 @@ __all__ = [
     "RECORD_FORCES",
     "RESPONSES",
     "RPM",
+    "SHARE",
     "TORQUE_BALANCE_TOLERANCE",
     "Angle",
     "Backlash",
@@ -91,6 +94,7 @@ __all__ = [
     "in_si",
     "note",
     "parse_quantity",
+    "plain_number",
     "readings",
     "registry",
     "response_values",

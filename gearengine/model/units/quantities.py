@@ -60,6 +60,17 @@ class QuantityKind:
         """``si`` in the kind's unit, 6 significant digits."""
         return f"{si:.6g} {self.unit}"
 
+    def span(self) -> str:
+        """The plausible range in the SI unit, and in the example's unit when it differs
+        ("0.10472 rad/s to 10472 rad/s (1 to 100,000 rpm)")."""
+        text = f"{self.describe(self.low)} to {self.describe(self.high)}"
+        shown = self.example.split(maxsplit=1)[-1]
+        if shown == self.unit:
+            return text
+        low, high = (registry().Quantity(v, self.unit).to(shown).magnitude
+                     for v in (self.low, self.high))  # fmt: skip
+        return f"{text} ({low:,.6g} to {high:,.6g} {shown})"
+
 
 TORQUE_SPELLINGS = {"Nm": "N*m", "kNm": "kN*m", "MNm": "MN*m", "Nmm": "N*mm"}
 """Torque units as typed on drawings and in spreadsheets, read as newton metres (pint reads
@@ -126,8 +137,8 @@ QUANTITIES: dict[str, QuantityKind] = {
     "backlash": QuantityKind("circumferential backlash", "m", 2e-7, 1e-2, ("um", "mm"), "100 um"),
     "error": QuantityKind("transmission error", "m", 0.0, 1e-3, ("um", "mm"), "5 um"),
     "speed": QuantityKind(
-        "shaft speed", "rad/s", 2 * math.pi / 60, 2e5 * 2 * math.pi / 60, ("rpm",), "1500 rpm"
-    ),
+        "shaft speed", "rad/s", 2 * math.pi / 60, 1e5 * 2 * math.pi / 60, ("rpm",), "1500 rpm"
+    ),  # 1 to 100,000 rpm: a bare 20000 (rad/s, 191,000 rpm) is refused, not read silently
     "torque": QuantityKind("torque", "N*m", 0.0, 1e6, (), "40 N*m", TORQUE_SPELLINGS),
     "stiffness": QuantityKind("mesh stiffness", "N/m", 1e6, 1e11, ("N/um", "N/mm"), "1e8 N/m"),
     "stiffness_variation": QuantityKind(
@@ -253,10 +264,7 @@ def _plausible(si: float, given: object, kind: QuantityKind, allow_zero: bool) -
     if si < 0.0 and kind.low > 0.0:  # no slip of the unit makes it positive
         raise ValueError(f"{shown} is negative; a {kind.name} is a positive magnitude, e.g. "
                          f"{kind.example!r}")  # fmt: skip
-    message = (
-        f"{shown} is outside the plausible range of a {kind.name}, "
-        f"{kind.describe(kind.low)} to {kind.describe(kind.high)}"
-    )
+    message = f"{shown} is outside the plausible range of a {kind.name}, {kind.span()}"
     magnitude = ureg.Quantity(given.strip()).magnitude if isinstance(given, str) else si
     for slip in kind.slips:
         meant = float(ureg.Quantity(abs(float(magnitude)), slip).to(kind.unit).magnitude)
@@ -319,8 +327,7 @@ class QuantitySchema:
                 *zero,
             ],
             "description": f"{kind.name}: a string with a unit (e.g. {kind.example!r}) or a "
-            f"number in {kind.unit}; plausible range {kind.describe(kind.low)} to "
-            f"{kind.describe(kind.high)}",
+            f"number in {kind.unit} (read with a note); plausible range {kind.span()}",
         }  # fmt: skip
 
 
@@ -336,6 +343,29 @@ def quantity_type(key: str, allow_zero: bool = False, keyword: str | None = None
 
     stored = float if keyword is None else float | str
     return Annotated[stored, BeforeValidator(parse), QuantitySchema(kind, allow_zero, keyword)]
+
+
+SHARE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*%\s*")
+"""A share in percent, "3 %"."""
+
+
+def plain_number(name: str) -> Any:
+    """A pydantic validator of a dimensionless field (a damping ratio): a share in percent
+    ("5 %") is refused naming the plain number meant (0.05), since "%" is read only where a
+    share of a nominal value is meant (a torque ripple of the mean torque); other input goes
+    on to the field's own type."""
+
+    def refuse_share(value: object) -> object:
+        if isinstance(value, str) and (match := SHARE.fullmatch(value)):
+            percent = float(match.group(1))
+            raise ValueError(
+                f"{value.strip()!r}: a {name} is a plain number: write {percent / 100:g} for "
+                f"{percent:g} % (a share in % is read only where one of a nominal value is "
+                "meant: a torque fluctuation amplitude, of the mean torque)"
+            )
+        return value
+
+    return BeforeValidator(refuse_share)
 
 
 Length = quantity_type("length")
