@@ -49,3 +49,26 @@ def sweep_design():
     from gearengine.model.design import Design
 
     return Design.model_validate(DOC["design"])
+
+
+def test_a_bare_number_on_a_physical_axis_is_read_with_a_note() -> None:
+    """A bare 157 on the speed axis is 157 rad/s (1,499 rpm): read as a design's bare speed is,
+    and said so in the result and by the CLI (issue 30 item 2; it was read with no note). Unit
+    strings and unitless fields (the damping ratio) get none."""
+    request = SweepRequest.model_validate({
+        "design": DOC["design"],
+        "settings": {"transient_periods": 30, "record_periods": 20, "steps_per_period": 64},
+        "axes": [{"parameter": "speed", "start": 157, "stop": "2000 rpm", "num": 2},
+                 {"parameter": "mesh.damping_ratio", "start": 0.05, "stop": 0.05, "num": 1}],
+    })  # fmt: skip
+    result = run_local(request)
+    assert result.notes == [
+        "axes[0].start (speed): the bare number 157 read as 157 rad/s = 1,499.24 rpm; "
+        "write '157 rpm' if rpm was meant"
+    ]
+    assert json.loads(result.model_dump_json())["notes"] == result.notes
+    assert result.points[0].values["speed"] == 157.0
+
+
+def test_axes_with_units_carry_no_notes(sweep) -> None:
+    assert sweep.notes is None

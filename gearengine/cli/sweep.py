@@ -95,6 +95,8 @@ def _sweep(args: argparse.Namespace) -> int:
     request = read_sweep(args.file)
     stem = "sweep" if args.file == "-" else Path(args.file).stem
     result = run_local(request, progress(time.monotonic(), stem), workers=os.cpu_count() or 1)
+    for text in result.notes or []:  # a bare number on a physical axis, read in SI
+        print(f"note: {text}", file=sys.stderr)
     csv = to_csv(result, request.outputs, design=request.design is not None)
     if args.out == "-":  # stream one document to standard output, no files
         sys.stdout.write("".join(csv) if args.format == "csv" else dumps(result) + "\n")

@@ -42,6 +42,22 @@ def axis_unit(parameter: str) -> str:
     return "1" if is_dimensionless(parameter) else field_unit(parameter).si
 
 
+def bare_reading(parameter: str, where: str, value: object) -> str | None:
+    """How a bare number at one end of a physical axis was read: in the field's SI unit
+    (``axis_unit``: speed in rad/s), said in words as a design's own bare numbers are
+    (``model.units``); None for a unit string, a dimensionless alias or a unitless field."""
+    unit = field_unit(parameter)
+    bare = isinstance(value, (int, float)) and not isinstance(value, bool)
+    if not bare or is_dimensionless(parameter) or unit.si in ("1", "SI"):
+        return None
+    text = f"{where} ({parameter}): the bare number {value:g} read as {value:g} {unit.si}"
+    if unit.display != unit.si:
+        shown = float(value) * unit.factor
+        text += (f" = {shown:,.6g} {unit.display}; write '{value:g} {unit.display}' if "
+                 f"{unit.display} was meant")  # fmt: skip
+    return text
+
+
 def _set(tree: dict[str, Any], path: str, value: object) -> None:
     """Set the field at ``path``; a whole float on an integer field (a grid value 19.0 of
     ``driver.teeth``) is set as that integer, since the design refuses floats there."""

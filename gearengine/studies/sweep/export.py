@@ -13,7 +13,7 @@ import numpy as np
 from pydantic import BaseModel, Field, TypeAdapter
 
 from gearengine.model.units import POINT_OUTPUTS, display_label, field_unit, in_display_unit
-from gearengine.studies.sweep.axes import axis_unit, is_dimensionless
+from gearengine.studies.sweep.axes import axis_unit, bare_reading, is_dimensionless
 from gearengine.studies.sweep.points import SweepBifurcation, SweepPoint
 from gearengine.studies.sweep.request import SweepAxis
 
@@ -67,9 +67,12 @@ def result_json(
     ``partial``: some chunks are missing (a job that did not succeed); ``windows``: the speed
     windows (``studies.sweep.windows``) of a sweep over the driver speed."""
     units = {a.parameter: axis_unit(a.parameter) for a in axes}
+    ends = [(a.parameter, f"axes[{i}].{end}", getattr(a, end))
+            for i, a in enumerate(axes) for end in ("start", "stop")]  # fmt: skip
+    notes = [text for end in ends if (text := bare_reading(*end))]
     yield (
         '{"axes":[' + ",".join(a.model_dump_json() for a in axes) + '],"values_units":'
-        + json.dumps(units) + ',"points":['
+        + json.dumps(units) + ',"notes":' + json.dumps(notes or None) + ',"points":['
     )  # fmt: skip
     first = True
     located: list[dict[str, object]] | None = None

@@ -32,6 +32,11 @@ class SweepResult(BaseModel):
         "rpm), a dimensionless alias 1.",
         examples=[{"speed": "rad/s", "torque": "N*m"}],
     )
+    notes: list[str] | None = Field(
+        None,
+        description="How bare numbers on physical axes were read (in the field's SI unit, "
+        "speed in rad/s), one sentence each; absent when every end has its unit.",
+    )
     points: list[SweepPoint] = Field(description="One entry per point and branch.")
     bifurcations: list[SweepBifurcation] | None = Field(
         None,
