@@ -9,6 +9,8 @@ one by one in the single kernels (``numerics.runs``). Numbers equal those of ``s
 
 from __future__ import annotations
 
+import functools
+import threading
 from collections.abc import Sequence
 
 import numba
@@ -65,10 +67,9 @@ def _strobes(run: Run) -> np.ndarray:
 
 
 def step_plans(points: Sequence[Point], steps_per_period: int) -> list[StepPlan]:
-    """``step_plan`` of each point, computed once per set of active harmonics: the plan depends
-    only on the excitations' frequencies and which of their harmonics are active (a ``System``
-    point's own ``plan``)."""
-    known: dict[tuple, StepPlan] = {}
+    """``step_plan`` of each point, computed once per process for each set of active harmonics
+    (``PLANS``): the plan depends only on the excitations' frequencies and which of their
+    harmonics are active (a ``System`` point's own ``plan``)."""
     plans = []
     for p in points:
         if isinstance(p, System):
@@ -77,11 +78,39 @@ def step_plans(points: Sequence[Point], steps_per_period: int) -> list[StepPlan]
         key = (*(
             (name, exc.frequency, tuple(r for r, _ in exc.active()))
             for name, exc in p.excitations()
-        ), str(p.shaft_orders))  # fmt: skip
-        if key not in known:
-            known[key] = step_plan(p, steps_per_period)
-        plans.append(known[key])
+        ), str(p.shaft_orders), steps_per_period)  # fmt: skip
+        plan = _plans.get(key)
+        if plan is None:
+            plan = step_plan(p, steps_per_period)
+            with _plans_lock:
+                _plans[key] = plan
+                while len(_plans) > PLANS:
+                    _plans.pop(next(iter(_plans)))
+        plans.append(plan)
     return plans
+
+
+PLANS = 4096
+"""Step plans kept in this process (``step_plans``): an envelope's speeds give the same
+frequencies at every torque and every lever value of a remedies search, so its checks, their
+refinements and the basin starts of a chunk find the plan of an earlier call (the search for
+Omega_0 over the active frequencies costs ~1.5 ms a point)."""
+_plans: dict[tuple, StepPlan] = {}
+_plans_lock = threading.Lock()
+
+TABLES = 256
+"""Forcing tables kept in this process (``forcing_table``; 2N + 1 values of K and F each,
+~94 kB at N = 2,944): a chunk's points run once from the settings' starts and once from their
+basin starts, and the gate's refinement and a remedies search run points again."""
+
+
+@functools.lru_cache(maxsize=TABLES)
+def _table(period: float, N: int, kc: bytes, fm: float, fc: bytes) -> tuple[np.ndarray, np.ndarray]:
+    """``kernels.forcing_table`` of the packed forcing whose arrays (3, n) are the bytes
+    ``kc`` and ``fc`` (a key that hashes), computed once per process for the same bits."""
+    k = np.frombuffer(kc, dtype=np.float64).reshape(3, -1).copy()  # writable: the compiled type
+    f = np.frombuffer(fc, dtype=np.float64).reshape(3, -1).copy()
+    return kernels.forcing_table(period, N, k, fm, f)
 
 
 def run_lanes(
@@ -135,8 +164,8 @@ def _run_lanes(
         owner = np.array([lanes[k][0] for k in ks], dtype=np.int64)
         members, inverse = np.unique(owner, return_inverse=True)
         packed = [packed_forcing(points[i]) for i in members.tolist()]
-        tables = [kernels.forcing_table(plans[i].period, N, *f)
-                  for i, f in zip(members.tolist(), packed, strict=True)]  # fmt: skip
+        tables = [_table(plans[i].period, N, kc.tobytes(), fm, fc.tobytes())
+                  for i, (kc, fm, fc) in zip(members.tolist(), packed, strict=True)]  # fmt: skip
         per = np.array([plans[i].period for i in members.tolist()])[inverse]
         mu = np.array([points[i].damping for i in members.tolist()])[inverse]
         starts = np.array([lanes[k][1] for k in ks], dtype=np.float64).reshape(-1, 2)
