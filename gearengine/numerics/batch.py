@@ -261,20 +261,30 @@ def simulate_batch(
     such start on a tie), whose index in ``settings.starts()`` is ``start_index``. Numbers equal
     those of ``simulate`` for the same point and start.
     """
-    settings = settings or SimulationSettings()
+    return simulate_batch_with(points, settings or SimulationSettings(), [])[0]
+
+
+def simulate_batch_with(
+    points: Sequence[Point], settings: SimulationSettings, more: Sequence[Lane]
+) -> tuple[list[BatchPoint], list[BatchPoint]]:
+    """``simulate_batch`` of ``points`` and ``run_lanes`` of ``more`` lanes of the same points
+    (a chunk's basin starts), in one call of the kernels: one forcing table a point and one
+    pass of the lock-step chunks for both. The same numbers as two calls: a lane's run does
+    not depend on the lanes beside it."""
     starts = settings.starts()
     plans = step_plans(points, settings.steps_per_period)
     for plan in plans:
         check_work(settings, plan.steps)
     lanes = [(i, s) for i in range(len(points)) for s in starts]
-    per_lane = _run_lanes(points, plans, lanes, settings)
+    per_lane = _run_lanes(points, plans, [*lanes, *more], settings)
     S = len(starts)
     worst = []
     for i in range(len(points)):
         block = per_lane[i * S : (i + 1) * S]
         j = max(range(S), key=lambda j: severity(block[j].classification, block[j].period))
         worst.append(block[j].model_copy(update={"start_index": j}))
-    return worst
+    rest = [bp.model_copy(update={"start_index": k}) for k, bp in enumerate(per_lane[len(lanes) :])]
+    return worst, rest
 
 
 def threads_may_share_kernels() -> bool:
