@@ -98,10 +98,10 @@ Omega_0 over the active frequencies costs ~1.5 ms a point)."""
 _plans: dict[tuple, StepPlan] = {}
 _plans_lock = threading.Lock()
 
-TABLES = 256
+TABLES = 128
 """Forcing tables kept in this process (``forcing_table``; 2N + 1 values of K and F each,
-~94 kB at N = 2,944): a chunk's points run once from the settings' starts and once from their
-basin starts, and the gate's refinement and a remedies search run points again."""
+~94 kB at N = 2,944, at most ~12 MB): the gate's refinement, the hints of a remedies search and
+a lever that leaves the forcing as it is (the damping) run the same points again."""
 
 
 @functools.lru_cache(maxsize=TABLES)
