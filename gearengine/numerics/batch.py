@@ -27,7 +27,7 @@ from gearengine.signals.classify import DIVERGENCE_BOUND, severity
 from gearengine.systems.base import System
 from gearengine.systems.spur_pair import kernels
 from gearengine.systems.spur_pair.forcing import StepPlan, packed_forcing, step_plan
-from gearengine.systems.spur_pair.laws import LAWS, law
+from gearengine.systems.spur_pair.laws import LAWS, Carry, fresh_carry, law
 
 Lane = tuple[int, tuple[float, float]]
 """One run of a request: (index of its parameter point, initial state (x0, v0))."""
@@ -186,7 +186,7 @@ def _run_lanes(
         streams = max(1, min(numba.get_num_threads(), -(-len(ks) // kernels.LANES)))
         shared = (per, N, settings.transient_periods, settings.record_periods, DIVERGENCE_BOUND,
                   settings.adaptive, streams, *lle_tolerances(settings))  # fmt: skip
-        out = lanes_of(laws, inverse, packed, mu, x0, v0, tabled, shared)
+        out = lanes_of(laws, inverse, packed, mu, x0, v0, tabled, shared, fresh_carry(len(ks)))
         verdicts = lane_verdicts(out, per)
         strobes = last_strobes(out, list(range(len(ks))))
         for j, k in enumerate(ks):
@@ -199,7 +199,9 @@ def physical_lanes(
 ) -> list[BatchPoint]:
     """The ``BatchPoint`` of every lane of one lock-step group, its lengths decided in physical
     time (``numerics.physical``): the transient and the record run in chunks through the same
-    lock-step kernel (no early stopping inside it); ``periods_run`` counts both.
+    lock-step kernel (no early stopping inside it), a longer record on from the end of the
+    shorter (``extend``: state and ``Carry`` from the kernel, the outputs ``joined``);
+    ``periods_run`` counts both.
 
     Args:
         group: (lanes kernel, laws of the points, point of each lane (L,), packed forcing,
@@ -209,22 +211,36 @@ def physical_lanes(
     """
     lanes_of, laws, inverse, packed, mu, tabled, per, N = group
 
-    def advance(idx: np.ndarray, xa: np.ndarray, va: np.ndarray, n: int) -> physical.Chunk:
+    def call(idx: np.ndarray, xa: np.ndarray, va: np.ndarray, n: int, carry: Carry) -> tuple:
         streams = max(1, min(numba.get_num_threads(), -(-idx.size // kernels.LANES)))
         owner = inverse[idx].astype(np.int64)
         shared = (per[idx], N, 0, n, DIVERGENCE_BOUND, False, streams, 0.0, 0.0)
-        out = lanes_of(laws, owner, packed, mu[idx], xa.copy(), va.copy(),
-                       (tabled[0], tabled[1], owner), shared)  # fmt: skip
+        return lanes_of(laws, owner, packed, mu[idx], xa.copy(), va.copy(),
+                        (tabled[0], tabled[1], owner), shared, carry)  # fmt: skip
+
+    def chunk(out: tuple, carry: Carry, idx: np.ndarray) -> physical.Chunk:
         xs, vs, logs, xmin, xmax, _, _, _, _, diverged, xf, vf = out
         per_of = per[idx]
-        keep = [(out, j, per_of) for j in range(idx.size)]
+        keep = [(out, j, per_of, carry) for j in range(idx.size)]
         return physical.Chunk(xs, vs, logs, xmin, xmax, xf, vf, diverged.astype(bool), keep)
 
-    spans = physical.lengths(advance, x0, v0, per, mu, N / settings.steps_per_period, settings)
+    def advance(idx: np.ndarray, xa: np.ndarray, va: np.ndarray, n: int) -> physical.Chunk:
+        carry = fresh_carry(idx.size)
+        return chunk(call(idx, xa, va, n, carry), carry, idx)
+
+    def extend(idx: np.ndarray, keeps: list[tuple], n: int) -> physical.Chunk:
+        rows = [(out, j) for out, j, _, _ in keeps]
+        dx, dv, reg = (np.array([c[i][j] for _, j, _, c in keeps]) for i in range(3))
+        xf, vf = (np.array([out[i][j] for out, j in rows]) for i in (10, 11))
+        carry = (dx, dv, reg)  # where each record ended: the kernel runs it on from there
+        return chunk(joined(rows, call(idx, xf, vf, n, carry)), carry, idx)
+
+    spans = physical.lengths(advance, x0, v0, per, mu, N / settings.steps_per_period, settings,
+                             extend)  # fmt: skip
     verdicts: dict[int, list[tuple]] = {}
     rows: dict[int, list[int]] = {}
     for s in spans:  # one verdict and one gather of strobes per kernel call
-        out, j, per_of = s.keep
+        out, j, per_of, _ = s.keep
         if id(out) not in verdicts:
             verdicts[id(out)], rows[id(out)] = lane_verdicts(out, per_of), []
         rows[id(out)].append(j)
@@ -235,12 +251,28 @@ def physical_lanes(
         strobes.update({(key, j): w for j, w in zip(rows[key], got, strict=True)})
     points = []
     for s in spans:
-        out, j, _ = s.keep
+        out, j, _, _ = s.keep
         point = lane_point(out, j, 0, verdicts[id(out)][j], strobes[(id(out), j)])
         n = out[0].shape[1]
         before = s.transient - (n if s.transient_reason == "diverged" else 0)
         points.append(point.model_copy(update={"periods_run": before + int(out[7][j])}))
     return points
+
+
+def joined(before: list[tuple[tuple, int]], after: tuple) -> tuple:
+    """The kernel outputs of records run on: lane k's earlier record, row ``before[k][1]`` of
+    the outputs ``before[k][0]``, followed by row k of ``after`` (the call that ran it on):
+    strobes and logs joined, extremes over both, intervals summed, the end state ``after``'s."""
+
+    def rows(i: int) -> np.ndarray:
+        return np.array([out[i][j] for out, j in before])
+
+    xs, vs, logs = (np.concatenate([rows(i), after[i]], axis=1) for i in range(3))
+    lows = (np.minimum(rows(i), after[i]) for i in (3, 5))
+    highs = (np.maximum(rows(i), after[i]) for i in (4, 6))
+    (xmin, fmin), (xmax, fmax) = lows, highs
+    done, rec = rows(7) + after[7], rows(8) + after[8]
+    return xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, after[9], after[10], after[11]
 
 
 def lle_tolerances(settings: SimulationSettings) -> tuple[float, float]:
