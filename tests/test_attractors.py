@@ -238,3 +238,38 @@ def test_basin_picture_over_http_and_the_cli_say_the_same(
     assert main(["basins", str(doc), "--starts", "4"]) == 0
     out = capsys.readouterr().out
     assert "periodic" in out and "4 starts: 0 diverged" in out
+
+
+def test_a_chunk_runs_its_start_and_basin_starts_in_one_kernel_call(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A sweep chunk with basins: the settings' start and the basin starts are lanes of one
+    ``_run_lanes`` call, each forcing table and step plan built once, and the points are those
+    of the two separate calls (``simulate_batch``, then ``points_attractors``)."""
+    from gearengine.numerics import attractors as attractors_module
+    from gearengine.numerics import batch
+    from gearengine.studies.sweep import validated
+    from gearengine.studies.sweep.compute import compute_chunk
+
+    settings = {**ENVELOPE["settings"], "basins": {"starts": 4}, "transient_periods": 30,
+                "record_periods": 30}  # fmt: skip
+    axis = {"parameter": "speed", "start": "5700 rpm", "stop": "5800 rpm", "num": 3}
+    doc = {"design": ENVELOPE["design"], "settings": settings, "axes": [axis]}
+    request = validated(doc)
+    batch._table.cache_clear()
+    batch._plans.clear()
+    calls: list[int] = []
+    run = batch._run_lanes
+    monkeypatch.setattr(batch, "_run_lanes", lambda *a: calls.append(len(a[2])) or run(*a))
+    points = compute_chunk(request, 0, 3)
+    assert calls == [3 * (1 + 4)]  # one call: 3 points x (own start + 4 basin starts)
+    assert batch._table.cache_info().misses == 3 and len(batch._plans) == 3  # one a speed
+    designs = [request.scaled_point(p.values)[0] for p in points]
+    scales = [request.scaled_point(p.values)[1] for p in points]
+    alone = batch.simulate_batch(designs, request.settings)
+    found = attractors_module.points_attractors(designs, request.settings, scales)
+    assert calls[1:] == [3, 3 * 4]  # the two calls of before
+    assert batch._table.cache_info().misses == 3  # their tables were kept
+    for p, bp, (a, counts) in zip(points, alone, found, strict=True):
+        assert p.periods_run == bp.periods_run and p.poincare_x == [s[0] for s in bp.poincare]
+        assert p.attractors == a and p.basins == counts

@@ -17,7 +17,7 @@ import xmlschema
 from pydantic import ValidationError
 
 from gearengine.analysis import AnalysisRequest, analyze
-from gearengine.gate.envelope import Rules, envelope_report
+from gearengine.gate.envelope import Rules, check_envelope, check_or_failures, envelope_report
 from gearengine.homoclinic import melnikov
 from gearengine.homoclinic.boundary import flips
 from gearengine.model.design import EXAMPLE_DESIGN
@@ -125,6 +125,31 @@ def test_windows_and_failing_windows_of_a_rattling_design() -> None:
     assert envelope_report(result, Rules(fail_on=["diverged"])).passed
     impacts = envelope_report(result, Rules(fail_on=["diverged", "impacts"]))
     assert {f.rule for f in impacts.failures} == {"back-flank impacts"}
+
+
+def test_pass_or_fail_stops_at_the_first_failing_chunk(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``check_or_failures`` (a remedies bisection step) runs the chunks holding the points
+    expected to fail first and stops at the first chunk with a failure; a grid that passes
+    gives ``check_envelope``'s report, byte for byte."""
+    from gearengine.studies import jobs
+
+    doc = speed_sweep(rattling(), "1000 rpm", "2000 rpm", 6)
+    doc["axes"].append({"parameter": "torque", "start": "1 N*m", "stop": "3 N*m", "num": 2})
+    request = validated(doc)
+    full = check_envelope(request, Rules())
+    assert not full.passed
+    last = next(p for p in reversed(full.sweep.points) if p.classification == "chaotic")
+    ran: list[int] = []
+    compute = jobs.compute_chunk_json
+    monkeypatch.setattr(jobs, "compute_chunk_json", lambda *a: ran.append(a[2]) or compute(*a))
+    failing = check_or_failures(request, Rules(), first=[last.values])
+    assert isinstance(failing, list) and last.values in [p.values for p in failing]
+    assert ran == [full.sweep.points.index(last) // 3]  # the chunk (of 3 points) holding it
+    passing = Rules(fail_on=["diverged"])
+    report = check_or_failures(request, passing)
+    assert not isinstance(report, list)
+    assert report.model_dump_json() == check_envelope(request, passing, refine_failing=False
+                                                      ).model_dump_json()  # fmt: skip
 
 
 def gearengine(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:

@@ -8,11 +8,13 @@ import copy
 import json
 import math
 
+import numpy as np
 import pytest
 
 from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.gate.envelope import ENVELOPE_SETTINGS
 from gearengine.model.params import GearParams
+from gearengine.numerics import physical
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.physical import DAMPING_TIMES, RECORD_MESH
 from gearengine.numerics.runs import integrate
@@ -147,3 +149,29 @@ def test_diverging_run_stops_where_it_leaves_the_bound() -> None:
     assert r.classification == "diverged" and r.transient.reason == "diverged"
     (b,) = simulate_batch([bad], SimulationSettings())
     assert b.classification == "diverged" and b.periods_run < r.transient.periods + 1
+
+
+@pytest.mark.parametrize(
+    "point", [paper(0.2, we=1.0), paper(0.3, we=0.5, model="piecewise")], ids=["cubic", "piecewise"]
+)
+def test_a_record_run_on_is_the_longer_record_run_at_once(
+    point: GearParams, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A chaotic point whose first record (400 T0) leaves the LLE's error unmet runs on to 500
+    from where it ended (state, tangent vector, region of Eq. (8) carried by the lanes), not
+    again from the record's start: the same bits as running the 500 at once, 100 more T0."""
+    lengths, ran_on = physical.lengths, []
+
+    def counted(*args: object) -> list:
+        def extend(idx: np.ndarray, keeps: list, n: int) -> physical.Chunk:
+            ran_on.append(n)
+            return args[7](idx, keeps, n)  # type: ignore[operator]
+
+        return lengths(*args[:7], extend)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(physical, "lengths", counted)
+    (b,) = simulate_batch([point])
+    assert ran_on == [100] and (b.classification, b.periods_run) == ("chaotic", 1000)
+    monkeypatch.setattr(physical, "lengths", lambda *args: lengths(*args[:7]))  # run again
+    (again,) = simulate_batch([point])
+    assert again.model_dump() == b.model_dump()

@@ -27,8 +27,10 @@ from gearengine.gate.resolution import REFINE_DEPTH, Resolution, resolution
 from gearengine.gate.resolution import refine as refine_points
 from gearengine.model.units import OUTPUTS, POINT_OUTPUTS
 from gearengine.signals.classify import SEVERITY
+from gearengine.studies import jobs
 from gearengine.studies.sweep.compute import run_local
-from gearengine.studies.sweep.plan import balanced_chunk_points
+from gearengine.studies.sweep.export import points_of_chunk
+from gearengine.studies.sweep.plan import SweepPlan, balanced_chunk_points
 from gearengine.studies.sweep.points import PhysicalValue, SpeedWindows, SweepPoint
 from gearengine.studies.sweep.request import SweepRequest
 from gearengine.studies.sweep.results import SweepResult
@@ -255,6 +257,37 @@ def check_envelope(
     chunk = balanced_chunk_points(request.n_points(), workers, smallest=1)
     result = run_local(request, progress_callback, chunk_points=chunk, workers=workers)
     return refined_report(request, result, rules, refine, refine_failing, workers)
+
+
+def check_or_failures(request: SweepRequest, rules: Rules, refine: int = REFINE_DEPTH,
+                      first: Sequence[dict[str, float]] = ()
+                      ) -> EnvelopeReport | list[SweepPoint]:  # fmt: skip
+    """Pass or fail of an envelope sweep with the least work, where only that is needed (a
+    bisection step): the chunks of ``check_envelope`` (one worker) one by one, those holding a
+    grid point of ``first`` (values expected to fail) before the others, stopping at the first
+    chunk with a failing point: its failing points are returned. A grid that passes gives
+    ``check_envelope``'s report (refined), the same bits: the same chunks, assembled alike."""
+    job = jobs.kind("sweep")
+    size = balanced_chunk_points(request.n_points(), 1, smallest=1)
+    plan = SweepPlan(request, size)
+    grids = request.grids()
+    wanted = {tuple(v[a.parameter] for a in request.axes) for v in first}
+
+    def expected(i: int) -> bool:
+        return any(tuple(g[k] for g, k in zip(grids, ix, strict=True)) in wanted
+                   for ix in plan.chunk(i).points)  # fmt: skip
+
+    text = request.model_dump_json()
+    outputs = [""] * plan.n_chunks()
+    for i in sorted(range(plan.n_chunks()), key=lambda i: not expected(i)):
+        outputs[i] = jobs.compute_chunk_json("sweep", text, i, size)
+        points = [SweepPoint.model_validate(p) for p in points_of_chunk(outputs[i])]
+        failing = [p for p in points if attractor_failures(p, rules)]
+        if failing:
+            return failing
+    result = job.assemble(request, outputs)
+    assert isinstance(result, SweepResult)
+    return refined_report(request, result, rules, refine, refine_failing=False)
 
 
 def refined_report(request: SweepRequest, result: SweepResult, rules: Rules,

@@ -180,7 +180,8 @@ def sublevel_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
     # g's own extrema join the samples: a sign of g missed by the grid still bounds p
     g_ext = extrema(g)
     probes = np.concatenate([taus, [e.tau0 for e in (g_ext.minimum, g_ext.maximum) if e.tau0]])
-    mv, gv = m0(probes), g(probes)
+    table = _sines(probes.tobytes(), freqs.tobytes(), m0.phases.tobytes())  # m0's and g's
+    mv, gv = m0.offset + table @ m0.amplitudes, g.offset + table @ g.amplitudes
     lo, hi = _line_envelope(mv, gv)
     if (lo is not None and lo == np.inf) or (hi is not None and hi == -np.inf):
         return None  # a bound beyond every float: the set is empty
@@ -188,12 +189,41 @@ def sublevel_interval(m0: TrigSum, g: TrigSum) -> Interval | None:
     hi = None if hi is not None and hi == np.inf else hi
     if lo is not None and hi is not None and lo > hi:
         return None
-    args = (m0.offset, m0.amplitudes, g.offset, g.amplitudes, freqs, m0.phases, period, taus)
+    table = _root_table(taus.tobytes(), freqs.tobytes(), m0.phases.tobytes())
+    args = (m0.offset, m0.amplitudes, g.offset, g.amplitudes, freqs, m0.phases, period, taus, table)
     lo = None if lo is None else float(kernels.sublevel_root(*args, lo))
     hi = None if hi is None else float(kernels.sublevel_root(*args, hi))
     if lo is not None and hi is not None and lo > hi:
         return None
     return Interval(lo, hi)
+
+
+SINE_TABLES = 64
+"""Sine tables kept (``_sines``): the 16 threshold searches of one verdict (4 parameters x 2
+branches x both signs) share a grid, frequencies and phases."""
+
+
+@functools.lru_cache(maxsize=SINE_TABLES)
+def _sines(probes: bytes, frequencies: bytes, phases: bytes) -> np.ndarray:
+    """sin(Omega_i tau_j + phi_i), shape (taus, terms), of the float64 arrays whose bytes are
+    given (a key that hashes): the table ``TrigSum.__call__`` builds, the same bits, built once
+    for the sums that share frequencies and phases (M0 and g of every control parameter)."""
+    tau = np.frombuffer(probes, dtype=np.float64)
+    arg = np.multiply.outer(tau, np.frombuffer(frequencies, dtype=np.float64))
+    table = np.sin(arg + np.frombuffer(phases, dtype=np.float64))
+    table.flags.writeable = False
+    return table
+
+
+@functools.lru_cache(maxsize=SINE_TABLES)
+def _root_table(taus: bytes, frequencies: bytes, phases: bytes) -> np.ndarray:
+    """``kernels.sine_table`` of the float64 arrays whose bytes are given, for
+    ``kernels.sublevel_root``: built once for the searches that share them."""
+
+    def array(b: bytes) -> np.ndarray:
+        return np.frombuffer(b, dtype=np.float64).copy()  # writable: the compiled type
+
+    return kernels.sine_table(array(frequencies), array(phases), array(taus))
 
 
 @functools.lru_cache(maxsize=4096)

@@ -150,11 +150,17 @@ def grid_sines(freqs, phases, period: float):
     phases_i): the table is shared by both branches and by every amplitude of a Newton search."""
     n = grid_size(freqs, period)
     taus = np.arange(n) * (period / n)
-    table = np.empty((n, freqs.size))
-    for k in range(n):
+    return taus, sine_table(freqs, phases, taus)
+
+
+@jit
+def sine_table(freqs, phases, taus):
+    """S[k, i] = sin(freqs_i taus_k + phases_i), shape (taus, freqs)."""
+    table = np.empty((taus.size, freqs.size))
+    for k in range(taus.size):
         for i in range(freqs.size):
             table[k, i] = math.sin(freqs[i] * taus[k] + phases[i])
-    return taus, table
+    return table
 
 
 @jit
@@ -371,18 +377,16 @@ def scan_roots(omegas, xtol: float, value: float, terms, system):
 
 
 @jit
-def sublevel_root(m0off, m0amps, goff, gamps, freqs, phases, period, taus, p):
-    """Root near p of the convex phi(p) = max_tau0 (m0 + p g) (``extrema._newton_root``).
+def sublevel_root(m0off, m0amps, goff, gamps, freqs, phases, period, taus, table, p):
+    """Root near p of the convex phi(p) = max_tau0 (m0 + p g) (``extrema._newton_root``);
+    ``table`` is ``sine_table(freqs, phases, taus)``, built once for every search that shares
+    them (the 16 of a verdict's thresholds).
 
     Newton with phi'(p) = g(tau*) (envelope theorem), monotone from outside the sublevel set;
     at most 30 steps, stopping at a relative step of 1e-14.
     """
     amps = np.empty(m0amps.size)
     values = np.empty(taus.size)
-    table = np.empty((taus.size, freqs.size))
-    for k in range(taus.size):
-        for i in range(freqs.size):
-            table[k, i] = math.sin(freqs[i] * taus[k] + phases[i])
     for _ in range(30):
         off = m0off + p * goff
         for i in range(amps.size):

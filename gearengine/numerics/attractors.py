@@ -25,6 +25,7 @@ of the request alone. Fractions are count / starts with the 95 % Wilson score in
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -34,13 +35,13 @@ from gearengine.model.design import Design
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import ParamsOrDesign
 from gearengine.model.units import Scales, response_values
-from gearengine.numerics.batch import run_lanes, run_verdict, step_plans
+from gearengine.numerics.batch import run_lanes, run_verdict, simulate_batch_with, step_plans
 from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint
 from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import BasinSettings, SimulationSettings
 from gearengine.signals.classify import severity
 from gearengine.signals.periodicity import SIZE_FLOOR
-from gearengine.systems.base import System
+from gearengine.systems.base import StepPlan, System
 
 ORBIT_TOL = 1e-2
 """Distance, relative to the attractor size, within which two strobes are the same point."""
@@ -143,10 +144,17 @@ def cluster(points: list[BatchPoint], commensurate: bool) -> list[int]:
 
 def wilson(count: int, n: int) -> list[float]:
     """The 95 % Wilson score interval of count / n (scipy.stats.binomtest)."""
+    return list(_wilson(count, n))
+
+
+@functools.lru_cache(maxsize=4096)
+def _wilson(count: int, n: int) -> tuple[float, float]:
+    """``wilson``, computed once per (count, n) in a process: scipy's binomtest costs ~1.5 ms,
+    and a gate's points share a few counts out of the same number of starts."""
     from scipy.stats import binomtest
 
     ci = binomtest(count, n).proportion_ci(confidence_level=CONFIDENCE, method="wilson")
-    return [float(ci.low), float(ci.high)]
+    return float(ci.low), float(ci.high)
 
 
 def describe(classification: str, period: int | None, impact: str | None) -> str:
@@ -239,7 +247,34 @@ def points_attractors(
     starts = [basin_starts(basins, sc) for sc in scales]
     lanes = [(i, s) for i, ss in enumerate(starts) for s in ss]
     plans = step_plans(points, settings.steps_per_period)
-    runs = run_lanes(points, lanes, settings, plans)
+    return _grouped(plans, settings, scales, starts, run_lanes(points, lanes, settings, plans))
+
+
+def verdicts_and_attractors(
+    points: Sequence[GearParams | System],
+    settings: SimulationSettings,
+    scales: list[Scales | None],
+) -> tuple[list[BatchPoint], list[tuple[list[Attractor], BasinCounts]]]:
+    """``simulate_batch`` and ``points_attractors`` of the same points (a sweep's chunk with
+    basins), the settings' starts and the basin starts as lanes of one kernel call
+    (``batch.simulate_batch_with``): the same numbers as the two calls."""
+    basins = settings.basins or BasinSettings()
+    starts = [basin_starts(basins, sc) for sc in scales]
+    lanes = [(i, s) for i, ss in enumerate(starts) for s in ss]
+    verdicts, runs = simulate_batch_with(points, settings, lanes)
+    plans = step_plans(points, settings.steps_per_period)  # kept per process: the same plans
+    return verdicts, _grouped(plans, settings, scales, starts, runs)
+
+
+def _grouped(
+    plans: list[StepPlan],
+    settings: SimulationSettings,
+    scales: list[Scales | None],
+    starts: list[list[tuple[float, float]]],
+    runs: list[BatchPoint],
+) -> list[tuple[list[Attractor], BasinCounts]]:
+    """Each point's attractors and counts from the runs of its basin ``starts`` (in order)."""
+    basins = settings.basins or BasinSettings()
     out = []
     for i, (plan, sc) in enumerate(zip(plans, scales, strict=True)):
         mine = runs[i * len(starts[i]) : (i + 1) * len(starts[i])]

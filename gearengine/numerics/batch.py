@@ -11,6 +11,8 @@ forcing) run one by one in the single kernels (``numerics.runs``). Numbers equal
 
 from __future__ import annotations
 
+import functools
+import threading
 from collections.abc import Sequence
 
 import numba
@@ -34,7 +36,7 @@ from gearengine.signals.classify import DIVERGENCE_BOUND, severity
 from gearengine.systems.base import System
 from gearengine.systems.spur_pair import kernels
 from gearengine.systems.spur_pair.forcing import StepPlan, packed_forcing, step_plan
-from gearengine.systems.spur_pair.laws import LAWS, law
+from gearengine.systems.spur_pair.laws import LAWS, Carry, fresh_carry, law
 
 Lane = tuple[int, tuple[float, float]]
 """One run of a request: (index of its parameter point, initial state (x0, v0))."""
@@ -74,10 +76,9 @@ def _strobes(run: Run) -> np.ndarray:
 
 
 def step_plans(points: Sequence[Point], steps_per_period: int) -> list[StepPlan]:
-    """``step_plan`` of each point, computed once per set of active harmonics: the plan depends
-    only on the excitations' frequencies and which of their harmonics are active (a ``System``
-    point's own ``plan``)."""
-    known: dict[tuple, StepPlan] = {}
+    """``step_plan`` of each point, computed once per process for each set of active harmonics
+    (``PLANS``): the plan depends only on the excitations' frequencies and which of their
+    harmonics are active (a ``System`` point's own ``plan``)."""
     plans = []
     for p in points:
         if isinstance(p, System):
@@ -86,11 +87,39 @@ def step_plans(points: Sequence[Point], steps_per_period: int) -> list[StepPlan]
         key = (*(
             (name, exc.frequency, tuple(r for r, _ in exc.active()))
             for name, exc in p.excitations()
-        ), str(p.shaft_orders))  # fmt: skip
-        if key not in known:
-            known[key] = step_plan(p, steps_per_period)
-        plans.append(known[key])
+        ), str(p.shaft_orders), steps_per_period)  # fmt: skip
+        plan = _plans.get(key)
+        if plan is None:
+            plan = step_plan(p, steps_per_period)
+            with _plans_lock:
+                _plans[key] = plan
+                while len(_plans) > PLANS:
+                    _plans.pop(next(iter(_plans)))
+        plans.append(plan)
     return plans
+
+
+PLANS = 4096
+"""Step plans kept in this process (``step_plans``): an envelope's speeds give the same
+frequencies at every torque and every lever value of a remedies search, so its checks, their
+refinements and the basin starts of a chunk find the plan of an earlier call (the search for
+Omega_0 over the active frequencies costs ~1.5 ms a point)."""
+_plans: dict[tuple, StepPlan] = {}
+_plans_lock = threading.Lock()
+
+TABLES = 128
+"""Forcing tables kept in this process (``forcing_table``; 2N + 1 values of K and F each,
+~94 kB at N = 2,944, at most ~12 MB): the gate's refinement, the hints of a remedies search and
+a lever that leaves the forcing as it is (the damping) run the same points again."""
+
+
+@functools.lru_cache(maxsize=TABLES)
+def _table(period: float, N: int, kc: bytes, fm: float, fc: bytes) -> tuple[np.ndarray, np.ndarray]:
+    """``kernels.forcing_table`` of the packed forcing whose arrays (3, n) are the bytes
+    ``kc`` and ``fc`` (a key that hashes), computed once per process for the same bits."""
+    k = np.frombuffer(kc, dtype=np.float64).reshape(3, -1).copy()  # writable: the compiled type
+    f = np.frombuffer(fc, dtype=np.float64).reshape(3, -1).copy()
+    return kernels.forcing_table(period, N, k, fm, f)
 
 
 def run_lanes(
@@ -156,8 +185,8 @@ def _run_lanes(
         owner = np.array([lanes[k][0] for k in ks], dtype=np.int64)
         members, inverse = np.unique(owner, return_inverse=True)
         packed = [packed_forcing(points[i]) for i in members.tolist()]
-        tables = [kernels.forcing_table(plans[i].period, N, *f)
-                  for i, f in zip(members.tolist(), packed, strict=True)]  # fmt: skip
+        tables = [_table(plans[i].period, N, kc.tobytes(), fm, fc.tobytes())
+                  for i, (kc, fm, fc) in zip(members.tolist(), packed, strict=True)]  # fmt: skip
         per = np.array([plans[i].period for i in members.tolist()])[inverse]
         mu = np.array([points[i].damping for i in members.tolist()])[inverse]
         starts = np.array([lanes[k][1] for k in ks], dtype=np.float64).reshape(-1, 2)
@@ -178,7 +207,7 @@ def _run_lanes(
         streams = max(1, min(numba.get_num_threads(), -(-len(ks) // kernels.LANES)))
         shared = (per, N, settings.transient_periods, settings.record_periods, DIVERGENCE_BOUND,
                   settings.adaptive, streams, *lle_tolerances(settings))  # fmt: skip
-        out = lanes_of(laws, inverse, packed, mu, x0, v0, tabled, shared)
+        out = lanes_of(laws, inverse, packed, mu, x0, v0, tabled, shared, fresh_carry(len(ks)))
         verdicts = lane_verdicts(out, per)
         strobes = last_strobes(out, list(range(len(ks))))
         for j, k in enumerate(ks):
@@ -216,7 +245,9 @@ def physical_lanes(
 ) -> list[BatchPoint]:
     """The ``BatchPoint`` of every lane of one lock-step group, its lengths decided in physical
     time (``numerics.physical``): the transient and the record run in chunks through the same
-    lock-step kernel (no early stopping inside it); ``periods_run`` counts both.
+    lock-step kernel (no early stopping inside it), a longer record on from the end of the
+    shorter (``extend``: state and ``Carry`` from the kernel, the outputs ``joined``);
+    ``periods_run`` counts both.
 
     Args:
         group: (lanes kernel, laws of the points, point of each lane (L,), packed forcing,
@@ -226,22 +257,36 @@ def physical_lanes(
     """
     lanes_of, laws, inverse, packed, mu, tabled, per, N = group
 
-    def advance(idx: np.ndarray, xa: np.ndarray, va: np.ndarray, n: int) -> physical.Chunk:
+    def call(idx: np.ndarray, xa: np.ndarray, va: np.ndarray, n: int, carry: Carry) -> tuple:
         streams = max(1, min(numba.get_num_threads(), -(-idx.size // kernels.LANES)))
         owner = inverse[idx].astype(np.int64)
         shared = (per[idx], N, 0, n, DIVERGENCE_BOUND, False, streams, 0.0, 0.0)
-        out = lanes_of(laws, owner, packed, mu[idx], xa.copy(), va.copy(),
-                       (tabled[0], tabled[1], owner), shared)  # fmt: skip
+        return lanes_of(laws, owner, packed, mu[idx], xa.copy(), va.copy(),
+                        (tabled[0], tabled[1], owner), shared, carry)  # fmt: skip
+
+    def chunk(out: tuple, carry: Carry, idx: np.ndarray) -> physical.Chunk:
         xs, vs, logs, xmin, xmax, _, _, _, _, diverged, xf, vf = out
         per_of = per[idx]
-        keep = [(out, j, per_of) for j in range(idx.size)]
+        keep = [(out, j, per_of, carry) for j in range(idx.size)]
         return physical.Chunk(xs, vs, logs, xmin, xmax, xf, vf, diverged.astype(bool), keep)
 
-    spans = physical.lengths(advance, x0, v0, per, mu, N / settings.steps_per_period, settings)
+    def advance(idx: np.ndarray, xa: np.ndarray, va: np.ndarray, n: int) -> physical.Chunk:
+        carry = fresh_carry(idx.size)
+        return chunk(call(idx, xa, va, n, carry), carry, idx)
+
+    def extend(idx: np.ndarray, keeps: list[tuple], n: int) -> physical.Chunk:
+        rows = [(out, j) for out, j, _, _ in keeps]
+        dx, dv, reg = (np.array([c[i][j] for _, j, _, c in keeps]) for i in range(3))
+        xf, vf = (np.array([out[i][j] for out, j in rows]) for i in (10, 11))
+        carry = (dx, dv, reg)  # where each record ended: the kernel runs it on from there
+        return chunk(joined(rows, call(idx, xf, vf, n, carry)), carry, idx)
+
+    spans = physical.lengths(advance, x0, v0, per, mu, N / settings.steps_per_period, settings,
+                             extend)  # fmt: skip
     verdicts: dict[int, list[tuple]] = {}
     rows: dict[int, list[int]] = {}
     for s in spans:  # one verdict and one gather of strobes per kernel call
-        out, j, per_of = s.keep
+        out, j, per_of, _ = s.keep
         if id(out) not in verdicts:
             verdicts[id(out)], rows[id(out)] = lane_verdicts(out, per_of), []
         rows[id(out)].append(j)
@@ -252,12 +297,28 @@ def physical_lanes(
         strobes.update({(key, j): w for j, w in zip(rows[key], got, strict=True)})
     points = []
     for s in spans:
-        out, j, _ = s.keep
+        out, j, _, _ = s.keep
         point = lane_point(out, j, 0, verdicts[id(out)][j], strobes[(id(out), j)])
         n = out[0].shape[1]
         before = s.transient - (n if s.transient_reason == "diverged" else 0)
         points.append(point.model_copy(update={"periods_run": before + int(out[7][j])}))
     return points
+
+
+def joined(before: list[tuple[tuple, int]], after: tuple) -> tuple:
+    """The kernel outputs of records run on: lane k's earlier record, row ``before[k][1]`` of
+    the outputs ``before[k][0]``, followed by row k of ``after`` (the call that ran it on):
+    strobes and logs joined, extremes over both, intervals summed, the end state ``after``'s."""
+
+    def rows(i: int) -> np.ndarray:
+        return np.array([out[i][j] for out, j in before])
+
+    xs, vs, logs = (np.concatenate([rows(i), after[i]], axis=1) for i in range(3))
+    lows = (np.minimum(rows(i), after[i]) for i in (3, 5))
+    highs = (np.maximum(rows(i), after[i]) for i in (4, 6))
+    (xmin, fmin), (xmax, fmax) = lows, highs
+    done, rec = rows(7) + after[7], rows(8) + after[8]
+    return xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, after[9], after[10], after[11]
 
 
 def lle_tolerances(settings: SimulationSettings) -> tuple[float, float]:
@@ -278,20 +339,30 @@ def simulate_batch(
     such start on a tie), whose index in ``settings.starts()`` is ``start_index``. Numbers equal
     those of ``simulate`` for the same point and start.
     """
-    settings = settings or SimulationSettings()
+    return simulate_batch_with(points, settings or SimulationSettings(), [])[0]
+
+
+def simulate_batch_with(
+    points: Sequence[Point], settings: SimulationSettings, more: Sequence[Lane]
+) -> tuple[list[BatchPoint], list[BatchPoint]]:
+    """``simulate_batch`` of ``points`` and ``run_lanes`` of ``more`` lanes of the same points
+    (a chunk's basin starts), in one call of the kernels: one forcing table a point and one
+    pass of the lock-step chunks for both. The same numbers as two calls: a lane's run does
+    not depend on the lanes beside it."""
     starts = settings.starts()
     plans = step_plans(points, settings.steps_per_period)
     for plan in plans:
         check_work(settings, plan.steps)
     lanes = [(i, s) for i in range(len(points)) for s in starts]
-    per_lane = _run_lanes(points, plans, lanes, settings)
+    per_lane = _run_lanes(points, plans, [*lanes, *more], settings)
     S = len(starts)
     worst = []
     for i in range(len(points)):
         block = per_lane[i * S : (i + 1) * S]
         j = max(range(S), key=lambda j: severity(block[j].classification, block[j].period))
         worst.append(block[j].model_copy(update={"start_index": j}))
-    return worst
+    rest = [bp.model_copy(update={"start_index": k}) for k, bp in enumerate(per_lane[len(lanes) :])]
+    return worst, rest
 
 
 def threads_may_share_kernels() -> bool:

@@ -31,9 +31,8 @@ every lane, so a lane's numbers do not depend on the lanes it shares a kernel ca
 **Record**, from the transient's end state: R0 = ``RECORD_MESH`` mesh periods, at least
 ``BLOCKS`` periods p of the settled cycle (one cycle per block of the LLE's standard error),
 rounded up to a multiple of ``BLOCKS`` p; a response that did not settle on a cycle records at
-least ``LLE_RECORD_MESH`` mesh periods (2 ``BLOCKS`` intervals). The record is run again from
-the same state twice as long (so its LLE sums are one uninterrupted record's, as a fixed-length
-run's) until
+least ``LLE_RECORD_MESH`` mesh periods (2 ``BLOCKS`` intervals). The record is made twice as
+long (one uninterrupted record, so its LLE sums are a fixed-length run's) until
 
 * ``detect_period`` finds a period <= 64 in it ("period");
 * no period and the LLE's standard error over ``BLOCKS`` blocks is within the settings'
@@ -47,7 +46,10 @@ run's) until
 A run that leaves the divergence bound stops there ("diverged"). The driver is the same for the
 single kernels (``simulate``) and the lock-step lanes (``batch.run_lanes``): ``advance`` runs a
 set of lanes a given number of recorded intervals from given states through the existing
-kernels.
+kernels. A longer record runs on from the end of the shorter one where the kernels can carry
+the state, tangent vector and extremes across calls (``Extend``, the lock-step lanes): the same
+bits as running the longer record from the same start, at the cost of the extra intervals only;
+otherwise (the single kernels) it is run again from the record's start.
 """
 
 from __future__ import annotations
@@ -137,6 +139,12 @@ Advance = Callable[[np.ndarray, np.ndarray, np.ndarray, int], Chunk]
 """advance(lanes, x0, v0, n): the lanes (indices, shape (m,)) run n intervals T0 from (x0, v0),
 all recorded (no transient), through the kernels."""
 
+Extend = Callable[[np.ndarray, list[Any], int], Chunk]
+"""extend(lanes, keeps, n): the lanes run n more recorded intervals on from the end of the
+chunks whose handles are ``keeps`` (one a lane: state, tangent vector and the kernels' own state
+carried), the returned ``Chunk`` their whole records (the earlier intervals and the n new ones),
+with the numbers of one call running them all."""
+
 
 @dataclass
 class Lengths:
@@ -161,6 +169,7 @@ def lengths(
     mu: np.ndarray,
     mesh_per_T0: float,
     settings: SimulationSettings,
+    extend: Extend | None = None,
 ) -> list[Lengths]:
     """Run the transient and the record of every lane in physical time (see the module doc).
 
@@ -171,10 +180,11 @@ def lengths(
         mu: damping ratio of each lane's point, shape (L,).
         mesh_per_T0: r = T0 / T_f, shared by the lanes (same steps per T0).
         settings: caps (transient_periods, record_periods) and the LLE tolerances.
+        extend: runs records on (``Extend``); None: a longer record runs again from its start.
     """
     out = [Lengths() for _ in range(x0.size)]
     x, v = _settle(advance, x0.copy(), v0.copy(), period, mu, mesh_per_T0, settings, out)
-    _record(advance, x, v, period, mesh_per_T0, settings, out)
+    _record((advance, extend), x, v, period, mesh_per_T0, settings, out)
     return out
 
 
@@ -265,20 +275,26 @@ def _first_record(s: Lengths, r: float, cap: int) -> int:
     return min(cap, unit * math.ceil(n / unit))
 
 
-def _record(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, r: float,
-            settings: SimulationSettings, out: list[Lengths]) -> None:  # fmt: skip
-    """The record of every lane that did not diverge in its transient."""
+def _record(run: tuple[Advance, Extend | None], x: np.ndarray, v: np.ndarray, period: np.ndarray,
+            r: float, settings: SimulationSettings, out: list[Lengths]) -> None:  # fmt: skip
+    """The record of every lane that did not diverge in its transient: ``run`` is (advance,
+    extend) of ``lengths``."""
+    advance, extend = run
     cap = settings.record_periods
     want = {lane: _first_record(s, r, cap) for lane, s in enumerate(out)
             if s.transient_reason != "diverged"}  # fmt: skip
+    recorded: dict[int, int] = {}  # lanes whose record runs on: intervals recorded so far
     while want:
-        by_length: dict[int, list[int]] = {}
+        by_length: dict[tuple[int, int], list[int]] = {}
         for lane, n in want.items():
-            by_length.setdefault(n, []).append(lane)
-        want = {}
-        for n, lanes in by_length.items():
+            by_length.setdefault((n, recorded.get(lane, 0)), []).append(lane)
+        want, recorded = {}, {}
+        for (n, before), lanes in by_length.items():
             idx = np.array(lanes, dtype=np.int64)
-            c = advance(idx, x[idx], v[idx], n)
+            if before and extend is not None:
+                c = extend(idx, [out[lane].keep for lane in lanes], n - before)
+            else:
+                c = advance(idx, x[idx], v[idx], n)
             for j, lane in enumerate(lanes):
                 s = out[lane]
                 s.record, s.keep = n, c.keep[j]
@@ -293,6 +309,8 @@ def _record(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, 
                     s.transient_reason = "transient_extended"
                     x[lane], v[lane] = c.xf[j], c.vf[j]
                     nxt = n
+                elif extend is not None:
+                    recorded[lane] = n
                 want[lane] = nxt
 
 

@@ -38,6 +38,7 @@ from gearengine.gate.envelope import (
     EnvelopeReport,
     attractor_failures,
     check_envelope,
+    check_or_failures,
 )
 from gearengine.gate.remedies.levers import accuracy_classes, contact_ratio
 from gearengine.gate.remedies.request import (
@@ -234,14 +235,25 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
         return report.passed, report.failing_points
 
     def passes_at(value: float, finer: bool = False) -> bool:
-        """Pass or fail at ``value``: the grid points that failed last run first (``HINTS``);
-        one failing there fails the grid, the answer the full check would give."""
+        """Pass or fail at ``value``: the grid points that failed last run first (``HINTS``),
+        then the grid chunk by chunk, theirs first, to the first chunk with a failing point
+        (``check_or_failures``); one failing fails the grid, the answer the full check would
+        give. A grid that passes leaves its full report, refined."""
+        if (value, finer) in reports:
+            return reports[(value, finer)].passed
         sweep = request.sweep(design_with(request.design, {lever.path: value}), finer)
         names = [a.parameter for a in sweep.axes]
         hints = [{n: p.values[n] for n in names} for p in failed[finer][:HINTS]]
         if hints and any(attractor_failures(p, rules) for p in points_at(sweep, hints)):
             return False
-        return run(value, finer).passed
+        got = check_or_failures(sweep, rules, request.envelope.refine, hints)
+        if isinstance(got, list):
+            failed[finer] = got
+            return False
+        reports[(value, finer)] = got
+        if not got.passed:  # its refined points failed: the grid's failing points are none
+            failed[finer] = [p for p in got.sweep.points if attractor_failures(p, rules)]
+        return got.passed
 
     def snapped(value: float) -> float:
         """``value`` as the answer prints it (``SHOWN_DIGITS``, rounded toward the far end),

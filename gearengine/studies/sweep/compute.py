@@ -23,7 +23,12 @@ from gearengine.model.units import (
     shown,
     to_physical,
 )
-from gearengine.numerics.attractors import coexisting, headline, points_attractors
+from gearengine.numerics.attractors import (
+    coexisting,
+    headline,
+    points_attractors,
+    verdicts_and_attractors,
+)
 from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
 from gearengine.numerics.bifurcations import PointResponse, locate_bifurcations
 from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint
@@ -135,8 +140,7 @@ def _compute(
     scaled = [request.scaled_point(v) for v in values]
     designs = [params for params, _ in scaled]
     if not request.continuation:
-        return _points(request, values, chunk.branch, scaled,
-                       simulate_batch(designs, request.settings)), None  # fmt: skip
+        return _points(request, values, chunk.branch, scaled), None
     verdicts = []
     settings = request.settings
     for design in designs:
@@ -155,16 +159,22 @@ def points_at(request: SweepRequest, values: list[dict[str, float]]) -> list[Swe
     point's ``values``), not only its grid's: each computed as a grid point is (the same
     settings, starts and verdict), e.g. the gate's refinement between grid points."""
     assert not request.continuation, "a continuation line's points depend on their order"
-    scaled = [request.scaled_point(v) for v in values]
-    verdicts = simulate_batch([params for params, _ in scaled], request.settings)
-    return _points(request, values, None, scaled, verdicts)
+    return _points(request, values, None, [request.scaled_point(v) for v in values])
 
 
 def _points(request: SweepRequest, values: list[dict[str, float]], branch: SweepBranch | None,
-            scaled: list[tuple[GearParams, Scales | None]], verdicts: list[BatchPoint]
-            ) -> list[SweepPoint]:  # fmt: skip
-    """The sweep's points from the engine's verdicts at ``values``, with their ensembles."""
-    ensembles = _basins(request, scaled, verdicts)
+            scaled: list[tuple[GearParams, Scales | None]],
+            verdicts: list[BatchPoint] | None = None) -> list[SweepPoint]:  # fmt: skip
+    """The sweep's points from the engine's verdicts at ``values`` (None: computed here, with
+    the basin starts in the same kernel call), with their ensembles."""
+    designs = [params for params, _ in scaled]
+    if verdicts is None and request.settings.basins is not None:
+        verdicts, found = verdicts_and_attractors(designs, request.settings,
+                                                  [sc for _, sc in scaled])  # fmt: skip
+        ensembles = _ensembles(request, found, verdicts)
+    else:
+        verdicts = simulate_batch(designs, request.settings) if verdicts is None else verdicts
+        ensembles = _basins(request, scaled, verdicts)
     return [
         _point(v, branch, params, scales, bp, e)
         for v, (params, scales), bp, e in zip(values, scaled, verdicts, ensembles, strict=True)
@@ -184,6 +194,14 @@ def _basins(
         return [{} for _ in scaled]
     designs = [params for params, _ in scaled]
     found = points_attractors(designs, request.settings, [sc for _, sc in scaled])
+    return _ensembles(request, found, verdicts)
+
+
+def _ensembles(request: SweepRequest, found: list[tuple[list[Attractor], BasinCounts]],
+               verdicts: list[BatchPoint]) -> list[dict[str, Any]]:  # fmt: skip
+    """Per point, its attractors and basin counts ``found``, the verdict they decide, and on a
+    continuation line the attractors coexisting with the followed branch."""
+    assert request.settings.basins is not None
     min_fraction = request.settings.basins.min_fraction
     out: list[dict[str, Any]] = [
         {"attractors": a, "basins": c, **_decided(a, c, min_fraction)} for a, c in found

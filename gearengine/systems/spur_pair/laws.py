@@ -65,25 +65,40 @@ def run_kink(lw: Law, mu: float, start: Sequence[float], forcing: tuple, plan: S
 
 
 LanesKernel = Callable[..., tuple]
-"""A lock-step call: (laws, inverse, packed, mu, x0, v0, tables, shared) -> kernel outputs, laws
-one per parameter point, ``inverse`` the point of each lane (see ``numerics.batch``)."""
+"""A lock-step call: (laws, inverse, packed, mu, x0, v0, tables, shared, carry) -> kernel
+outputs, laws one per parameter point, ``inverse`` the point of each lane (see
+``numerics.batch``), ``carry`` the lanes' ``Carry``."""
+
+Carry = tuple[np.ndarray, np.ndarray, np.ndarray]
+"""What a lane's run carries from one lock-step call into the next, shape (L,) each: its tangent
+vector (dx, dv) and its region of Eq. (8) (the piecewise law's; ``kernels.NO_REGION``: that of
+x0). The kernels start each lane from it and overwrite it with where the lane ended, so a
+record run on from a call's end has the numbers of one longer call."""
+
+
+def fresh_carry(lanes: int) -> Carry:
+    """The ``Carry`` of runs started afresh: tangent (1, 1)/sqrt 2, the region of x0."""
+    tangent = np.full(lanes, kernels.SQRT1_2)
+    return tangent, tangent.copy(), np.full(lanes, kernels.NO_REGION, dtype=np.int64)
 
 
 def lanes_cubic(laws: list[Law], inverse: np.ndarray, packed: list, mu: np.ndarray,
-                x0: np.ndarray, v0: np.ndarray, tabled: tuple, shared: tuple) -> tuple:  # fmt: skip
+                x0: np.ndarray, v0: np.ndarray, tabled: tuple, shared: tuple,
+                carry: Carry) -> tuple:  # fmt: skip
     a = np.array([lw.a for lw in laws])[inverse]
     c = np.array([lw.c for lw in laws])[inverse]
-    return kernels.run_batch(a, c, mu, x0, v0, *tabled, *shared)
+    return kernels.run_batch(a, c, mu, x0, v0, carry[0], carry[1], *tabled, *shared)
 
 
 def lanes_piecewise(laws: list[Law], inverse: np.ndarray, packed: list, mu: np.ndarray,
-                    x0: np.ndarray, v0: np.ndarray, tabled: tuple,
-                    shared: tuple) -> tuple:  # fmt: skip
+                    x0: np.ndarray, v0: np.ndarray, tabled: tuple, shared: tuple,
+                    carry: Carry) -> tuple:  # fmt: skip
     alpha = np.array([lw.alpha for lw in laws])[inverse]
     kc, nk = padded_terms([f[0] for f in packed])
     fc, nf = padded_terms([f[2] for f in packed])
     fm = np.array([f[1] for f in packed])
-    return kernels.run_kink_batch(alpha, mu, x0, v0, *tabled, kc, nk, fm, fc, nf, *shared)
+    return kernels.run_kink_batch(alpha, mu, x0, v0, *carry, *tabled, kc, nk, fm, fc, nf,
+                                  *shared)  # fmt: skip
 
 
 def padded_terms(terms: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:

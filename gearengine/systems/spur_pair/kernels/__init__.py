@@ -41,7 +41,7 @@ from pathlib import Path
 
 from gearengine.jitcache import drop_stale
 from gearengine.systems.spur_pair.kernels.kink import run_kink
-from gearengine.systems.spur_pair.kernels.kinklanes import run_kink_batch
+from gearengine.systems.spur_pair.kernels.kinklanes import NO_REGION, run_kink_batch
 from gearengine.systems.spur_pair.kernels.lockstep import LANES, run_batch
 from gearengine.systems.spur_pair.kernels.monodromy import monodromy
 from gearengine.systems.spur_pair.kernels.smooth import (
@@ -55,6 +55,7 @@ from gearengine.systems.spur_pair.kernels.smooth import (
 
 __all__ = [
     "LANES",
+    "NO_REGION",
     "SQRT1_2",
     "forcing_at",
     "forcing_table",

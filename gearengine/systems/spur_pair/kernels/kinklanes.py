@@ -26,6 +26,8 @@ of h (|v0| + |v1|): a step whose bound stays strictly inside its region has no s
 ``kink.kink_split`` outside it, so it is accepted without that test."""
 ROUNDING_MARGIN = 1e-9
 """Absolute margin (units of b) added to that bound for the rounding of the samples."""
+NO_REGION = 2
+"""``regc`` of a run that starts in the region of its x0 (not -1, 0 or 1)."""
 
 
 @njit(**JIT_OPTIONS)
@@ -55,6 +57,9 @@ def run_kink_batch(
     mu: np.ndarray,
     x0: np.ndarray,
     v0: np.ndarray,
+    dxc: np.ndarray,
+    dvc: np.ndarray,
+    regc: np.ndarray,
     Ktab: np.ndarray,
     Ftab: np.ndarray,
     owner: np.ndarray,
@@ -91,6 +96,10 @@ def run_kink_batch(
     Args:
         alpha, mu, x0, v0, T: per-run slope of Eq. (8) inside the clearance, damping, initial
             state and period T0, shape (P,).
+        dxc, dvc, regc: the tangent vector and region of Eq. (8) each run starts in, shape (P,),
+            overwritten with those it ends in, as ``run_batch``'s tangent (the region is
+            carried too: at a kink it follows the direction of motion, not x alone);
+            ``NO_REGION`` for the region of x0.
         Ktab, Ftab: forcing tables from ``forcing_table`` of the M parameter points, shape
             (M, 2N+1); owner: the point of each run, shape (P,), values in 0..M-1.
         kc, fc: forcing coefficients of the points (``systems.spur_pair.forcing.packed_forcing``)
@@ -106,8 +115,8 @@ def run_kink_batch(
     xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf = new_outputs(P, n_rec)
     for stream in prange(streams):  # one call per stream: tuples stay out of the parfor
         _kink_stream(
-            stream, streams, alpha, mu, x0, v0, Ktab, Ftab, owner, kc, nk, fm, fc, nf, T, N,
-            n_trans, n_rec, bound, adaptive, lle_rel, lle_abs,
+            stream, streams, alpha, mu, x0, v0, dxc, dvc, regc, Ktab, Ftab, owner, kc, nk, fm,
+            fc, nf, T, N, n_trans, n_rec, bound, adaptive, lle_rel, lle_abs,
             xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf,
         )  # fmt: skip
     return xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf
@@ -121,6 +130,9 @@ def _kink_stream(
     mu,
     x0,
     v0,
+    dxc,
+    dvc,
+    regc,
     Ktab,
     Ftab,
     owner,
@@ -216,7 +228,9 @@ def _kink_stream(
             H6[lane] = H[lane] / 6.0
             X[lane] = x0[p]
             V[lane] = v0[p]
-            REG[lane] = region(x0[p])
+            DX[lane] = dxc[p]
+            DV[lane] = dvc[p]
+            REG[lane] = region(x0[p]) if regc[p] == NO_REGION else regc[p]
             S[lane], O[lane] = _law_slope_offset(REG[lane], alpha[p])
             LO[lane], HI[lane] = _region_interval(REG[lane])
         if active == 0:
@@ -300,3 +314,5 @@ def _kink_stream(
             ):  # fmt: skip
                 NEED[lane] = True
                 active -= 1
+                p = PT[lane]
+                dxc[p], dvc[p], regc[p] = DX[lane], DV[lane], REG[lane]

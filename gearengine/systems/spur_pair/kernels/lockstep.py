@@ -27,6 +27,8 @@ def run_batch(
     mu: np.ndarray,
     x0: np.ndarray,
     v0: np.ndarray,
+    dxc: np.ndarray,
+    dvc: np.ndarray,
     Ktab: np.ndarray,
     Ftab: np.ndarray,
     owner: np.ndarray,
@@ -64,6 +66,10 @@ def run_batch(
     Args:
         a, c, mu, x0, v0, T: per-point law coefficients, damping, initial state and period T0,
             shape (P,).
+        dxc, dvc: the tangent vector each point starts from, shape (P,), overwritten with the
+            (renormalised) one it ends with: a record continued by a second call from the first
+            one's final state and tangent has the numbers of one call running on
+            (``numerics.physical``); (1, 1)/sqrt 2 for a fresh start.
         Ktab, Ftab: forcing tables from ``forcing_table`` of the M parameter points, shape
             (M, 2N+1); owner: the point of each lane's run, shape (P,), values in 0..M-1 (the
             runs of a point share its table).
@@ -83,8 +89,8 @@ def run_batch(
     xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf = new_outputs(P, n_rec)
     for stream in prange(streams):  # one call per stream: tuples stay out of the parfor
         _cubic_stream(
-            stream, streams, a, c, mu, x0, v0, Ktab, Ftab, owner, T, N, n_trans, n_rec, bound,
-            adaptive, lle_rel, lle_abs,
+            stream, streams, a, c, mu, x0, v0, dxc, dvc, Ktab, Ftab, owner, T, N, n_trans, n_rec,
+            bound, adaptive, lle_rel, lle_abs,
             xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf,
         )  # fmt: skip
     return xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf
@@ -99,6 +105,8 @@ def _cubic_stream(
     mu,
     x0,
     v0,
+    dxc,
+    dvc,
     Ktab,
     Ftab,
     owner,
@@ -182,6 +190,8 @@ def _cubic_stream(
             H6[lane] = H[lane] / 6.0
             X[lane] = x0[p]
             V[lane] = v0[p]
+            DX[lane] = dxc[p]
+            DV[lane] = dvc[p]
         if active == 0:
             break
         for j in range(N):
@@ -236,3 +246,4 @@ def _cubic_stream(
             ):  # fmt: skip
                 NEED[lane] = True
                 active -= 1
+                dxc[PT[lane]], dvc[PT[lane]] = DX[lane], DV[lane]
