@@ -16,6 +16,7 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
 
 from gearengine.engineering import IMPACT_WORDS, Engineering, engineering
+from gearengine.homoclinic.boundary import design_windows
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
 from gearengine.homoclinic.train_reduction import train_melnikov
 from gearengine.homoclinic.verdict import melnikov, not_applicable
@@ -236,6 +237,10 @@ def analyze(
         mel, conv, no_windows = melnikov(system), request.conversion, None
     else:
         mel, conv, no_windows = train_answer(train)
+    scan = None
+    if conv is not None:  # the speed windows right after the verdict, handed to engineering
+        speeds = request.speed_rpm_range()
+        scan = design_windows(conv.params, conv.speed_rpm, speeds, mel, no_windows is None)
     num = simulate(system, settings)
     if conv is not None and train is None:  # the pair's run lengths in seconds too
         ts = conv.time_scale_s
@@ -250,7 +255,7 @@ def analyze(
                             verdict=verdict(mel, num, decided))  # fmt: skip
     if conv is None:
         return result
-    eng = engineering(conv, request.speed_rpm_range(), mel, num, decided, no_windows)
+    eng = engineering(conv, speeds, mel, scan, num, decided, no_windows)
     if train is None:
         return result.model_copy(update={"params": conv.params, "engineering": eng})
     notes = [f"gear train: {train.model.size} coordinates; numerics of the train, scales of "
@@ -289,7 +294,9 @@ def answer_melnikov(request: MelnikovRequest) -> MelnikovResult:
     conv = request.conversion
     if conv is None:
         return mel
-    eng = engineering(conv, request.speed_rpm_range(), mel)
+    speeds = request.speed_rpm_range()
+    scan = design_windows(conv.params, conv.speed_rpm, speeds, mel)
+    eng = engineering(conv, speeds, mel, scan)
     return MelnikovAnswer(**dict(mel), params=conv.params, engineering=eng)
 
 
@@ -318,6 +325,6 @@ def convert(request: DesignRequest) -> DesignReport:
     if conv is None:
         raise InputError("design", "give a design (physical units) to convert")
     mel = melnikov(conv.params)
-    return DesignReport(
-        conversion=conv, engineering=engineering(conv, request.speed_rpm_range(), mel)
-    )
+    speeds = request.speed_rpm_range()
+    scan = design_windows(conv.params, conv.speed_rpm, speeds, mel)
+    return DesignReport(conversion=conv, engineering=engineering(conv, speeds, mel, scan))

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from gearengine.homoclinic.boundary import WINDOW_BOUND, speed_window_scan
+from gearengine.homoclinic.boundary import WINDOW_BOUND
 from gearengine.homoclinic.coefficients import T_CRIT_WHY
 from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
 from gearengine.model.aliases import get_alias
@@ -218,16 +218,6 @@ def critical_torque(conv: DesignConversion, mel: MelnikovResult) -> float | None
     return to_physical("mesh_force", mel.critical_mean_force, conv.scales) * r_a
 
 
-def over_critical(conv: DesignConversion, mel: MelnikovResult) -> bool:
-    """True when the design's mean load leaves no saddle (|F~_m| >= F_crit, mean load in the
-    unperturbed system): the criterion does not apply at this torque."""
-    return (
-        mel.mean_load == "unperturbed"
-        and mel.critical_mean_force is not None
-        and abs(conv.params.mean_force) >= mel.critical_mean_force
-    )
-
-
 def load_words(conv: DesignConversion, f_crit: float, t_crit: float) -> str:
     """Why the criterion does not apply at this torque (F~_m >= F_crit), in gear words."""
     fm, b_um = conv.params.mean_force, to_physical("displacement", 1.0, conv.scales)
@@ -303,13 +293,15 @@ def summary(
     num: NumericsResult | None,
     decided: Headline | None,
     t_crit: float | None,
+    over: bool,
 ) -> str:
     """Two or three sentences an engineer can paste into a design review; with basins the
     response named is the worst attractor's above the basin threshold (``decided``, with its
     fraction and LLE), and the contact, DTE, dynamic factor and the LLE that follow are the
     recorded run's when that run settled elsewhere (said so); ``t_crit`` the critical torque
-    (``critical_torque``)."""
-    f_crit = mel.critical_mean_force if over_critical(conv, mel) and t_crit is not None else None
+    (``critical_torque``); ``over`` True above the critical load (no saddle, no speed windows
+    looked for)."""
+    f_crit = mel.critical_mean_force if over and t_crit is not None else None
     if f_crit or not mel.applicable:  # its load, or its notes' reason (a train, no reduction)
         why = load_words(conv, f_crit, t_crit) if f_crit and t_crit else mel.notes[0]
         text = f"At {conv.speed_rpm:,.0f} rpm the Melnikov criterion does not apply: {why}."
@@ -363,16 +355,19 @@ def engineering(
     conv: DesignConversion,
     rpm_range: tuple[float, float],
     mel: MelnikovResult,
+    scan: tuple[list[list[float]], float] | None,
     num: NumericsResult | None = None,
     decided: Headline | None = None,
     no_windows: str | None = None,
 ) -> Engineering:
     """The engineering block of a design's Melnikov verdict (and analysis, given ``num``;
-    ``decided`` the worst attractor of its basins, ``numerics.attractors.headline``).
+    ``decided`` the worst attractor of its basins, ``numerics.attractors.headline``) from the
+    values handed to it: ``scan`` the speed windows [rpm] and the end of their scan
+    (``homoclinic.boundary.design_windows``, None above the critical load).
     ``no_windows``: why the speed windows are not looked for (a train without a Melnikov
     reduction), said in their note; the range stays the scan's."""
-    params = conv.params  # the values of this file first, then the rooms below
-    t_crit, over = critical_torque(conv, mel), over_critical(conv, mel)
+    params = conv.params
+    t_crit = critical_torque(conv, mel)
     crit = {
         CONTROLS[name]: critical(name, t, conv.scales)
         for name, t in mel.thresholds.items()
@@ -381,12 +376,11 @@ def engineering(
     resp = None if num is None else response(params, num, conv)
     note = None
     lo, hi = rpm_range
-    if over and t_crit is not None:
+    if scan is None:  # no saddle at this load: a critical torque exists
         windows: list[list[float]] = []
         note = f"not applicable above T_crit = {t_crit:,.3g} N*m: {T_CRIT_WHY}"
     else:
-        find = no_windows is None
-        windows, hi = speed_window_scan(params, conv.speed_rpm, lo, hi, mel.mean_load, find)
+        windows, hi = scan
         if windows and windows[-1][1] >= hi and hi > rpm_range[1]:
             note = (
                 f"the window from {windows[-1][0]:,.0f} rpm is open-ended: chaos is still "
@@ -410,6 +404,6 @@ def engineering(
         critical=crit,
         derived=conv.derived,
         response=resp,
-        summary=summary(conv, mel, windows, (lo, hi), resp, num, decided, t_crit),
+        summary=summary(conv, mel, windows, (lo, hi), resp, num, decided, t_crit, scan is None),
         notes=conv.notes,
     )

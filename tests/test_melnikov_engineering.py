@@ -103,3 +103,24 @@ def test_an_open_ended_window_says_so() -> None:
     assert eng.speed_range_rpm[1] == pytest.approx(15_000.0)
     assert eng.speed_windows_rpm[-1][1] == pytest.approx(15_000.0)
     assert "open-ended" in eng.speed_windows_note
+
+
+def test_engineering_reads_the_speed_windows_handed_to_it() -> None:
+    """The speed-window scan runs once at the top (``homoclinic.boundary.design_windows``,
+    right after the verdict) and the engineering block reads the windows handed to it; it
+    scans nothing itself, and None (no saddle at this load) reads as no windows."""
+    from gearengine.engineering import engineering
+    from gearengine.homoclinic.boundary import design_windows
+
+    request = MelnikovRequest.model_validate({"design": LIGHT})
+    conv, speeds = request.conversion, request.speed_rpm_range()
+    mel = melnikov(conv.params)
+    scan = design_windows(conv.params, conv.speed_rpm, speeds, mel)
+    assert scan is not None
+    assert engineering(conv, speeds, mel, scan) == answer(LIGHT).engineering
+    made_up = engineering(conv, speeds, mel, ([[1000.0, 1200.0]], speeds[1]))
+    assert made_up.speed_windows_rpm == [[1000.0, 1200.0]]
+    heavy = MelnikovRequest.model_validate({"design": EXAMPLE_DESIGN})
+    mel = melnikov(heavy.conversion.params)
+    assert design_windows(heavy.conversion.params, heavy.conversion.speed_rpm,
+                          heavy.speed_rpm_range(), mel) is None  # fmt: skip

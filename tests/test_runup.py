@@ -10,6 +10,7 @@ import json
 import math
 from collections.abc import Callable
 from pathlib import Path
+from types import SimpleNamespace
 
 import httpx
 import numpy as np
@@ -289,3 +290,35 @@ def test_a_jump_caught_half_way_by_a_bin_is_one_jump() -> None:
         (150.0, 10.0, 50.0),
         (250.0, 50.0, 12.0),
     ]
+
+
+def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.MonkeyPatch) -> None:
+    """check --runup: each torque level's run-up carries the envelope's validated design at
+    the level's torque (not a dump of it read again: its own unit readings stay), with the
+    same ramp; nothing is re-validated from a document per level."""
+    import gearengine.gate.runup as gate
+    from gearengine.gate.envelope import EnvelopeReport
+    from gearengine.studies.runup.results import RunupResult
+    from gearengine.studies.sweep.request import validated as sweep_request
+
+    seen: list[RunupRequest] = []
+
+    def fake_run(request: RunupRequest, workers: int = 1) -> RunupResult:
+        seen.append(request)
+        return RunupResult.model_construct(up=None, down=None)
+
+    monkeypatch.setattr(gate, "run_local", fake_run)
+    doc = json.loads((ROOT / "examples" / "ci" / "design.json").read_text())
+    sweep = sweep_request({"design": doc.get("design", doc), "axes": [
+        {"parameter": "speed", "start": "3500 rpm", "stop": "4500 rpm", "num": 5},
+        {"parameter": "torque", "start": "10 N*m", "stop": "40 N*m", "num": 2}]})  # fmt: skip
+    levels = [{"torque": SimpleNamespace(value=t)} for t in (10.0, 40.0)]
+    windows = [SimpleNamespace(level=lv) for lv in levels]
+    sweep_result = SimpleNamespace(windows=windows)
+    report = EnvelopeReport.model_construct(failures=[], rules=Rules(), sweep=sweep_result)
+    gate.gate_envelope(report, sweep, 1000.0)
+    assert [r.design.torque for r in seen] == [10.0, 40.0]
+    for r in seen:
+        assert r.design.readings == sweep.design.readings
+        assert r.design.model_copy(update={"torque": sweep.design.torque}) == sweep.design
+        assert (r.from_speed, r.to_speed) == (seen[0].from_speed, seen[0].to_speed)

@@ -16,7 +16,8 @@ from collections.abc import Callable
 from gearengine.gate.envelope import BACK_FLANK, EnvelopeReport, FailingWindow, Rules
 from gearengine.model.units import RPM
 from gearengine.studies.runup.compute import run_local
-from gearengine.studies.runup.profile import validated
+from gearengine.studies.runup.profile import checked
+from gearengine.studies.runup.request import RunupRequest
 from gearengine.studies.runup.results import RunupBin, RunupResult
 from gearengine.studies.sweep.points import PhysicalValue
 from gearengine.studies.sweep.request import SweepRequest
@@ -91,24 +92,29 @@ def gate_envelope(
 ) -> EnvelopeReport:  # fmt: skip
     """``report`` with the failing windows of a run-up and run-down at ``rate_rpm_s`` [rpm/s]
     through the envelope sweep's speed range (its grid step as the bins) at each of its torque
-    levels. Raises ``ValidationError`` naming the field of a bad ramp."""
-    assert sweep.design is not None
-    axes = {a.parameter: (a, g) for a, g in zip(sweep.axes, sweep.grids(), strict=True)}
-    axis, grid = axes["speed"]
+    levels. Raises ``ValidationError`` naming the field of a bad ramp.
+
+    The sweep's design is validated already (every corner of its grid, ``request_errors``):
+    each level's run-up carries it, at the level's torque, as the validated ``Design`` it is,
+    not as a document to read again."""
+    design = sweep.design
+    assert design is not None
+    axis = next(a for a in sweep.axes if a.parameter == "speed")
+    grid = axis.values(design)
     lo, hi = grid[0] / RPM, grid[-1] / RPM
     if axis.num < 2 or not lo < hi:
         raise ValueError("--runup: give the envelope a speed range, --speed LOW:HIGH")
+    ramp = {
+        "from_speed": f"{lo!r} rpm", "to_speed": f"{hi!r} rpm",
+        "rate": f"{rate_rpm_s!r} rpm/s", "direction": "up_down",
+        "bin_rpm": (hi - lo) / (axis.num - 1), "ensemble": {"size": GATE_ENSEMBLE},
+    }  # fmt: skip
     levels = [w.level for w in report.sweep.windows or []] or [{}]
-    design = sweep.design.model_dump()
     failures = list(report.failures)
     for k, level in enumerate(levels):
-        torque = level["torque"].value if "torque" in level else sweep.design.torque
-        request = validated({
-            "design": {**design, "torque": torque},
-            "from_speed": f"{lo!r} rpm", "to_speed": f"{hi!r} rpm",
-            "rate": f"{rate_rpm_s!r} rpm/s", "direction": "up_down",
-            "bin_rpm": (hi - lo) / (axis.num - 1), "ensemble": {"size": GATE_ENSEMBLE},
-        })  # fmt: skip
+        at_level = design if "torque" not in level else (
+            design.model_copy(update={"torque": level["torque"].value}))  # fmt: skip
+        request = checked(RunupRequest.model_validate({"design": at_level, **ramp}))
         failures += runup_failures(run_local(request, workers=workers), report.rules, level)
         if progress is not None:
             progress(k + 1, len(levels))

@@ -21,6 +21,7 @@ from collections.abc import Callable
 import numpy as np
 
 from gearengine.homoclinic.coefficients import MeanLoad
+from gearengine.homoclinic.schemas import MelnikovResult
 from gearengine.homoclinic.thresholds import strength_at
 from gearengine.model.aliases import with_speed_factor
 from gearengine.model.params import GearParams
@@ -120,3 +121,19 @@ def speed_window_scan(
         return [], top
     scan = WINDOW_SCAN if top == hi else math.ceil(WINDOW_SCAN * (top - lo) / (hi - lo))
     return chaos_intervals(path, lo, top, scan, mean_load), top
+
+
+def design_windows(
+    params: GearParams, speed_rpm: float, rpm_range: tuple[float, float],
+    mel: MelnikovResult, find: bool = True,
+) -> tuple[list[list[float]], float] | None:  # fmt: skip
+    """``speed_window_scan`` of the design at ``speed_rpm`` over ``rpm_range`` [rpm] with the
+    mean load of its verdict ``mel``; None when the mean load F~_m (Eq. 9) leaves no saddle
+    (|F~_m| >= F_crit, mean load in the unperturbed system): the criterion does not apply at
+    this load and there are no windows to look for. Computed once at the top (``analysis``)
+    and handed to the engineering block."""
+    f_crit = mel.critical_mean_force
+    if mel.mean_load == "unperturbed" and f_crit is not None and abs(params.mean_force) >= f_crit:
+        return None
+    lo, hi = rpm_range
+    return speed_window_scan(params, speed_rpm, lo, hi, mel.mean_load, find)
