@@ -305,8 +305,9 @@ def _melnikov_said(blind: int, passed: bool) -> str:
     grid = Resolution(speed_points=23, torque_points=5, speed_step_rpm=227.3,
                       torque_step_nm=13.75, starts=16, depth=0,
                       finest_speed_step_rpm=227.3)  # fmt: skip
-    check = EnvelopeReport.model_construct(passed=passed, points=115,
-                                           failing_points=0 if passed else 3, resolution=grid)
+    check = EnvelopeReport.model_construct(
+        passed=passed, points=115, failing_points=0 if passed else 3, resolution=grid
+    )
     mel = Remedy.model_construct(lever=ACCURACY_FIELD, from_=11.3, to=4.0, unit="um",
                                  bound="melnikov", monotone=True, iso1328_class=None,
                                  not_applicable_points=blind, melnikov_points=115,
@@ -326,8 +327,10 @@ def test_melnikov_guarantee_only_where_the_criterion_applies() -> None:
     # said "or lower ... to 4 um (... no guarantee ...)" beside "no value ... clears")
     assert said(115).startswith("no single lever clears the envelope; ")
     assert "guarantee against homoclinic chaos at the 40 of 115 points" in said(75)
-    assert "(Melnikov guarantee against homoclinic chaos; the envelope check passes there " \
+    assert (
+        "(Melnikov guarantee against homoclinic chaos; the envelope check passes there "
         "(checked on 23 x 5 grid (227.3 rpm x 13.75 N*m), 16 starts a point;" in said(0)
+    )
 
 
 def test_no_melnikov_guarantee_where_the_check_fails() -> None:
