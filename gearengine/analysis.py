@@ -17,6 +17,7 @@ from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
 
 from gearengine.engineering import IMPACT_WORDS, Engineering, engineering
 from gearengine.homoclinic.boundary import design_windows
+from gearengine.homoclinic.coefficients import T_CRIT_WHY
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
 from gearengine.homoclinic.train_reduction import train_melnikov
 from gearengine.homoclinic.verdict import melnikov, not_applicable
@@ -146,8 +147,9 @@ class AnalysisResult(BaseModel):
             lo, hi = eng.speed_range_rpm
             spans = ", ".join(f"{a:,.0f}-{b:,.0f}" for a, b in eng.speed_windows_rpm) or "nowhere"
             scanned = f"{spans} rpm (scanned {lo:,.0f}-{hi:,.0f} rpm)"
-            if eng.speed_windows_note and not eng.speed_windows_rpm:
-                line += f"; Melnikov speed windows: {eng.speed_windows_note}"
+            if eng.speed_windows_note and not eng.speed_windows_rpm:  # why T_crit: the block's
+                note = eng.speed_windows_note.removesuffix(f": {T_CRIT_WHY}")
+                line += f"; Melnikov speed windows: {note}"
             else:
                 line += f"; Melnikov chaos possible at {scanned}"
         return line
