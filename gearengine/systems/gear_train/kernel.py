@@ -36,23 +36,34 @@ drop_stale("kernel", [Path(__file__), Path(smooth.__file__)], _HERE / "__pycache
 
 
 @njit(**JIT_OPTIONS)
-def train_forcing(
-    t: float, kc: np.ndarray, ec: np.ndarray, tc: np.ndarray
+def forcing_at_phase(
+    psi: float, omega: float, kc: np.ndarray, ec: np.ndarray, tc: np.ndarray
 ) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
-    """K(t), e(t), e'(t) and T(t) at dimensionless time t (module docstring)."""
+    """K, e, e' and T at driver phase psi turning at the rate omega = dpsi/dtau (orders q in
+    row 1 of each table): K = 1 + sum kc0 cos(q psi + kc2), e = sum ec0 cos(q psi + ec2),
+    e' = -sum ec0 q omega sin(q psi + ec2), T = sum tc0 cos(q psi + tc2)."""
     K = 1.0
     for i in range(kc.shape[1]):
-        K += kc[0, i] * math.cos(kc[1, i] * t + kc[2, i])
+        K += kc[0, i] * math.cos(kc[1, i] * psi + kc[2, i])
     e = 0.0
     ed = 0.0
     for i in range(ec.shape[1]):
-        arg = ec[1, i] * t + ec[2, i]
+        arg = ec[1, i] * psi + ec[2, i]
         e += ec[0, i] * math.cos(arg)
-        ed -= ec[0, i] * ec[1, i] * math.sin(arg)
+        ed -= ec[0, i] * ec[1, i] * omega * math.sin(arg)
     T = 0.0
     for i in range(tc.shape[1]):
-        T += tc[0, i] * math.cos(tc[1, i] * t + tc[2, i])
+        T += tc[0, i] * math.cos(tc[1, i] * psi + tc[2, i])
     return K, e, ed, T
+
+
+@njit(**JIT_OPTIONS)
+def train_forcing(
+    t: float, kc: np.ndarray, ec: np.ndarray, tc: np.ndarray
+) -> tuple[float, float, float, float]:  # pragma: no cover - compiled
+    """K(t), e(t), e'(t) and T(t) at dimensionless time t (module docstring): the phase is t
+    at unit rate (times 1.0 is exact: the same bits as the sum written out)."""
+    return forcing_at_phase(t, 1.0, kc, ec, tc)
 
 
 @njit(**JIT_OPTIONS)

@@ -24,7 +24,7 @@ from numba import njit
 
 from gearengine.jitcache import drop_stale
 from gearengine.systems.gear_train import kernel
-from gearengine.systems.gear_train.kernel import train_step
+from gearengine.systems.gear_train.kernel import forcing_at_phase, train_step
 from gearengine.systems.spur_pair.kernels import smooth
 from gearengine.systems.spur_pair.kernels.ramp import BLOCK_COLUMNS, TANGENT_FLOOR
 from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, law_force, region
@@ -45,19 +45,7 @@ def ramp_train_forcing(
     """K, e, e' and T at tau = t after the segment's start; ``ramp`` = (Omega_0, beta, psi_0)."""
     omega = ramp[0] + ramp[1] * t
     psi = ramp[2] + ramp[0] * t + 0.5 * ramp[1] * t * t
-    K = 1.0
-    for i in range(kc.shape[1]):
-        K += kc[0, i] * math.cos(kc[1, i] * psi + kc[2, i])
-    e = 0.0
-    ed = 0.0
-    for i in range(ec.shape[1]):
-        arg = ec[1, i] * psi + ec[2, i]
-        e += ec[0, i] * math.cos(arg)
-        ed -= ec[0, i] * ec[1, i] * omega * math.sin(arg)
-    T = 0.0
-    for i in range(tc.shape[1]):
-        T += tc[0, i] * math.cos(tc[1, i] * psi + tc[2, i])
-    return K, e, ed, T
+    return forcing_at_phase(psi, omega, kc, ec, tc)
 
 
 @njit(**JIT_OPTIONS)
