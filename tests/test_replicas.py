@@ -138,11 +138,8 @@ def test_a_replica_killed_mid_job_loses_only_its_chunk(
 ) -> None:
     with replicas(tmp_path, database_url, 2) as (a, b):
         job = httpx.post(a.url + "/v1/sweeps", json=SWEEP, timeout=30).json()
-        held = poll(
-            lambda: (store.commit_log(job["id"]), leases(store, job["id"])),
-            lambda s: len(s[0]) >= 2 and a.proc.pid in s[1].values(),
-        )[1]
-        interrupted = [idx for idx, pid in held.items() if pid == a.proc.pid]
+        poll(lambda: store.commit_log(job["id"]), lambda log: len(log) >= 2)
+        interrupted = stopped_holding_leases(a, store, job["id"])
         children = pool_workers(a)
         os.kill(a.proc.pid, signal.SIGKILL)
         a.proc.wait()
@@ -158,15 +155,16 @@ def test_a_replica_killed_mid_job_loses_only_its_chunk(
     assert all(store.attempts(job["id"])[idx] == 2 for idx in interrupted)
 
 
-def stopped_holding_a_lease(worker: Worker, store: JobStore, job_id: str) -> int:
-    """SIGSTOP ``worker`` at a moment it holds a chunk's lease (a chunk computing in its pool
-    process); returns the chunk's index."""
+def stopped_holding_leases(worker: Worker | Server, store: JobStore, job_id: str) -> list[int]:
+    """SIGSTOP ``worker``'s dispatcher at a moment it holds chunk leases (chunks computing in
+    its pool process); returns their indices. Read after the stop, so none of them can still be
+    committed by it (a lease read before the stop may be committed before a kill lands)."""
     while True:
         poll(lambda: leases(store, job_id), lambda held: worker.proc.pid in held.values())
         os.kill(worker.proc.pid, signal.SIGSTOP)
         held = [i for i, pid in leases(store, job_id).items() if pid == worker.proc.pid]
         if held:
-            return held[0]
+            return held
         os.kill(worker.proc.pid, signal.SIGCONT)  # it committed in between: try again
 
 
@@ -182,7 +180,7 @@ def test_a_worker_whose_heartbeat_stops_mid_chunk_loses_the_lease_and_cannot_com
         frozen, other = Worker(database_url), None
         try:
             poll(lambda: store.commit_log(job["id"]), lambda log: len(log) >= 1)
-            stalled = stopped_holding_a_lease(frozen, store, job["id"])
+            stalled = stopped_holding_leases(frozen, store, job["id"])[0]
             other = Worker(database_url)
             url = f"{api.url}/v1/sweeps/{job['id']}"
             assert poll_url(url, finished)["status"] == "succeeded"
