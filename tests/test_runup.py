@@ -343,3 +343,17 @@ def test_the_assembly_reads_the_design_converted_with_the_plan(
     assert len(calls) == 1  # its plan's: reading the members converts no more
     monkeypatch.undo()
     assert result == run_local(r)
+
+
+def test_a_pair_run_up_converts_its_design_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The members integrate the pair that validation converted: the plan converts no more."""
+    import gearengine.systems.designs as designs
+    from gearengine.studies.runup.profile import runup_plan
+
+    r = validated(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s"))
+    conversions = []
+    convert = designs.convert_design
+    monkeypatch.setattr(designs, "convert_design", lambda d: conversions.append(d) or convert(d))
+    plan = runup_plan(r)
+    assert conversions == [] and plan.conversion is r.conversion
+    assert plan.system.params == r.params
