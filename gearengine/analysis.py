@@ -26,12 +26,13 @@ from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
-from gearengine.numerics.attractors import Headline, attractors, coexistence, headline
+from gearengine.numerics.attractors import Headline, coexistence, headline, planned_attractors
 from gearengine.numerics.physical import in_seconds
 from gearengine.numerics.results import NumericsResult
-from gearengine.numerics.settings import RequestSettings, SimulationSettings
+from gearengine.numerics.runs import as_system
+from gearengine.numerics.settings import RequestSettings, SimulationSettings, plan_work
 from gearengine.numerics.simulation import simulate
-from gearengine.systems.base import System
+from gearengine.systems.base import StepPlan, System
 from gearengine.systems.designs import design_model
 from gearengine.systems.gear_train.modes import modes
 from gearengine.systems.gear_train.system import TrainSystem
@@ -52,17 +53,20 @@ class AnalysisRequest(ParamsOrDesign):
         "(0.01, 0.01)).",
     )
     _system: GearParams | System | None = PrivateAttr(None)
+    _plan: StepPlan | None = PrivateAttr(None)
 
     @model_validator(mode="after")
     def _carry_system(self) -> AnalysisRequest:
         """Build what the numerics run once, when the request is validated: its params, or
-        for a design with a ``train`` its ``TrainSystem`` (``systems.designs.design_model``);
-        the budget check, the analysis and the basins job all read it from here."""
+        for a design with a ``train`` its ``TrainSystem`` (``systems.designs.design_model``),
+        and its RK4 step plan at ``settings.steps_per_period``; the budget check, the
+        analysis and the basins job all read them from here."""
         design = self.design
         if design is not None and design.train is not None:
             self._system = design_model(design)[0]
         else:
             self._system = self.params
+        self._plan = as_system(self._system).plan(self.settings.steps_per_period)
         return self
 
     @property
@@ -70,6 +74,19 @@ class AnalysisRequest(ParamsOrDesign):
         """What the numerics run: the pair's params, or the train's ``TrainSystem``."""
         assert self._system is not None
         return self._system
+
+    @property
+    def plan(self) -> StepPlan:
+        """The RK4 step plan of ``system`` at ``settings.steps_per_period`` (the runs and the
+        basin starts share it: a copy with other basins keeps it)."""
+        assert self._plan is not None
+        return self._plan
+
+    @property
+    def work(self) -> int:
+        """RK4 steps of the analysis, basin starts included (``numerics.settings.plan_work``),
+        for the compute budgets."""
+        return plan_work(self.system, self.settings, self.plan)
 
 
 class Verdict(BaseModel):
@@ -250,7 +267,8 @@ def analyze(
                                      "record": in_seconds(num.record, ts)})  # fmt: skip
     decided = None
     if settings.basins is not None:  # the worst attractor above min_fraction decides
-        found, counts = attractors(system, settings, None if conv is None else conv.scales)
+        scales = None if conv is None else conv.scales
+        found, counts = planned_attractors(system, settings, request.plan, scales)
         num = num.model_copy(update={"attractors": found, "basins": counts})
         decided = headline(found, counts, settings.basins.min_fraction)
     result = AnalysisResult(melnikov=mel, numerics=num, settings=settings,

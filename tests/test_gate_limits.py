@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from gearengine.cli.documents import InvalidInputError
+from gearengine.cli.documents import InvalidInputError, read_document
 from gearengine.cli.envelope import envelope_request
 from gearengine.cli.main import build_parser, main
 from gearengine.gate.envelope import Rules, point_failures, verdict_failures
@@ -125,12 +125,12 @@ def test_envelope_settings_merge_over_the_light_defaults(tmp_path: Path) -> None
     path.write_text(json.dumps({**doc, "settings": {"random_initial_states": starts}}))
     args = argparse.Namespace(file=str(path), speed="1000:2000", speed_points=3, torque=None,
                               starts=1)  # fmt: skip
-    settings = envelope_request(args).settings
+    settings = envelope_request(args, read_document(str(path))).settings
     assert (settings.transient_periods, settings.record_periods) == (60, 60)
     assert settings.steps_per_period == 128 and settings.random_initial_states.count == 4
     path.write_text(json.dumps({**doc, "settings": [1]}))
     with pytest.raises(InvalidInputError, match="settings must be an object"):
-        envelope_request(args)
+        envelope_request(args, read_document(str(path)))
 
 
 @pytest.mark.parametrize(

@@ -123,3 +123,19 @@ def test_the_result_names_the_units_of_its_points_values(design_file: Path, tmp_
     document = json.loads(out.read_text())
     assert document["values_units"] == {"speed": "rad/s"}
     assert document["shown_units"] == {"speed": "rpm"}
+
+
+def test_samples_auto_reads_a_design_from_standard_input_once(
+    design_file: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every round of ``--samples auto`` studies the one document ``check`` read: from standard
+    input the second round used to read it again, find it empty and exit 2."""
+    import io
+
+    import gearengine.cli.robustness as robustness
+
+    monkeypatch.setattr(robustness, "decided", lambda result, limits: result.samples >= 128)
+    monkeypatch.setattr("sys.stdin", io.StringIO(design_file.read_text()))
+    args = ["check", "-", "--samples", "auto", "--max-probability", "impacts=0.4"]
+    assert main(args) == 1  # the design point impacts in most samples
+    assert "--samples auto: decided at 128 samples" in capsys.readouterr().err

@@ -322,3 +322,38 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
         assert r.design.readings == sweep.design.readings
         assert r.design.model_copy(update={"torque": sweep.design.torque}) == sweep.design
         assert (r.from_speed, r.to_speed) == (seen[0].from_speed, seen[0].to_speed)
+
+
+def test_the_assembly_reads_the_design_converted_with_the_plan(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The plan carries the conversion its system was built with: assembling a run-up converts
+    the design once (for its plan), not a second time to read the members."""
+    from gearengine.studies.runup.compute import RUNUP_JOB, chunk_counts
+    from gearengine.studies.runup.profile import runup_plan
+
+    r = validated(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s",
+                           settle_periods=0, ensemble={"size": 1}))  # fmt: skip
+    assert runup_plan(r).conversion == r.model()[1]
+    chunks = [compute_chunk(r, i) for i in range(len(chunk_counts(r, 1)))]
+    calls = []
+    model = RunupRequest.model
+    monkeypatch.setattr(RunupRequest, "model", lambda self: calls.append(1) or model(self))
+    result = RUNUP_JOB.assemble(r, chunks)
+    assert len(calls) == 1  # its plan's: reading the members converts no more
+    monkeypatch.undo()
+    assert result == run_local(r)
+
+
+def test_a_pair_run_up_converts_its_design_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The members integrate the pair that validation converted: the plan converts no more."""
+    import gearengine.systems.designs as designs
+    from gearengine.studies.runup.profile import runup_plan
+
+    r = validated(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s"))
+    conversions = []
+    convert = designs.convert_design
+    monkeypatch.setattr(designs, "convert_design", lambda d: conversions.append(d) or convert(d))
+    plan = runup_plan(r)
+    assert conversions == [] and plan.conversion is r.conversion
+    assert plan.system.params == r.params

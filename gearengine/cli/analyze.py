@@ -11,7 +11,14 @@ from __future__ import annotations
 import argparse
 
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
-from gearengine.cli.documents import EXIT_FAIL, EXIT_OK, InvalidInputError, read_request
+from gearengine.cli.documents import (
+    EXIT_FAIL,
+    EXIT_OK,
+    InvalidInputError,
+    read_document,
+    read_request,
+    validated_input,
+)
 from gearengine.cli.envelope import cmd_envelope, physical_limits, rules_of
 from gearengine.cli.melnikov import fmt_value, render_engineering, render_melnikov
 from gearengine.gate.envelope import Rules, verdict_failures
@@ -103,13 +110,14 @@ def failures(r: AnalysisResult, rules: Rules, min_margin: float | None = None) -
 def cmd_check(args: argparse.Namespace) -> int:
     """CI gate: exit 0 pass, 1 fail, 2 invalid input; one summary line. With --speed or
     --torque, the gate over the operating envelope (``cli.envelope``); with --max-probability,
-    over the design's tolerances (``cli.robustness``)."""
+    over the design's tolerances (``cli.robustness``). The document is read once, here."""
+    doc = read_document(args.file)
     if args.max_probability:
         from gearengine.cli.robustness import cmd_probability_gate
 
-        return cmd_probability_gate(args)
+        return cmd_probability_gate(args, doc)
     if args.speed or args.torque:
-        return cmd_envelope(args)
+        return cmd_envelope(args, doc)
     if args.starts is not None or args.min_basin is not None or args.json or args.junit or \
             args.server:  # fmt: skip
         raise InvalidInputError(
@@ -118,7 +126,7 @@ def cmd_check(args: argparse.Namespace) -> int:
                 "--speed LOW:HIGH (rpm) and/or --torque LOW:HIGH (N m)"
             ]
         )
-    request = read_request(args.file, AnalysisRequest)
+    request = validated_input(AnalysisRequest.model_validate, doc, args.file)
     rules = rules_of(args)
     if request.design is None and physical_limits(rules):
         raise InvalidInputError(

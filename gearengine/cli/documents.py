@@ -14,6 +14,7 @@ from typing import TypeVar
 from pydantic import BaseModel, ValidationError
 
 from gearengine.jsonio import error_lines, load_document
+from gearengine.studies import jobs
 
 EXIT_OK, EXIT_FAIL, EXIT_INVALID = 0, 1, 2
 EXIT_PIPE = 141
@@ -90,6 +91,16 @@ def axis_options(axes: list[dict[str, object]], given: list[int], name: str = "a
 def read_request(path: str, model: type[R]) -> R:
     """Read and validate a request document from a file or ``-`` (stdin)."""
     return validated_input(model.model_validate, read_document(path), path)
+
+
+def counted_points(axes: object, noun: str) -> int:
+    """The operating points of ``axes`` (``points_of``), refused over the job limit
+    (``studies.jobs.too_many_points``) before the request's checks cost each point's design."""
+    n = points_of(axes)
+    why = jobs.too_many_points(n, noun)
+    if why is not None:
+        raise InvalidInputError([why])
+    return n
 
 
 def points_of(axes: object) -> int:

@@ -30,8 +30,7 @@ from gearengine.cli.documents import (
     EXIT_OK,
     InvalidInputError,
     axis_options,
-    points_of,
-    read_document,
+    counted_points,
     validated_input,
 )
 from gearengine.cli.junit import envelope_junit
@@ -82,9 +81,8 @@ def option_axes(args: argparse.Namespace, design: dict | None = None) -> list[di
     return axes
 
 
-def envelope_request(args: argparse.Namespace) -> SweepRequest:
-    """The speed x torque sweep of the design file under ``args``."""
-    doc = read_document(args.file)
+def envelope_request(args: argparse.Namespace, doc: object) -> SweepRequest:
+    """The speed x torque sweep of the design document ``doc`` (``args.file`` read)."""
     if not isinstance(doc, dict) or "design" not in doc:
         raise InvalidInputError([f'{args.file}: an envelope check needs {{"design": {{...}}}}'])
     design = doc["design"]
@@ -98,13 +96,10 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
         axes,
         f"envelope check of {Path(args.file).name}",
     )
-    n = points_of(axes)
-    if n > jobs.MAX_JOB_POINTS:  # before the sweep's checks build its grids
-        raise InvalidInputError([f"this envelope check has {n} points, the limit is "
-                                 f"{jobs.MAX_JOB_POINTS} (max_job_points)"])  # fmt: skip
+    counted_points(axes, "envelope check")  # before the sweep's checks build its grids
     given = [i for i, name in enumerate(["speed", "torque"]) if getattr(args, name)]
     request = validated_input(validated, sweep, args.file, axis_options(axes, given))
-    why = jobs.over_budget("sweep", request, n, "envelope check")
+    why = jobs.over_budget("sweep", request, "envelope check")
     if why is not None:
         raise InvalidInputError([f"{why}, or run it on a server (--server URL)"])
     return request
@@ -252,8 +247,9 @@ def spans_text(spans: list[list[float]]) -> str:
     return ", ".join(f"{a:g}" if a == b else f"{a:g}-{b:g}" for a, b in spans) + " rpm"
 
 
-def cmd_envelope(args: argparse.Namespace) -> int:
-    """The envelope gate; exit 0 pass, 1 fail, 2 invalid input."""
+def cmd_envelope(args: argparse.Namespace, doc: object) -> int:
+    """The envelope gate of the design document ``doc``; exit 0 pass, 1 fail, 2 invalid
+    input."""
     if args.min_stability_margin is not None:
         raise InvalidInputError(
             [
@@ -261,7 +257,7 @@ def cmd_envelope(args: argparse.Namespace) -> int:
                 "multipliers): drop --speed/--torque, or check each operating point"
             ]
         )
-    request = envelope_request(args)
+    request = envelope_request(args, doc)
     rules = rules_of(args)
     print(settings_text(request.settings), file=sys.stderr)
     tick = progress(time.monotonic(), "envelope")

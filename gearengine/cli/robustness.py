@@ -18,7 +18,7 @@ from gearengine.cli.documents import (
     EXIT_OK,
     InvalidInputError,
     axis_options,
-    points_of,
+    counted_points,
     read_document,
     validated_input,
 )
@@ -41,10 +41,9 @@ GATED = ("chaotic", "quasi_periodic", "diverged", "separation", "impacts", "back
 """Probabilities a gate may limit (``impacts``: the older name of ``separation``, noted)."""
 
 
-def robustness_request(args: argparse.Namespace) -> RobustnessRequest:
-    """The study of the design file under ``args`` (its tolerances; light settings unless the
-    file gives its own; axes from --speed/--torque)."""
-    doc = read_document(args.file)
+def robustness_request(args: argparse.Namespace, doc: object) -> RobustnessRequest:
+    """The study of the design document ``doc`` (``args.file`` read; its tolerances; light
+    settings unless the file gives its own; axes from --speed/--torque)."""
     if not isinstance(doc, dict) or "design" not in doc:
         raise InvalidInputError([f'{args.file}: a robustness study needs {{"design": {{...}}}}'])
     axes = option_axes(args)
@@ -58,23 +57,20 @@ def robustness_request(args: argparse.Namespace) -> RobustnessRequest:
             "samples": args.samples, "seed": args.seed}  # fmt: skip
     if getattr(args, "sensitivity", False):
         body["sensitivity"] = True
-    n = points_of(body["axes"])
-    if n > jobs.MAX_JOB_POINTS:  # before the study's checks cost each point's design
-        raise InvalidInputError([f"this robustness study has {n} points, the limit is "
-                                 f"{jobs.MAX_JOB_POINTS} (max_job_points)"])  # fmt: skip
+    counted_points(body["axes"], "robustness study")
     options = {"samples": "--samples", "seed": "--seed",
                **axis_options(axes, list(range(len(axes))))}  # fmt: skip
     request = validated_input(
         lambda d: checked(RobustnessRequest.model_validate(d)), body, args.file, options
     )
-    why = jobs.over_budget("robustness", request, n, "robustness study")
+    why = jobs.over_budget("robustness", request, "robustness study")
     if why is not None:
         raise InvalidInputError([why])
     return request
 
 
-def study(args: argparse.Namespace) -> tuple[RobustnessRequest, RobustnessResult]:
-    request = robustness_request(args)
+def study(args: argparse.Namespace, doc: object) -> tuple[RobustnessRequest, RobustnessResult]:
+    request = robustness_request(args, doc)
     tick = progress(time.monotonic(), "robustness")
     return request, run_local(request, tick, workers=os.cpu_count() or 1)
 
@@ -137,7 +133,7 @@ def junit(result: RobustnessResult, why: list[list[str]], name: str) -> str:
 
 def cmd_robustness(args: argparse.Namespace) -> int:
     """Run the study; print one line per point; --json and --plot write the outputs."""
-    request, result = study(args)
+    request, result = study(args, read_document(args.file))
     for p in result.points:
         pr = p.probabilities
         words = ", ".join(
@@ -205,15 +201,16 @@ def decided(result: RobustnessResult, limits: dict[str, float]) -> bool:
 
 
 def sequential_study(
-    args: argparse.Namespace, limits: dict[str, float], least: int
+    args: argparse.Namespace, doc: object, limits: dict[str, float], least: int
 ) -> RobustnessResult:
     """``--samples auto``: from the fewest samples that can prove the limits, doubled (the
     seeded Sobol points of 2N begin with those of N) until every point is decided or
-    ``AUTO_SAMPLES`` is reached."""
+    ``AUTO_SAMPLES`` is reached; every round studies the one document ``doc`` (read once:
+    standard input too)."""
     n = max(least, 64)
     while True:
         args.samples = n
-        _, result = study(args)
+        _, result = study(args, doc)
         if decided(result, limits) or n >= AUTO_SAMPLES:
             state = "decided" if decided(result, limits) else "still undecided"
             print(f"--samples auto: {state} at {n} samples", file=sys.stderr)
@@ -221,17 +218,18 @@ def sequential_study(
         n *= 2
 
 
-def cmd_probability_gate(args: argparse.Namespace) -> int:
-    """``check --max-probability``: exit 1 where an upper bound exceeds its limit; a sample
-    count that cannot prove a limit is refused before computing (``samples_needed``)."""
+def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
+    """``check --max-probability`` of the design document ``doc``: exit 1 where an upper bound
+    exceeds its limit; a sample count that cannot prove a limit is refused before computing
+    (``samples_needed``)."""
     limits, notes = limits_of(args.max_probability)
     for note in notes:
         print(f"note: {note}")
     least = samples_needed(limits, args.samples)
     if args.samples == "auto":
-        result = sequential_study(args, limits, least)
+        result = sequential_study(args, doc, limits, least)
     else:
-        _, result = study(args)
+        _, result = study(args, doc)
     why = failures(result, limits)
     print(f"probabilities from {result.samples} samples, {result.starts_text()}")
     for p, reasons in zip(result.points, why, strict=True):

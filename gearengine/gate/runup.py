@@ -16,8 +16,7 @@ from collections.abc import Callable
 from gearengine.gate.envelope import BACK_FLANK, EnvelopeReport, FailingWindow, Rules
 from gearengine.model.units import RPM
 from gearengine.studies.runup.compute import run_local
-from gearengine.studies.runup.profile import checked
-from gearengine.studies.runup.request import RunupRequest
+from gearengine.studies.runup.profile import validated
 from gearengine.studies.runup.results import RunupBin, RunupResult
 from gearengine.studies.sweep.points import PhysicalValue
 from gearengine.studies.sweep.request import SweepRequest
@@ -114,7 +113,7 @@ def gate_envelope(
     for k, level in enumerate(levels):
         at_level = design if "torque" not in level else (
             design.model_copy(update={"torque": level["torque"].value}))  # fmt: skip
-        request = checked(RunupRequest.model_validate({"design": at_level, **ramp}))
+        request = validated({"design": at_level, **ramp})
         failures += runup_failures(run_local(request, workers=workers), report.rules, level)
         if progress is not None:
             progress(k + 1, len(levels))

@@ -220,11 +220,23 @@ def attractors(
         The attractors, and the ``BasinCounts`` with each start's label (its attractor's index
         in the returned list, -1 diverged, -2 unsettled).
     """
+    spp = settings.steps_per_period
+    plan = params.plan(spp) if isinstance(params, System) else step_plans([params], spp)[0]
+    return planned_attractors(params, settings, plan, scales)
+
+
+def planned_attractors(
+    params: GearParams | System,
+    settings: SimulationSettings,
+    plan: StepPlan,
+    scales: Scales | None = None,
+) -> tuple[list[Attractor], BasinCounts]:
+    """``attractors`` on ``plan``, the step plan of ``params`` at ``settings.steps_per_period``
+    made already (an ``analysis.AnalysisRequest`` carries it, made once when validated)."""
     if isinstance(params, GearParams):
-        return points_attractors([params], settings, [scales])[0]
+        return _lanes_attractors([params], settings, [scales], [plan])[0]
     basins = settings.basins or BasinSettings()
     starts = basin_starts(basins, scales)
-    plan = params.plan(settings.steps_per_period)
     runs = [run_verdict(integrate(params, settings, params.start_state(*s)), s, plan, k)
             for k, s in enumerate(starts)]  # fmt: skip
     return _group(plan.omega0 is not None, scales, basins, starts, runs)
@@ -243,10 +255,20 @@ def points_attractors(
         settings: as for ``attractors``.
         scales: per point, its scales or None, shape (P,).
     """
+    plans = step_plans(points, settings.steps_per_period)
+    return _lanes_attractors(points, settings, scales, plans)
+
+
+def _lanes_attractors(
+    points: Sequence[GearParams | System],
+    settings: SimulationSettings,
+    scales: list[Scales | None],
+    plans: list[StepPlan],
+) -> list[tuple[list[Attractor], BasinCounts]]:
+    """``points_attractors`` on the points' step ``plans``, shape (P,)."""
     basins = settings.basins or BasinSettings()
     starts = [basin_starts(basins, sc) for sc in scales]
     lanes = [(i, s) for i, ss in enumerate(starts) for s in ss]
-    plans = step_plans(points, settings.steps_per_period)
     return _grouped(plans, settings, scales, starts, run_lanes(points, lanes, settings, plans))
 
 

@@ -22,7 +22,7 @@ from pydantic import (
 from gearengine.model.errors import InputError
 from gearengine.model.params import Finite, GearParams, WholeNumber, not_both, request_config
 from gearengine.model.units import QUANTITIES, parse_quantity
-from gearengine.systems.base import System
+from gearengine.systems.base import StepPlan, System
 from gearengine.systems.spur_pair.forcing import step_plan
 
 MAX_PERIODS = 100_000
@@ -352,12 +352,18 @@ def run_steps(settings: SimulationSettings, steps: int) -> int:
 
 
 def work(params: GearParams | System, settings: SimulationSettings) -> int:
-    """RK4 steps ``simulate(params, settings)`` takes (for compute budgets); a ``System``'s
-    steps count ``System.step_cost`` each (a train's, raised for stiff shafts, 3)."""
-    if isinstance(params, System):
-        steps = params.plan(settings.steps_per_period).steps
-        return params.step_cost * run_steps(settings, steps)
-    return run_steps(settings, step_plan(params, settings.steps_per_period).steps)
+    """RK4 steps ``simulate(params, settings)`` takes (for compute budgets): ``plan_work`` on
+    the step plan of ``params`` at ``settings.steps_per_period``."""
+    spp = settings.steps_per_period
+    plan = params.plan(spp) if isinstance(params, System) else step_plan(params, spp)
+    return plan_work(params, settings, plan)
+
+
+def plan_work(params: GearParams | System, settings: SimulationSettings, plan: StepPlan) -> int:
+    """RK4 steps of ``simulate(params, settings)`` on ``plan``, its step plan made already; a
+    ``System``'s steps count ``System.step_cost`` each (a train's, raised for stiff shafts, 3)."""
+    cost = params.step_cost if isinstance(params, System) else 1
+    return cost * run_steps(settings, plan.steps)
 
 
 def check_work(settings: SimulationSettings, steps: int) -> None:

@@ -12,7 +12,7 @@ and its result is the CLI's document byte for byte.
 from __future__ import annotations
 
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
-from gearengine.numerics.settings import BasinSettings, work
+from gearengine.numerics.settings import BasinSettings
 from gearengine.studies.jobs import one_chunk_kind
 
 
@@ -25,10 +25,9 @@ def with_basins(request: AnalysisRequest) -> AnalysisRequest:
 
 
 def basins_work(request: AnalysisRequest) -> int:
-    """RK4 steps of the analysis with its basin starts (``numerics.settings.work``; a train's
+    """RK4 steps of the analysis with its basin starts (``AnalysisRequest.work``; a train's
     at its ``System.step_cost``)."""
-    full = with_basins(request)
-    return work(full.system, full.settings)
+    return with_basins(request).work
 
 
 BASINS_JOB = one_chunk_kind(

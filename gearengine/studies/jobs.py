@@ -90,12 +90,18 @@ MAX_JOB_STEPS = 20_000_000_000
 minute on two cores."""
 
 
-def over_budget(name: str, request: BaseModel, points: int, noun: str) -> str | None:
-    """Why a job of kind ``name`` with ``points`` operating points is over the default limits
-    (``MAX_JOB_POINTS``, then its work against ``MAX_JOB_STEPS``), else None: the CLI refuses
-    what the API refuses, before computing (the points first, so no work is costed for them)."""
+def too_many_points(points: int, noun: str) -> str | None:
+    """Why a job of ``points`` operating points is over ``MAX_JOB_POINTS``, else None (checked
+    first, so that no work is costed for them)."""
     if points > MAX_JOB_POINTS:
         return f"this {noun} has {points} points, the limit is {MAX_JOB_POINTS} (max_job_points)"
+    return None
+
+
+def over_budget(name: str, request: BaseModel, noun: str) -> str | None:
+    """Why a job of kind ``name`` is over the default budget (its work against
+    ``MAX_JOB_STEPS``), else None: the CLI refuses what the API refuses, before computing (its
+    points were counted before the request was validated, ``too_many_points``)."""
     steps = kind(name).work(request)
     if steps > MAX_JOB_STEPS:
         return (

@@ -30,6 +30,7 @@ from pydantic_core import InitErrorDetails
 
 from gearengine.model.errors import Problems
 from gearengine.model.params import GearParams
+from gearengine.model.reduction import DesignConversion
 from gearengine.model.units import RPM, in_si
 from gearengine.studies.runup.request import MAX_RUNUP_STEPS, RunupRequest, request_errors
 from gearengine.studies.sweep.axes import point_params
@@ -99,6 +100,9 @@ class RunupPlan:
 
     system: System
     """What the members integrate (``RunupRequest.model``)."""
+    conversion: DesignConversion
+    """The conversion whose scales read the members (``RunupRequest.model``, converted once
+    with ``system``)."""
     segments: list[Segment]
     forcing: RampForcing
     mean_force: tuple[float, float]
@@ -193,6 +197,7 @@ def runup_plan(request: RunupRequest) -> RunupPlan:
         segments.append(_segment(request, forcing, limit, t0, t1, w0, w1, branch))
     return RunupPlan(
         system=system,
+        conversion=conv,
         segments=segments,
         forcing=forcing,
         mean_force=(f0, f1),

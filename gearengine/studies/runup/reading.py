@@ -199,8 +199,9 @@ def _quasi_branch(points: list[SweepPoint], branch: Branch, b_um: float) -> Quas
 def read_runup(
     request: RunupRequest, plan: RunupPlan, tables: list[list], quasi: SweepResult
 ) -> RunupResult:
-    """The run-up's document from the members' block tables and the quasi-static sweep."""
-    design, (system, conv) = request.design, request.model()
+    """The run-up's document from the members' block tables and the quasi-static sweep, read
+    with the system and conversion of ``plan`` (the design converted once)."""
+    design, system, conv = request.design, plan.system, plan.conversion
     assert design is not None
     arrays = [np.array(t, dtype=float).reshape(-1, len(t[0]) if t else CMAX + 1)
               for t in tables]  # fmt: skip

@@ -160,10 +160,15 @@ class RunupRequest(ParamsOrDesign):
     def model(self) -> tuple[System, DesignConversion]:
         """(the system the members integrate, the conversion whose scales read them): the
         pair of Eq. (9) and the design's conversion, or a train's ``TrainSystem`` and its
-        equivalent pair's (I_a = I_m + I_p, I_b = I_g + I_l)."""
+        equivalent pair's (I_a = I_m + I_p, I_b = I_g + I_l). The pair's conversion is the
+        one validation made (``ParamsOrDesign.conversion``), not made again."""
         assert self.design is not None
+        if self.design.train is None:
+            assert self.conversion is not None
+            return SpurPair(self.conversion.params), self.conversion
         model, conversion = design_model(self.design)
-        return (model if isinstance(model, System) else SpurPair(model)), conversion
+        assert isinstance(model, System)
+        return model, conversion
 
     def leg_seconds(self) -> float:
         """Duration of one leg of a linear ramp [s]."""

@@ -12,7 +12,6 @@ from fastapi import APIRouter, Depends, Request, Response
 
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.jsonio import dumps
-from gearengine.numerics import work
 from gearengine.numerics.settings import BasinSettings
 from gearengine.plots import MEDIA_TYPES, analysis_figure, basins_figure, campbell_figure
 from gearengine.systems.gear_train.campbell import Campbell, CampbellRequest, campbell
@@ -27,13 +26,13 @@ router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 def check_analysis_budget(limits: Limits, body: AnalysisRequest) -> None:
     """422 before any compute when the analysis (its starts and basin starts) is over the
     synchronous budget; names settings.basins.starts when basins are asked for. The work is
-    that of the request's system (``numerics.settings.work``: a train counts its own steps,
-    raised for stiff shafts and bearings, at their cost)."""
-    steps = work(body.system, body.settings)
+    that of the request's system (``AnalysisRequest.work``: a train counts its own steps,
+    raised for stiff shafts and bearings, at their cost), on the step plan the request made
+    when validated and hands to ``analyze``."""
     if body.settings.basins is None:
-        limits.check_budget(steps)
+        limits.check_budget(body.work)
     else:
-        limits.check_budget(steps, hint=BASINS_HINT, field="settings.basins.starts")
+        limits.check_budget(body.work, hint=BASINS_HINT, field="settings.basins.starts")
 
 
 def _analysis(metrics: Metrics, body: AnalysisRequest) -> AnalysisResult:
