@@ -31,9 +31,9 @@ from gearengine.numerics.attractors import (
     attractors,
     coexistence,
     headline,
-    most_adverse,
     of_starts,
 )
+from gearengine.numerics.magnitudes import most_adverse
 from gearengine.numerics.physical import in_seconds
 from gearengine.numerics.results import Attractor, NumericsResult
 from gearengine.numerics.settings import RequestSettings, SimulationSettings

@@ -45,7 +45,8 @@ from gearengine.model.units import (
     shown,
     to_physical,
 )
-from gearengine.numerics.attractors import Headline, of_starts
+from gearengine.numerics.attractors import Headline
+from gearengine.numerics.magnitudes import worst_words
 from gearengine.numerics.results import NumericsResult, WorstValue
 from gearengine.systems.gear_train.modes import Modes
 from gearengine.systems.spur_pair.forcing import contact_force_of, static_error
@@ -361,22 +362,6 @@ def summary(
         text += lle_words(num.lle if a is None else a.lle, conv) + "."
         text += worst_words(worst or {})
     return text
-
-
-def worst_words(worst: dict[str, WorstValue]) -> str:
-    """' Over the attractors: the largest dynamic transmission error 62 µm peak to peak
-    (periodic 1T, ... from 69 % of starts), the largest dynamic factor 9.92 (the same).'; ''
-    without basins."""
-    parts, last = [], None
-    for key, words, unit in (("dte", "dynamic transmission error", " µm peak to peak"),
-                             ("dynamic_factor", "dynamic factor", "")):  # fmt: skip
-        w = worst.get(key)
-        if w is None:
-            continue
-        who = "the same attractor" if w.label == last else of_starts(w.label, w.fraction)
-        parts.append(f"the largest {words} {w.value:.3g}{unit} ({who})")
-        last = w.label
-    return f" Over the attractors: {', '.join(parts)}." if parts else ""
 
 
 def lle_words(lle: float | None, conv: DesignConversion) -> str:

@@ -36,7 +36,7 @@ from gearengine.model.params import GearParams
 from gearengine.model.reduction import ParamsOrDesign
 from gearengine.model.units import Scales, response_values, shown, to_physical
 from gearengine.numerics.batch import run_lanes, run_verdict, simulate_batch_with, step_plans
-from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint, WorstValue
+from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint
 from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import BasinSettings, SimulationSettings
 from gearengine.signals.classify import severity
@@ -396,41 +396,6 @@ def headline(found: list[Attractor], counts: BasinCounts, min_fraction: float) -
 def of_starts(label: str, fraction: float) -> str:
     """An attractor named with its basin fraction: 'chaotic, ... from 31 % of starts'."""
     return f"{label} from {percent(fraction)} of starts"
-
-
-ADVERSE = {
-    "dte": ("dte_um", "um", max),
-    "dynamic_factor": ("dynamic_factor", "1", max),
-    "force_max": ("force_max_n", "N", max),
-    "force_min": ("force_min_n", "N", min),
-}
-"""The magnitudes of a design's response shown and gated (``model.units.POINT_OUTPUTS``): the
-``Attractor`` field holding each, its unit, and which end is the most adverse (the smallest
-force_min: the hardest back-flank contact)."""
-
-
-def most_adverse(found: list[Attractor], head: Headline | None,
-                 min_fraction: float) -> dict[str, WorstValue]:  # fmt: skip
-    """Each magnitude of ``ADVERSE`` at its most adverse over the attractors whose basin
-    fraction is above ``min_fraction`` (those the verdict ``head`` was chosen from), naming the
-    attractor it comes from: the verdict is the worst attractor by class, a DTE, a dynamic
-    factor or a force is the largest (force_min the smallest) over them, which need not be that
-    attractor's (a chaotic 31 % with DTE 20 µm beside a periodic 69 % with 62 µm: 62 µm).
-    Empty when no attractor decides (``head`` None) or the starts diverged (no finite
-    magnitude); on a tie the worse attractor (earlier in ``found``) names it."""
-    if head is None or head.attractor is None:
-        return {}
-    out = {}
-    for name, (field, unit, pick) in ADVERSE.items():
-        have = [(getattr(a, field), k) for k, a in enumerate(found)
-                if a.fraction > min_fraction and getattr(a, field) is not None]  # fmt: skip
-        if have:
-            value, k = pick(have, key=lambda vk: vk[0])
-            a = found[k]
-            out[name] = WorstValue(value=value, unit=unit, attractor=k, label=a.label,
-                                   classification=a.classification,
-                                   fraction=a.fraction)  # fmt: skip
-    return out
 
 
 def coexistence(found: list[Attractor], counts: BasinCounts) -> str:

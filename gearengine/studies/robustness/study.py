@@ -68,14 +68,12 @@ RUN_FIELDS = ("class", "contact", "melnikov", "dte_um", "dynamic_factor")
 """The entries of one stored run, in order."""
 EVENTS = (
     "separation",
-    "impacts",
     "back_flank",
     "dynamic_factor_above_limit",
     "melnikov_chaos_possible",
 )
 OUTPUTS = ("chaotic", "separation", "back_flank", "dte", "dynamic_factor")
-"""The outputs whose Sobol indices are reported (``sensitivity`` also holds separation's
-under ``impacts``, its older name)."""
+"""The outputs whose Sobol indices are reported."""
 DEFAULT_CHUNK_ROWS = 16
 MAX_SAMPLES = 4096
 
@@ -262,16 +260,13 @@ class RobustnessPoint(BaseModel):
     probabilities: dict[str, Probability] = Field(
         description="Of each class (periodic, quasi_periodic, chaotic, diverged) and event "
         "(separation: the teeth separate, drive-flank or back-flank impacts, as the gate's "
-        "--fail-on separation; impacts: its older name, the same count (deprecated: "
-        "--fail-on impacts is back_flank); back_flank: back-flank "
-        "impacts, as --fail-on back_flank; "
+        "--fail-on separation; back_flank: back-flank impacts, as --fail-on back_flank; "
         "dynamic_factor_above_limit; melnikov_chaos_possible)."
     )
     dte_um: dict[str, float | None] = Field(description="DTE over the samples: mean, p5, p95.")
     sensitivity: dict[str, dict[str, dict[str, float | None]] | None] | None = Field(
         None, description="Sobol indices by output (chaotic, separation, back_flank, dte, "
-        "dynamic_factor; impacts: separation's under its older name) and field: first, total, "
-        "and their 95 % half-widths.",
+        "dynamic_factor) and field: first, total, and their 95 % half-widths.",
     )  # fmt: skip
     ranking: list[str] | None = Field(None, description="The indices in plain words.")
 
@@ -337,7 +332,6 @@ def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[
     n = len(base)
     probs = {c: probability(sum(r[0] == k for r in base), n) for k, c in enumerate(CLASSES)}
     probs["separation"] = probability(sum(r[1] in (1, 2) for r in base), n)
-    probs["impacts"] = probs["separation"]  # its older name
     probs["back_flank"] = probability(sum(r[1] == 2 for r in base), n)
     limit = request.dynamic_factor_limit
     probs["dynamic_factor_above_limit"] = probability(
@@ -364,7 +358,7 @@ def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[
                  for k, y in ys.items()}  # fmt: skip
         labels = {v.path: v.name for v in variables_}
         out["ranking"] = [sensitivity.ranked(k, t, labels) for k, t in table.items()]
-        out["sensitivity"] = {**table, "impacts": table["separation"]}  # its older name
+        out["sensitivity"] = table
     return out
 
 

@@ -26,12 +26,12 @@ from gearengine.model.units import (
 from gearengine.numerics.attractors import (
     coexisting,
     headline,
-    most_adverse,
     points_attractors,
     verdicts_and_attractors,
 )
 from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
 from gearengine.numerics.bifurcations import PointResponse, locate_bifurcations
+from gearengine.numerics.magnitudes import most_adverse
 from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint, FromAttractor
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies import jobs

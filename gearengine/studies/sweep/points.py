@@ -199,8 +199,10 @@ class SpeedWindows(BaseModel):
         description="Per response (periodic 1T, periodic 2T, ..., quasi-periodic, chaotic, "
         "diverged): [first, last] speeds [rpm] of each run of grid points."
     )
-    impacts: dict[str, list[list[float]]] = Field(
-        description="single_sided (teeth separate) and double_sided (back-flank contact) runs."
+    contact: dict[str, list[list[float]]] = Field(
+        description="Runs of grid speeds by contact, the words of --fail-on and P(...) "
+        "(docs/units.md): separation (the teeth apart at some time, on either flank's side) "
+        "and back_flank (back-flank impacts, within separation's runs)."
     )
     melnikov: list[list[float]] = Field(
         description="Runs of grid speeds where the Melnikov criterion allows chaos."
