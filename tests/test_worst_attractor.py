@@ -205,3 +205,23 @@ def test_the_numerics_say_they_are_the_settings_starts_answer(analysis, tmp_path
     text = capsys.readouterr().out
     assert "of the settings' start: Floquet multipliers" in text
     assert f"note: {note}" in text
+
+
+def test_the_gates_min_basin_is_the_threshold_of_the_points_it_shows(tmp_path):
+    """check --min-basin X checked the attractors above X while each point's verdict and
+    magnitudes came from those above the file's basins.min_fraction (0): a 10 % attractor's DTE
+    was shown on a point the gate passed. The gate's threshold is now the points' too (CLI and
+    the remedies' envelope)."""
+    from gearengine.cli.envelope import envelope_request
+    from gearengine.cli.main import build_parser
+    from gearengine.gate.envelope import gate_settings
+
+    assert gate_settings({}, 16, 0.2)["basins"] == {"starts": 16, "grid": True, "min_fraction": 0.2}
+    assert gate_settings({"basins": {"starts": 8}}, None, 0.3)["basins"]["min_fraction"] == 0.3
+    assert gate_settings({"record_periods": 60}, 1, 0.2) == {"record_periods": 60}
+    assert "min_fraction" not in gate_settings({}, 16)["basins"]
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": DOC["design"]}))
+    args = build_parser().parse_args(["check", str(path), "--speed", "5000:6000", "--speed-points",
+                                      "2", "--min-basin", "0.2"])  # fmt: skip
+    assert envelope_request(args).settings.basins.min_fraction == 0.2

@@ -94,7 +94,7 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
         raise InvalidInputError([f"{args.file}: settings must be an object"])
     sweep = envelope_sweep(
         design,
-        gate_settings(settings, args.starts),
+        gate_settings(settings, args.starts, getattr(args, "min_basin", None)),
         axes,
         f"envelope check of {Path(args.file).name}",
     )

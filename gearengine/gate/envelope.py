@@ -205,19 +205,22 @@ GATE_STARTS = 16
 its cost); ``--starts 1`` checks the settings' own start alone, as before basins."""
 
 
-def gate_settings(settings: dict, starts: int | None) -> dict:
+def gate_settings(settings: dict, starts: int | None, min_basin: float | None = None) -> dict:
     """The gate's settings with its basin starts: ``starts`` (a grid when it is a square, else
     random draws), else the file's basins, else ``GATE_STARTS``; ``starts`` 1 leaves basins
-    out."""
+    out. ``min_basin`` (the rules'), when given, is the basins' ``min_fraction`` too: a point's
+    verdict and the magnitudes it shows come from the attractors the gate checks (with the
+    file's 0 a 10 % attractor's DTE was shown where --min-basin 0.2 passed the point)."""
     if starts is None:
         starts = None if settings.get("basins") is not None else GATE_STARTS
-    if starts is None:
-        return settings
     if starts == 1:
         return {k: v for k, v in settings.items() if k != "basins"}
     basins = dict(settings.get("basins") or {})
-    basins.update(starts=starts, grid=math.isqrt(max(starts, 0)) ** 2 == starts)
-    return {**settings, "basins": basins}
+    if starts is not None:
+        basins.update(starts=starts, grid=math.isqrt(max(starts, 0)) ** 2 == starts)
+    if min_basin is not None and basins:
+        basins["min_fraction"] = min_basin
+    return {**settings, "basins": basins} if basins else settings
 
 
 def envelope_axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
