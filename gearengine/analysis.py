@@ -15,7 +15,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
 
-from gearengine.engineering import IMPACT_WORDS, Engineering, engineering
+from gearengine.engineering import IMPACT_WORDS, Engineering, engineering, response
 from gearengine.homoclinic.boundary import design_windows
 from gearengine.homoclinic.coefficients import T_CRIT_WHY
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
@@ -33,9 +33,9 @@ from gearengine.numerics.attractors import (
     headline,
     of_starts,
 )
-from gearengine.numerics.magnitudes import most_adverse
+from gearengine.numerics.magnitudes import adverse_over, most_adverse
 from gearengine.numerics.physical import in_seconds
-from gearengine.numerics.results import Attractor, NumericsResult
+from gearengine.numerics.results import Attractor, NumericsResult, WorstValue
 from gearengine.numerics.settings import RequestSettings, SimulationSettings
 from gearengine.numerics.simulation import simulate
 from gearengine.systems.base import System
@@ -244,6 +244,34 @@ def verdict(mel: MelnikovResult, num: NumericsResult, decided: Headline | None =
     )
 
 
+HISTORY_MAGNITUDES = {
+    "te_with_static": ("te_with_static_peak_to_peak_um", "um", max),
+    "contact_force_max": ("contact_force_max_n", "N", max),
+    "contact_force_min": ("contact_force_min_n", "N", min),
+}
+"""The magnitudes of ``engineering.Response`` read from a run's time history (the TE an
+encoder sees, with the static TE; the contact force, zero while apart): ``most_adverse``'s
+table for them."""
+
+
+def history_magnitudes(request: AnalysisRequest, found: list[Attractor],
+                       min_fraction: float) -> dict[str, WorstValue]:  # fmt: skip
+    """``HISTORY_MAGNITUDES`` at their most adverse over the attractors above ``min_fraction``:
+    the basin runs keep extremes, not histories, so each attractor is run again from the start
+    that reached it (the settings' lengths, one start, ~0.02-0.1 s) and read as the recorded
+    run is (``engineering.response``)."""
+    conv = request.conversion
+    assert conv is not None
+    runs = {}
+    for k, a in enumerate(found):
+        if a.fraction > min_fraction:
+            one = request.settings.model_copy(update={
+                "initial_state": a.start, "initial_states": None, "random_initial_states": None,
+                "basins": None})  # fmt: skip
+            runs[k] = response(conv.params, simulate(request.system, one), conv)
+    return adverse_over(found, runs, HISTORY_MAGNITUDES)
+
+
 def whose_note(num: NumericsResult, decided: Headline) -> str:
     """The note that says whose the numerics' detailed fields are when basins decide the
     verdict: the settings' own start's, which need not be the deciding attractor's (a periodic
@@ -303,6 +331,8 @@ def analyze(
         num = num.model_copy(update={"attractors": found, "basins": counts})
         decided = headline(found, counts, settings.basins.min_fraction)
         worst = most_adverse(found, decided, settings.basins.min_fraction)  # each magnitude's
+        if worst and conv is not None and train is None:  # and those read from a history
+            worst |= history_magnitudes(request, found, settings.basins.min_fraction)
         if decided is not None:
             num = num.model_copy(update={"notes": [*num.notes, whose_note(num, decided)]})
     result = AnalysisResult(melnikov=mel, numerics=num, settings=settings,

@@ -157,11 +157,13 @@ class Engineering(_Doc):
         None,
         exclude_if=lambda worst: worst is None,  # an analysis without basins keeps its JSON
         description="With settings.basins: the magnitudes shown and gated (dte [um], "
-        "dynamic_factor, force_max [N], force_min [N]) at their most adverse over the "
-        "attractors whose basin fraction is above basins.min_fraction (the largest; force_min "
-        "the smallest), each naming the attractor it comes from. The verdict is the worst "
-        "attractor by class (verdict.decided_by); a magnitude's attractor may be another one. "
-        "The summary, the one-line summary and gearengine check read these.",
+        "dynamic_factor, force_max [N], force_min [N]; for a pair also te_with_static [um] and "
+        "contact_force_max / contact_force_min [N], each attractor run again from a start that "
+        "reached it) at their most adverse over the attractors whose basin fraction is above "
+        "basins.min_fraction (the largest; force_min and contact_force_min the smallest), each "
+        "naming the attractor it comes from. The verdict is the worst attractor by class "
+        "(verdict.decided_by); a magnitude's attractor may be another one. The summary, the "
+        "one-line summary and gearengine check read these.",
     )
     summary: str = Field(description="Plain sentences for a design review.")
     notes: list[str]

@@ -225,3 +225,19 @@ def test_the_gates_min_basin_is_the_threshold_of_the_points_it_shows(tmp_path):
     args = build_parser().parse_args(["check", str(path), "--speed", "5000:6000", "--speed-points",
                                       "2", "--min-basin", "0.2"])  # fmt: skip
     assert envelope_request(args).settings.basins.min_fraction == 0.2
+
+
+def test_the_te_with_static_and_contact_forces_are_over_the_attractors_too(analysis):
+    """The magnitudes read from a time history (the TE an encoder sees, the contact force) are
+    the most adverse over the attractors as well, each attractor run again from a start that
+    reached it; engineering.response stays the settings' start's, one of them."""
+    worst, run = analysis.engineering.most_adverse, analysis.engineering.response
+    assert set(worst) == {"dte", "dynamic_factor", "force_max", "force_min", "te_with_static",
+                          "contact_force_max", "contact_force_min"}  # fmt: skip
+    assert worst["te_with_static"].value >= run.te_with_static_peak_to_peak_um
+    assert worst["contact_force_max"].value >= run.contact_force_max_n
+    assert worst["contact_force_min"].value <= run.contact_force_min_n
+    # the contact force is the model's force where a flank touches: within its extremes
+    assert worst["force_min"].value <= worst["contact_force_min"].value
+    assert worst["contact_force_max"].value <= worst["force_max"].value
+    assert {w.unit for k, w in worst.items() if k.startswith("contact")} == {"N"}

@@ -6,6 +6,8 @@ from, which need not be the one that decided the verdict (issue 30; docs/basins.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from gearengine.numerics.attractors import Headline, of_starts
 from gearengine.numerics.results import Attractor, WorstValue
 
@@ -28,13 +30,23 @@ def most_adverse(found: list[Attractor], head: Headline | None,
     factor or a force is the largest (force_min the smallest) over them, which need not be that
     attractor's (a chaotic 31 % with DTE 20 µm beside a periodic 69 % with 62 µm: 62 µm).
     Empty when no attractor decides (``head`` None) or the starts diverged (no finite
-    magnitude); on a tie the worse attractor (earlier in ``found``) names it."""
+    magnitude)."""
     if head is None or head.attractor is None:
         return {}
+    counted = {k: a for k, a in enumerate(found) if a.fraction > min_fraction}
+    return adverse_over(found, counted, ADVERSE)
+
+
+def adverse_over(found: list[Attractor], sources: dict[int, object],
+                 table: dict[str, tuple[str, str, Callable]]) -> dict[str, WorstValue]:  # fmt: skip
+    """Per magnitude of ``table`` (name: field, unit, ``max`` or ``min``) its most adverse value
+    over ``sources`` (attractor index: what holds the field, the attractor itself or a response
+    of its own), named by the attractor in ``found``; on a tie the worse attractor (earlier in
+    ``found``) names it."""
     out = {}
-    for name, (field, unit, pick) in ADVERSE.items():
-        have = [(getattr(a, field), k) for k, a in enumerate(found)
-                if a.fraction > min_fraction and getattr(a, field) is not None]  # fmt: skip
+    for name, (field, unit, pick) in table.items():
+        have = [(getattr(src, field), k) for k, src in sources.items()
+                if getattr(src, field) is not None]  # fmt: skip
         if have:
             value, k = pick(have, key=lambda vk: vk[0])
             a = found[k]
