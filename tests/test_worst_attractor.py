@@ -13,6 +13,7 @@ import pytest
 
 from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.studies.sweep import SweepRequest, run_local
+from gearengine.studies.sweep.export import csv_rows
 from gearengine.studies.sweep.results import to_csv
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -159,6 +160,9 @@ def test_csv_and_dataframe_magnitudes_are_the_largest_over_the_attractors_named(
     assert row["force_min [N]"] == pytest.approx(p.physical["force_min"].value)
     assert row["dte_from"] == f"{owner.label} from {100 * owner.fraction:.0f} % of starts"
     assert row["classification"] == "chaotic" and row["decided_fraction"] == pytest.approx(9 / 16)
+    # the service writes the CSV from stored points (JSON objects): the same rows
+    stored = [json.loads(q.model_dump_json()) for q in sweep.points]
+    assert list(csv_rows(sweep.axes, stored, None, True, True)) == list(to_csv(sweep, design=True))
 
 
 def test_the_z23_67_point_gives_one_dte_in_headline_check_json_and_gate():
