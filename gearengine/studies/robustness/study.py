@@ -41,6 +41,7 @@ from gearengine.model.reduction import convert_design
 from gearengine.model.units import Scales, display_unit, in_display_unit, response_values
 from gearengine.numerics.attractors import headline, points_attractors
 from gearengine.numerics.batch import simulate_batch
+from gearengine.numerics.magnitudes import most_adverse
 from gearengine.numerics.settings import SimulationSettings, work
 from gearengine.studies import jobs
 from gearengine.studies.robustness import sensitivity
@@ -206,9 +207,11 @@ def _run(bp: Any, model: Any, scales: Scales) -> list[Any]:
 
 
 def _worst(run: list[Any], found: list[Any], counts: Any, min_fraction: float) -> list[Any]:
-    """``run`` decided by its worst attractor above ``min_fraction`` (``headline``): its class,
-    contact, DTE and dynamic factor (None where it diverged); ``run`` itself when no basin is
-    above the fraction (the settings' own start decides, as in a sweep)."""
+    """``run`` decided by its worst attractor above ``min_fraction`` (``headline``): its class
+    and contact, and the DTE and dynamic factor at their largest over those attractors
+    (``most_adverse``, as a sweep point shows and the gate judges them; None where it
+    diverged); ``run`` itself when no basin is above the fraction (the settings' own start
+    decides, as in a sweep)."""
     head = headline(found, counts, min_fraction)
     if head is None:
         return run
@@ -216,7 +219,10 @@ def _worst(run: list[Any], found: list[Any], counts: Any, min_fraction: float) -
     if a is None:  # diverged: no contact or response numbers
         return [CLASSES.index("diverged"), None, run[2], None, None]
     contact = CONTACTS.index(a.impact_regime) if a.impact_regime in CONTACTS else None
-    return [CLASSES.index(a.classification), contact, run[2], a.dte_um, a.dynamic_factor]
+    worst = most_adverse(found, head, min_fraction)
+    dte, factor = (None if (w := worst.get(k)) is None else w.value
+                   for k in ("dte", "dynamic_factor"))  # fmt: skip
+    return [CLASSES.index(a.classification), contact, run[2], dte, factor]
 
 
 def compute_chunk(request: RobustnessRequest, index: int, rows: int) -> str:
@@ -320,8 +326,9 @@ ASSUMPTIONS = [
 def basin_assumption(basins: Any) -> str:
     """The model line of a study with ``settings.basins``: how a sample is decided."""
     return (f"with settings.basins a sample counts as its worst attractor whose basin fraction "
-            f"is above {basins.min_fraction:g}, found from {basins.starts} basin starts per "
-            "sample (the gate's and the sweep's verdict of a point)")  # fmt: skip
+            f"is above {basins.min_fraction:g} (its class and contact; its DTE and dynamic "
+            f"factor the largest over those attractors), found from {basins.starts} basin "
+            "starts per sample (the gate's and the sweep's verdict of a point)")  # fmt: skip
 
 
 def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[int],
