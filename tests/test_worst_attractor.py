@@ -272,3 +272,15 @@ def test_a_robustness_sample_counts_the_largest_dte_and_dynamic_factor():
     run = _worst([0, 0, True, 62.0, 9.92], found, counts, 0.0)
     assert run == [CLASSES.index("chaotic"), 1, True, 62.0, 9.92]
     assert _worst([0, 0, True, 1.0, 1.0], found, counts, 0.5)[3:] == [62.0, 9.92]
+
+
+def test_a_sweep_keeping_some_outputs_keeps_whose_they_are():
+    """A sweep whose outputs keep classification and physical kept the worst attractor's class
+    and the largest DTE without decided_by or magnitudes_from: numbers without their owner."""
+    request = SweepRequest.model_validate(
+        {"design": DOC["design"], "settings": SETTINGS, "outputs": ["classification", "physical"],
+         "axes": [{"parameter": "speed", "start": "5750 rpm", "stop": "5750 rpm", "num": 1}]}
+    )  # fmt: skip
+    (p,) = run_local(request).points
+    assert p.classification == "chaotic" and p.decided_by.startswith("chaotic")
+    assert p.magnitudes_from["dte"].classification == "periodic" and p.lle is None

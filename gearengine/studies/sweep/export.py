@@ -34,12 +34,22 @@ def chunk_json(
     for a line of a one-axis continuation sweep, a second line with the JSON array of its
     bifurcations. Compact JSON holds no raw newline (strings escape it), so each line is one
     whole document. With ``outputs`` (``SweepRequest.outputs``) a point holds values, branch
-    and those fields only."""
+    and those fields only, with the names of whose they are (``NAMED_WITH``)."""
     keep = None if outputs is None else {"values", "branch", *outputs}
+    if keep is not None:
+        keep |= {name for field in outputs or () for name in NAMED_WITH.get(field, ())}
     array = "[" + ",".join(p.model_dump_json(include=keep) for p in points) + "]"
     if bifurcations is None:
         return array
     return array + "\n[" + ",".join(b.model_dump_json() for b in bifurcations) + "]"
+
+
+NAMED_WITH = {
+    "classification": ("decided_by", "decided_fraction"),
+    "physical": ("magnitudes_from",),
+}
+"""Fields kept with an output a sweep keeps (with basins): who decided the verdict fields, and
+which attractor each magnitude of ``physical`` comes from."""
 
 
 def _chunk_parts(text: str) -> tuple[str, list[dict[str, object]] | None]:
