@@ -15,7 +15,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
 
-from gearengine.engineering import IMPACT_WORDS, Engineering, engineering
+from gearengine.engineering import IMPACT_WORDS, Engineering, engineering, response
 from gearengine.homoclinic.boundary import design_windows
 from gearengine.homoclinic.coefficients import T_CRIT_WHY
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
@@ -26,9 +26,16 @@ from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
-from gearengine.numerics.attractors import Headline, coexistence, headline, planned_attractors
+from gearengine.numerics.attractors import (
+    Headline,
+    coexistence,
+    headline,
+    of_starts,
+    planned_attractors,
+)
+from gearengine.numerics.magnitudes import adverse_over, most_adverse
 from gearengine.numerics.physical import in_seconds
-from gearengine.numerics.results import NumericsResult
+from gearengine.numerics.results import Attractor, NumericsResult, WorstValue
 from gearengine.numerics.runs import as_system
 from gearengine.numerics.settings import RequestSettings, SimulationSettings, plan_work
 from gearengine.numerics.simulation import simulate
@@ -109,7 +116,14 @@ class Verdict(BaseModel):
     decided_by: str | None = Field(
         None,
         description="With settings.basins: the attractor (or divergence) that decided the "
-        "verdict and its basin fraction; null without.",
+        "verdict and its basin fraction; null without. numerics.classification, worst_case, "
+        "floquet and the records are then the settings' own start's (numerics.notes says so).",
+    )
+    decided_attractor: int | None = Field(
+        None,
+        exclude_if=lambda index: index is None,  # an analysis without basins keeps its JSON
+        description="With settings.basins: the index in numerics.attractors of the attractor "
+        "that decided the verdict (absent without basins, or when the starts diverged).",
     )
 
 
@@ -132,8 +146,9 @@ class AnalysisResult(BaseModel):
     def summary(self) -> str:
         """The verdicts in one line: response, LLE (with a design also in 1/s), contact,
         Melnikov, and with a design the DTE, dynamic factor and Melnikov speed windows (the
-        gate's PASS or FAIL line). With basins the LLE, contact, DTE and dynamic factor are the
-        deciding attractor's."""
+        gate's PASS or FAIL line). With basins the LLE and contact are the deciding attractor's,
+        the DTE and dynamic factor the largest over the attractors above the basin threshold
+        (``magnitudes_text``: named where another attractor holds them)."""
         num = self.numerics
         decided = decision(num, self.settings) or num  # with basins the worst attractor's
         kind = f"periodic {decided.period}T" if decided.period else decided.classification
@@ -152,15 +167,7 @@ class AnalysisResult(BaseModel):
         line = f"{kind} ({lle}, {contact}), Melnikov: {mel}"
         eng = self.engineering
         if eng is not None:
-            resp = eng.response
-            dte = None if resp is None else resp.dte_peak_to_peak_um
-            factor = None if resp is None else resp.dynamic_factor
-            if decided is not num and who is not None:  # the worst attractor's, as its LLE
-                dte, factor = who.dte_um, who.dynamic_factor
-            if dte is not None:
-                line += f"; DTE {dte:.3g} µm"
-            if factor is not None:
-                line += f", dynamic factor {factor:.3g}"
+            line += magnitudes_text(eng, None if decided is num else decided.attractor)
             lo, hi = eng.speed_range_rpm
             spans = ", ".join(f"{a:,.0f}-{b:,.0f}" for a, b in eng.speed_windows_rpm) or "nowhere"
             scanned = f"{spans} rpm (scanned {lo:,.0f}-{hi:,.0f} rpm)"
@@ -175,6 +182,31 @@ class AnalysisResult(BaseModel):
         return f"AnalysisResult({self.summary()!r})"
 
     __str__ = summary
+
+
+def magnitudes_text(eng: Engineering, decided: Attractor | None) -> str:
+    """'; DTE 62 µm, dynamic factor 9.92' of the one-line summary: the settings' run's, or
+    with basins the largest over the attractors above the threshold (``most_adverse``), named
+    with its basin fraction when it is not the deciding attractor ``decided``'s (once after
+    both when one attractor holds both): '; DTE 62 µm, dynamic factor 9.92 (periodic 1T, ...
+    from 69 % of starts)'."""
+    resp, worst = eng.response, eng.most_adverse
+    if worst is None:
+        dte = None if resp is None else resp.dte_peak_to_peak_um
+        factor = None if resp is None else resp.dynamic_factor
+        values = [(dte, ""), (factor, "")]
+    else:
+        values = []
+        for key in ("dte", "dynamic_factor"):
+            w = worst.get(key)
+            same = w is None or (decided is not None and w.label == decided.label)
+            values.append((None if w is None else w.value,
+                           "" if same else f" ({of_starts(w.label, w.fraction)})"))  # fmt: skip
+    (dte, dte_who), (factor, factor_who) = values
+    if dte is not None and factor is not None and dte_who == factor_who:
+        dte_who = ""  # one attractor holds both: named once, after both
+    out = "" if dte is None else f"; DTE {dte:.3g} µm{dte_who}"
+    return out + ("" if factor is None else f", dynamic factor {factor:.3g}{factor_who}")
 
 
 class MelnikovAnswer(MelnikovResult):
@@ -192,18 +224,22 @@ def verdict(mel: MelnikovResult, num: NumericsResult, decided: Headline | None =
     """Compare the Melnikov verdict with the numerical classification: that of the worst
     start, or with basins of the worst attractor that decides (``decision``)."""
     classification, period_n, decided_by, basins = num.classification, num.period, None, ""
+    index = None
     if num.attractors is not None and num.basins is not None:
         basins = f" ({coexistence(num.attractors, num.basins)})"
         if decided is not None:
             classification, period_n = decided.classification, decided.period
             decided_by = decided.decided_by
+            if decided.attractor is not None:
+                index = num.attractors.index(decided.attractor)
     chaotic = classification == "chaotic"
     period = f" ({period_n}T)" if period_n else ""
     numerics = f"numerics: {classification}{period}{basins}"
     if classification == "diverged" or mel.chaos_possible is None:
         why = "Melnikov not applicable" if mel.chaos_possible is None else "the state diverged"
         return Verdict(agreement="undecided", consistent=True, chaotic=chaotic,
-                       summary=f"{numerics}; {why}", decided_by=decided_by)  # fmt: skip
+                       summary=f"{numerics}; {why}", decided_by=decided_by,
+                       decided_attractor=index)  # fmt: skip
     if mel.chaos_possible and chaotic:
         agreement, text = "both_chaotic", "transverse homoclinic tangle and chaotic response"
     elif mel.chaos_possible:
@@ -221,7 +257,48 @@ def verdict(mel: MelnikovResult, num: NumericsResult, decided: Headline | None =
         chaotic=chaotic,
         summary=f"{numerics}; Melnikov: chaos {possible} — {text}",
         decided_by=decided_by,
+        decided_attractor=index,
     )
+
+
+HISTORY_MAGNITUDES = {
+    "te_with_static": ("te_with_static_peak_to_peak_um", "um", max),
+    "contact_force_max": ("contact_force_max_n", "N", max),
+    "contact_force_min": ("contact_force_min_n", "N", min),
+}
+"""The magnitudes of ``engineering.Response`` read from a run's time history (the TE an
+encoder sees, with the static TE; the contact force, zero while apart): ``most_adverse``'s
+table for them."""
+
+
+def history_magnitudes(request: AnalysisRequest, found: list[Attractor],
+                       min_fraction: float) -> dict[str, WorstValue]:  # fmt: skip
+    """``HISTORY_MAGNITUDES`` at their most adverse over the attractors above ``min_fraction``:
+    the basin runs keep extremes, not histories, so each attractor is run again from the start
+    that reached it (the settings' lengths, one start, ~0.02-0.1 s) and read as the recorded
+    run is (``engineering.response``)."""
+    conv = request.conversion
+    assert conv is not None
+    runs = {}
+    for k, a in enumerate(found):
+        if a.fraction > min_fraction:
+            one = request.settings.model_copy(update={
+                "initial_state": a.start, "initial_states": None, "random_initial_states": None,
+                "basins": None})  # fmt: skip
+            runs[k] = response(conv.params, simulate(request.system, one), conv)
+    return adverse_over(found, runs, HISTORY_MAGNITUDES)
+
+
+def whose_note(num: NumericsResult, decided: Headline) -> str:
+    """The note that says whose the numerics' detailed fields are when basins decide the
+    verdict: the settings' own start's, which need not be the deciding attractor's (a periodic
+    start beside a chaotic verdict read as the design's answer; issue 30 review, finding 2)."""
+    run = f"periodic ({num.period}T)" if num.period else num.classification.replace("_", "-")
+    other = "another attractor's" if decided.kind != run else "the worst attractor's"
+    return (f"numerics.classification, period, lle, impact_regime, worst_case, floquet, spectrum, "
+            f"poincare and time_history are the settings' own start's answer ({run}), not the "
+            f"design's verdict; the verdict is {other} above basins.min_fraction: "
+            f"{decided.decided_by} (verdict.decided_by)")  # fmt: skip
 
 
 def decision(num: NumericsResult, settings: SimulationSettings) -> Headline | None:
@@ -265,17 +342,22 @@ def analyze(
         ts = conv.time_scale_s
         num = num.model_copy(update={"transient": in_seconds(num.transient, ts),
                                      "record": in_seconds(num.record, ts)})  # fmt: skip
-    decided = None
+    decided, worst = None, None
     if settings.basins is not None:  # the worst attractor above min_fraction decides
         scales = None if conv is None else conv.scales
         found, counts = planned_attractors(system, settings, request.plan, scales)
         num = num.model_copy(update={"attractors": found, "basins": counts})
         decided = headline(found, counts, settings.basins.min_fraction)
+        worst = most_adverse(found, decided, settings.basins.min_fraction)  # each magnitude's
+        if worst and conv is not None and train is None:  # and those read from a history
+            worst |= history_magnitudes(request, found, settings.basins.min_fraction)
+        if decided is not None:
+            num = num.model_copy(update={"notes": [*num.notes, whose_note(num, decided)]})
     result = AnalysisResult(melnikov=mel, numerics=num, settings=settings,
                             verdict=verdict(mel, num, decided))  # fmt: skip
     if conv is None:
         return result
-    eng = engineering(conv, speeds, mel, scan, num, decided, no_windows)
+    eng = engineering(conv, speeds, mel, scan, num, decided, no_windows, worst)
     if train is None:
         return result.model_copy(update={"params": conv.params, "engineering": eng})
     notes = [f"gear train: {train.model.size} coordinates; numerics of the train, scales of "

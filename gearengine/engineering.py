@@ -46,7 +46,8 @@ from gearengine.model.units import (
     to_physical,
 )
 from gearengine.numerics.attractors import Headline
-from gearengine.numerics.results import NumericsResult
+from gearengine.numerics.magnitudes import worst_words
+from gearengine.numerics.results import NumericsResult, WorstValue
 from gearengine.systems.gear_train.modes import Modes
 from gearengine.systems.spur_pair.forcing import contact_force_of, static_error
 
@@ -78,7 +79,10 @@ class Contact(_Doc):
 
 
 class Response(_Doc):
-    """The numerical response in physical units (last recorded periods)."""
+    """The numerical response in physical units (last recorded periods) of the recorded run:
+    the worst of the settings' own starts (``numerics.worst_case``). With settings.basins the
+    verdict is the worst attractor's (``verdict.decided_by``) and the DTE, dynamic factor and
+    forces shown and gated are ``most_adverse``'s, over the attractors."""
 
     dte_peak_to_peak_um: float | None = Field(
         description="Dynamic transmission error p-p [µm]: x = r_a theta_a - r_b theta_b - e(t) "
@@ -144,7 +148,23 @@ class Engineering(_Doc):
     )
     critical: dict[str, Critical] = Field(description="Thresholds in physical units.")
     derived: dict[str, Derived]
-    response: Response | None = Field(None, description="For analyses: the response.")
+    response: Response | None = Field(
+        None,
+        description="For analyses: the response of the recorded run (the worst of the "
+        "settings' own starts, numerics.worst_case); with settings.basins see most_adverse.",
+    )
+    most_adverse: dict[str, WorstValue] | None = Field(
+        None,
+        exclude_if=lambda worst: worst is None,  # an analysis without basins keeps its JSON
+        description="With settings.basins: the magnitudes shown and gated (dte [um], "
+        "dynamic_factor, force_max [N], force_min [N]; for a pair also te_with_static [um] and "
+        "contact_force_max / contact_force_min [N], each attractor run again from a start that "
+        "reached it) at their most adverse over the attractors whose basin fraction is above "
+        "basins.min_fraction (the largest; force_min and contact_force_min the smallest), each "
+        "naming the attractor it comes from. The verdict is the worst attractor by class "
+        "(verdict.decided_by); a magnitude's attractor may be another one. The summary, the "
+        "one-line summary and gearengine check read these.",
+    )
     summary: str = Field(description="Plain sentences for a design review.")
     notes: list[str]
     modes: Modes | None = Field(
@@ -294,11 +314,13 @@ def summary(
     decided: Headline | None,
     t_crit: float | None,
     over: bool,
+    worst: dict[str, WorstValue] | None = None,
 ) -> str:
     """Two or three sentences an engineer can paste into a design review; with basins the
     response named is the worst attractor's above the basin threshold (``decided``, with its
-    fraction and LLE), and the contact, DTE, dynamic factor and the LLE that follow are the
-    recorded run's when that run settled elsewhere (said so); ``t_crit`` the critical torque
+    fraction and LLE), and the contact and the LLE that follow are the recorded run's when that
+    run settled elsewhere (said so); the DTE and dynamic factor are ``worst``'s with basins
+    (the largest over the attractors, each named), else the run's; ``t_crit`` the critical torque
     (``critical_torque``); ``over`` True above the critical load (no saddle, no speed windows
     looked for)."""
     f_crit = mel.critical_mean_force if over and t_crit is not None else None
@@ -334,12 +356,13 @@ def summary(
             text += f" with {IMPACT_WORDS.get(resp.contact.regime or '', 'no verdict on impacts')}"
             if resp.contact.separation_fraction > 0.0:
                 text += f" (teeth apart {100 * resp.contact.separation_fraction:.0f} % of the time)"
-        if resp.dte_peak_to_peak_um is not None:
+        if worst is None and resp.dte_peak_to_peak_um is not None:
             text += f", dynamic transmission error {resp.dte_peak_to_peak_um:.3g} µm peak to peak"
-        if resp.dynamic_factor is not None:
+        if worst is None and resp.dynamic_factor is not None:
             text += f", dynamic factor {resp.dynamic_factor:.3g}"
         a = None if decided is None or other else decided.attractor  # tau = omega_n t
         text += lle_words(num.lle if a is None else a.lle, conv) + "."
+        text += worst_words(worst or {})
     return text
 
 
@@ -359,13 +382,15 @@ def engineering(
     num: NumericsResult | None = None,
     decided: Headline | None = None,
     no_windows: str | None = None,
+    worst: dict[str, WorstValue] | None = None,
 ) -> Engineering:
     """The engineering block of a design's Melnikov verdict (and analysis, given ``num``;
     ``decided`` the worst attractor of its basins, ``numerics.attractors.headline``) from the
     values handed to it: ``scan`` the speed windows [rpm] and the end of their scan
     (``homoclinic.boundary.design_windows``, None above the critical load).
     ``no_windows``: why the speed windows are not looked for (a train without a Melnikov
-    reduction), said in their note; the range stays the scan's."""
+    reduction), said in their note; the range stays the scan's. ``worst``: with basins each
+    magnitude at its most adverse over the attractors (``numerics.attractors.most_adverse``)."""
     params = conv.params
     t_crit = critical_torque(conv, mel)
     crit = {
@@ -404,6 +429,18 @@ def engineering(
         critical=crit,
         derived=conv.derived,
         response=resp,
-        summary=summary(conv, mel, windows, (lo, hi), resp, num, decided, t_crit, scan is None),
+        most_adverse=worst if num is not None and decided is not None else None,
+        summary=summary(
+            conv,
+            mel,
+            windows,
+            (lo, hi),
+            resp,
+            num,
+            decided,
+            t_crit,
+            scan is None,
+            worst if decided is not None else None,
+        ),
         notes=conv.notes,
     )

@@ -22,10 +22,9 @@ def _point(regime: str) -> SweepPoint:
 
 
 def test_back_flank_is_the_gate_rule_of_back_flank_impacts() -> None:
-    for word in ("back_flank", "impacts"):  # impacts: the older name of the same rule
-        rules = Rules(fail_on=[word])
-        assert point_failures(_point("double_sided"), rules) == ["back-flank impacts"]
-        assert point_failures(_point("single_sided"), rules) == []
+    rules = Rules(fail_on=["back_flank"])
+    assert point_failures(_point("double_sided"), rules) == ["back-flank impacts"]
+    assert point_failures(_point("single_sided"), rules) == []
     rules = Rules(fail_on=["separation"])
     assert point_failures(_point("single_sided"), rules) == ["tooth separation"]
 
@@ -39,7 +38,7 @@ def test_robustness_names_separation_as_the_gate_does() -> None:
     (point,) = run_local(request).points
     probs = point.probabilities
     assert probs["separation"].count > 0  # this point separates in 7 of 8 samples
-    assert probs["separation"] == probs["impacts"]
+    assert "impacts" not in probs  # one word per outcome
     assert probs["back_flank"].count <= probs["separation"].count
 
 
@@ -83,32 +82,50 @@ def test_analysis_reports_both_transmission_errors_and_the_contact_force() -> No
     assert r.contact_force_max_n == pytest.approx(r.dynamic_mesh_force_max_n, rel=1e-3)
 
 
-def test_the_old_word_impacts_is_read_with_a_note_where_it_is_given() -> None:
+def test_the_old_word_impacts_is_refused_everywhere_naming_the_two_words(tmp_path, capsys):
     """'impacts' meant back-flank contact in ``check --fail-on`` and any separation in
-    ``--max-probability``: it keeps each meaning as an alias of back_flank and separation, and
-    the answer says how it was read (it was read silently; issue 30 item 6, new-user review)."""
-    from gearengine.cli.envelope import print_report
+    ``--max-probability``; read with a note it stayed ambiguous (issue 30 review, finding 3).
+    It is refused in the library, the API and the CLI, naming the field or option and the two
+    words to write."""
+    import json
+
+    from pydantic import ValidationError
+
+    from gearengine.cli.documents import InvalidInputError
+    from gearengine.cli.main import main
     from gearengine.cli.robustness import limits_of
-    from gearengine.gate.envelope import EnvelopeReport, envelope_report
+    from gearengine.gate.remedies.request import RemediesRequest
+    from gearengine.model.errors import InputError
+    from service.main import create_app
     from tests.conftest import ROOT
 
-    golden = EnvelopeReport.model_validate_json((ROOT / "tests/golden/check-envelope.json")
-                                                .read_text())  # fmt: skip
-    report = envelope_report(golden.sweep, Rules(fail_on=["chaotic", "impacts"]))
-    (note,) = report.notes
-    assert "--fail-on impacts is read as back_flank" in note and "separation" in note
-    assert envelope_report(golden.sweep, Rules(fail_on=["back_flank"])).notes == []
-    limits, notes = limits_of(["impacts=0.05", "chaotic=0.01"])
-    assert limits == {"separation": 0.05, "chaotic": 0.01}
-    (note,) = notes
-    assert "--max-probability impacts is read as separation" in note and "back_flank" in note
-    import contextlib
-    import io
+    words = "write back_flank (back-flank impacts) or separation (the teeth apart at some time)"
+    with pytest.raises(ValidationError) as caught:
+        Rules(fail_on=["chaotic", "impacts"])
+    (error,) = caught.value.errors()
+    assert isinstance(error["ctx"]["error"], InputError) and words in error["msg"]
+    assert error["ctx"]["error"].loc == ("fail_on", "1") and "fail_on.1: " in error["msg"]
+    with pytest.raises(InvalidInputError) as refused:
+        limits_of(["impacts=0.05"])
+    assert "--max-probability impacts=0.05" in str(refused.value) and words in str(refused.value)
+    design = tmp_path / "design.json"
+    design.write_text((ROOT / "examples/ci/design.json").read_text())
+    with pytest.raises(SystemExit) as stopped:
+        main(["check", str(design), "--fail-on", "impacts"])
+    assert stopped.value.code == 2
+    err = capsys.readouterr().err
+    assert "--fail-on" in err and words in err
+    from fastapi.testclient import TestClient
 
-    shown = io.StringIO()
-    with contextlib.redirect_stdout(shown):
-        print_report(report)
-    assert "--fail-on impacts is read as back_flank" in shown.getvalue()
+    doc = {"design": json.loads(design.read_text())["design"], "fail_on": ["impacts"],
+           "envelope": {"speed": "1000:2000", "speed_points": 2}}  # fmt: skip
+    with pytest.raises(ValidationError):
+        RemediesRequest.model_validate(doc)
+    with TestClient(create_app()) as client:
+        r = client.post("/v1/remedies", json=doc)
+    assert r.status_code == 422, r.text
+    (refusal,) = r.json()["errors"]
+    assert refusal["path"] == "fail_on[0]" and words in refusal["message"]
 
 
 def test_robustness_outputs_and_panels_say_separation() -> None:

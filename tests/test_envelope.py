@@ -115,7 +115,10 @@ def test_windows_and_failing_windows_of_a_rattling_design() -> None:
     doc["axes"].append({"parameter": "torque", "start": "1 N*m", "stop": "3 N*m", "num": 2})
     result = run_local(validated(doc))
     assert [w.level["torque"].value for w in result.windows] == [1.0, 3.0]
-    assert result.windows[0].impacts == {"double_sided": [[1000.0, 2000.0]]}
+    assert result.windows[0].contact == {
+        "separation": [[1000.0, 2000.0]],
+        "back_flank": [[1000.0, 2000.0]],
+    }
     report = envelope_report(result, Rules())
     assert not report.passed and report.failing_points == sum(
         p.classification == "chaotic" for p in result.points
@@ -123,8 +126,8 @@ def test_windows_and_failing_windows_of_a_rattling_design() -> None:
     chaotic = {tuple(s) for w in result.windows for s in w.response.get("chaotic", [])}
     assert {tuple(f.speeds_rpm) for f in report.failures} == chaotic
     assert envelope_report(result, Rules(fail_on=["diverged"])).passed
-    impacts = envelope_report(result, Rules(fail_on=["diverged", "impacts"]))
-    assert {f.rule for f in impacts.failures} == {"back-flank impacts"}
+    back = envelope_report(result, Rules(fail_on=["diverged", "back_flank"]))
+    assert {f.rule for f in back.failures} == {"back-flank impacts"}
 
 
 def test_pass_or_fail_stops_at_the_first_failing_chunk(monkeypatch: pytest.MonkeyPatch) -> None:

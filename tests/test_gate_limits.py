@@ -61,18 +61,18 @@ def test_limits_that_cannot_apply_are_refused(
 
 
 def test_separation_fails_drive_flank_impacts() -> None:
-    """--fail-on impacts counts back-flank contact only; separation counts every regime in
+    """--fail-on back_flank counts back-flank contact only; separation counts every regime in
     which the teeth come apart (drive-flank impacts too)."""
 
     def point(regime: str) -> SweepPoint:
         return SweepPoint(values={}, branch=None, classification="periodic", impact_regime=regime)
 
     separation = Rules(fail_on=["diverged", "separation"])
-    impacts = Rules(fail_on=["diverged", "impacts"])
+    back = Rules(fail_on=["diverged", "back_flank"])
     assert point_failures(point("single_sided"), separation) == ["tooth separation"]
     assert point_failures(point("double_sided"), separation) == ["tooth separation"]
     assert point_failures(point("no_impact"), separation) == []
-    assert point_failures(point("single_sided"), impacts) == []
+    assert point_failures(point("single_sided"), back) == []
     args = build_parser().parse_args(["check", "x.json", "--fail-on", "separation"])
     assert args.fail_on == ["separation"]
 

@@ -71,7 +71,7 @@ def test_probabilities_equal_the_single_analysis_of_each_sample(
     request, result = study
     base = base_design(request.design)
     (runs,) = json.loads(compute_chunk(request, 0, 16))["runs"]
-    counts = dict.fromkeys(("periodic", "quasi_periodic", "chaotic", "impacts", "melnikov"), 0)
+    counts = dict.fromkeys(("periodic", "quasi_periodic", "chaotic", "separation", "melnikov"), 0)
     for run, values in zip(
         runs, sample_values(request.variables(), request.unit_rows()), strict=True
     ):
@@ -80,14 +80,14 @@ def test_probabilities_equal_the_single_analysis_of_each_sample(
         response = one.engineering.response  # type: ignore[union-attr]
         assert run[3:] == [response.dte_peak_to_peak_um, response.dynamic_factor]
         counts[one.numerics.classification] = counts.get(one.numerics.classification, 0) + 1
-        counts["impacts"] += one.numerics.impact_regime in ("single_sided", "double_sided")
+        counts["separation"] += one.numerics.impact_regime in ("single_sided", "double_sided")
         counts["melnikov"] += bool(one.melnikov.chaos_possible)
     p = result.points[0].probabilities
-    assert {k: p[k].count for k in ("periodic", "quasi_periodic", "chaotic", "impacts")} == {
-        k: counts[k] for k in ("periodic", "quasi_periodic", "chaotic", "impacts")
+    assert {k: p[k].count for k in ("periodic", "quasi_periodic", "chaotic", "separation")} == {
+        k: counts[k] for k in ("periodic", "quasi_periodic", "chaotic", "separation")
     }
     assert p["melnikov_chaos_possible"].count == counts["melnikov"]
-    assert 0 < p["impacts"].count < 16  # the outcome varies: the test can fail
+    assert 0 < p["separation"].count < 16  # the outcome varies: the test can fail
 
 
 def test_plain_monte_carlo_with_another_seed_agrees_within_the_intervals(
@@ -96,12 +96,12 @@ def test_plain_monte_carlo_with_another_seed_agrees_within_the_intervals(
     request, result = study
     rng = np.random.default_rng(12345)
     base = base_design(request.design)
-    impacts = 0
+    apart = 0
     for values in sample_values(request.variables(), rng.random((16, 3))):
         design = sample_design(base, values).model_dump(exclude={"tolerances"})
         one = analyze(AnalysisRequest.model_validate({"design": design, "settings": SHORT}))
-        impacts += one.numerics.impact_regime in ("single_sided", "double_sided")
-    qmc, mc = result.points[0].probabilities["impacts"], probability(impacts, 16)
+        apart += one.numerics.impact_regime in ("single_sided", "double_sided")
+    qmc, mc = result.points[0].probabilities["separation"], probability(apart, 16)
     assert qmc.interval[0] <= mc["value"] <= qmc.interval[1]
     assert mc["interval"][0] <= qmc.value <= mc["interval"][1]
 
@@ -242,6 +242,6 @@ def test_a_cancelled_study_gives_a_partial_result_of_its_finished_chunks(tmp_pat
         assert result["partial"] is True and result["points"][0]["samples"] == 16
         runs = json.loads(done)["runs"][0]  # [class, contact, melnikov, dte, dynamic factor]
         p = result["points"][0]["probabilities"]
-        assert p["impacts"]["count"] == sum(r[1] in (1, 2) for r in runs)
+        assert p["separation"]["count"] == sum(r[1] in (1, 2) for r in runs)
         assert p["chaotic"]["count"] == sum(r[0] == 2 for r in runs)
-        assert p["impacts"]["samples"] == 16
+        assert p["separation"]["samples"] == 16

@@ -42,7 +42,7 @@ def test_the_gate_fails_on_the_upper_bound_and_names_the_points(
     junit = design_file.with_name("junit.xml")
     base = ["check", str(design_file), "--speed", "2000:5000", "--speed-points", "2"]
     # 8 samples prove 0.4 (0 events: upper bound 0.369); 7 of 8 impact at 5000 rpm
-    assert main([*base, "--samples", "8", "--max-probability", "impacts=0.4",
+    assert main([*base, "--samples", "8", "--max-probability", "separation=0.4",
                  "--junit", str(junit)]) == 1  # fmt: skip
     cases = ElementTree.parse(junit).getroot().findall("testsuite/testcase")
     assert [c.get("name") for c in cases] == ["speed 2000 rpm", "speed 5000 rpm"]
@@ -87,7 +87,7 @@ def test_samples_auto_samples_until_every_point_is_decided(
     design_file: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     base = ["check", str(design_file), "--speed", "2000:5000", "--speed-points", "2"]
-    assert main([*base, "--samples", "auto", "--max-probability", "impacts=0.4"]) == 1
+    assert main([*base, "--samples", "auto", "--max-probability", "separation=0.4"]) == 1
     captured = capsys.readouterr()
     assert "--samples auto: decided at 64 samples" in captured.err
     assert "PASS: speed 2000 rpm" in captured.out and "FAIL: speed 5000 rpm" in captured.out

@@ -33,3 +33,19 @@ def test_a_bin_that_separates_at_times_is_labelled_separation() -> None:
     bins = run_local(r).up.bins  # type: ignore[union-attr]
     apart = [b for b in bins if b.separation_fraction and b.back_flank_fraction == 0]
     assert apart and {b.contact for b in apart} == {"separation"}
+
+
+def test_a_bin_labelled_separation_shows_how_long_the_teeth_are_apart() -> None:
+    """A bin is separation when the teeth are apart for any time in it (docs/units.md); the
+    table gave the share to two decimals, so 0.2 % read '0.00' beside 'separation' (issue 30
+    review, item 7). It is in % to two significant digits now."""
+    b = RunupBin.model_construct(
+        speed_rpm=[3500.0, 3550.0], time_s=[0.0, 0.025], dte_peak_to_peak_um=30.0,
+        dynamic_factor=2.0, contact="separation", separation_fraction=0.002,
+        back_flank_fraction=0.0, back_flank_impacts=0, drive_flank_impacts=3, lle=None,
+        chaotic=None,
+    )  # fmt: skip
+    result = SimpleNamespace(quasi_static=SimpleNamespace(up=SimpleNamespace(points=[])))
+    header, line = branch_table("up", RunupBranch.model_construct(bins=[b], jumps=[]), result)[1:]
+    assert "sep %  back %" in header
+    assert line.split()[-5:-2] == ["separation", "0.2", "0"]

@@ -235,7 +235,7 @@ def test_the_gates_text_says_why_melnikov_judges_no_point_of_a_train() -> None:
     criterion judges no point at any torque. It names the reason now; a train with stiff
     shafts and bearings (the reduction holds, 99.96 %) names the reduction's T_crit, and the
     pair keeps its words."""
-    row = SpeedWindows(level={}, response={}, impacts={}, melnikov=[],
+    row = SpeedWindows(level={}, response={}, contact={}, melnikov=[],
                        melnikov_not_applicable=[[1000.0, 3000.0]])  # fmt: skip
     stiff = json.loads(json.dumps(EXAMPLE_TRAIN))
     for shaft in ("input_shaft", "output_shaft"):

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import argparse
 
-from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
+from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze, decision
 from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
@@ -42,7 +42,8 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         print(f"  {lengths_line(result)}")
         line = floquet_line(result)
         if line is not None:
-            print(f"  {line}")
+            who = "" if result.verdict.decided_by is None else "of the settings' start: "
+            print(f"  {who}{line}")
         for note in result.numerics.notes:
             print(f"  note: {note}")
         if result.engineering is not None:
@@ -94,12 +95,21 @@ def margin_failure(r: AnalysisResult, min_margin: float) -> str | None:
 
 def failures(r: AnalysisResult, rules: Rules, min_margin: float | None = None) -> list[str]:
     """Reasons the design fails the gate (empty: pass): the envelope's rules judging its one
-    verdict (its worst start, its DTE and dynamic factor in µm and 1:
-    ``gate.envelope.verdict_failures``), and the Floquet stability margin (one design only)."""
-    worst = r.numerics.worst_case
-    resp = None if r.engineering is None else r.engineering.response
+    verdict (``gate.envelope.verdict_failures``: its worst start's, with basins its worst
+    attractor's; its DTE and dynamic factor in µm and 1, with basins the largest over the
+    attractors, as the summary line gives them), and the Floquet stability margin."""
+    run = r.numerics.worst_case
+    decided = decision(r.numerics, r.settings)
+    who = run if decided is None else decided.attractor  # None: diverged
+    classification = run.classification if decided is None else decided.classification
+    eng = r.engineering
+    resp = None if eng is None else eng.response
     dte, factor = (None, None) if resp is None else (resp.dte_peak_to_peak_um, resp.dynamic_factor)
-    reasons = verdict_failures(rules, worst.classification, worst.lle, r.numerics.impact_regime,
+    if eng is not None and eng.most_adverse is not None:
+        dte, factor = (None if (w := eng.most_adverse.get(key)) is None else w.value
+                       for key in ("dte", "dynamic_factor"))  # fmt: skip
+    impact = r.numerics.impact_regime if who is run else getattr(who, "impact_regime", None)
+    reasons = verdict_failures(rules, classification, None if who is None else who.lle, impact,
                                r.melnikov.chaos_possible, dte, factor)  # fmt: skip
     margin = None if min_margin is None else margin_failure(r, min_margin)
     if margin is not None:

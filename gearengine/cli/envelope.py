@@ -92,7 +92,7 @@ def envelope_request(args: argparse.Namespace, doc: object) -> SweepRequest:
         raise InvalidInputError([f"{args.file}: settings must be an object"])
     sweep = envelope_sweep(
         design,
-        gate_settings(settings, args.starts),
+        gate_settings(settings, args.starts, getattr(args, "min_basin", None)),
         axes,
         f"envelope check of {Path(args.file).name}",
     )
@@ -219,27 +219,27 @@ def settings_text(settings: SimulationSettings) -> str:
 
 def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit") -> list[str]:
     """Per level of the other axis, the impact and Melnikov windows in rpm, pass or fail:
-    "windows at torque 40 N*m: tooth separation (drive-flank impacts) 500-1100 rpm; Melnikov:
+    "windows at torque 40 N*m: tooth separation 500-1100 rpm; Melnikov:
     chaos possible nowhere"; ``reason`` says why Melnikov does not apply where it does not
     (``not_judged_reason``)."""
     out = []
     for w in windows:
-        impacts = "; ".join(f"{IMPACT_LABELS[k]} {spans_text(v)}" for k, v in w.impacts.items())
+        contact = "; ".join(f"{CONTACT_LABELS[k]} {spans_text(v)}" for k, v in w.contact.items())
         melnikov = f"chaos possible {spans_text(w.melnikov) if w.melnikov else 'nowhere'}"
         if w.melnikov_not_applicable:
             na = f"not applicable at {spans_text(w.melnikov_not_applicable)} ({reason})"
             melnikov = f"{melnikov}, {na}" if w.melnikov else na
         where = f" at {level_text(w.level)}" if w.level else ""
-        out.append(f"windows{where}: {impacts or 'teeth always in contact'}; "
+        out.append(f"windows{where}: {contact or 'teeth always in contact'}; "
                    f"Melnikov: {melnikov}")  # fmt: skip
     return out
 
 
-IMPACT_LABELS = {
-    "single_sided": "tooth separation (drive-flank impacts)",
-    "double_sided": "back-flank impacts",
+CONTACT_LABELS = {
+    "separation": "tooth separation",
+    "back_flank": "back-flank impacts",
 }
-"""Impact regimes of a speed window in the gate's words."""
+"""The contact of a speed window (``SpeedWindows.contact``) in the gate's words."""
 
 
 def spans_text(spans: list[list[float]]) -> str:

@@ -40,7 +40,7 @@ from importlib.metadata import entry_points
 from typing import NoReturn
 
 from gearengine.cli.documents import EXIT_INTERNAL, EXIT_INVALID, EXIT_PIPE, InvalidInputError
-from gearengine.model.units import QUANTITIES, parse_quantity
+from gearengine.model.units import IMPACTS_REFUSED, QUANTITIES, parse_quantity
 
 PLUGIN_GROUP = "gearengine.commands"
 """Entry-point group of command plugins: each is a ``register(subparsers)`` function."""
@@ -100,22 +100,23 @@ def samples_count(text: str) -> int | str:
         raise argparse.ArgumentTypeError("give a whole number (a power of 2) or auto") from None
 
 
+def fail_on_word(text: str) -> str:
+    """A --fail-on word; the old word impacts refused saying which two to write
+    (``gate.envelope.IMPACTS_REFUSED``), as the API and the library refuse it."""
+    if text == "impacts":
+        raise argparse.ArgumentTypeError(IMPACTS_REFUSED)
+    return text
+
+
 def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -> None:
     """The gate's rules and envelope options, shared by ``check`` and ``remedies``."""
     p.add_argument(
         "--fail-on",
         action="append",
-        choices=[
-            "chaotic",
-            "quasi_periodic",
-            "diverged",
-            "melnikov",
-            "back_flank",
-            "impacts",
-            "separation",
-        ],
-        help="repeatable; back_flank: back-flank impacts, separation: the teeth separate "
-        "(impacts: the older name of back_flank, read with a note)",
+        type=fail_on_word,
+        choices=["chaotic", "quasi_periodic", "diverged", "melnikov", "back_flank", "separation"],
+        help="repeatable; back_flank: back-flank impacts, separation: the teeth apart at some "
+        "time (the old word impacts is refused: it meant two things)",
     )
     p.add_argument("--speed", metavar="LOW:HIGH", required=speed_required,
                    help="driver speeds: rpm, or with units")  # fmt: skip
@@ -172,8 +173,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="CI gate: exit 1 when the design fails (0 pass, 2 invalid input)",
         description="--fail-on X fails on X or anything worse "
         "(periodic < quasi_periodic < chaotic < diverged); melnikov fails when a transverse "
-        "homoclinic tangle is possible; back_flank (or impacts) on back-flank impacts; "
-        "separation when the "
+        "homoclinic tangle is possible; back_flank on back-flank impacts; separation when the "
         "teeth separate (drive-flank impacts, or impacts on both flanks). Default: --fail-on "
         "chaotic; the limits (--max-lle, --max-dte, --max-dynamic-factor, --min-stability-margin) "
         "add to it. With "
@@ -203,8 +203,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="append",
         metavar="NAME=P",
         help="fail where the 95 %% upper bound of P(NAME) over the design's "
-        "tolerances exceeds P (chaotic, separation, back_flank; impacts: the older name of "
-        "separation, read with a note; repeatable)",
+        "tolerances exceeds P (chaotic, separation, back_flank; repeatable)",
     )
     p.add_argument("--samples", type=samples_count, default=64,
                    help="with --max-probability: N, a power of 2 (64), refused when too few "

@@ -26,7 +26,7 @@ from gearengine.cli.envelope import option_axes
 from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import ENVELOPE_SETTINGS, gate_settings
-from gearengine.model.units import display_unit
+from gearengine.model.units import IMPACTS_REFUSED, display_unit
 from gearengine.studies import jobs
 from gearengine.studies.robustness.study import (
     RobustnessRequest,
@@ -36,9 +36,9 @@ from gearengine.studies.robustness.study import (
 )
 from gearengine.studies.robustness.tolerances import samples_to_prove
 
-GATED = ("chaotic", "quasi_periodic", "diverged", "separation", "impacts", "back_flank",
+GATED = ("chaotic", "quasi_periodic", "diverged", "separation", "back_flank",
          "dynamic_factor_above_limit", "melnikov_chaos_possible")  # fmt: skip
-"""Probabilities a gate may limit (``impacts``: the older name of ``separation``, noted)."""
+"""Probabilities a gate may limit (the old word ``impacts`` refused: ``IMPACTS_REFUSED``)."""
 
 
 def robustness_request(args: argparse.Namespace, doc: object) -> RobustnessRequest:
@@ -81,20 +81,14 @@ def point_name(values: dict[str, float]) -> str:
     return ", ".join(parts) or "operating point"
 
 
-OLD_IMPACTS_LIMIT = (
-    "--max-probability impacts is read as separation (the teeth separate, on either flank), "
-    "its older name; write separation, or back_flank for back-flank impacts (as --fail-on "
-    "back_flank)"
-)
-"""The note of a probability gate given the older name ``impacts``."""
-
-
-def limits_of(texts: list[str]) -> tuple[dict[str, float], list[str]]:
-    """``["chaotic=0.01", ...]`` as {name: limit}, the older name ``impacts`` read as
-    ``separation``, and the notes saying so; InvalidInputError naming a bad one."""
-    out, notes = {}, []
+def limits_of(texts: list[str]) -> dict[str, float]:
+    """``["chaotic=0.01", ...]`` as {name: limit}; InvalidInputError naming a bad one, and
+    the old word ``impacts`` saying which two words to write (``IMPACTS_REFUSED``)."""
+    out = {}
     for text in texts:
         name, _, value = text.partition("=")
+        if name == "impacts":
+            raise InvalidInputError([f"--max-probability {text}: {IMPACTS_REFUSED}"])
         try:
             limit = float(value)
         except ValueError:
@@ -102,11 +96,8 @@ def limits_of(texts: list[str]) -> tuple[dict[str, float], list[str]]:
         if name not in GATED or not 0.0 <= limit <= 1.0:
             raise InvalidInputError([f"--max-probability {text}: give NAME=P with P in [0, 1] "
                                      f"and NAME one of {', '.join(GATED)}"])  # fmt: skip
-        if name == "impacts":
-            name = "separation"
-            notes += [] if OLD_IMPACTS_LIMIT in notes else [OLD_IMPACTS_LIMIT]
         out[name] = limit
-    return out, notes
+    return out
 
 
 def failures(result: RobustnessResult, limits: dict[str, float]) -> list[list[str]]:
@@ -222,9 +213,7 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     """``check --max-probability`` of the design document ``doc``: exit 1 where an upper bound
     exceeds its limit; a sample count that cannot prove a limit is refused before computing
     (``samples_needed``)."""
-    limits, notes = limits_of(args.max_probability)
-    for note in notes:
-        print(f"note: {note}")
+    limits = limits_of(args.max_probability)
     least = samples_needed(limits, args.samples)
     if args.samples == "auto":
         result = sequential_study(args, doc, limits, least)

@@ -59,13 +59,19 @@ def _number(value: float | None, fmt: str) -> str:
     return "-" if value is None else format(value, fmt)
 
 
+def _percent(share: float | None) -> str:
+    """A share of the time in %, two significant digits: '0.2' beside a bin labelled
+    separation, where '0.00' (a fraction to two decimals) read as never apart."""
+    return "-" if share is None else "0" if share == 0 else f"{100 * share:.2g}"
+
+
 def branch_table(name: str, branch: RunupBranch, result: RunupResult) -> list[str]:
     """One line per bin: speed, DTE (and the quasi-static one), factor, contact (shares of time
-    apart and on the back flank, entries onto the drive and the back flank), FTLE."""
+    apart and on the back flank in %, entries onto the drive and the back flank), FTLE."""
     quasi = {round(p.speed_rpm, 6): p for p in getattr(result.quasi_static, name).points}
     lines = [
         f"run-{name}:",
-        "  speed [rpm]    time [s]   DTE [µm]  QS DTE  dyn.f.  contact       sep   back  "
+        "  speed [rpm]    time [s]   DTE [µm]  QS DTE  dyn.f.  contact      sep %  back % "
         "impacts drive/back  FTLE/tau",
     ]
     for b in branch.bins:
@@ -79,7 +85,7 @@ def branch_table(name: str, branch: RunupBranch, result: RunupResult) -> list[st
             f"{_number(b.dte_peak_to_peak_um, '8.2f')} "
             f"{_number(None if q is None else q.dte_peak_to_peak_um, '7.2f')} "
             f"{_number(b.dynamic_factor, '6.2f')}  {b.contact or '-':12s} "
-            f"{_number(b.separation_fraction, '5.2f')} {_number(b.back_flank_fraction, '5.2f')} "
+            f"{_percent(b.separation_fraction):>5s}  {_percent(b.back_flank_fraction):>6s} "
             f"{impacts:>18s}  {_number(b.lle, '+8.4f')}{' chaotic' if b.chaotic else ''}"
         )
     for j in branch.jumps:

@@ -4,10 +4,10 @@ that GitHub, GitLab and Jenkins show.
 
 Rules (``Rules``): ``fail_on`` classes (``chaotic`` fails chaotic and diverged points, ordered
 periodic < quasi_periodic < chaotic < diverged as in ``signals.classify.SEVERITY``),
-``melnikov`` (the criterion allows chaos), ``back_flank`` (back-flank impacts; ``impacts``, its
-older name, means the same), ``separation`` (the teeth separate: drive-flank impacts, or impacts
-on both flanks) - the words of the robustness probabilities P(separation), P(back_flank); and
-numeric limits,
+``melnikov`` (the criterion allows chaos), ``back_flank`` (back-flank impacts), ``separation``
+(the teeth separate: drive-flank impacts, or impacts on both flanks) - the words of the
+robustness probabilities P(separation), P(back_flank); the old word ``impacts``, which meant
+back_flank here and separation in P(...), is refused (``IMPACTS_REFUSED``); and numeric limits,
 which add to the classes instead of replacing them: ``max_lle`` (per unit tau), ``max_dte_um``
 (dynamic transmission error peak to peak, µm), ``max_dynamic_factor`` (largest mesh force over
 the static force F~_m). With basins (``settings.basins``) every attractor of a point whose
@@ -21,11 +21,12 @@ import math
 from collections.abc import Callable, Sequence
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from gearengine.gate.resolution import REFINE_DEPTH, Resolution, resolution
 from gearengine.gate.resolution import refine as refine_points
-from gearengine.model.units import OUTPUTS, POINT_OUTPUTS
+from gearengine.model.errors import InputError
+from gearengine.model.units import IMPACTS_REFUSED, OUTPUTS, POINT_OUTPUTS
 from gearengine.signals.classify import SEVERITY
 from gearengine.studies import jobs
 from gearengine.studies.sweep.compute import run_local
@@ -34,18 +35,9 @@ from gearengine.studies.sweep.plan import SweepPlan, balanced_chunk_points
 from gearengine.studies.sweep.points import PhysicalValue, SpeedWindows, SweepPoint
 from gearengine.studies.sweep.request import SweepRequest
 from gearengine.studies.sweep.results import SweepResult
-from gearengine.studies.sweep.windows import SPEED, runs, speed_windows
+from gearengine.studies.sweep.windows import SEPARATING, SPEED, runs, speed_windows
 
-FailOn = Literal[
-    "chaotic", "quasi_periodic", "diverged", "melnikov", "back_flank", "impacts", "separation"
-]
-BACK_FLANK = ("back_flank", "impacts")
-"""The rule names of back-flank impacts (``impacts`` the older one, kept: the same rule)."""
-OLD_IMPACTS_RULE = (
-    "--fail-on impacts is read as back_flank (back-flank impacts), its older name; write "
-    "back_flank, or separation to fail wherever the teeth separate (as P(separation))"
-)
-"""The note of a report whose rules give the older rule name ``impacts``."""
+FailOn = Literal["chaotic", "quasi_periodic", "diverged", "melnikov", "back_flank", "separation"]
 
 
 class Rules(BaseModel):
@@ -56,8 +48,9 @@ class Rules(BaseModel):
     fail_on: list[FailOn] = Field(
         default_factory=lambda: ["chaotic"],
         description="Classes that fail (and anything worse), melnikov, back_flank (back-flank "
-        "impacts; impacts is its older name, the same rule), separation (the teeth separate: "
-        "drive-flank or back-flank impacts), as the robustness probabilities name them.",
+        "impacts), separation (the teeth separate: drive-flank or back-flank impacts), as the "
+        "robustness probabilities name them. The old word impacts is refused: write back_flank "
+        "or separation.",
     )
     max_lle: float | None = Field(None, description="Largest LLE allowed, per unit tau.")
     max_dte_um: float | None = Field(None, description="Largest DTE peak to peak [µm].")
@@ -72,9 +65,15 @@ class Rules(BaseModel):
         "checked; null checks every attractor found.",
     )
 
-
-SEPARATING = ("single_sided", "double_sided")
-"""Impact regimes in which the teeth separate (``signals.diagnostics.impact_regime``)."""
+    @model_validator(mode="before")
+    @classmethod
+    def _refuse_impacts(cls, data: object) -> object:
+        """The old word ``impacts`` meant two things (``IMPACTS_REFUSED``): refused, naming
+        its place (``fail_on.1``), before the list of words would answer with the words alone."""
+        words = data.get("fail_on") if isinstance(data, dict) else None
+        if isinstance(words, list) and "impacts" in words:
+            raise InputError(f"fail_on.{words.index('impacts')}", IMPACTS_REFUSED)
+        return data
 
 
 def point_failures(p: SweepPoint, rules: Rules) -> list[str]:
@@ -111,7 +110,7 @@ def verdict_failures(
             break
     if "melnikov" in rules.fail_on and melnikov_chaos_possible:
         out.append("Melnikov: chaos possible")
-    if any(r in rules.fail_on for r in BACK_FLANK) and impact_regime == "double_sided":
+    if "back_flank" in rules.fail_on and impact_regime == "double_sided":
         out.append("back-flank impacts")
     if "separation" in rules.fail_on and impact_regime in SEPARATING:
         out.append("tooth separation")
@@ -206,19 +205,22 @@ GATE_STARTS = 16
 its cost); ``--starts 1`` checks the settings' own start alone, as before basins."""
 
 
-def gate_settings(settings: dict, starts: int | None) -> dict:
+def gate_settings(settings: dict, starts: int | None, min_basin: float | None = None) -> dict:
     """The gate's settings with its basin starts: ``starts`` (a grid when it is a square, else
     random draws), else the file's basins, else ``GATE_STARTS``; ``starts`` 1 leaves basins
-    out."""
+    out. ``min_basin`` (the rules'), when given, is the basins' ``min_fraction`` too: a point's
+    verdict and the magnitudes it shows come from the attractors the gate checks (with the
+    file's 0 a 10 % attractor's DTE was shown where --min-basin 0.2 passed the point)."""
     if starts is None:
         starts = None if settings.get("basins") is not None else GATE_STARTS
-    if starts is None:
-        return settings
     if starts == 1:
         return {k: v for k, v in settings.items() if k != "basins"}
     basins = dict(settings.get("basins") or {})
-    basins.update(starts=starts, grid=math.isqrt(max(starts, 0)) ** 2 == starts)
-    return {**settings, "basins": basins}
+    if starts is not None:
+        basins.update(starts=starts, grid=math.isqrt(max(starts, 0)) ** 2 == starts)
+    if min_basin is not None and basins:
+        basins["min_fraction"] = min_basin
+    return {**settings, "basins": basins} if basins else settings
 
 
 def envelope_axis(name: str, text: str, unit: str, num: int) -> dict[str, object]:
@@ -348,10 +350,7 @@ class EnvelopeReport(BaseModel):
         [], description="The points inserted between the grid points (gate.resolution), "
         "checked by the same rules; their failures are in failures.",
     )  # fmt: skip
-    notes: list[str] = Field(
-        [], description="How the rules were read: an older rule name (impacts, read as "
-        "back_flank) is named with its reading."
-    )  # fmt: skip
+    notes: list[str] = Field([], description="How the rules were read, where it needs saying.")
 
 
 def _level_key(p: SweepPoint) -> tuple:
@@ -397,7 +396,6 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
         resolution=resolution,
         sweep=result,
         refined=list(refined),
-        notes=[OLD_IMPACTS_RULE] if "impacts" in rules.fail_on else [],
     )
 
 

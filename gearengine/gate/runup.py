@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from gearengine.gate.envelope import BACK_FLANK, EnvelopeReport, FailingWindow, Rules
+from gearengine.gate.envelope import EnvelopeReport, FailingWindow, Rules
 from gearengine.model.units import RPM
 from gearengine.studies.runup.compute import run_local
 from gearengine.studies.runup.profile import validated
@@ -31,7 +31,7 @@ GATE_ENSEMBLE = 4
 def bin_failures(b: RunupBin, rules: Rules) -> list[str]:
     """The per-bin rules a bin breaks (chaos is judged over runs, see ``runup_failures``)."""
     out = []
-    if any(r in rules.fail_on for r in BACK_FLANK) and (b.back_flank_impacts or 0) > 0:
+    if "back_flank" in rules.fail_on and (b.back_flank_impacts or 0) > 0:
         out.append("back-flank impacts")
     if "separation" in rules.fail_on and (b.separation_fraction or 0) > 0:
         out.append("tooth separation")

@@ -34,7 +34,7 @@ import numpy as np
 from gearengine.model.design import Design
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import ParamsOrDesign
-from gearengine.model.units import Scales, response_values
+from gearengine.model.units import Scales, response_values, shown, to_physical
 from gearengine.numerics.batch import run_lanes, run_verdict, simulate_batch_with, step_plans
 from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint
 from gearengine.numerics.runs import integrate
@@ -177,11 +177,15 @@ def _attractor(
     ptp = max((bp.x_peak_to_peak for _, bp in members if bp.x_peak_to_peak is not None),
               default=None)  # fmt: skip
     fmax = max((bp.force_max for _, bp in members if bp.force_max is not None), default=None)
+    fmin = min((bp.force_min for _, bp in members if bp.force_min is not None), default=None)
     impact = max((bp.impact_regime for _, bp in members), key=IMPACT_ORDER.__getitem__)
     dte = factor = None
+    forces: list[float | None] = [None, None]
     if scales is not None:
         response = response_values(ptp, fmax, scales)
         dte, factor = response["dte"], response["dynamic_factor"]
+        forces = [None if f is None else shown(to_physical("mesh_force", f, scales))
+                  for f in (fmax, fmin)]  # fmt: skip
     return Attractor(
         label=describe(rep.classification, rep.period, impact),
         classification=rep.classification,
@@ -192,6 +196,8 @@ def _attractor(
         x_peak_to_peak=ptp,
         dte_um=dte,
         dynamic_factor=factor,
+        force_max_n=forces[0],
+        force_min_n=forces[1],
         fraction=len(members) / n,
         interval=wilson(len(members), n),
         count=len(members),
@@ -367,8 +373,7 @@ def coexisting(bp: BatchPoint, found: list[Attractor], counts: BasinCounts) -> l
     """The attractors other than the one ``bp`` (a followed branch) settled on, as 'label from
     NN % of starts' (largest basin first)."""
     others = [a for a in found if not follows(bp, a)]
-    return [f"{a.label} from {percent(a.fraction)} of starts"
-            for a in sorted(others, key=lambda a: -a.count)]  # fmt: skip
+    return [of_starts(a.label, a.fraction) for a in sorted(others, key=lambda a: -a.count)]
 
 
 @dataclass(frozen=True)
@@ -405,9 +410,14 @@ def headline(found: list[Attractor], counts: BasinCounts, min_fraction: float) -
         return Headline("diverged", None, f"diverged from {percent(diverged)} of starts", diverged)
     for a in found:  # worst first
         if a.fraction > min_fraction:
-            text = f"{a.label} from {percent(a.fraction)} of starts"
-            return Headline(a.classification, a.period, text, a.fraction, a)
+            return Headline(a.classification, a.period, of_starts(a.label, a.fraction), a.fraction,
+                            a)  # fmt: skip
     return None
+
+
+def of_starts(label: str, fraction: float) -> str:
+    """An attractor named with its basin fraction: 'chaotic, ... from 31 % of starts'."""
+    return f"{label} from {percent(fraction)} of starts"
 
 
 def coexistence(found: list[Attractor], counts: BasinCounts) -> str:

@@ -99,6 +99,14 @@ class Attractor(FiniteAnswer):
     dynamic_factor: float | None = Field(
         None, description="With a design: largest mesh force / static force."
     )
+    force_max_n: float | None = Field(
+        None, description="With a design: largest mesh force of the model seen on it [N]."
+    )
+    force_min_n: float | None = Field(
+        None,
+        description="With a design: smallest mesh force of the model seen on it [N] "
+        "(negative: back-flank contact, or the damping term while apart).",
+    )
     fraction: float = Field(description="count / basins.starts: the basin fraction.")
     interval: list[float] = Field(
         description="95 % Wilson score interval [low, high] of the fraction "
@@ -110,6 +118,23 @@ class Attractor(FiniteAnswer):
         description="Its stroboscopic orbit [[x, v], ...]: the n points of a period-n orbit, "
         "else the representative start's last strobes (<= 64)."
     )
+
+
+class FromAttractor(FiniteAnswer):
+    """The attractor a shown magnitude comes from (``numerics.attractors.most_adverse``)."""
+
+    attractor: int = Field(description="Its index in attractors (worst first).")
+    label: str = Field(description="Its label, as attractors[attractor].label.")
+    classification: str = Field(description="periodic | chaotic | quasi_periodic.")
+    fraction: float = Field(description="Its basin fraction.")
+
+
+class WorstValue(FromAttractor):
+    """A magnitude's most adverse value over the attractors above basins.min_fraction, with
+    the attractor it comes from."""
+
+    value: float = Field(description="The value, in unit.")
+    unit: str = Field(description="Its unit: um, 1, N.")
 
 
 class BasinCounts(FiniteAnswer):
@@ -160,7 +185,12 @@ class RunLength(FiniteAnswer):
 class NumericsResult(FiniteAnswer):
     """Numerical verdict. Detailed fields describe the worst-case start (``worst_case``)."""
 
-    classification: str = Field(description="periodic | chaotic | quasi_periodic | diverged.")
+    classification: str = Field(
+        description="periodic | chaotic | quasi_periodic | diverged: the worst of the settings' "
+        "own starts. With settings.basins the design's verdict is the worst attractor's "
+        "(verdict.decided_by, verdict.chaotic): this field, worst_case, floquet and the "
+        "records below stay the settings' start's answer (notes says so)."
+    )
     period: int | None = Field(description="Period in units of T0, null if none found.")
     forcing_period: float | None = Field(description="T0 = 2 pi / Omega_0, null if none.")
     sampling_interval: float = Field(description="Interval between strobes, tau units.")
@@ -186,13 +216,17 @@ class NumericsResult(FiniteAnswer):
     steps_per_forcing_period: int = Field(description="RK4 steps per sampling interval.")
     method: str = Field(description="Integrator used.")
     starts: list[StartSummary] = Field(description="One verdict per initial state.")
-    worst_case: StartSummary = Field(description="The worst start.")
+    worst_case: StartSummary = Field(
+        description="The worst of the settings' own starts (not the basins' attractors: with "
+        "settings.basins the verdict is verdict.decided_by's)."
+    )
     notes: list[str] = Field(description="Remarks on choices and limitations.")
     floquet: FloquetResult | None = Field(
         None,
-        description="Floquet multipliers and stability margin of the worst start's periodic "
-        "orbit; null when the response is not periodic, the forcing has no common period or "
-        "Newton shooting did not converge (floquet_note says which).",
+        description="Floquet multipliers and stability margin of the worst settings' start's "
+        "periodic orbit (with settings.basins not necessarily the deciding attractor's); "
+        "null when the response is not periodic, the forcing has no common period or Newton "
+        "shooting did not converge (floquet_note says which).",
     )
     floquet_note: str | None = Field(None, description="Why floquet is null; else null.")
     transient: RunLength | None = Field(

@@ -1,5 +1,5 @@
 """The operating envelope of a design: a map over two physical axes (driver speed in rpm and
-mean torque in N m, say), each grid cell coloured by its response, impacts marked, and the
+mean torque in N m, say), each grid cell coloured by its response, its contact marked, and the
 Melnikov boundary drawn, with a legend an engineer reads without the paper.
 """
 

@@ -298,9 +298,15 @@ function facts(result) {
       rows.push(["Critical torque", `${fmt(eng.critical_torque_nm, 3)} N·m (the Melnikov criterion applies below it)`]);
     }
   }
+  // with basins the DTE and the dynamic factor are the largest over the attractors, named
+  const worst = eng && eng.most_adverse;
+  const largest = (key, unit) => `${fmt(worst[key].value, 3)}${unit} (the largest over the attractors: `
+    + `${worst[key].label}, ${fmt(100 * worst[key].fraction, 2)} % of starts)`;
   if (resp) {
-    rows.push(["Dynamic transmission error", `${fmt(resp.dte_peak_to_peak_um, 3)} µm peak to peak`],
-      ["Dynamic factor", fmt(resp.dynamic_factor, 3)],
+    rows.push(["Dynamic transmission error", worst && worst.dte ? largest("dte", " µm peak to peak")
+      : `${fmt(resp.dte_peak_to_peak_um, 3)} µm peak to peak`],
+      ["Dynamic factor", worst && worst.dynamic_factor ? largest("dynamic_factor", "")
+        : fmt(resp.dynamic_factor, 3)],
       ["Contact", (CONTACT[resp.contact.regime] || resp.contact.regime)
         + (resp.contact.separation_fraction
           ? `, separated ${fmt(100 * resp.contact.separation_fraction, 2)} % of the time` : "")]);
@@ -643,6 +649,13 @@ async function drawEnvelope(id, result) {
   offerFix(id, result);
 }
 
+// With basins a point's DTE and dynamic factor are the largest over its attractors above the
+// threshold (``magnitudes_from``): the attractor they come from, with its fraction.
+function magnitudesFrom(p) {
+  const a = p.magnitudes_from && p.magnitudes_from.dte;
+  return a ? `<br>(largest over the attractors: ${a.label}, ${fmt(100 * a.fraction, 2)} % of starts)` : "";
+}
+
 // A speed x torque map of a sweep result into ``map``: one marker per point by class, the
 // Melnikov region shaded.
 async function drawMap(map, result, height) {
@@ -659,12 +672,13 @@ async function drawMap(map, result, height) {
         p.melnikov_chaos_possible === null ? "not applicable (above T_crit)"
           : p.melnikov_chaos_possible ? "chaos possible" : "chaos ruled out",
         physicalText(p, "dynamic_factor", 3, ""), physicalText(p, "dte", 3, " µm"),
-        // with basins every number above is the worst attractor's: name it and its fraction
+        // with basins the verdict is the worst attractor's: name it and its fraction
         p.decided_by ? `<br>decided by ${p.decided_by}` : "",
+        magnitudesFrom(p),
       ]),
       hovertemplate: "speed %{x:,.0f} rpm<br>torque %{y:,.1f} N·m"
         + "<br>class %{customdata[0]}, period %{customdata[1]}<br>LLE %{customdata[2]} ± %{customdata[3]} per unit τ"
-        + "<br>%{customdata[4]}<br>dynamic factor %{customdata[6]}, DTE %{customdata[7]}"
+        + "<br>%{customdata[4]}<br>dynamic factor %{customdata[6]}, DTE %{customdata[7]}%{customdata[9]}"
         + "<br>Melnikov: %{customdata[5]}%{customdata[8]}<extra></extra>",
       marker: {
         color: CLASS_COLORS[cls], symbol: sel.map((p) => IMPACT_SYMBOLS[p.impact_regime] || "square"),
@@ -753,7 +767,7 @@ async function pollFix(id) {
 }
 
 // The windows table: per torque level, the speed intervals [rpm] of each response, of tooth
-// impacts and of Melnikov chaos (the result's `windows`).
+// contact (separation, back-flank) and of Melnikov chaos (the result's `windows`).
 const span = ([a, b]) => (a === b ? `${rpm(a)}` : `${rpm(a)}–${rpm(b)}`) + " rpm";
 const runs = (byName) => Object.entries(byName)
   .map(([name, list]) => `${name.replaceAll("_", "-")}: ${list.map(span).join(", ")}`);
@@ -764,13 +778,13 @@ function showWindows(windows) {
   const row = (w) => {
     const level = Object.entries(w.level)
       .map(([k, v]) => `${k} ${fmt(v.value)} ${v.unit.replace("*", "·")}`).join(", ") || "all";
-    const cells = [[level], runs(w.response), runs(w.impacts).concat(w.impacts && Object.keys(w.impacts).length ? [] : ["none"]),
+    const cells = [[level], runs(w.response), runs(w.contact).concat(w.contact && Object.keys(w.contact).length ? [] : ["always in contact"]),
       (w.melnikov.length ? w.melnikov.map(span) : ["none"])
         .concat((w.melnikov_not_applicable || []).map((s) => `not applicable: ${span(s)}`))];
     return el("tr", {}, ...cells.map((lines) => el("td", {}, ...lines.flatMap((t, i) => (i ? [el("br"), t] : [t])))));
   };
   box.replaceChildren(el("h3", { text: "Speed windows" }), el("table", {},
-    el("thead", {}, el("tr", {}, ...["level", "response", "tooth impacts", "Melnikov: chaos possible"]
+    el("thead", {}, el("tr", {}, ...["level", "response", "tooth contact", "Melnikov: chaos possible"]
       .map((c) => el("th", { text: c })))),
     el("tbody", {}, ...windows.map(row))));
 }

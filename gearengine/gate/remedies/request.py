@@ -149,7 +149,8 @@ class RemediesRequest(Rules):
         axes = [envelope_axis("speed", env.speed, "rpm", num(env.speed_points))]
         if env.torque is not None:
             axes.append(envelope_axis("torque", env.torque, "N*m", num(env.torque_points)))
-        settings = gate_settings(self.settings.model_dump(exclude_none=True), self.starts)
+        settings = gate_settings(self.settings.model_dump(exclude_none=True), self.starts,
+                                 self.min_basin)  # fmt: skip
         doc = envelope_sweep((design or self.design).model_dump(), settings, axes, "remedies")
         return SweepRequest.model_validate(doc)
 

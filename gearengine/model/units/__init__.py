@@ -6,6 +6,7 @@ output table). Everything else imports units from here.
 """
 
 from gearengine.model.units.outputs import (
+    IMPACTS_REFUSED,
     OUTPUTS,
     POINT_OUTPUTS,
     RADIUS_RATIO_TOLERANCE,
@@ -56,6 +57,7 @@ from gearengine.model.units.quantities import (
 )
 
 __all__ = [
+    "IMPACTS_REFUSED",
     "OUTPUTS",
     "POINT_OUTPUTS",
     "QUANTITIES",

@@ -130,6 +130,15 @@ POINT_OUTPUTS = (*RESPONSES, *RECORD_FORCES)
 """Every ``physical`` entry of a sweep point that is an output, not an axis."""
 
 
+IMPACTS_REFUSED = (
+    "'impacts' is no longer read (it meant back-flank impacts in --fail-on and any separation "
+    "in P(...)): write back_flank (back-flank impacts) or separation (the teeth apart at some "
+    "time)"
+)
+"""Why the old word ``impacts`` is refused wherever a contact outcome is named (one vocabulary,
+docs/units.md): a gate's fail_on (API, library, ``--fail-on``) and ``--max-probability``."""
+
+
 def in_si(name: str, value: float, scales: Scales) -> float:
     """The dimensionless ``value`` of output ``name`` in its SI unit (``OUTPUTS``)."""
     return OUTPUTS[name].to_si(value, scales)

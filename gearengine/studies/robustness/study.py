@@ -41,6 +41,7 @@ from gearengine.model.reduction import convert_design
 from gearengine.model.units import Scales, display_unit, in_display_unit, response_values
 from gearengine.numerics.attractors import headline, points_attractors
 from gearengine.numerics.batch import simulate_batch
+from gearengine.numerics.magnitudes import most_adverse
 from gearengine.numerics.settings import SimulationSettings, work
 from gearengine.studies import jobs
 from gearengine.studies.robustness import sensitivity
@@ -68,14 +69,12 @@ RUN_FIELDS = ("class", "contact", "melnikov", "dte_um", "dynamic_factor")
 """The entries of one stored run, in order."""
 EVENTS = (
     "separation",
-    "impacts",
     "back_flank",
     "dynamic_factor_above_limit",
     "melnikov_chaos_possible",
 )
 OUTPUTS = ("chaotic", "separation", "back_flank", "dte", "dynamic_factor")
-"""The outputs whose Sobol indices are reported (``sensitivity`` also holds separation's
-under ``impacts``, its older name)."""
+"""The outputs whose Sobol indices are reported."""
 DEFAULT_CHUNK_ROWS = 16
 MAX_SAMPLES = 4096
 
@@ -208,9 +207,11 @@ def _run(bp: Any, model: Any, scales: Scales) -> list[Any]:
 
 
 def _worst(run: list[Any], found: list[Any], counts: Any, min_fraction: float) -> list[Any]:
-    """``run`` decided by its worst attractor above ``min_fraction`` (``headline``): its class,
-    contact, DTE and dynamic factor (None where it diverged); ``run`` itself when no basin is
-    above the fraction (the settings' own start decides, as in a sweep)."""
+    """``run`` decided by its worst attractor above ``min_fraction`` (``headline``): its class
+    and contact, and the DTE and dynamic factor at their largest over those attractors
+    (``most_adverse``, as a sweep point shows and the gate judges them; None where it
+    diverged); ``run`` itself when no basin is above the fraction (the settings' own start
+    decides, as in a sweep)."""
     head = headline(found, counts, min_fraction)
     if head is None:
         return run
@@ -218,7 +219,10 @@ def _worst(run: list[Any], found: list[Any], counts: Any, min_fraction: float) -
     if a is None:  # diverged: no contact or response numbers
         return [CLASSES.index("diverged"), None, run[2], None, None]
     contact = CONTACTS.index(a.impact_regime) if a.impact_regime in CONTACTS else None
-    return [CLASSES.index(a.classification), contact, run[2], a.dte_um, a.dynamic_factor]
+    worst = most_adverse(found, head, min_fraction)
+    dte, factor = (None if (w := worst.get(k)) is None else w.value
+                   for k in ("dte", "dynamic_factor"))  # fmt: skip
+    return [CLASSES.index(a.classification), contact, run[2], dte, factor]
 
 
 def compute_chunk(request: RobustnessRequest, index: int, rows: int) -> str:
@@ -262,16 +266,13 @@ class RobustnessPoint(BaseModel):
     probabilities: dict[str, Probability] = Field(
         description="Of each class (periodic, quasi_periodic, chaotic, diverged) and event "
         "(separation: the teeth separate, drive-flank or back-flank impacts, as the gate's "
-        "--fail-on separation; impacts: its older name, the same count (deprecated: "
-        "--fail-on impacts is back_flank); back_flank: back-flank "
-        "impacts, as --fail-on back_flank; "
+        "--fail-on separation; back_flank: back-flank impacts, as --fail-on back_flank; "
         "dynamic_factor_above_limit; melnikov_chaos_possible)."
     )
     dte_um: dict[str, float | None] = Field(description="DTE over the samples: mean, p5, p95.")
     sensitivity: dict[str, dict[str, dict[str, float | None]] | None] | None = Field(
         None, description="Sobol indices by output (chaotic, separation, back_flank, dte, "
-        "dynamic_factor; impacts: separation's under its older name) and field: first, total, "
-        "and their 95 % half-widths.",
+        "dynamic_factor) and field: first, total, and their 95 % half-widths.",
     )  # fmt: skip
     ranking: list[str] | None = Field(None, description="The indices in plain words.")
 
@@ -325,8 +326,9 @@ ASSUMPTIONS = [
 def basin_assumption(basins: Any) -> str:
     """The model line of a study with ``settings.basins``: how a sample is decided."""
     return (f"with settings.basins a sample counts as its worst attractor whose basin fraction "
-            f"is above {basins.min_fraction:g}, found from {basins.starts} basin starts per "
-            "sample (the gate's and the sweep's verdict of a point)")  # fmt: skip
+            f"is above {basins.min_fraction:g} (its class and contact; its DTE and dynamic "
+            f"factor the largest over those attractors), found from {basins.starts} basin "
+            "starts per sample (the gate's and the sweep's verdict of a point)")  # fmt: skip
 
 
 def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[int],
@@ -337,7 +339,6 @@ def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[
     n = len(base)
     probs = {c: probability(sum(r[0] == k for r in base), n) for k, c in enumerate(CLASSES)}
     probs["separation"] = probability(sum(r[1] in (1, 2) for r in base), n)
-    probs["impacts"] = probs["separation"]  # its older name
     probs["back_flank"] = probability(sum(r[1] == 2 for r in base), n)
     limit = request.dynamic_factor_limit
     probs["dynamic_factor_above_limit"] = probability(
@@ -364,7 +365,7 @@ def _point_answer(request: RobustnessRequest, runs: list[list[Any]], rows: list[
                  for k, y in ys.items()}  # fmt: skip
         labels = {v.path: v.name for v in variables_}
         out["ranking"] = [sensitivity.ranked(k, t, labels) for k, t in table.items()]
-        out["sensitivity"] = {**table, "impacts": table["separation"]}  # its older name
+        out["sensitivity"] = table
     return out
 
 

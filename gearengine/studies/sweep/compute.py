@@ -14,8 +14,8 @@ from gearengine.model.aliases import ALIASES, get_alias
 from gearengine.model.params import GearParams
 from gearengine.model.units import (
     OUTPUTS,
+    POINT_OUTPUTS,
     RECORD_FORCES,
-    RESPONSES,
     Scales,
     display_unit,
     in_display_unit,
@@ -31,7 +31,8 @@ from gearengine.numerics.attractors import (
 )
 from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
 from gearengine.numerics.bifurcations import PointResponse, locate_bifurcations
-from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint
+from gearengine.numerics.magnitudes import most_adverse
+from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint, FromAttractor
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies import jobs
 from gearengine.studies.sweep.axes import is_dimensionless
@@ -59,10 +60,11 @@ def _physical(
     responses: dict[str, float | None] | None = None,
 ) -> dict[str, Any]:
     """With a design (its ``scales``): the axes in display units, the responses (DTE in µm,
-    dynamic factor), the record's mesh forces in N and the point's aliases. The responses are
-    the deciding attractor's with basins (``responses``, from ``_decided``), else
-    ``model.units.response_values`` of the settings' own run ``bp``; the forces are always the
-    record's (``RECORD_FORCES``, as ``force_max`` and ``force_min``)."""
+    dynamic factor), the mesh forces in N and the point's aliases. With basins these magnitudes
+    are the most adverse over the attractors above the threshold (``responses``, from
+    ``_decided``: the largest DTE, dynamic factor and force_max, the smallest force_min), else
+    those of the settings' own run ``bp`` (``model.units.response_values``, its ``force_max``
+    and ``force_min`` x b k_m)."""
     if scales is None:
         return {}
     out = {
@@ -75,7 +77,7 @@ def _physical(
         key: None if f is None else shown(to_physical("mesh_force", f, scales))
         for key, f in zip(RECORD_FORCES, (bp.force_max, bp.force_min), strict=True)
     }
-    for key, value in {**record, **(responses or {}), **forces}.items():
+    for key, value in {**record, **forces, **(responses or {})}.items():
         if value is not None:
             out[key] = PhysicalValue(value=value, unit=OUTPUTS[key].unit)
     aliases = {a: get_alias(params, a) for a in ALIASES}
@@ -215,23 +217,26 @@ def _ensembles(request: SweepRequest, found: list[tuple[list[Attractor], BasinCo
 def _decided(found: list[Attractor], counts: BasinCounts, min_fraction: float) -> dict[str, Any]:
     """The point's verdict from its ensemble (docs/basins.md): the worst attractor (or the
     divergence) whose basin fraction is above ``min_fraction`` (``numerics.attractors.headline``),
-    its classification, period, LLE and impacts, named with its fraction in ``decided_by``, and
-    its responses (DTE, dynamic factor: the point's ``physical`` entries, so the CSV's and the
-    DataFrame's columns are that attractor's too); empty when no basin is above it (the
-    settings' own starts decide)."""
+    its classification, period, LLE and impacts, named with its fraction in ``decided_by``; and
+    the magnitudes (DTE, dynamic factor, forces: the point's ``physical`` entries, so the CSV's
+    and the DataFrame's columns too) at their most adverse over the attractors above it
+    (``most_adverse``), each named in ``magnitudes_from``; none after a divergence. Empty when
+    no basin is above it (the settings' own starts decide)."""
     head = headline(found, counts, min_fraction)
     if head is None:
         return {}
     verdict: dict[str, Any] = {"classification": head.classification, "period": head.period}
     a = head.attractor
-    if a is None:  # diverged: no LLE, no impact verdict, no response
+    if a is None:  # diverged: no LLE, no impact verdict
         verdict.update(lle=None, lle_stderr=None, impact_regime=None)
-        responses: dict[str, float | None] = dict.fromkeys(RESPONSES)  # none of them
     else:
         verdict.update(lle=a.lle, lle_stderr=a.lle_stderr, impact_regime=a.impact_regime)
-        responses = {"dte": a.dte_um, "dynamic_factor": a.dynamic_factor}
+    worst = most_adverse(found, head, min_fraction)
+    responses = {key: None if key not in worst else worst[key].value for key in POINT_OUTPUTS}
+    named = {key: FromAttractor(**w.model_dump(include=set(FromAttractor.model_fields)))
+             for key, w in worst.items()}  # fmt: skip
     return {"verdict": verdict, "responses": responses, "decided_by": head.decided_by,
-            "decided_fraction": head.fraction}  # fmt: skip
+            "decided_fraction": head.fraction, "magnitudes_from": named or None}  # fmt: skip
 
 
 def _line_bifurcations(

@@ -12,7 +12,14 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel, Field, TypeAdapter
 
-from gearengine.model.units import POINT_OUTPUTS, display_label, field_unit, in_display_unit
+from gearengine.model.units import (
+    POINT_OUTPUTS,
+    RECORD_FORCES,
+    display_label,
+    field_unit,
+    in_display_unit,
+)
+from gearengine.numerics.attractors import of_starts
 from gearengine.studies.sweep.axes import axis_unit, bare_reading, is_dimensionless
 from gearengine.studies.sweep.points import SweepBifurcation, SweepPoint
 from gearengine.studies.sweep.request import SweepAxis
@@ -27,12 +34,22 @@ def chunk_json(
     for a line of a one-axis continuation sweep, a second line with the JSON array of its
     bifurcations. Compact JSON holds no raw newline (strings escape it), so each line is one
     whole document. With ``outputs`` (``SweepRequest.outputs``) a point holds values, branch
-    and those fields only."""
+    and those fields only, with the names of whose they are (``NAMED_WITH``)."""
     keep = None if outputs is None else {"values", "branch", *outputs}
+    if keep is not None:
+        keep |= {name for field in outputs or () for name in NAMED_WITH.get(field, ())}
     array = "[" + ",".join(p.model_dump_json(include=keep) for p in points) + "]"
     if bifurcations is None:
         return array
     return array + "\n[" + ",".join(b.model_dump_json() for b in bifurcations) + "]"
+
+
+NAMED_WITH = {
+    "classification": ("decided_by", "decided_fraction"),
+    "physical": ("magnitudes_from",),
+}
+"""Fields kept with an output a sweep keeps (with basins): who decided the verdict fields, and
+which attractor each magnitude of ``physical`` comes from."""
 
 
 def _chunk_parts(text: str) -> tuple[str, list[dict[str, object]] | None]:
@@ -112,6 +129,11 @@ BASIN_COLUMNS = ("decided_by", "decided_fraction", "basin_starts", "attractors")
 """The CSV's last columns with settings.basins: who decided the verdict columns (the worst
 attractor above basins.min_fraction) and its fraction, the starts run, and every attractor with
 its basin fraction, worst first ('chaotic, double-sided impacts: 0.3125; periodic 1T, ...')."""
+FROM_COLUMNS = tuple(f"{key}_from" for key in POINT_OUTPUTS)
+"""With settings.basins and a design's magnitude columns, before ``BASIN_COLUMNS``: the
+attractor each magnitude column comes from (``SweepPoint.magnitudes_from``, 'periodic 1T, ...
+from 69 % of starts'): the largest over the attractors above basins.min_fraction (force_min the
+smallest), which need not be the one that decided the verdict."""
 
 
 def csv_rows(
@@ -126,8 +148,8 @@ def csv_rows(
     in physical units) the axes whose display unit differs also in that unit (``speed [rpm]``)
     and, unless ``outputs`` leaves ``physical`` out, the DTE, the dynamic factor and the mesh
     forces in N (``dte [um]``, ``dynamic_factor``, ``force_max [N]``, ``force_min [N]``, from the
-    point's ``physical``; ``force_max`` and ``force_min`` are the same in units of b k_m); then
-    the verdicts, and
+    point's ``physical``; the unitless ``force_max`` and ``force_min`` in units of b k_m are
+    then left out: with basins they would be another start's); then the verdicts, and
     poincare_x as space-separated numbers. Empty cells are nulls; booleans are true/false. Axis
     cells are plain decimals (``_axis_cell``: 500, 0.000001, never 500.0 beside 1e-6), rounded
     to the 15 significant digits they were given with (``_grid_value``); every other number is
@@ -135,19 +157,40 @@ def csv_rows(
     (``SweepRequest.outputs``) only the columns it names (and branch) are written. Rows are
     yielded one by one, so a streamed response never holds the whole table. With ``basins`` (a
     sweep with settings.basins, whose verdict columns are the worst attractor's) the
-    ``BASIN_COLUMNS`` follow."""
+    ``FROM_COLUMNS`` (with the magnitude columns) and the ``BASIN_COLUMNS`` follow."""
     names = [a.parameter for a in axes]
     extra = _physical_columns(names, outputs) if design else []
-    fields = [f for f in CSV_FIELDS if outputs is None or f == "branch" or f in outputs]
+    magnitudes = [key for key, _, axis in extra if not axis]
+    fields = [f for f in CSV_FIELDS if (outputs is None or f == "branch" or f in outputs)
+              and not (f in RECORD_FORCES and f in magnitudes)]  # fmt: skip
     header = [*map(_axis_title, names), *(title for _, title, _ in extra), *fields]
-    header += BASIN_COLUMNS if basins else ()
+    named = basins and bool(magnitudes)
+    header += (*(FROM_COLUMNS if named else ()), *BASIN_COLUMNS) if basins else ()
     yield ",".join(_text_cell(c) for c in header) + "\n"
     shown = [(key, axis) for key, _, axis in extra]
     for p in points:
         cells = _row(p, names, shown, fields)
         if basins:
-            cells += _basin_cells(p.__dict__ if isinstance(p, SweepPoint) else p)
+            fields_of = p.__dict__ if isinstance(p, SweepPoint) else p
+            cells += _from_cells(fields_of) if named else []
+            cells += _basin_cells(fields_of)
         yield ",".join(cells) + "\n"
+
+
+def _from_cells(p: PointFields) -> list[str]:
+    """The ``FROM_COLUMNS`` cells of a point: each magnitude's attractor named with its basin
+    fraction (empty where the point has none)."""
+    named = p.get("magnitudes_from") or {}
+    out = []
+    for key in POINT_OUTPUTS:
+        a = named.get(key)
+        if a is None:
+            out.append("")
+            continue
+        label, fraction = (a["label"], a["fraction"]) if isinstance(a, Mapping) else \
+            (a.label, a.fraction)  # fmt: skip
+        out.append(_text_cell(of_starts(label, fraction)))
+    return out
 
 
 def _basin_cells(p: PointFields) -> list[str]:

@@ -7,7 +7,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, SerializerFunctionWrapHandler, model_serializer
 
-from gearengine.numerics.results import Attractor, BasinCounts
+from gearengine.numerics.results import Attractor, BasinCounts, FromAttractor
 from gearengine.studies.sweep.request import SweepBranch
 
 
@@ -20,7 +20,14 @@ class PhysicalValue(BaseModel):
     unit: str
 
 
-BASIN_FIELDS = ("attractors", "basins", "coexisting", "decided_by", "decided_fraction")
+BASIN_FIELDS = (
+    "attractors",
+    "basins",
+    "coexisting",
+    "decided_by",
+    "decided_fraction",
+    "magnitudes_from",
+)
 """Point fields that exist only with settings.basins (left out of a point without them)."""
 
 
@@ -42,7 +49,9 @@ class SweepPoint(BaseModel):
         None,
         description="periodic | chaotic | quasi_periodic | diverged; with settings.basins the "
         "worst attractor's above basins.min_fraction (decided_by names it; period, lle, "
-        "lle_stderr, impact_regime and physical's dte and dynamic_factor are its too). This "
+        "lle_stderr and impact_regime are its too; physical's dte, dynamic_factor, force_max "
+        "and force_min are the most adverse over those attractors, magnitudes_from names "
+        "each one's). This "
         "and every field below are left out of the stored and returned points that a "
         "sweep's outputs do not name (null when read back into this model).",
     )
@@ -84,7 +93,10 @@ class SweepPoint(BaseModel):
         description="With a design: the physical axes' values in display units (rpm, N*m, "
         "µm, ...), the dynamic transmission error dte (µm peak to peak), the "
         "dynamic_factor (largest mesh force / static force F~_m), and force_max and force_min "
-        "in N (the record's, as the fields force_max and force_min x b k_m).",
+        "in N: the record's (the fields force_max and force_min x b k_m), or with "
+        "settings.basins the most adverse over the attractors above basins.min_fraction "
+        "(largest dte, dynamic_factor and force_max, smallest force_min; magnitudes_from "
+        "names the attractor of each).",
         examples=[{"speed": {"value": 1500.0, "unit": "rpm"}, "torque": {"value": 40.0,
                    "unit": "N*m"}, "dte": {"value": 3.4, "unit": "um"}}],
     )  # fmt: skip
@@ -97,10 +109,11 @@ class SweepPoint(BaseModel):
         None,
         description="With settings.basins: the attractors reached from the point's basin "
         "starts, worst first (as numerics.attractors of an analysis). The verdict fields "
-        "(classification, period, lle, lle_stderr, impact_regime) and physical's dte and "
-        "dynamic_factor are the worst attractor's above basins.min_fraction (decided_by names "
-        "it); the record fields (poincare_x, x_peak_to_peak, force_max, force_min) describe "
-        "the worst of settings' own starts.",
+        "(classification, period, lle, lle_stderr, impact_regime) are the worst attractor's "
+        "above basins.min_fraction (decided_by names it); physical's dte, dynamic_factor, "
+        "force_max and force_min the most adverse over those attractors (magnitudes_from); "
+        "the record fields (poincare_x, x_peak_to_peak, force_max, force_min) describe the "
+        "worst of settings' own starts.",
     )
     basins: BasinCounts | None = Field(
         None, description="With settings.basins: how the point's basin starts ended."
@@ -119,6 +132,14 @@ class SweepPoint(BaseModel):
     )
     decided_fraction: float | None = Field(
         None, description="With settings.basins: the basin fraction of decided_by's attractor."
+    )
+    magnitudes_from: dict[str, FromAttractor] | None = Field(
+        None,
+        description="With settings.basins and a design: per magnitude of physical (dte, "
+        "dynamic_factor, force_max, force_min), the attractor its most adverse value comes "
+        "from (index in attractors, label, class, basin fraction): the verdict is the worst "
+        "attractor by class, a magnitude the largest (force_min the smallest) over the "
+        "attractors above basins.min_fraction, which may be another one.",
     )
 
     @model_serializer(mode="wrap")
@@ -178,8 +199,10 @@ class SpeedWindows(BaseModel):
         description="Per response (periodic 1T, periodic 2T, ..., quasi-periodic, chaotic, "
         "diverged): [first, last] speeds [rpm] of each run of grid points."
     )
-    impacts: dict[str, list[list[float]]] = Field(
-        description="single_sided (teeth separate) and double_sided (back-flank contact) runs."
+    contact: dict[str, list[list[float]]] = Field(
+        description="Runs of grid speeds by contact, the words of --fail-on and P(...) "
+        "(docs/units.md): separation (the teeth apart at some time, on either flank's side) "
+        "and back_flank (back-flank impacts, within separation's runs)."
     )
     melnikov: list[list[float]] = Field(
         description="Runs of grid speeds where the Melnikov criterion allows chaos."

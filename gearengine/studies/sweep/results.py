@@ -51,7 +51,8 @@ class SweepResult(BaseModel):
     windows: list[SpeedWindows] | None = Field(
         None,
         description="Sweeps over the driver speed: per level of the other axis, the speed "
-        "intervals [rpm] of each response, of impacts and of Melnikov chaos; null otherwise.",
+        "intervals [rpm] of each response, of tooth contact (separation, back_flank) and of "
+        "Melnikov chaos; null otherwise.",
     )
 
     def summary(self) -> str:

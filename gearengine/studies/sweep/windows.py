@@ -1,5 +1,6 @@
 """Speed windows of a sweep over the driver speed: the intervals (rpm) of each response class,
-of tooth impacts and of Melnikov chaos, at each level of the other axis (a torque, say).
+of tooth contact (separation, back_flank) and of Melnikov chaos, at each level of the other
+axis (a torque, say).
 
 An interval joins consecutive grid speeds with the same verdict and reports the first and last
 of them, so a window is known to the grid step: [500, 1100] rpm on a 100 rpm grid means the
@@ -17,6 +18,9 @@ from gearengine.studies.sweep.points import PhysicalValue, SpeedWindows, SweepPo
 from gearengine.studies.sweep.request import SweepAxis
 
 SPEED = "speed"
+SEPARATING = ("single_sided", "double_sided")
+"""Impact regimes in which the teeth separate at some time: ``separation`` (the gate's
+--fail-on separation, P(separation); ``double_sided`` is also ``back_flank``)."""
 
 
 def response_label(p: SweepPoint) -> str:
@@ -62,7 +66,8 @@ def speed_windows(request: _Axes, points: Sequence[SweepPoint]) -> list[SpeedWin
     for level, row in sorted(rows.items(), key=lambda item: item[0] or 0.0):
         row.sort(key=lambda p: p.values[SPEED])
         speeds = [rounded(p.values[SPEED] * factor) for p in row]
-        impacts = [p.impact_regime if p.impact_regime != "no_impact" else None for p in row]
+        apart = ["separation" if p.impact_regime in SEPARATING else None for p in row]
+        back = ["back_flank" if p.impact_regime == "double_sided" else None for p in row]
         melnikov = [
             "n/a" if p.melnikov_chaos_possible is None else
             "chaos" if p.melnikov_chaos_possible else None
@@ -75,7 +80,7 @@ def speed_windows(request: _Axes, points: Sequence[SweepPoint]) -> list[SpeedWin
             SpeedWindows(
                 level=shown,
                 response=runs(speeds, [response_label(p) for p in row]),
-                impacts=runs(speeds, impacts),
+                contact={**runs(speeds, apart), **runs(speeds, back)},
                 melnikov=runs(speeds, melnikov).get("chaos", []),
                 melnikov_not_applicable=runs(speeds, melnikov).get("n/a", []),
             )
