@@ -136,6 +136,6 @@ def test_samples_auto_reads_a_design_from_standard_input_once(
 
     monkeypatch.setattr(robustness, "decided", lambda result, limits: result.samples >= 128)
     monkeypatch.setattr("sys.stdin", io.StringIO(design_file.read_text()))
-    args = ["check", "-", "--samples", "auto", "--max-probability", "impacts=0.4"]
-    assert main(args) == 1  # the design point impacts in most samples
+    args = ["check", "-", "--samples", "auto", "--max-probability", "separation=0.4"]
+    assert main(args) == 1  # the design point separates in most samples
     assert "--samples auto: decided at 128 samples" in capsys.readouterr().err

@@ -224,11 +224,10 @@ def test_the_gates_min_basin_is_the_threshold_of_the_points_it_shows(tmp_path):
     assert gate_settings({"basins": {"starts": 8}}, None, 0.3)["basins"]["min_fraction"] == 0.3
     assert gate_settings({"record_periods": 60}, 1, 0.2) == {"record_periods": 60}
     assert "min_fraction" not in gate_settings({}, 16)["basins"]
-    path = tmp_path / "design.json"
-    path.write_text(json.dumps({"design": DOC["design"]}))
-    args = build_parser().parse_args(["check", str(path), "--speed", "5000:6000", "--speed-points",
-                                      "2", "--min-basin", "0.2"])  # fmt: skip
-    assert envelope_request(args).settings.basins.min_fraction == 0.2
+    args = build_parser().parse_args(["check", "design.json", "--speed", "5000:6000",
+                                      "--speed-points", "2", "--min-basin", "0.2"])  # fmt: skip
+    doc = {"design": DOC["design"]}
+    assert envelope_request(args, doc).settings.basins.min_fraction == 0.2
 
 
 def test_the_te_with_static_and_contact_forces_are_over_the_attractors_too(analysis):
