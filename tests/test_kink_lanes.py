@@ -112,9 +112,12 @@ def test_lle_rule_off_runs_the_full_length_bit_for_bit() -> None:
 
 
 def test_both_lock_step_kernels_run_the_one_lane_scheduler() -> None:
-    """Refill, interval ends and adaptive stopping are written once (``kernels.scheduler``):
-    the cubic and the piecewise streams are that one body with their law's steps."""
-    streams = (lockstep._cubic_stream, kinklanes._kink_stream)
+    """Streams, refill, interval ends and adaptive stopping are written once
+    (``kernels.scheduler``): the cubic and the piecewise kernels are its one kernel and stream
+    bodies with their law's steps."""
+    kernels = (lockstep.run_batch, kinklanes.run_kink_batch)
+    assert all(k.py_func.__code__ is scheduler._lanes.__code__ for k in kernels)
+    streams = [k.py_func.__globals__["law_stream"] for k in kernels]
     assert all(s.py_func.__code__ is scheduler._stream.__code__ for s in streams)
     laws = [s.py_func.__globals__["law_steps"] for s in streams]
     assert laws == [lockstep._cubic_steps, kinklanes._kink_steps]

@@ -87,7 +87,7 @@ def lanes_cubic(laws: list[Law], inverse: np.ndarray, packed: list, mu: np.ndarr
                 carry: Carry) -> tuple:  # fmt: skip
     a = np.array([lw.a for lw in laws])[inverse]
     c = np.array([lw.c for lw in laws])[inverse]
-    return kernels.run_batch(a, c, mu, x0, v0, carry[0], carry[1], *tabled, *shared)
+    return kernels.run_batch(mu, x0, v0, carry[0], carry[1], *tabled, *shared, a, c)
 
 
 def lanes_piecewise(laws: list[Law], inverse: np.ndarray, packed: list, mu: np.ndarray,
@@ -97,8 +97,8 @@ def lanes_piecewise(laws: list[Law], inverse: np.ndarray, packed: list, mu: np.n
     kc, nk = padded_terms([f[0] for f in packed])
     fc, nf = padded_terms([f[2] for f in packed])
     fm = np.array([f[1] for f in packed])
-    return kernels.run_kink_batch(alpha, mu, x0, v0, *carry, *tabled, kc, nk, fm, fc, nf,
-                                  *shared)  # fmt: skip
+    return kernels.run_kink_batch(mu, x0, v0, carry[0], carry[1], *tabled, *shared, alpha,
+                                  carry[2], kc, nk, fm, fc, nf)  # fmt: skip
 
 
 def padded_terms(terms: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:

@@ -5,11 +5,10 @@ numbers of the scalar kink kernel (``kink.run_kink`` with its forcing table)."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from gearengine.systems.spur_pair.kernels.intervals import new_outputs
 from gearengine.systems.spur_pair.kernels.kink import kink_split, rk4_region_kf
-from gearengine.systems.spur_pair.kernels.scheduler import LANES, LaneLaw, lane_stream
+from gearengine.systems.spur_pair.kernels.scheduler import LANES, LaneLaw, lane_kernel
 from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, region
 
 HERMITE_REACH = 0.15
@@ -42,79 +41,6 @@ def _region_interval(reg: int) -> tuple[float, float]:  # pragma: no cover - com
     if reg < 0:
         return -np.inf, -1.0
     return -1.0, 1.0
-
-
-@njit(**JIT_OPTIONS, parallel=True)
-def run_kink_batch(
-    alpha: np.ndarray,
-    mu: np.ndarray,
-    x0: np.ndarray,
-    v0: np.ndarray,
-    dxc: np.ndarray,
-    dvc: np.ndarray,
-    regc: np.ndarray,
-    Ktab: np.ndarray,
-    Ftab: np.ndarray,
-    owner: np.ndarray,
-    kc: np.ndarray,
-    nk: np.ndarray,
-    fm: np.ndarray,
-    fc: np.ndarray,
-    nf: np.ndarray,
-    T: np.ndarray,
-    N: int,
-    n_trans: int,
-    n_rec: int,
-    bound: float,
-    adaptive: bool = False,
-    streams: int = 1,
-    lle_rel: float = 0.0,
-    lle_abs: float = 0.0,
-):  # pragma: no cover - compiled
-    """Kink-splitting RK4 of Eq. (9) + tangent, piecewise law of Eq. (8), for P runs in lanes.
-
-    Every step of every lane is first taken whole in its current region with the lane's forcing
-    table (the arithmetic of ``kink.rk4_region_kf`` written out per lane, so LLVM vectorises the
-    lane loop) and bounded by its Hermite reach (``HERMITE_REACH``): a lane whose bound stays in
-    its region keeps the step, by selects, not branches. A lane whose bound touches a switching
-    point |x| = 1 keeps its state in that loop; a second loop, entered only when some lane is
-    near a kink, retakes its step with ``rk4_region_kf`` and hands it to ``kink.kink_split``
-    (the crossing test, the regula falsi and the substeps of the scalar kernel, forcing at the
-    time within the period). So each run has the numbers of ``run_kink(..., use_table=True)``
-    bit for bit, while the steps far from the kinks cost what the cubic lanes' cost. The forcing
-    rows are indexed in place (``Kl[2j, lane]``), not taken as row views: a view's reference
-    count is updated around every step (12 atomic calls) once the split loop may use it.
-    Streams, lanes, refills, adaptive stopping and outputs are those of ``lockstep.run_batch``:
-    the one lane scheduler (``kernels.scheduler``) with this law's pieces.
-
-    Args:
-        alpha, mu, x0, v0, T: per-run slope of Eq. (8) inside the clearance, damping, initial
-            state and period T0, shape (P,).
-        dxc, dvc, regc: the tangent vector and region of Eq. (8) each run starts in, shape (P,),
-            overwritten with those it ends in, as ``run_batch``'s tangent (the region is
-            carried too: at a kink it follows the direction of motion, not x alone);
-            ``NO_REGION`` for the region of x0.
-        Ktab, Ftab: forcing tables from ``forcing_table`` of the M parameter points, shape
-            (M, 2N+1); owner: the point of each run, shape (P,), values in 0..M-1.
-        kc, fc: forcing coefficients of the points (``systems.spur_pair.forcing.packed_forcing``)
-            padded to shapes (M, 3, max terms); nk, nf: their numbers of terms, shape (M,);
-            fm: mean force, shape (M,). The substeps of split steps evaluate the forcing from
-            them.
-        N, n_trans, n_rec, bound, adaptive, streams, lle_rel, lle_abs: as in ``run_batch``.
-
-    Returns:
-        The outputs of ``run_batch``.
-    """
-    P = alpha.size
-    xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf = new_outputs(P, n_rec)
-    for stream in prange(streams):  # one call per stream: tuples stay out of the parfor
-        _kink_stream(
-            stream, streams, mu, x0, v0, dxc, dvc, Ktab, Ftab, owner, T, N, n_trans, n_rec,
-            bound, adaptive, lle_rel, lle_abs,
-            xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf,
-            alpha, regc, kc, nk, fm, fc, nf,
-        )  # fmt: skip
-    return xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf
 
 
 @njit(**JIT_OPTIONS)
@@ -236,4 +162,39 @@ def _kink_keep(lane: int, p: int, law: tuple, coeffs: tuple) -> None:  # pragma:
     coeffs[1][p] = law[1][lane]
 
 
-_kink_stream = lane_stream(LaneLaw("kink", _kink_lanes, _kink_load, _kink_steps, _kink_keep))
+KINK = LaneLaw(
+    "kink",
+    """Kink-splitting RK4 of Eq. (9) + tangent, piecewise law of Eq. (8), for P runs in lanes.
+
+    Every step of every lane is first taken whole in its current region with the lane's forcing
+    table (the arithmetic of ``kink.rk4_region_kf`` written out per lane, so LLVM vectorises the
+    lane loop) and bounded by its Hermite reach (``HERMITE_REACH``): a lane whose bound stays in
+    its region keeps the step, by selects, not branches. A lane whose bound touches a switching
+    point |x| = 1 keeps its state in that loop; a second loop, entered only when some lane is
+    near a kink, retakes its step with ``rk4_region_kf`` and hands it to ``kink.kink_split``
+    (the crossing test, the regula falsi and the substeps of the scalar kernel, forcing at the
+    time within the period). So each run has the numbers of ``run_kink(..., use_table=True)``
+    bit for bit, while the steps far from the kinks cost what the cubic lanes' cost. The forcing
+    rows are indexed in place (``Kl[2j, lane]``), not taken as row views: a view's reference
+    count is updated around every step (12 atomic calls) once the split loop may use it.
+    Streams, lanes, refills, adaptive stopping and outputs are the lane scheduler's
+    (``kernels.scheduler``), shared with the cubic law.
+
+    ``coeffs`` = (alpha, regc, kc, nk, fm, fc, nf): alpha, the runs' slope of Eq. (8) inside
+    the clearance, shape (P,); regc, the region of Eq. (8) each run starts in, shape (P,),
+    overwritten with the one it ends in, as the tangent (at a kink the region follows the
+    direction of motion, not x alone), ``NO_REGION`` for the region of x0; kc, fc: the points'
+    forcing coefficients (``systems.spur_pair.forcing.packed_forcing``) padded to shapes
+    (M, 3, max terms), nk, nf their numbers of terms, shape (M,), fm their mean force, shape
+    (M,): the substeps of split steps evaluate the forcing from them.""",
+    _kink_lanes,
+    _kink_load,
+    _kink_steps,
+    _kink_keep,
+)
+"""The piecewise law's pieces of the lane scheduler."""
+
+run_kink_batch = lane_kernel(KINK)
+"""The piecewise law's lock-step kernel: ``run_kink_batch(mu, x0, v0, dxc, dvc, Ktab, Ftab,
+owner, T, N, n_trans, n_rec, bound, adaptive, streams, lle_rel, lle_abs, alpha, regc, kc, nk,
+fm, fc, nf)`` (``scheduler._lanes``)."""

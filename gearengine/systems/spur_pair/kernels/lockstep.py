@@ -4,87 +4,10 @@ advanced together; the cubic law's pieces of the lane scheduler (``kernels.sched
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
-from gearengine.systems.spur_pair.kernels.intervals import new_outputs
-from gearengine.systems.spur_pair.kernels.scheduler import LANES, LaneLaw, lane_stream
+from gearengine.systems.spur_pair.kernels.scheduler import LANES, LaneLaw, lane_kernel
 from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS
-
-
-@njit(**JIT_OPTIONS, parallel=True)
-def run_batch(
-    a: np.ndarray,
-    c: np.ndarray,
-    mu: np.ndarray,
-    x0: np.ndarray,
-    v0: np.ndarray,
-    dxc: np.ndarray,
-    dvc: np.ndarray,
-    Ktab: np.ndarray,
-    Ftab: np.ndarray,
-    owner: np.ndarray,
-    T: np.ndarray,
-    N: int,
-    n_trans: int,
-    n_rec: int,
-    bound: float,
-    adaptive: bool = False,
-    streams: int = 1,
-    lle_rel: float = 0.0,
-    lle_abs: float = 0.0,
-):  # pragma: no cover - compiled
-    """RK4 of Eq. (9) + tangent, cubic law, for P points advanced together.
-
-    Same arithmetic, operation by operation, as ``run_rk4`` with a forcing table, so results are
-    identical to the single kernel. The stages are written out per lane (no helper calls) in
-    the law's ``steps`` so LLVM vectorises the lane loop; the streams, the lanes' refill and the
-    end of every interval are the scheduler's (``kernels.scheduler``), shared with the
-    piecewise lanes.
-
-    The points are dealt to ``streams`` streams (point p to stream p mod streams, so clustered
-    chaotic regions of a map are shared out) run in parallel (prange); a stream keeps ``LANES``
-    lanes busy, each lane advancing one point, and loads the stream's next point into a lane as
-    soon as its point is finished (lanes run at different interval counts; the forcing table
-    of a lane is its point's). With ``adaptive`` a point may finish early by the rule of
-    ``kernels.adaptive`` (its last ``ADAPT_WINDOW`` strobes kept in a ring buffer per lane),
-    and a chaotic or quasi-periodic one by its LLE rule when ``lle_rel`` or ``lle_abs`` is
-    positive; otherwise every point runs ``n_trans + n_rec`` intervals, as ``run_rk4``. The end
-    of an interval is ``kernels.intervals.end_interval``.
-
-    The dimensionless mesh force K(t) f_h(x) + 2 mu x' is evaluated at every step end (a few
-    flops) and its extremes over the record returned.
-
-    Args:
-        a, c, mu, x0, v0, T: per-point law coefficients, damping, initial state and period T0,
-            shape (P,).
-        dxc, dvc: the tangent vector each point starts from, shape (P,), overwritten with the
-            (renormalised) one it ends with: a record continued by a second call from the first
-            one's final state and tangent has the numbers of one call running on
-            (``numerics.physical``); (1, 1)/sqrt 2 for a fresh start.
-        Ktab, Ftab: forcing tables from ``forcing_table`` of the M parameter points, shape
-            (M, 2N+1); owner: the point of each lane's run, shape (P,), values in 0..M-1 (the
-            runs of a point share its table).
-        N, n_trans, n_rec, bound: as in ``run_rk4`` (shared by all points).
-        adaptive: allow early stopping of periodic points (``kernels.adaptive``).
-        streams: parallel streams of lanes (at most the number of threads is useful).
-        lle_rel, lle_abs: tolerances of the LLE rule (``kernels.adaptive.lle_known``); 0 and 0
-            turn it off.
-
-    Returns:
-        xs, vs, logs: shape (P, n_rec), the record in its first ``rec`` entries; xmin, xmax,
-        fmin, fmax (extremes of x and of the mesh force over the record's steps), xf, vf (final
-        state): shape (P,); done (intervals run), rec (intervals recorded), diverged (1 if the
-        run left ``bound``): shape (P,).
-    """
-    P = a.size
-    xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf = new_outputs(P, n_rec)
-    for stream in prange(streams):  # one call per stream: tuples stay out of the parfor
-        _cubic_stream(
-            stream, streams, mu, x0, v0, dxc, dvc, Ktab, Ftab, owner, T, N, n_trans, n_rec,
-            bound, adaptive, lle_rel, lle_abs,
-            xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf, a, c,
-        )  # fmt: skip
-    return xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf
 
 
 @njit(**JIT_OPTIONS)
@@ -164,4 +87,19 @@ def _cubic_keep(lane: int, p: int, law: tuple, coeffs: tuple) -> None:  # pragma
     """Nothing: a cubic run carries its tangent vector alone."""
 
 
-_cubic_stream = lane_stream(LaneLaw("cubic", _cubic_lanes, _cubic_load, _cubic_steps, _cubic_keep))
+CUBIC = LaneLaw(
+    "cubic",
+    """RK4 of Eq. (9) + tangent, cubic law, ``coeffs`` = (a, c): the runs' law coefficients, shape
+    (P,). Same arithmetic, operation by operation, as ``run_rk4`` with a forcing table, so the
+    results are identical to the single kernel's. The stages are written out per lane (no
+    helper calls) in the law's ``steps`` so LLVM vectorises the lane loop.""",
+    _cubic_lanes,
+    _cubic_load,
+    _cubic_steps,
+    _cubic_keep,
+)
+"""The cubic law's pieces of the lane scheduler."""
+
+run_batch = lane_kernel(CUBIC)
+"""The cubic law's lock-step kernel: ``run_batch(mu, x0, v0, dxc, dvc, Ktab, Ftab, owner, T, N,
+n_trans, n_rec, bound, adaptive, streams, lle_rel, lle_abs, a, c)`` (``scheduler._lanes``)."""

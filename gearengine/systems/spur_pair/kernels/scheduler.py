@@ -1,19 +1,20 @@
 """The lane scheduler of the lock-step kernels, written once: each backlash law is data.
 
-A stream of ``LANES`` lanes loads the stream's next run into every free lane, advances all
-lanes by one interval T0 of N RK4 steps, and ends the interval of every lane
-(``intervals.end_interval``: record, divergence, adaptive stopping), until the stream's runs are
-finished. Only the step differs between the laws (as scipy's ``RungeKutta`` writes ``_step_impl``
-once and each method is its tableau): a ``LaneLaw`` names the law's four compiled pieces, and
-``lane_stream`` makes the scheduler of one law (``lockstep.run_batch`` for the cubic law,
-``kinklanes.run_kink_batch`` for the piecewise law).
+A lock-step kernel deals its runs to streams run in parallel; a stream of ``LANES`` lanes loads
+its next run into every free lane, advances all lanes by one interval T0 of N RK4 steps, and
+ends the interval of every lane (``intervals.end_interval``: record, divergence, adaptive
+stopping), until its runs are finished. Only the step differs between the laws (as scipy's
+``RungeKutta`` writes ``_step_impl`` once and each method is its tableau): a ``LaneLaw`` names
+the law's four compiled pieces, and ``lane_kernel`` makes the kernel of one law
+(``lockstep.run_batch`` for the cubic law, ``kinklanes.run_kink_batch`` for the piecewise law).
 
 Why a factory and not the step as an argument: numba cannot cache a kernel that passes a
 compiled function as a value (it counts as a dynamic global), nor one that closes over it (the
 closure's hash holds the dispatcher's per-process id, so every process compiles anew). So
-``lane_stream`` makes one function per law from the one body ``_stream`` with the law's pieces
-as its globals and its own name: each law's scheduler is compiled, with the law's steps called
-directly, and cached under that name like any kernel.
+``lane_kernel`` makes one kernel and one stream per law from the one bodies ``_lanes`` and
+``_stream``, with the law's pieces as their globals and names of their own
+(``<law>_kernel``, ``<law>_stream``): each law's kernel is compiled with the law's steps called
+directly, and cached under its name like any kernel.
 
 The law's pieces (``coeffs``: the law's own per-run inputs, a tuple, as the kernel was given
 them; ``law_lanes``: the tuple its ``lanes`` made):
@@ -38,12 +39,13 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from gearengine.systems.spur_pair.kernels.adaptive import ADAPT_SETTLE
 from gearengine.systems.spur_pair.kernels.intervals import (
     adaptive_window,
     end_interval,
+    new_outputs,
     new_ring,
     reset_lane,
 )
@@ -54,9 +56,11 @@ LANES = 16
 
 
 class LaneLaw(NamedTuple):
-    """A backlash law of the lock-step kernels: its name and compiled pieces (module doc)."""
+    """A backlash law of the lock-step kernels: its name, what its kernel does and with which
+    ``coeffs`` (the first lines of the kernel's doc), and its compiled pieces (module doc)."""
 
     name: str
+    doc: str
     lanes: Callable
     load: Callable
     steps: Callable
@@ -99,7 +103,7 @@ def _stream(
     """One stream of lanes: runs ``stream``, ``stream + streams``, ... of the kernel's P runs
     (arguments and outputs of ``lockstep.run_batch``; ``coeffs`` the law's own inputs).
     ``law_lanes``, ``law_load``, ``law_steps`` and ``law_keep`` are the law's pieces, set as
-    this body's globals by ``lane_stream``."""
+    this body's globals by ``lane_kernel``."""
     P = x0.size
     W = adaptive_window(adaptive, n_rec)
     settle0 = min(n_trans, ADAPT_SETTLE)
@@ -129,7 +133,7 @@ def _stream(
     FMAX = np.full(LANES, -np.inf)
     lane_state = (X, V, DX, DV, XMIN, XMAX, FMIN, FMAX)
     ring = new_ring(W, LANES)
-    law = law_lanes(LANES)  # noqa: F821 - a global set by lane_stream
+    law = law_lanes(LANES)  # noqa: F821 - a global set by lane_kernel
     taken = 0  # runs of this stream loaded so far
     active = 0
     while True:
@@ -175,18 +179,91 @@ def _stream(
                 law_keep(lane, p, law, coeffs)  # noqa: F821
 
 
-def lane_stream(law: LaneLaw) -> Callable:
-    """The compiled scheduler of ``law``: ``_stream`` with the law's pieces as its globals,
-    named ``<law.name>_stream`` (its numba cache files carry that name)."""
-    name = f"{law.name}_stream"
-    scope = {
-        **globals(),
+def _lanes(
+    mu,
+    x0,
+    v0,
+    dxc,
+    dvc,
+    Ktab,
+    Ftab,
+    owner,
+    T,
+    N,
+    n_trans,
+    n_rec,
+    bound,
+    adaptive,
+    streams,
+    lle_rel,
+    lle_abs,
+    *coeffs,
+):  # pragma: no cover - compiled
+    """RK4 of Eq. (9) + tangent for P runs advanced together in lanes, by one backlash law.
+
+    The runs are dealt to ``streams`` streams (run p to stream p mod streams, so clustered
+    chaotic regions of a map are shared out) run in parallel (prange); a stream keeps ``LANES``
+    lanes busy, each lane advancing one run, and loads the stream's next run into a lane as
+    soon as its run is finished (lanes run at different interval counts; the forcing table of
+    a lane is its point's). With ``adaptive`` a run may finish early by the rule of
+    ``kernels.adaptive`` (its last ``ADAPT_WINDOW`` strobes kept in a ring buffer per lane),
+    and a chaotic or quasi-periodic one by its LLE rule when ``lle_rel`` or ``lle_abs`` is
+    positive; otherwise every run takes ``n_trans + n_rec`` intervals, as ``run_rk4``. The end
+    of an interval is ``kernels.intervals.end_interval``. The mesh force K(t) f_h(x) + 2 mu x'
+    is evaluated at every step end and its extremes over the record returned.
+
+    Args:
+        mu, x0, v0, T: per-run damping, initial state and period T0, shape (P,).
+        dxc, dvc: the tangent vector each run starts from, shape (P,), overwritten with the
+            (renormalised) one it ends with: a record continued by a second call from the first
+            one's final state and tangent has the numbers of one call running on
+            (``numerics.physical``); (1, 1)/sqrt 2 for a fresh start.
+        Ktab, Ftab: forcing tables from ``forcing_table`` of the M parameter points, shape
+            (M, 2N+1); owner: the point of each run, shape (P,), values in 0..M-1 (the runs of
+            a point share its table).
+        N, n_trans, n_rec, bound: as in ``run_rk4`` (shared by all runs).
+        adaptive: allow early stopping of periodic runs (``kernels.adaptive``).
+        streams: parallel streams of lanes (at most the number of threads is useful).
+        lle_rel, lle_abs: tolerances of the LLE rule (``kernels.adaptive.lle_known``); 0 and 0
+            turn it off.
+        coeffs: the law's own per-run inputs (its module says which).
+
+    Returns:
+        xs, vs, logs: shape (P, n_rec), the record in its first ``rec`` entries; xmin, xmax,
+        fmin, fmax (extremes of x and of the mesh force over the record's steps), xf, vf (final
+        state): shape (P,); done (intervals run), rec (intervals recorded), diverged (1 if the
+        run left ``bound``): shape (P,).
+    """
+    P = x0.size
+    xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf = new_outputs(P, n_rec)
+    for stream in prange(streams):
+        law_stream(  # noqa: F821 - a global set by lane_kernel
+            stream, streams, mu, x0, v0, dxc, dvc, Ktab, Ftab, owner, T, N, n_trans, n_rec,
+            bound, adaptive, lle_rel, lle_abs,
+            xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf, *coeffs,
+        )  # fmt: skip
+    return xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf
+
+
+def _compiled(template: Callable, name: str, scope: dict, doc: str, **options: bool) -> Callable:
+    """``template``'s body compiled under ``name`` with ``scope`` added to its globals."""
+    body = types.FunctionType(template.__code__, {**globals(), **scope}, name)
+    body.__qualname__ = name
+    body.__doc__ = doc
+    return njit(**JIT_OPTIONS, **options)(body)
+
+
+def lane_kernel(law: LaneLaw) -> Callable:
+    """The lock-step kernel of ``law`` (``_lanes``, named ``<law.name>_kernel``; arguments
+    ``mu, x0, v0, dxc, dvc, Ktab, Ftab, owner, T, N, n_trans, n_rec, bound, adaptive, streams,
+    lle_rel, lle_abs, *coeffs``), over its scheduler ``<law.name>_stream``; numba caches each
+    under its name."""
+    pieces = {
         "law_lanes": law.lanes,
         "law_load": law.load,
         "law_steps": law.steps,
         "law_keep": law.keep,
     }
-    body = types.FunctionType(_stream.__code__, scope, name)
-    body.__qualname__ = name
-    body.__doc__ = _stream.__doc__
-    return njit(**JIT_OPTIONS)(body)
+    stream = _compiled(_stream, f"{law.name}_stream", pieces, _stream.__doc__)
+    doc = f"{law.doc}\n\n{_lanes.__doc__}"
+    return _compiled(_lanes, f"{law.name}_kernel", {"law_stream": stream}, doc, parallel=True)
