@@ -11,8 +11,10 @@ How to add a law (the contract):
 3. Give its step to the kernels: a ``kernel_code`` that ``kernels.smooth.law_force`` and
    ``kernels.monodromy`` switch on (a smooth law), or a kernel of its own that splits the steps
    at its kinks (as ``kernels.kink``); ``run`` calls it with the common arguments.
-4. Optionally ``lanes``: a lock-step kernel over many lanes (``kernels.lockstep``); without it
-   the lanes of that law run one by one through ``run``.
+4. Optionally ``lanes``: a lock-step kernel over many lanes, the one lane scheduler with the
+   law's steps: a ``kernels.scheduler.LaneLaw`` (per-lane arrays, load, steps, keep) made into a
+   kernel by ``lane_kernel``, as ``kernels.lockstep.CUBIC``; without it the lanes of that law
+   run one by one through ``run``.
 5. Register it in ``LAWS``; ``tests/test_kernels.py`` and ``tests/test_scipy_crosscheck.py``
    hold a new law against scipy's DOP853 (with events at its kinks).
 """
