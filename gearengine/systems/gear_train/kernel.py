@@ -171,6 +171,24 @@ def train_step(
 
 
 @njit(**JIT_OPTIONS)
+def renormalised(y: np.ndarray) -> tuple[float, float]:  # pragma: no cover - compiled
+    """Benettin's renormalisation at the end of an interval of the state y = (u, v, du, dv),
+    shape (4, n): the tangent (du, dv) divided by its norm in place; (that norm, the largest
+    |u_i|, |v_i|) for the log of its growth and the divergence test."""
+    n = y.shape[1]
+    nrm = 0.0
+    big = 0.0
+    for i in range(n):
+        nrm += y[2, i] * y[2, i] + y[3, i] * y[3, i]
+        big = max(big, abs(y[0, i]), abs(y[1, i]))
+    nrm = math.sqrt(nrm)
+    for i in range(n):
+        y[2, i] /= nrm
+        y[3, i] /= nrm
+    return nrm, big
+
+
+@njit(**JIT_OPTIONS)
 def run_train(
     law: int,
     a: float,
@@ -273,15 +291,7 @@ def run_train(
                 hx[ih] = delta
                 hv[ih] = deltad
                 ih = ih + 1 if rec else 0
-        nrm = 0.0
-        big = 0.0
-        for i in range(n):
-            nrm += y[2, i] * y[2, i] + y[3, i] * y[3, i]
-            big = max(big, abs(y[0, i]), abs(y[1, i]))
-        nrm = math.sqrt(nrm)
-        for i in range(n):
-            y[2, i] /= nrm
-            y[3, i] /= nrm
+        nrm, big = renormalised(y)
         if not big < bound:
             break
         if rec:

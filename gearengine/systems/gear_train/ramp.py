@@ -24,7 +24,7 @@ from numba import njit
 
 from gearengine.jitcache import drop_stale
 from gearengine.systems.gear_train import kernel
-from gearengine.systems.gear_train.kernel import forcing_at_phase, train_step
+from gearengine.systems.gear_train.kernel import forcing_at_phase, renormalised, train_step
 from gearengine.systems.spur_pair.kernels import ramp as pair_ramp
 from gearengine.systems.spur_pair.kernels import smooth
 from gearengine.systems.spur_pair.kernels.ramp import (
@@ -134,15 +134,7 @@ def run_ramp(
             reg = region(delta)
             force = forcing[2, 0] * law_force(law, a, c, alpha, delta)[0] + twomu * deltad
             tally = tallied(tally, reg, prev, delta, force)
-        nrm = 0.0
-        big = 0.0
-        for i in range(n):
-            nrm += y[2, i] * y[2, i] + y[3, i] * y[3, i]
-            big = max(big, abs(y[0, i]), abs(y[1, i]))
-        nrm = math.sqrt(nrm)
-        for i in range(n):
-            y[2, i] /= nrm
-            y[3, i] /= nrm
+        nrm, big = renormalised(y)
         if not big < bound:
             return out, blk
         write_block(out[blk], tally, grown + math.log(nrm))
