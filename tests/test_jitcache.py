@@ -62,7 +62,7 @@ def test_the_kernels_caches_are_stamped_with_their_current_sources() -> None:
     homoclinic = Path(gearengine.homoclinic.__file__).parent
     groups = {
         numerics / "__pycache__" / (
-            "adaptive+intervals+kink+kinklanes+lockstep+monodromy+phase+ramp+smooth"
+            "adaptive+intervals+kink+kinklanes+lockstep+monodromy+phase+ramp+scheduler+smooth"
         ): [
             *numerics.glob("*.py"), signals / "periodicity.py",
             signals / "lyapunov.py", signals / "classify.py",

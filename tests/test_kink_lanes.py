@@ -11,6 +11,7 @@ from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate
 from gearengine.signals.lyapunov import BLOCKS
+from gearengine.systems.spur_pair.kernels import kinklanes, lockstep, scheduler
 from gearengine.systems.spur_pair.kernels.adaptive import ADAPT_LLE_MIN_RECORD
 from tests._gear_cases import paper
 
@@ -108,3 +109,15 @@ def test_lle_rule_off_runs_the_full_length_bit_for_bit() -> None:
     (a,) = run_lanes([point], [(0, (0.01, 0.01))], off)
     (f,) = run_lanes([point], [(0, (0.01, 0.01))], SimulationSettings(adaptive=False))
     assert a == f and a.periods_run == 1000
+
+
+def test_both_lock_step_kernels_run_the_one_lane_scheduler() -> None:
+    """Streams, refill, interval ends and adaptive stopping are written once
+    (``kernels.scheduler``): the cubic and the piecewise kernels are its one kernel and stream
+    bodies with their law's steps."""
+    kernels = (lockstep.run_batch, kinklanes.run_kink_batch)
+    assert all(k.py_func.__code__ is scheduler._lanes.__code__ for k in kernels)
+    streams = [k.py_func.__globals__["law_stream"] for k in kernels]
+    assert all(s.py_func.__code__ is scheduler._stream.__code__ for s in streams)
+    laws = [s.py_func.__globals__["law_steps"] for s in streams]
+    assert laws == [lockstep._cubic_steps, kinklanes._kink_steps]

@@ -15,8 +15,8 @@ from gearengine.numerics.batch import run_lanes, run_verdict, step_plans
 from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.systems.designs import design_model
-from gearengine.systems.gear_train.kernel import run_train
-from gearengine.systems.gear_train.lanes import forcing_table, run_train_lanes
+from gearengine.systems.gear_train.kernel import forcing_table, run_train
+from gearengine.systems.gear_train.lanes import run_train_lanes
 from gearengine.systems.gear_train.system import TrainSystem
 from gearengine.systems.spur_pair.laws import law
 

@@ -67,6 +67,19 @@ def train_forcing(
 
 
 @njit(**JIT_OPTIONS)
+def forcing_table(
+    kc: np.ndarray, ec: np.ndarray, tc: np.ndarray, T: float, N: int
+) -> np.ndarray:  # pragma: no cover - compiled
+    """(K, e, e', T) at the 2N + 1 stage times s h / 2 of a period T, h = T / N: the table of
+    ``run_train``, ``flow_train`` and the lanes."""
+    h2 = 0.5 * (T / N)
+    table = np.empty((2 * N + 1, 4))
+    for q in range(2 * N + 1):
+        table[q, 0], table[q, 1], table[q, 2], table[q, 3] = train_forcing(q * h2, kc, ec, tc)
+    return table
+
+
+@njit(**JIT_OPTIONS)
 def _field(
     law: int,
     a: float,
@@ -158,6 +171,24 @@ def train_step(
 
 
 @njit(**JIT_OPTIONS)
+def renormalised(y: np.ndarray) -> tuple[float, float]:  # pragma: no cover - compiled
+    """Benettin's renormalisation at the end of an interval of the state y = (u, v, du, dv),
+    shape (4, n): the tangent (du, dv) divided by its norm in place; (that norm, the largest
+    |u_i|, |v_i|) for the log of its growth and the divergence test."""
+    n = y.shape[1]
+    nrm = 0.0
+    big = 0.0
+    for i in range(n):
+        nrm += y[2, i] * y[2, i] + y[3, i] * y[3, i]
+        big = max(big, abs(y[0, i]), abs(y[1, i]))
+    nrm = math.sqrt(nrm)
+    for i in range(n):
+        y[2, i] /= nrm
+        y[3, i] /= nrm
+    return nrm, big
+
+
+@njit(**JIT_OPTIONS)
 def run_train(
     law: int,
     a: float,
@@ -210,12 +241,7 @@ def run_train(
     means = np.empty((3, n))  # the mean force at the three stage times: constant here
     for q in range(3):
         means[q] = f
-    if use_table:
-        table = np.empty((2 * N + 1, 4))
-        for s in range(2 * N + 1):
-            table[s, 0], table[s, 1], table[s, 2], table[s, 3] = train_forcing(s * h2, kc, ec, tc)
-    else:
-        table = np.empty((0, 4))
+    table = forcing_table(kc, ec, tc, T, N) if use_table else np.empty((0, 4))
     y = np.empty((4, n))  # u, v, du, dv
     start = 1.0 / math.sqrt(2.0 * n)
     for i in range(n):
@@ -265,15 +291,7 @@ def run_train(
                 hx[ih] = delta
                 hv[ih] = deltad
                 ih = ih + 1 if rec else 0
-        nrm = 0.0
-        big = 0.0
-        for i in range(n):
-            nrm += y[2, i] * y[2, i] + y[3, i] * y[3, i]
-            big = max(big, abs(y[0, i]), abs(y[1, i]))
-        nrm = math.sqrt(nrm)
-        for i in range(n):
-            y[2, i] /= nrm
-            y[3, i] /= nrm
+        nrm, big = renormalised(y)
         if not big < bound:
             break
         if rec:
@@ -380,9 +398,7 @@ def flow_train(
     h2 = 0.5 * h
     h6 = h / 6.0
     twomu = 2.0 * mu
-    table = np.empty((2 * N + 1, 4))
-    for q in range(2 * N + 1):
-        table[q, 0], table[q, 1], table[q, 2], table[q, 3] = train_forcing(q * h2, kc, ec, tc)
+    table = forcing_table(kc, ec, tc, T, N)
     y = np.empty((2, n))
     D = np.zeros((2, n, M))
     for i in range(n):

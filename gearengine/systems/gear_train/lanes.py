@@ -20,31 +20,15 @@ import numpy as np
 from numba import njit
 
 from gearengine.jitcache import drop_stale
-from gearengine.systems.gear_train import kernel
-from gearengine.systems.gear_train.kernel import train_forcing
 from gearengine.systems.spur_pair.kernels import smooth
 from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, law_force
 
 drop_stale(
     "lanes",
-    [Path(__file__), Path(kernel.__file__), Path(smooth.__file__)],
+    [Path(__file__), Path(smooth.__file__)],
     Path(__file__).parent / "__pycache__",
 )
-"""Before any kernel runs: numba watches only this file; ``law_force`` lives in smooth and
-``train_forcing`` in kernel."""
-
-
-@njit(**JIT_OPTIONS)
-def forcing_table(
-    kc: np.ndarray, ec: np.ndarray, tc: np.ndarray, T: float, N: int
-) -> np.ndarray:  # pragma: no cover - compiled
-    """(K, e, e', T) at the 2N + 1 stage times s h / 2 of a period T, h = T / N: the table of
-    ``kernel.run_train`` (the same arithmetic)."""
-    h2 = 0.5 * (T / N)
-    table = np.empty((2 * N + 1, 4))
-    for q in range(2 * N + 1):
-        table[q, 0], table[q, 1], table[q, 2], table[q, 3] = train_forcing(q * h2, kc, ec, tc)
-    return table
+"""Before any kernel runs: numba watches only this file; ``law_force`` lives in smooth."""
 
 
 @njit(**JIT_OPTIONS)
@@ -77,7 +61,7 @@ def run_train_lanes(
         law, a, c, alpha: the backlash law shared by the lanes.
         mu (P,), AK, AC (P, n, n), g, w, f, p (P, n): each point's train (``kernel``).
         tables: each point's forcing (K, e, e', T) at the 2N + 1 stage times of a period,
-            (P, 2N + 1, 4) (``kernel.train_forcing``, as ``run_train`` tabulates it).
+            (P, 2N + 1, 4) (``kernel.forcing_table``, as ``run_train`` tabulates it).
         owner: the point of each lane (L,); per: each point's T0 (P,).
         u0, v0: the lanes' starts, (L, n).
         N, n_trans, n_rec: steps per T0, intervals; last: the record step (1-based) of the

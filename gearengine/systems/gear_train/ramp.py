@@ -24,18 +24,25 @@ from numba import njit
 
 from gearengine.jitcache import drop_stale
 from gearengine.systems.gear_train import kernel
-from gearengine.systems.gear_train.kernel import forcing_at_phase, train_step
+from gearengine.systems.gear_train.kernel import forcing_at_phase, renormalised, train_step
+from gearengine.systems.spur_pair.kernels import ramp as pair_ramp
 from gearengine.systems.spur_pair.kernels import smooth
-from gearengine.systems.spur_pair.kernels.ramp import BLOCK_COLUMNS, TANGENT_FLOOR
+from gearengine.systems.spur_pair.kernels.ramp import (
+    BLOCK_COLUMNS,
+    TANGENT_FLOOR,
+    fresh_tally,
+    tallied,
+    write_block,
+)
 from gearengine.systems.spur_pair.kernels.smooth import JIT_OPTIONS, law_force, region
 
 drop_stale(
     "ramp",
-    [Path(__file__), Path(kernel.__file__), Path(smooth.__file__)],
+    [Path(__file__), Path(kernel.__file__), Path(smooth.__file__), Path(pair_ramp.__file__)],
     Path(__file__).parent / "__pycache__",
 )
-"""Before any kernel runs: numba watches only this file; ``train_step`` lives in kernel and
-``law_force`` in smooth."""
+"""Before any kernel runs: numba watches only this file; ``train_step`` lives in kernel,
+``law_force`` in smooth and the block tally in the pair's ``kernels.ramp``."""
 
 
 @njit(**JIT_OPTIONS)
@@ -98,9 +105,7 @@ def run_ramp(
         delta += w[i] * y[0, i]
     reg = region(delta)
     for blk in range(n_blocks):
-        xmin, xmax, fmin, fmax = np.inf, -np.inf, np.inf, -np.inf
-        cmin, cmax = np.inf, -np.inf
-        sep, back, back_in, drive_in = 0, 0, 0, 0
+        tally = fresh_tally()
         grown = 0.0
         t0 = blk * steps * h
         for j in range(steps):
@@ -128,38 +133,9 @@ def run_ramp(
                     y[3, i] /= scale
             reg = region(delta)
             force = forcing[2, 0] * law_force(law, a, c, alpha, delta)[0] + twomu * deltad
-            xmin = min(xmin, delta)
-            xmax = max(xmax, delta)
-            fmin = min(fmin, force)
-            fmax = max(fmax, force)
-            contact = 0.0  # apart: no contact force, whatever the mesh damping term
-            if reg == 0:
-                sep += 1
-            elif reg < 0:
-                back += 1
-                contact = min(force, 0.0)  # a flank pushes, never pulls
-                if prev >= 0:
-                    back_in += 1
-            else:
-                contact = max(force, 0.0)
-                if prev == 0:
-                    drive_in += 1
-            cmin = min(cmin, contact)
-            cmax = max(cmax, contact)
-        nrm = 0.0
-        big = 0.0
-        for i in range(n):
-            nrm += y[2, i] * y[2, i] + y[3, i] * y[3, i]
-            big = max(big, abs(y[0, i]), abs(y[1, i]))
-        nrm = math.sqrt(nrm)
-        for i in range(n):
-            y[2, i] /= nrm
-            y[3, i] /= nrm
+            tally = tallied(tally, reg, prev, delta, force)
+        nrm, big = renormalised(y)
         if not big < bound:
             return out, blk
-        row = out[blk]
-        row[0], row[1], row[2], row[3] = xmin, xmax, fmin, fmax
-        row[4], row[5], row[6], row[7] = sep, back, back_in, drive_in
-        row[8] = grown + math.log(nrm)
-        row[9], row[10] = cmin, cmax
+        write_block(out[blk], tally, grown + math.log(nrm))
     return out, n_blocks

@@ -26,8 +26,8 @@ from gearengine.model.reduction import DesignConversion
 from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.systems.base import Run, StepPlan, StroboscopicFlow, System
 from gearengine.systems.gear_train import ramp as train_ramp
-from gearengine.systems.gear_train.kernel import flow_train, run_train, train_forcing
-from gearengine.systems.gear_train.lanes import forcing_table, run_train_lanes
+from gearengine.systems.gear_train.kernel import flow_train, forcing_table, run_train, train_forcing
+from gearengine.systems.gear_train.lanes import run_train_lanes
 from gearengine.systems.gear_train.model import (
     RELATIVE,
     Dimensionless,

@@ -11,8 +11,10 @@ How to add a law (the contract):
 3. Give its step to the kernels: a ``kernel_code`` that ``kernels.smooth.law_force`` and
    ``kernels.monodromy`` switch on (a smooth law), or a kernel of its own that splits the steps
    at its kinks (as ``kernels.kink``); ``run`` calls it with the common arguments.
-4. Optionally ``lanes``: a lock-step kernel over many lanes (``kernels.lockstep``); without it
-   the lanes of that law run one by one through ``run``.
+4. Optionally ``lanes``: a lock-step kernel over many lanes, the one lane scheduler with the
+   law's steps: a ``kernels.scheduler.LaneLaw`` (per-lane arrays, load, steps, keep) made into a
+   kernel by ``lane_kernel``, as ``kernels.lockstep.CUBIC``; without it the lanes of that law
+   run one by one through ``run``.
 5. Register it in ``LAWS``; ``tests/test_kernels.py`` and ``tests/test_scipy_crosscheck.py``
    hold a new law against scipy's DOP853 (with events at its kinks).
 """
@@ -87,7 +89,7 @@ def lanes_cubic(laws: list[Law], inverse: np.ndarray, packed: list, mu: np.ndarr
                 carry: Carry) -> tuple:  # fmt: skip
     a = np.array([lw.a for lw in laws])[inverse]
     c = np.array([lw.c for lw in laws])[inverse]
-    return kernels.run_batch(a, c, mu, x0, v0, carry[0], carry[1], *tabled, *shared)
+    return kernels.run_batch(mu, x0, v0, carry[0], carry[1], *tabled, *shared, a, c)
 
 
 def lanes_piecewise(laws: list[Law], inverse: np.ndarray, packed: list, mu: np.ndarray,
@@ -97,8 +99,8 @@ def lanes_piecewise(laws: list[Law], inverse: np.ndarray, packed: list, mu: np.n
     kc, nk = padded_terms([f[0] for f in packed])
     fc, nf = padded_terms([f[2] for f in packed])
     fm = np.array([f[1] for f in packed])
-    return kernels.run_kink_batch(alpha, mu, x0, v0, *carry, *tabled, kc, nk, fm, fc, nf,
-                                  *shared)  # fmt: skip
+    return kernels.run_kink_batch(mu, x0, v0, carry[0], carry[1], *tabled, *shared, alpha,
+                                  carry[2], kc, nk, fm, fc, nf)  # fmt: skip
 
 
 def padded_terms(terms: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:

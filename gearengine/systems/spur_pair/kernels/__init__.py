@@ -21,7 +21,8 @@ The three run kernels share one output layout (see ``run_rk4``); ``monodromy`` i
   arithmetic as ``run_rk4`` with a forcing table.
 * ``run_kink_batch`` (``kinklanes``): the piecewise law in lock-step lanes, each step split at
   the kinks lane by lane; the numbers of ``run_kink`` with its forcing table. Both lock-step
-  kernels end their intervals with ``intervals.end_interval`` (record, adaptive stopping).
+  kernels are the one lane scheduler (``scheduler``: streams, refill, and the end of every
+  interval, ``intervals.end_interval``: record, adaptive stopping) with their law's steps.
 
 Benettin et al. (Meccanica 15, 1980): the tangent vector starts at (1, 1)/sqrt(2) and is
 renormalised at the end of every interval T0; the log of its norm is recorded over the n_rec
@@ -42,8 +43,9 @@ from pathlib import Path
 from gearengine.jitcache import drop_stale
 from gearengine.systems.spur_pair.kernels.kink import run_kink
 from gearengine.systems.spur_pair.kernels.kinklanes import NO_REGION, run_kink_batch
-from gearengine.systems.spur_pair.kernels.lockstep import LANES, run_batch
+from gearengine.systems.spur_pair.kernels.lockstep import run_batch
 from gearengine.systems.spur_pair.kernels.monodromy import monodromy
+from gearengine.systems.spur_pair.kernels.scheduler import LANES
 from gearengine.systems.spur_pair.kernels.smooth import (
     SQRT1_2,
     forcing_at,
@@ -70,7 +72,7 @@ __all__ = [
 
 _HERE = Path(__file__).parent
 drop_stale(  # before any kernel runs: numba loads a cached kernel on its first call
-    "adaptive,intervals,kink,kinklanes,lockstep,monodromy,phase,ramp,smooth",
+    "adaptive,intervals,kink,kinklanes,lockstep,monodromy,phase,ramp,scheduler,smooth",
     [
         *_HERE.glob("*.py"),
         *(

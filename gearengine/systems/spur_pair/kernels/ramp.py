@@ -40,6 +40,53 @@ force where a flank touches, clipped to that flank's sign, 0 while apart: as
 
 
 @njit(**JIT_OPTIONS)
+def fresh_tally() -> tuple:  # pragma: no cover - compiled
+    """A block's tally before its first step: (x_min, x_max, force_min, force_max,
+    steps_separated, steps_back_flank, back_flank_impacts, drive_flank_impacts,
+    contact_force_min, contact_force_max) of ``BLOCK_COLUMNS``, extremes empty, counts 0."""
+    return np.inf, -np.inf, np.inf, -np.inf, 0, 0, 0, 0, np.inf, -np.inf
+
+
+@njit(**JIT_OPTIONS, inline="always")
+def tallied(
+    tally: tuple, reg: int, prev: int, x: float, force: float
+) -> tuple:  # pragma: no cover - compiled
+    """``tally`` with one more step end: deflection x in region ``reg`` of Eq. (8) (``prev``
+    before the step) and mesh force ``force`` (the pair's x; a train's mesh deflection).
+    Inlined by numba, so the ten values stay in registers as the written-out tallies did."""
+    xmin, xmax, fmin, fmax, sep, back, back_in, drive_in, cmin, cmax = tally
+    xmin = min(xmin, x)
+    xmax = max(xmax, x)
+    fmin = min(fmin, force)
+    fmax = max(fmax, force)
+    contact = 0.0  # apart: no contact force, whatever the model's damping term
+    if reg == 0:
+        sep += 1
+    elif reg < 0:
+        back += 1
+        contact = min(force, 0.0)  # a flank pushes, never pulls
+        if prev >= 0:
+            back_in += 1
+    else:
+        contact = max(force, 0.0)
+        if prev == 0:
+            drive_in += 1
+    cmin = min(cmin, contact)
+    cmax = max(cmax, contact)
+    return xmin, xmax, fmin, fmax, sep, back, back_in, drive_in, cmin, cmax
+
+
+@njit(**JIT_OPTIONS)
+def write_block(row: np.ndarray, tally: tuple, growth: float) -> None:  # pragma: no cover
+    """A block's row of ``BLOCK_COLUMNS``: its tally and the log of the tangent's growth."""
+    xmin, xmax, fmin, fmax, sep, back, back_in, drive_in, cmin, cmax = tally
+    row[0], row[1], row[2], row[3] = xmin, xmax, fmin, fmax
+    row[4], row[5], row[6], row[7] = sep, back, back_in, drive_in
+    row[8] = growth
+    row[9], row[10] = cmin, cmax
+
+
+@njit(**JIT_OPTIONS)
 def run_ramp(
     alpha: float,
     mu: float,
@@ -69,9 +116,7 @@ def run_ramp(
     x, v, dx, dv = state[0], state[1], state[2], state[3]
     reg = region(x)
     for n in range(n_blocks):
-        xmin, xmax, fmin, fmax = np.inf, -np.inf, np.inf, -np.inf
-        cmin, cmax = np.inf, -np.inf
-        sep, back, back_in, drive_in = 0, 0, 0, 0
+        tally = fresh_tally()
         grown = 0.0  # log of the tangent's norm taken out within the block
         t0 = n * steps * h
         for j in range(steps):
@@ -86,34 +131,13 @@ def run_ramp(
                 dv /= scale
             K = ramp_forcing_at(t0 + (j + 1) * h, kc, ramp, fc)[0]
             force = K * region_force(reg, alpha, x)[0] + twomu * v
-            xmin = min(xmin, x)
-            xmax = max(xmax, x)
-            fmin = min(fmin, force)
-            fmax = max(fmax, force)
-            contact = 0.0  # apart: no contact force, whatever the model's damping term
-            if reg == 0:
-                sep += 1
-            elif reg < 0:
-                back += 1
-                contact = min(force, 0.0)  # a flank pushes, never pulls
-                if prev >= 0:
-                    back_in += 1
-            else:
-                contact = max(force, 0.0)
-                if prev == 0:
-                    drive_in += 1
-            cmin = min(cmin, contact)
-            cmax = max(cmax, contact)
+            tally = tallied(tally, reg, prev, x, force)
         nrm = math.sqrt(dx * dx + dv * dv)
         dx /= nrm
         dv /= nrm
         if not (abs(x) < bound and abs(v) < bound):
             state[0], state[1], state[2], state[3] = x, v, dx, dv
             return out, n
-        row = out[n]
-        row[0], row[1], row[2], row[3] = xmin, xmax, fmin, fmax
-        row[4], row[5], row[6], row[7] = sep, back, back_in, drive_in
-        row[8] = grown + math.log(nrm)
-        row[9], row[10] = cmin, cmax
+        write_block(out[n], tally, grown + math.log(nrm))
     state[0], state[1], state[2], state[3] = x, v, dx, dv
     return out, n_blocks
