@@ -101,3 +101,12 @@ def test_junit_cases_come_in_ascending_torque() -> None:
     root = ElementTree.fromstring(envelope_junit(report, "envelope"))
     names = [c.get("name") for c in root.iter("testcase")]
     assert names == ["torque 2 N*m", "torque 6.75 N*m", "torque 11.5 N*m"]
+
+
+def test_a_one_point_check_says_there_is_nothing_to_refine() -> None:
+    """One operating point has no neighbours: the resolution says so (it printed "refined to
+    where" with nothing between "to" and "where")."""
+    from gearengine.gate.resolution import resolution
+
+    text = resolution(sweep(4.591, "4500:4500", 1), 1).text()
+    assert text == "1 speed (one point), 16 starts a point; no neighbours to refine between"

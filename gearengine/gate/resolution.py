@@ -50,14 +50,16 @@ class Resolution(BaseModel):
     def text(self) -> str:
         """ "23 x 5 grid (227 rpm x 13.8 N*m), 16 starts a point; refined ... 7 points added"."""
         grid = f"{self.speed_points} x {self.torque_points} grid" if self.torque_points > 1 \
-            else f"{self.speed_points} speeds"  # fmt: skip
+            else f"{self.speed_points} speeds" if self.speed_points > 1 else "1 speed"  # fmt: skip
         steps = [f"{s:.4g} {u}" for s, u in ((self.speed_step_rpm, "rpm"),
                  (self.torque_step_nm, "N*m")) if s is not None]  # fmt: skip
         out = f"{grid} ({' x '.join(steps) or 'one point'}), {self.starts} starts a point"
-        if self.depth == 0:
-            return out + "; not refined between grid points"
         fine = [f"{s:.4g} {u}" for s, u in ((self.finest_speed_step_rpm, "rpm"),
                 (self.finest_torque_step_nm, "N*m")) if s is not None]  # fmt: skip
+        if not fine:  # one operating point: no neighbours, nothing between them
+            return out + "; no neighbours to refine between"
+        if self.depth == 0:
+            return out + "; not refined between grid points"
         return (f"{out}; refined to {' x '.join(fine)} where neighbours differ or a point is "
                 f"near a limit: {self.refined_points} points added")  # fmt: skip
 
