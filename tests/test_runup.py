@@ -322,3 +322,18 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
         assert r.design.readings == sweep.design.readings
         assert r.design.model_copy(update={"torque": sweep.design.torque}) == sweep.design
         assert (r.from_speed, r.to_speed) == (seen[0].from_speed, seen[0].to_speed)
+
+
+def test_a_run_up_alone_prints_no_quasi_static_down_jump() -> None:
+    """``runup --direction up`` printed the quasi-static loop's "quasi-static down" jump as if a
+    run-down had been made (review of issue 30, item 7): only the directions run are printed."""
+    from gearengine.cli.runup import quasi_static_lines
+    from gearengine.studies.runup.results import RunupResult
+    from tests.conftest import ROOT
+
+    both = RunupResult.model_validate_json((ROOT / "tests/golden/runup-ci.json").read_text())
+    assert both.quasi_static.down.jumps and both.quasi_static.up.jumps
+    assert [line.split(":")[0] for line in quasi_static_lines(both)] == [
+        "quasi-static up", "quasi-static down"]  # fmt: skip
+    up = quasi_static_lines(both.model_copy(update={"down": None}))
+    assert up == ["quasi-static up: jump at 4150 rpm, 25.3 -> 53.7 µm"]
