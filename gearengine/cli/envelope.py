@@ -104,10 +104,27 @@ def envelope_request(args: argparse.Namespace) -> SweepRequest:
                                  f"{jobs.MAX_JOB_POINTS} (max_job_points)"])  # fmt: skip
     given = [i for i, name in enumerate(["speed", "torque"]) if getattr(args, name)]
     request = validated_input(validated, sweep, args.file, axis_options(axes, given))
-    why = jobs.over_budget("sweep", request, n, "envelope check")
+    why = budget_refusal("sweep", request, n, "envelope check", ENVELOPE_WAYS)
     if why is not None:
-        raise InvalidInputError([f"{why}, or run it on a server (--server URL)"])
+        raise InvalidInputError([why])
     return request
+
+
+ENVELOPE_WAYS = (
+    "use fewer points (--speed-points, --torque-points, or a narrower --speed/--torque range at "
+    "the same spacing) or starts (--starts), or run it on a server (--server URL); or allow it "
+    f"here with {jobs.BUDGET_ENV[0]}=STEPS in the environment"
+)
+"""The ways out of an envelope check over the job budget, in the CLI's options."""
+
+
+def budget_refusal(kind: str, request: object, points: int, noun: str, ways: str) -> str | None:
+    """``jobs.over_budget`` of a CLI command, a bad ``GEARCHAOS_MAX_JOB_STEPS`` refused as
+    invalid input."""
+    try:
+        return jobs.over_budget(kind, request, points, noun, ways)  # type: ignore[arg-type]
+    except ValueError as exc:
+        raise InvalidInputError([str(exc)]) from None
 
 
 def _here(design: dict, name: str) -> str:
