@@ -4,7 +4,7 @@ A grid of 23 speeds x 5 torques proves nothing between its points: chaos in a na
 (a speed band, or a torque level between two of the five) passes unseen. The gate therefore
 states what it checked (``Resolution``: grid spacing in rpm and N*m, points, starts) and refines
 where the grid cannot be trusted: between two neighbouring points (along speed or torque) whose
-verdicts differ, or next to a point near a limit, it inserts the midpoint, and
+verdicts or attractor sets differ, or next to a point near a limit, it inserts the midpoint, and
 repeats on the halves so created, ``depth`` times, down to a finest spacing of the grid's
 / 2**depth. Every inserted point is computed exactly as a grid point is
 (``studies.sweep.compute.points_at``) and checked by the same rules.
@@ -26,9 +26,12 @@ from gearengine.studies.sweep.compute import points_at
 from gearengine.studies.sweep.points import SweepPoint
 from gearengine.studies.sweep.request import SweepRequest
 
-REFINE_DEPTH = 1
-"""Default halvings of the grid spacing where neighbours differ or a point is near a limit:
-the finest spacing checked is the grid's / 2 there (a 2x finer grid's points)."""
+REFINE_DEPTH = 2
+"""Default halvings of the grid spacing where neighbours differ, a point is near a limit or the
+attractor set changes: the finest spacing checked is the grid's / 4 there. One halving missed
+chaos between a refined point near the limit and its grid neighbours (the z = 23/67 pair at
+5 N*m, 3,557 rpm, 19 % of starts; a chaotic 8.44 N*m level at 4,636 rpm, 38 %): depth 2 finds
+them at 1.6x the CPU of depth 1 on its 1,000-6,000 rpm x 5-60 N*m envelope (benchmarks)."""
 MAX_REFINE_DEPTH = 4
 
 
@@ -60,8 +63,9 @@ class Resolution(BaseModel):
             return out + "; no neighbours to refine between"
         if self.depth == 0:
             return out + "; not refined between grid points"
-        return (f"{out}; refined to {' x '.join(fine)} where neighbours differ or a point is "
-                f"near a limit: {self.refined_points} points added")  # fmt: skip
+        return (f"{out}; refined to {' x '.join(fine)} where neighbours differ (verdict or "
+                "attractors) or a point is near a limit: "
+                f"{self.refined_points} points added")  # fmt: skip
 
 
 def resolution(request: SweepRequest, depth: int, refined: int = 0) -> Resolution:
@@ -89,11 +93,12 @@ Lattice = tuple[int, int]
 def refine(
     request: SweepRequest, points: list[SweepPoint], fails: Callable[[SweepPoint], bool],
     near: Callable[[SweepPoint], bool], depth: int, workers: int = 1,
+    kind: Callable[[SweepPoint], object] = lambda p: None,
 ) -> list[SweepPoint]:  # fmt: skip
     """The points inserted between the grid ``points`` of ``request`` (its speed axis first,
-    then a torque axis if any): midpoints of neighbour pairs that differ in ``fails`` or where
-    either is ``near``, then of the halves so made, ``depth`` times. Computed ``workers`` at a
-    time."""
+    then a torque axis if any): midpoints of neighbour pairs (along speed and along torque)
+    that differ in ``fails`` or in ``kind`` (the attractor set) or where either is ``near``,
+    then of the halves so made, ``depth`` times. Computed ``workers`` at a time."""
     grids = request.grids()
     names = [a.parameter for a in request.axes]
     if depth <= 0 or not points:
@@ -118,17 +123,17 @@ def refine(
     pairs = [((i, j), (i + f, j)) for (i, j) in known if (i + f, j) in known]
     pairs += [((i, j), (i, j + f)) for (i, j) in known if (i, j + f) in known]
     added: list[SweepPoint] = []
-    flags: dict[Lattice, tuple[bool, bool]] = {}
+    flags: dict[Lattice, tuple[bool, bool, object]] = {}
 
-    def flag(ij: Lattice) -> tuple[bool, bool]:
+    def flag(ij: Lattice) -> tuple[bool, bool, object]:
         if ij not in flags:
-            flags[ij] = (fails(known[ij]), near(known[ij]))
+            flags[ij] = (fails(known[ij]), near(known[ij]), kind(known[ij]))
         return flags[ij]
 
     h = f
     while h > 1 and pairs:
-        chosen = [(a, b) for a, b in pairs
-                  if flag(a)[0] != flag(b)[0] or flag(a)[1] or flag(b)[1]]  # fmt: skip
+        chosen = [(a, b) for a, b in pairs if flag(a)[0] != flag(b)[0] or flag(a)[1]
+                  or flag(b)[1] or flag(a)[2] != flag(b)[2]]  # fmt: skip
         mids = {(a, b): ((a[0] + b[0]) // 2, (a[1] + b[1]) // 2) for a, b in chosen}
         todo = list(dict.fromkeys(m for m in mids.values() if m not in known))
         for ij, p in zip(todo, _compute(request, [values(ij) for ij in todo], workers),
