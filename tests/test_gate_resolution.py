@@ -167,3 +167,23 @@ def test_refined_levels_say_where_they_were_checked_and_each_is_a_junit_case() -
     root = ElementTree.fromstring(envelope_junit(report, "envelope"))
     names = [c.get("name") for c in root.iter("testcase")]
     assert names == ["torque 2 N*m", "torque 6.75 N*m", "torque 11.5 N*m"]
+
+
+def test_refinement_reaches_inside_a_cell() -> None:
+    """The damping remedy of the z = 23/67 pair (0.1672; the TE 11.3 µm design) passed its
+    45 x 9 verification: every corner of the cell 5,432-5,545 rpm x 5-11.9 N*m passes, and so
+    did every edge midpoint main refined, but 5,489 rpm / 6.72 N*m, inside the cell, is chaotic
+    from every start (found by check on the 89 x 17 grid). Splitting cells (edge midpoints and
+    centre, twice) reaches it."""
+    design = json.loads(DESIGN.read_text())["design"]
+    design["mesh"]["damping_ratio"] = 0.1672
+    axes = [envelope_axis("speed", f"{1000 + 39 * 5000 / 44!r}:{1000 + 40 * 5000 / 44!r}",
+                          "rpm", 2), envelope_axis("torque", "5:11.875", "N*m", 2)]  # fmt: skip
+    request = validated(envelope_sweep(design, gate_settings({}, None), axes, "cell test"))
+    result = run_local(request, chunk_points=1)
+    report = refined_report(request, result, Rules())
+    assert all(p.classification != "chaotic" for p in result.points)
+    assert not report.passed, report.resolution
+    (window,) = report.failures
+    assert window.level["torque"].value == 6.71875
+    assert [round(v, 2) for v in window.speeds_rpm] == [5488.64, 5488.64]
