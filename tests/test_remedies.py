@@ -281,27 +281,35 @@ def test_iso1328_class_that_delivers_a_transmission_error() -> None:
 
 
 def test_the_remedy_found_passes_the_check_on_a_2x_finer_grid() -> None:
-    """The z = 23/67 class-7 pair at 5 N*m over 4,250-5,250 rpm on 3 speeds: the TE that makes
-    these 3 speeds pass (7.81 µm, main's answer) is chaotic at 4,500 rpm from 19 % of starts,
-    which the 2x finer grid holds; the remedy is verified there and passes it, and says so."""
+    """A remedy is a proof between its grid points: the TE remedy of the z = 23/67 class-7 pair
+    over 4,500-5,700 rpm x 5-12 N*m (4 x 2 grid; chaotic at 5 and 8.4 N*m), verified by the
+    search on the 2x finer 7 x 3 grid, refined, passes ``check`` on a grid 2x finer again, in
+    both axes (13 x 5), refined the same way. Main's test checked a 3-speed slice, on a "finer"
+    grid equal to the remedy's own verification grid (review of issue 30, item 6)."""
     doc = json.loads((ROOT / "examples" / "remedies-z23-67.json").read_text())
+    envelope = {"speed": "4500:5700", "torque": "5:12"}
     request = RemediesRequest.model_validate({
         "design": doc["design"], "fail_on": ["chaotic"],
-        "envelope": {"speed": "4250:5250", "speed_points": 3, "torque": "5:5", "torque_points": 1},
+        "envelope": {**envelope, "speed_points": 4, "torque_points": 2},
         "levers": [{"lever": ACCURACY_FIELD, "bounds": ["0 um", "11.3 um"]}],
     })  # fmt: skip
+    assert not check_envelope(request.sweep(), request.rules()).passed  # the design fails
     result = remedies(request)
     (found,) = [r for r in result.remedies if r.bound == "numerical"]
-    assert found.check.passed and found.check.resolution is not None
-    assert found.check.resolution.speed_points == 5 and found.check.resolution.depth == 1
-    assert "2x finer grid" in found.summary and "5 speeds (250 rpm)" in found.summary
+    verified = found.check.resolution
+    assert found.check.passed and verified is not None
+    assert (verified.speed_points, verified.torque_points, verified.depth) == (7, 3, 2)
+    assert "2x finer grid" in found.summary
     finer = RemediesRequest.model_validate({
         "design": with_value(doc, ACCURACY_FIELD, float(f"{found.to:.4g}"), "um")["design"],
         "fail_on": ["chaotic"],
-        "envelope": {"speed": "4250:5250", "speed_points": 5, "torque": "5:5", "torque_points": 1},
+        "envelope": {**envelope, "speed_points": 2 * verified.speed_points - 1,
+                     "torque_points": 2 * verified.torque_points - 1},
     })  # fmt: skip
-    assert check_envelope(finer.sweep(), finer.rules()).passed
-    assert found.to < 7.0  # main's 7.813 µm fails at 4,500 rpm on the finer grid
+    report = check_envelope(finer.sweep(), finer.rules())
+    assert report.resolution is not None and report.resolution.speed_points == 13
+    assert report.resolution.torque_points == 5
+    assert report.passed, [f.model_dump() for f in report.failures]
 
 
 def _melnikov_said(blind: int, passed: bool) -> str:

@@ -71,7 +71,8 @@ class Envelope(BaseModel):
         REFINE_DEPTH, ge=0, le=MAX_REFINE_DEPTH,
         description="Halvings of the grid spacing where neighbours differ (verdict or attractor "
         "set) or a point is near a limit (as the gate's --refine); a remedy's value is verified "
-        "on a 2x finer grid, refined the same way.",
+        "on a 2x finer grid, refined one halving more (as finely as a check of a grid 2x finer "
+        "again).",
     )  # fmt: skip
 
 
