@@ -84,19 +84,19 @@ def test_windows_are_the_failures_points_and_levels_ascend() -> None:
                                                 .read_text())  # fmt: skip
     report = envelope_report(golden.sweep, golden.rules, golden.refined, golden.resolution)
     torques = [w.level["torque"].value for w in report.windows]
-    assert torques == sorted(torques) == [2.0, 6.75, 11.5]
+    assert torques == sorted(torques) == [2.0, 4.375, 6.75, 9.125, 11.5]
     failing = [f.level["torque"].value for f in report.failures]
     assert failing == sorted(failing)
     for f in report.failures:
         (w,) = [w for w in report.windows if w.level == f.level]
         lo, hi = f.speeds_rpm
         assert any(a <= lo and hi <= b for a, b in w.response[f.rule]), (f, w.response)
-    assert len(windows_summary(report.windows)) == 3
+    assert len(windows_summary(report.windows)) == 5
 
 
 def test_junit_cases_come_in_ascending_torque() -> None:
-    """The JUnit report lists its torque levels as the text does, ascending: a refined level
-    with failures (6.75 N*m) stands between the grid's 2 and 11.5 N*m, not after them."""
+    """The JUnit report lists its torque levels as the text does, ascending: refined levels
+    (4.375, 6.75, 9.125 N*m) stand between the grid's 2 and 11.5 N*m, not after them."""
     from xml.etree import ElementTree
 
     from gearengine.gate.envelope import EnvelopeReport, envelope_report
@@ -106,7 +106,7 @@ def test_junit_cases_come_in_ascending_torque() -> None:
     report = envelope_report(golden.sweep, golden.rules, golden.refined, golden.resolution)
     root = ElementTree.fromstring(envelope_junit(report, "envelope"))
     names = [c.get("name") for c in root.iter("testcase")]
-    assert names == ["torque 2 N*m", "torque 6.75 N*m", "torque 11.5 N*m"]
+    assert names == [f"torque {t} N*m" for t in ("2", "4.375", "6.75", "9.125", "11.5")]
 
 
 def test_a_one_point_check_says_there_is_nothing_to_refine() -> None:
@@ -158,15 +158,14 @@ def test_refined_levels_say_where_they_were_checked_and_each_is_a_junit_case() -
                                                 .read_text())  # fmt: skip
     report = envelope_report(golden.sweep, Rules(fail_on=["diverged"]), golden.refined,
                              golden.resolution)  # fmt: skip
-    assert report.passed and len(report.windows) == 3
+    assert report.passed and len(report.windows) == 5
     lines = windows_summary(report.windows, refined=refined_levels(report))
-    assert [line.split(":")[0] for line in lines][1].startswith(
-        "windows at torque 6.75 N*m (refined level, checked at "
-    )
-    assert "(refined level" not in lines[0] + lines[2]
+    for line, torque in zip(lines[1:4], ("4.375", "6.75", "9.125"), strict=True):
+        assert line.startswith(f"windows at torque {torque} N*m (refined level, checked at ")
+    assert "(refined level" not in lines[0] + lines[4]
     root = ElementTree.fromstring(envelope_junit(report, "envelope"))
     names = [c.get("name") for c in root.iter("testcase")]
-    assert names == ["torque 2 N*m", "torque 6.75 N*m", "torque 11.5 N*m"]
+    assert names == [f"torque {t} N*m" for t in ("2", "4.375", "6.75", "9.125", "11.5")]
 
 
 def test_refinement_reaches_inside_a_cell() -> None:
