@@ -85,4 +85,7 @@ def test_cli_check_refuses_work_over_the_job_budget(
     assert main(["check", str(design_file), *many]) == 2
     err = capsys.readouterr().err
     assert "over the budget of 20000000000 RK4 steps per job" in err
-    assert "40000 points x 257 starts = 10280000 runs; the budget allows 5066 points" in err
+    assert (
+        "40000 points x 257 starts (1 + 256 basin starts) = 10280000 runs; the budget "
+        "allows 5066 points" in err
+    )

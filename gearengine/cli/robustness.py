@@ -74,7 +74,7 @@ def robustness_request(args: argparse.Namespace) -> RobustnessRequest:
     request = validated_input(
         lambda d: checked(RobustnessRequest.model_validate(d)), body, args.file, options
     )
-    gate = getattr(args, "max_probability", None) and args.samples != "auto"
+    gate = getattr(args, "max_probability", None) and not getattr(args, "auto", False)
     why = budget_refusal("robustness", request, n, "robustness study",
                          PROBABILITY_WAYS if gate else STUDY_WAYS)  # fmt: skip
     if why is not None:
@@ -197,7 +197,7 @@ def auto_study(args: argparse.Namespace, limits: dict[str, float]) -> Sequential
     """``--samples auto``: each point sampled until it is decided, within the job budget
     (``studies.robustness.sequential``); refused before computing when even the first round
     (``FIRST_SAMPLES`` at every point) is over the budget."""
-    args.samples = FIRST_SAMPLES
+    args.samples, args.auto = FIRST_SAMPLES, True
     request = robustness_request(args)  # the first round's budget, in the user's terms
     budget = jobs.job_step_budget()
     tick = progress(time.monotonic(), "robustness")

@@ -100,6 +100,14 @@ BUDGET_ENV = ("GEARCHAOS_MAX_JOB_STEPS", "GEARCHAOS_MAX_SWEEP_STEPS")
 its old name), read by the CLI as by the service."""
 
 
+def starts_words(lanes: int, basin_starts: int) -> str:
+    """ "17 starts (1 + 16 basin starts)", "1 start": the runs of one point in words."""
+    plural = "s" if lanes != 1 else ""
+    if not basin_starts:
+        return f"{lanes} start{plural}"
+    return f"{lanes} start{plural} ({lanes - basin_starts} + {basin_starts} basin starts)"
+
+
 def job_step_budget() -> int:
     """The compute budget of one job in RK4 steps: ``GEARCHAOS_MAX_JOB_STEPS`` (or its old name)
     from the environment when set, as the service reads it, else ``MAX_JOB_STEPS``.

@@ -340,9 +340,10 @@ def assemble(request: SweepRequest, arrays: list[str]) -> SweepResult:
 def sweep_terms(request: SweepRequest, cap: int) -> str:
     """The sweep's cost in its own terms and what ``cap`` RK4 steps allow (``JobKind.terms``):
     "115 points x 17 starts = 1955 runs; the budget allows 80 points"."""
-    points, starts = request.n_points(), request.settings.lanes()
-    return (f"{points} points x {starts} start{'s' if starts != 1 else ''} = {points * starts} "
-            f"runs; the budget allows {cap * points // sweep_work(request)} points")  # fmt: skip
+    points, starts, basins = request.n_points(), request.settings.lanes(), request.settings.basins
+    words = jobs.starts_words(starts, 0 if basins is None else basins.starts)
+    return (f"{points} points x {words} = {points * starts} runs; the budget allows "
+            f"{cap * points // sweep_work(request)} points")  # fmt: skip
 
 
 SWEEP_JOB = jobs.JobKind(
