@@ -15,6 +15,12 @@ from service.speed import KernelSpeed
 
 SWEEP_HINT = "submit it as a sweep job: POST /v1/sweeps"
 """Where an analysis over the synchronous budget can run."""
+JOB_WAYS = (
+    "use fewer points (axes[].num, or a narrower range at the same spacing), starts "
+    "(settings.basins.starts), samples, periods or steps per period; or ask the server's "
+    "operator to raise GEARCHAOS_MAX_JOB_STEPS"
+)
+"""The ways out of a job over the budget, in the API's fields."""
 BASINS_HINT = (
     "submit it as a job, POST /v1/basins (the same request; its /plot is the basin picture), "
     "or use fewer basin starts or periods"
@@ -73,15 +79,9 @@ class Limits:
     def check_job(self, kind: str, body: BaseModel, noun: str, path: str = "axes") -> None:
         """Refuse a job whose total work (its kind's ``work``, in RK4 steps) is over the per-job
         budget (max_job_steps, for jobs of every kind); ``path`` is the field to shrink."""
-        steps = jobs.kind(kind).work(body)
-        cap = self.settings.max_job_steps
-        if steps > cap:
-            raise over_limit(
-                path,
-                f"this {noun} needs {steps} RK4 steps, over the budget of {cap} steps per "
-                f"{noun} (max_job_steps); use fewer points, periods or steps per period",
-                kind="over-budget",
-            )
+        why = jobs.budget_refusal(kind, body, noun, self.settings.max_job_steps, JOB_WAYS)
+        if why is not None:
+            raise over_limit(path, why, kind="over-budget")
 
 
 def over_limit(path: str, message: str, kind: str = "limit") -> ProblemError:

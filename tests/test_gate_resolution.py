@@ -57,13 +57,19 @@ def test_refinement_finds_chaos_between_passing_grid_points() -> None:
 
 
 def test_a_point_far_from_every_limit_is_not_refined() -> None:
-    """Two passing grid points, both contracting near the linear rate: nothing is inserted."""
+    """Two passing grid points, both contracting near the linear rate: nothing is inserted for
+    the limits (their attractor sets differ, 2T beside 1T: the gate refines there for that)."""
+    from gearengine.gate.envelope import attractor_failures
+    from gearengine.gate.resolution import refine
+
     request = sweep(4.591, "4500:4625", 2)
     result = run_local(request, chunk_points=1)
     rules = Rules(fail_on=["diverged"])  # the chaos limit is not a rule: LLEs are not near it
+    fails = lambda p: bool(attractor_failures(p, rules))  # noqa: E731
+    assert refine(request, result.points, fails, lambda p: near_limit(p, rules), 2) == []
     report = refined_report(request, result, rules, refine=2)
     assert report.passed and report.resolution is not None
-    assert report.resolution.refined_points == 0 and report.points == 2
+    assert report.resolution.refined_points == 2 and report.points == 4
 
 
 def test_windows_are_the_failures_points_and_levels_ascend() -> None:
@@ -78,19 +84,19 @@ def test_windows_are_the_failures_points_and_levels_ascend() -> None:
                                                 .read_text())  # fmt: skip
     report = envelope_report(golden.sweep, golden.rules, golden.refined, golden.resolution)
     torques = [w.level["torque"].value for w in report.windows]
-    assert torques == sorted(torques) == [2.0, 6.75, 11.5]
+    assert torques == sorted(torques) == [2.0, 4.375, 6.75, 9.125, 11.5]
     failing = [f.level["torque"].value for f in report.failures]
     assert failing == sorted(failing)
     for f in report.failures:
         (w,) = [w for w in report.windows if w.level == f.level]
         lo, hi = f.speeds_rpm
         assert any(a <= lo and hi <= b for a, b in w.response[f.rule]), (f, w.response)
-    assert len(windows_summary(report.windows)) == 3
+    assert len(windows_summary(report.windows)) == 5
 
 
 def test_junit_cases_come_in_ascending_torque() -> None:
-    """The JUnit report lists its torque levels as the text does, ascending: a refined level
-    with failures (6.75 N*m) stands between the grid's 2 and 11.5 N*m, not after them."""
+    """The JUnit report lists its torque levels as the text does, ascending: refined levels
+    (4.375, 6.75, 9.125 N*m) stand between the grid's 2 and 11.5 N*m, not after them."""
     from xml.etree import ElementTree
 
     from gearengine.gate.envelope import EnvelopeReport, envelope_report
@@ -100,4 +106,83 @@ def test_junit_cases_come_in_ascending_torque() -> None:
     report = envelope_report(golden.sweep, golden.rules, golden.refined, golden.resolution)
     root = ElementTree.fromstring(envelope_junit(report, "envelope"))
     names = [c.get("name") for c in root.iter("testcase")]
-    assert names == ["torque 2 N*m", "torque 6.75 N*m", "torque 11.5 N*m"]
+    assert names == [f"torque {t} N*m" for t in ("2", "4.375", "6.75", "9.125", "11.5")]
+
+
+def test_a_one_point_check_says_there_is_nothing_to_refine() -> None:
+    """One operating point has no neighbours: the resolution says so (it printed "refined to
+    where" with nothing between "to" and "where")."""
+    from gearengine.gate.resolution import resolution
+
+    text = resolution(sweep(4.591, "4500:4500", 1), 1).text()
+    assert text == "1 speed (one point), 16 starts a point; no neighbours to refine between"
+
+
+def test_the_default_refinement_finds_chaos_next_to_a_refined_point_near_the_limit() -> None:
+    """The z = 23/67 pair (TE 11.3 µm) at 5 N*m: 3,500 and 3,727 rpm (grid neighbours of the
+    default 23 x 5 grid) and their midpoint 3,614 rpm pass, all near the chaos limit; 3,557 rpm
+    is chaotic from 19 % of starts. One halving (main's default) passed it; ``--refine 2``
+    found it (review of issue 30, item 5), now the default."""
+    request = sweep(11.3, "3500:3727.2727272727", 2)
+    result = run_local(request, chunk_points=1)
+    report = refined_report(request, result, Rules())
+    assert report.resolution is not None and report.resolution.depth == 2
+    assert not report.passed
+    spans = [[round(v, 2) for v in w.speeds_rpm] for w in report.failures]
+    assert spans == [[3556.82, 3556.82], [3670.45, 3670.45]]
+
+
+def test_neighbours_whose_attractor_sets_differ_are_refined() -> None:
+    """Two passing points far from every limit are refined between when their attractor sets
+    differ (a bifurcation lies between them, where a window may hide)."""
+    from gearengine.gate.resolution import refine
+
+    request = sweep(4.591, "4500:4625", 2)
+    result = run_local(request, chunk_points=1)
+    never = lambda p: False  # noqa: E731
+    assert refine(request, result.points, never, never, 1) == []
+    added = refine(request, result.points, never, never, 1, kind=lambda p: p.values["speed"])
+    assert [round(p.physical["speed"].value, 2) for p in added] == [4562.5]
+
+
+def test_refined_levels_say_where_they_were_checked_and_each_is_a_junit_case() -> None:
+    """A torque level refined between the grid's was printed as if checked over the whole speed
+    range, and JUnit had a case for the grid's levels alone (6 cases for 8 levels in the text):
+    the text names the speeds checked there and JUnit has one case per level of the text."""
+    from xml.etree import ElementTree
+
+    from gearengine.cli.envelope import refined_levels, windows_summary
+    from gearengine.gate.envelope import EnvelopeReport, envelope_report
+
+    golden = EnvelopeReport.model_validate_json((ROOT / "tests/golden/check-envelope.json")
+                                                .read_text())  # fmt: skip
+    report = envelope_report(golden.sweep, Rules(fail_on=["diverged"]), golden.refined,
+                             golden.resolution)  # fmt: skip
+    assert report.passed and len(report.windows) == 5
+    lines = windows_summary(report.windows, refined=refined_levels(report))
+    for line, torque in zip(lines[1:4], ("4.375", "6.75", "9.125"), strict=True):
+        assert line.startswith(f"windows at torque {torque} N*m (refined level, checked at ")
+    assert "(refined level" not in lines[0] + lines[4]
+    root = ElementTree.fromstring(envelope_junit(report, "envelope"))
+    names = [c.get("name") for c in root.iter("testcase")]
+    assert names == [f"torque {t} N*m" for t in ("2", "4.375", "6.75", "9.125", "11.5")]
+
+
+def test_refinement_reaches_inside_a_cell() -> None:
+    """The damping remedy of the z = 23/67 pair (0.1672; the TE 11.3 µm design) passed its
+    45 x 9 verification: every corner of the cell 5,432-5,545 rpm x 5-11.9 N*m passes, and so
+    did every edge midpoint main refined, but 5,489 rpm / 6.72 N*m, inside the cell, is chaotic
+    from every start (found by check on the 89 x 17 grid). Splitting cells (edge midpoints and
+    centre, twice) reaches it."""
+    design = json.loads(DESIGN.read_text())["design"]
+    design["mesh"]["damping_ratio"] = 0.1672
+    axes = [envelope_axis("speed", f"{1000 + 39 * 5000 / 44!r}:{1000 + 40 * 5000 / 44!r}",
+                          "rpm", 2), envelope_axis("torque", "5:11.875", "N*m", 2)]  # fmt: skip
+    request = validated(envelope_sweep(design, gate_settings({}, None), axes, "cell test"))
+    result = run_local(request, chunk_points=1)
+    report = refined_report(request, result, Rules())
+    assert all(p.classification != "chaotic" for p in result.points)
+    assert not report.passed, report.resolution
+    (window,) = report.failures
+    assert window.level["torque"].value == 6.71875
+    assert [round(v, 2) for v in window.speeds_rpm] == [5488.64, 5488.64]

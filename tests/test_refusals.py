@@ -83,4 +83,9 @@ def test_cli_check_refuses_work_over_the_job_budget(
     many = ["--speed", "1000:6000", "--speed-points", "200", "--torque", "5:60",
             "--torque-points", "200", "--starts", "256"]  # fmt: skip
     assert main(["check", str(design_file), *many]) == 2
-    assert "over the budget of 20000000000 steps per envelope check" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "over the budget of 20000000000 RK4 steps per job" in err
+    assert (
+        "40000 points x 257 starts (1 + 256 basin starts) = 10280000 runs; the budget "
+        "allows 5066 points" in err
+    )

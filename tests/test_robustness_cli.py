@@ -47,7 +47,10 @@ def test_the_gate_fails_on_the_upper_bound_and_names_the_points(
     cases = ElementTree.parse(junit).getroot().findall("testsuite/testcase")
     assert [c.get("name") for c in cases] == ["speed 2000 rpm", "speed 5000 rpm"]
     assert [c.find("failure") is not None for c in cases] == [False, True]
-    assert "upper bound" in capsys.readouterr().out
+    assert (
+        "FAIL: speed 5000 rpm (8 samples) [P(separation) lower bound 0.473 > 0.4 (7/8 "
+        "samples)]" in capsys.readouterr().out
+    )
     assert main([*base, "--samples", "8", "--max-probability", "back_flank=0.5"]) == 0
     assert main([*base, "--max-probability", "nonsense=0.1"]) == 2
 
@@ -89,7 +92,7 @@ def test_samples_auto_samples_until_every_point_is_decided(
     base = ["check", str(design_file), "--speed", "2000:5000", "--speed-points", "2"]
     assert main([*base, "--samples", "auto", "--max-probability", "separation=0.4"]) == 1
     captured = capsys.readouterr()
-    assert "--samples auto: decided at 64 samples" in captured.err
+    assert "--samples auto: every point decided by 64 samples" in captured.err
     assert "PASS: speed 2000 rpm" in captured.out and "FAIL: speed 5000 rpm" in captured.out
 
 
@@ -105,10 +108,10 @@ def test_the_answers_say_how_many_starts_decided_each_sample(
             "--samples", "8", "--max-probability", "back_flank=0.5"]  # fmt: skip
     assert main([*base, "--json", str(out)]) == 0
     assert json.loads(out.read_text())["starts_per_sample"] == 1
-    assert "8 samples, 1 start a sample" in capsys.readouterr().out
+    assert "8 samples a point, 1 start a sample" in capsys.readouterr().out
     assert main([*base, "--starts", "4", "--json", str(out)]) == 0
     assert json.loads(out.read_text())["starts_per_sample"] == 4
-    assert "8 samples, 4 starts a sample (settings.basins)" in capsys.readouterr().out
+    assert "8 samples a point, 4 starts a sample (settings.basins)" in capsys.readouterr().out
     args = [str(design_file), "--speed", "5000:5000", "--speed-points", "1", "--samples", "8"]
     assert main(["robustness", *args]) == 0
     assert "(8 samples, 1 start a sample)" in capsys.readouterr().out
@@ -132,10 +135,69 @@ def test_samples_auto_reads_a_design_from_standard_input_once(
     input the second round used to read it again, find it empty and exit 2."""
     import io
 
-    import gearengine.cli.robustness as robustness
-
-    monkeypatch.setattr(robustness, "decided", lambda result, limits: result.samples >= 128)
+    monkeypatch.setenv("GEARCHAOS_MAX_JOB_STEPS", "3500000")  # stops after a second round
     monkeypatch.setattr("sys.stdin", io.StringIO(design_file.read_text()))
-    args = ["check", "-", "--samples", "auto", "--max-probability", "separation=0.4"]
-    assert main(args) == 1  # the design point separates in most samples
-    assert "--samples auto: decided at 128 samples" in capsys.readouterr().err
+    args = ["check", "-", "--speed", "2000:5000", "--speed-points", "2", "--samples", "auto",
+            "--max-probability", "separation=0.01"]  # fmt: skip
+    assert main(args) == 1  # not 2: the second round read no empty standard input
+    assert "rounds of 64, 128 samples" in capsys.readouterr().err
+
+
+def test_a_probability_gate_over_the_budget_is_refused_in_the_users_terms(
+    design_file: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--samples 512`` over the job budget was refused naming the internal max_job_steps
+    alone, and ``--samples auto`` was then refused too (review of issue 30, item 4): the refusal
+    says samples x starts x points, what the budget allows, and the ways out (the options, the
+    environment variable GEARCHAOS_MAX_JOB_STEPS, which the CLI now reads)."""
+    monkeypatch.setenv("GEARCHAOS_MAX_JOB_STEPS", "3500000")
+    base = ["check", str(design_file), "--speed", "2000:5000", "--speed-points", "2"]
+    assert main([*base, "--samples", "512", "--max-probability", "separation=0.01"]) == 2
+    err = capsys.readouterr().err
+    assert "512 samples x 1 start x 2 points = 1024 runs" in err
+    assert "over the budget of 3500000 RK4 steps per job" in err
+    assert "the budget allows 64 samples at these points, or 0 points at 512 samples" in err
+    for way in ("--speed-points", "--starts", "--samples auto", "GEARCHAOS_MAX_JOB_STEPS=STEPS"):
+        assert way in err
+
+
+def test_samples_auto_reports_the_points_the_budget_leaves_undecided(
+    design_file: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--samples auto`` samples each point only until it is decided: 5000 rpm fails at 64
+    samples (7 of 8 separate), 2000 rpm (no separation) needs 368 to prove 1 %; a budget of
+    3.5e6 RK4 steps (15,360 a sample a point) stops it at 128 samples, undecided, and the gate
+    fails: an undecided point does not pass silently."""
+    monkeypatch.setenv("GEARCHAOS_MAX_JOB_STEPS", "3500000")
+    base = ["check", str(design_file), "--speed", "2000:5000", "--speed-points", "2"]
+    assert main([*base, "--samples", "auto", "--max-probability", "separation=0.01"]) == 1
+    captured = capsys.readouterr()
+    assert (
+        "UNDECIDED: speed 2000 rpm (128 samples) [P(separation) undecided: upper bound "
+        "0.0284 > 0.01 (0/128 samples)]" in captured.out
+    )
+    assert "FAIL: speed 5000 rpm (64 samples) [P(separation) lower bound" in captured.out
+    assert "the budget of 3500000 RK4 steps ran out: 1 points undecided after 128" in captured.err
+    assert "FAIL: 1 of 2 points over a probability limit, 1 undecided" in captured.err
+
+
+def test_the_api_refuses_a_study_over_the_budget_in_the_same_terms(tmp_path: Path) -> None:
+    """One rule for the CLI and the API (``jobs.budget_refusal``): samples x starts x points."""
+    from fastapi.testclient import TestClient
+
+    from service.core.config import Settings
+    from service.main import create_app
+
+    app = create_app(Settings(data_dir=tmp_path, workers=0, max_job_steps=3_500_000))
+    body = {
+        "design": DESIGN,
+        "samples": 512,
+        "settings": ENVELOPE_SETTINGS,
+        "axes": [{"parameter": "speed", "start": "2000 rpm", "stop": "5000 rpm", "num": 2}],
+    }
+    with TestClient(app) as c:
+        r = c.post("/v1/robustness", json=body)
+    assert r.status_code == 422, r.text
+    detail = r.json()["detail"]
+    assert "512 samples x 1 start x 2 points = 1024 runs" in detail
+    assert "max_job_steps, environment GEARCHAOS_MAX_JOB_STEPS" in detail and "axes[].num" in detail

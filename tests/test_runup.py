@@ -357,3 +357,46 @@ def test_a_pair_run_up_converts_its_design_once(monkeypatch: pytest.MonkeyPatch)
     plan = runup_plan(r)
     assert conversions == [] and plan.conversion is r.conversion
     assert plan.system.params == r.params
+
+
+def test_a_run_up_alone_prints_no_quasi_static_down_jump() -> None:
+    """``runup --direction up`` printed the quasi-static loop's "quasi-static down" jump as if a
+    run-down had been made (review of issue 30, item 7): only the directions run are printed."""
+    from gearengine.cli.runup import quasi_static_lines
+    from gearengine.studies.runup.results import RunupResult
+    from tests.conftest import ROOT
+
+    both = RunupResult.model_validate_json((ROOT / "tests/golden/runup-ci.json").read_text())
+    assert both.quasi_static.down.jumps and both.quasi_static.up.jumps
+    assert [line.split(":")[0] for line in quasi_static_lines(both)] == [
+        "quasi-static up", "quasi-static down"]  # fmt: skip
+    up = quasi_static_lines(both.model_copy(update={"down": None}))
+    assert up == ["quasi-static up: jump at 4150 rpm, 25.3 -> 53.7 µm"]
+
+
+def test_chaos_in_the_ramps_transient_is_said_to_be_transient() -> None:
+    """A run-up flagged chaos where the steady state (and ``check``) finds none and neither said
+    so (review of issue 30, item 7): chaotic bins over a periodic quasi-static branch are named
+    as the ramp's transient, in the gate's failure and by ``transient_chaos`` (the notes)."""
+    from gearengine.studies.runup.reading import transient_chaos, transient_note
+    from gearengine.studies.runup.results import RunupResult
+
+    golden = RunupResult.model_validate_json((ROOT / "tests/golden/runup-ci.json").read_text())
+    assert golden.up is not None
+    bins = [b.model_copy(update={"chaotic": True}) if 3600 <= b.speed_rpm[0] < 3800 else b
+            for b in golden.up.bins]  # fmt: skip
+    up = golden.up.model_copy(update={"bins": bins})
+    result = golden.model_copy(update={"up": up, "down": None})
+    spans = transient_chaos(up, result.quasi_static.up)
+    assert spans == [[3600.0, 3800.0]]
+    assert transient_note("up", spans).startswith("run-up: chaotic bins at 3600-3800 rpm where")
+    (window,) = runup_failures(result, Rules(), {}, chaos_seconds=0.0)
+    assert window.rule.endswith("in the ramp's transient (the steady state is not chaotic there)")
+
+    points = [p.model_copy(update={"classification": "chaotic"})
+              for p in result.quasi_static.up.points]  # fmt: skip
+    steady = result.quasi_static.up.model_copy(update={"points": points})
+    assert transient_chaos(up, steady) == []
+    qs = result.quasi_static.model_copy(update={"up": steady})
+    (window,) = runup_failures(result.model_copy(update={"quasi_static": qs}), Rules(), {}, 0.0)
+    assert "transient" not in window.rule

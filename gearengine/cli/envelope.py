@@ -48,11 +48,13 @@ from gearengine.gate.envelope import (
     window_text,
 )
 from gearengine.jsonio import dumps
+from gearengine.model.units import POINT_OUTPUTS
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies import jobs
 from gearengine.studies.sweep.points import SpeedWindows
 from gearengine.studies.sweep.request import SweepRequest, validated
 from gearengine.studies.sweep.results import SweepResult
+from gearengine.studies.sweep.windows import SPEED
 
 if TYPE_CHECKING:
     from gearengine.model.design import Design
@@ -99,10 +101,27 @@ def envelope_request(args: argparse.Namespace, doc: object) -> SweepRequest:
     counted_points(axes, "envelope check")  # before the sweep's checks build its grids
     given = [i for i, name in enumerate(["speed", "torque"]) if getattr(args, name)]
     request = validated_input(validated, sweep, args.file, axis_options(axes, given))
-    why = jobs.over_budget("sweep", request, "envelope check")
+    why = budget_refusal("sweep", request, "envelope check", ENVELOPE_WAYS)
     if why is not None:
-        raise InvalidInputError([f"{why}, or run it on a server (--server URL)"])
+        raise InvalidInputError([why])
     return request
+
+
+ENVELOPE_WAYS = (
+    "use fewer points (--speed-points, --torque-points, or a narrower --speed/--torque range at "
+    "the same spacing) or starts (--starts), or run it on a server (--server URL); or allow it "
+    f"here with {jobs.BUDGET_ENV[0]}=STEPS in the environment"
+)
+"""The ways out of an envelope check over the job budget, in the CLI's options."""
+
+
+def budget_refusal(kind: str, request: object, noun: str, ways: str) -> str | None:
+    """``jobs.over_budget`` of a CLI command, a bad ``GEARCHAOS_MAX_JOB_STEPS`` refused as
+    invalid input."""
+    try:
+        return jobs.over_budget(kind, request, noun, ways)  # type: ignore[arg-type]
+    except ValueError as exc:
+        raise InvalidInputError([str(exc)]) from None
 
 
 def _here(design: dict, name: str) -> str:
@@ -205,7 +224,7 @@ def print_report(report: EnvelopeReport, design: Design | None = None) -> None:
         print(f"  resolution: {report.resolution.text()}")
     for w in report.failures:
         print(f"  {window_text(w)}")
-    for line in windows_summary(report.windows, short):
+    for line in windows_summary(report.windows, short, refined_levels(report)):
         print(f"  {line}")
 
 
@@ -217,11 +236,32 @@ def settings_text(settings: SimulationSettings) -> str:
             f"{settings.steps_per_period} steps per period{starts}")  # fmt: skip
 
 
-def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit") -> list[str]:
+def refined_levels(report: EnvelopeReport) -> dict[str, str]:
+    """The speeds checked at each torque level refined between the grid's (by its
+    ``level_text``): "refined level, checked at 3 speeds in 4636-4864 rpm" (the grid's levels
+    are checked over the whole range)."""
+    grid = {level_text(w.level) for w in report.sweep.windows or []}
+    speeds: dict[str, list[float]] = {}
+    for w in report.windows:
+        if level_text(w.level) not in grid:
+            speeds[level_text(w.level)] = []
+    for p in report.refined:
+        level = level_text({k: v for k, v in (p.physical or {}).items()
+                            if k not in (SPEED, *POINT_OUTPUTS)})  # fmt: skip
+        if level in speeds and p.physical is not None:
+            speeds[level].append(p.physical[SPEED].value)
+    return {level: f"refined level, checked at {len(v)} speed{'s' if len(v) != 1 else ''} "
+            f"in {spans_text([[min(v), max(v)]])}" for level, v in speeds.items() if v}  # fmt: skip
+
+
+def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit",
+                    refined: dict[str, str] | None = None) -> list[str]:  # fmt: skip
     """Per level of the other axis, the impact and Melnikov windows in rpm, pass or fail:
     "windows at torque 40 N*m: tooth separation 500-1100 rpm; Melnikov:
     chaos possible nowhere"; ``reason`` says why Melnikov does not apply where it does not
-    (``not_judged_reason``)."""
+    (``not_judged_reason``); ``refined`` (``refined_levels``) says over which speeds a level
+    refined between the grid's was checked: "windows at torque 8.44 N*m (refined level, checked
+    at 3 speeds in 4636-4864 rpm): ..."."""
     out = []
     for w in windows:
         contact = "; ".join(f"{CONTACT_LABELS[k]} {spans_text(v)}" for k, v in w.contact.items())
@@ -230,6 +270,8 @@ def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit") -
             na = f"not applicable at {spans_text(w.melnikov_not_applicable)} ({reason})"
             melnikov = f"{melnikov}, {na}" if w.melnikov else na
         where = f" at {level_text(w.level)}" if w.level else ""
+        if refined and level_text(w.level) in refined:
+            where += f" ({refined[level_text(w.level)]})"
         out.append(f"windows{where}: {contact or 'teeth always in contact'}; "
                    f"Melnikov: {melnikov}")  # fmt: skip
     return out

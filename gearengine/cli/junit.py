@@ -49,12 +49,11 @@ def junit_xml(suites_name: str, suite_name: str, classname: str, cases: Sequence
 
 
 def envelope_junit(report: EnvelopeReport, name: str) -> str:
-    """The envelope gate's JUnit: one test case per torque level (every level of the grid's
-    windows, sweep.windows, or one "all"; a level refined between the grid's, with failures, is a
-    case too), failed once with every failing window of the level in words; levels ascending,
-    as the text lists them."""
+    """The envelope gate's JUnit: one test case per torque level the text lists (the report's
+    windows: the grid's levels and those refined between them, or one "all"), failed once with
+    every failing window of the level in words; levels ascending, as the text lists them."""
     levels: list = []
-    for level in [w.level for w in report.sweep.windows or []] or [{}]:
+    for level in [w.level for w in report.windows or report.sweep.windows or []] or [{}]:
         if level not in levels:  # dicts: not hashable
             levels.append(level)
     levels += [lv for lv in (w.level for w in report.failures) if lv not in levels]

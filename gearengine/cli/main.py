@@ -138,8 +138,9 @@ def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -
                    "F (default: every attractor found)")  # fmt: skip
     p.add_argument("--refine", type=int, default=None, metavar="N", choices=range(5),
                    help="envelope checks: halve the grid spacing up to N times where neighbouring "
-                   "points differ or a point is near a limit (default 1: down to a 2x finer "
-                   "grid's points there; 0: the grid only)")  # fmt: skip
+                   "points differ (verdict or attractor set) or a point is near a limit "
+                   "(default 2: down to a 4x finer grid's points there; 0: the grid "
+                   "only)")  # fmt: skip
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -22,13 +22,20 @@ from gearengine.cli.documents import (
     read_document,
     validated_input,
 )
-from gearengine.cli.envelope import option_axes
+from gearengine.cli.envelope import budget_refusal, option_axes
 from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import ENVELOPE_SETTINGS, gate_settings
 from gearengine.model.units import IMPACTS_REFUSED, display_unit
 from gearengine.studies import jobs
+from gearengine.studies.robustness.sequential import (
+    FIRST_SAMPLES,
+    SequentialResult,
+    sequential,
+    verdict,
+)
 from gearengine.studies.robustness.study import (
+    RobustnessPoint,
     RobustnessRequest,
     RobustnessResult,
     checked,
@@ -63,10 +70,25 @@ def robustness_request(args: argparse.Namespace, doc: object) -> RobustnessReque
     request = validated_input(
         lambda d: checked(RobustnessRequest.model_validate(d)), body, args.file, options
     )
-    why = jobs.over_budget("robustness", request, "robustness study")
+    gate = getattr(args, "max_probability", None) and not getattr(args, "auto", False)
+    why = budget_refusal("robustness", request, "robustness study",
+                         PROBABILITY_WAYS if gate else STUDY_WAYS)  # fmt: skip
     if why is not None:
         raise InvalidInputError([why])
     return request
+
+
+STUDY_WAYS = (
+    "use fewer points (--speed-points, --torque-points, or a narrower --speed/--torque range at "
+    "the same spacing), starts (--starts) or --samples; or allow it here with "
+    f"{jobs.BUDGET_ENV[0]}=STEPS in the environment"
+)
+"""The ways out of a robustness study over the job budget, in the CLI's options."""
+PROBABILITY_WAYS = (
+    f"{STUDY_WAYS}; or --samples auto: each point sampled only until it is decided, within the "
+    "budget (points the budget leaves undecided are reported undecided and fail the gate)"
+)
+"""The ways out of a probability gate over the job budget."""
 
 
 def study(args: argparse.Namespace, doc: object) -> tuple[RobustnessRequest, RobustnessResult]:
@@ -100,21 +122,6 @@ def limits_of(texts: list[str]) -> dict[str, float]:
     return out
 
 
-def failures(result: RobustnessResult, limits: dict[str, float]) -> list[list[str]]:
-    """Per point, the limits its 95 % upper bounds exceed, in words."""
-    out = []
-    for p in result.points:
-        why = []
-        for name, limit in limits.items():
-            prob = p.probabilities[name]
-            if prob.interval is None or prob.interval[1] > limit:
-                upper = "no samples" if prob.interval is None else f"{prob.interval[1]:.3g}"
-                why.append(f"P({name}) upper bound {upper} > {limit:g} "
-                           f"({prob.count}/{prob.samples} samples)")  # fmt: skip
-        out.append(why)
-    return out
-
-
 def junit(result: RobustnessResult, why: list[list[str]], name: str) -> str:
     """JUnit XML: one test case per operating point, failed once with its reasons."""
     cases = [Case(point_name(p.shown), reasons, [r.split(")")[0] + ")" for r in reasons])
@@ -141,10 +148,6 @@ def cmd_robustness(args: argparse.Namespace) -> int:
 
         Path(args.plot).write_bytes(robustness_figure(request, result, "png"))
     return EXIT_OK
-
-
-AUTO_SAMPLES = 4096
-"""The most samples ``--samples auto`` draws before it stops undecided."""
 
 
 def samples_needed(limits: dict[str, float], samples: int | str) -> int:
@@ -177,58 +180,64 @@ def _power_of_two(n: int) -> int:
     return 1 << max(0, (int(n) - 1).bit_length())
 
 
-def decided(result: RobustnessResult, limits: dict[str, float]) -> bool:
-    """Every point proven under every limit (upper bound at or below it) or over one (a lower
-    bound above it)."""
-    for p in result.points:
-        probs = [(p.probabilities[name].interval, limit) for name, limit in limits.items()]
-        if any(ci is None for ci, _ in probs):
-            return False
-        if not any(ci[0] > limit for ci, limit in probs) and any(
-            ci[1] > limit for ci, limit in probs
-        ):
-            return False
-    return True
+def auto_study(args: argparse.Namespace, doc: object, limits: dict[str, float]) -> SequentialResult:
+    """``--samples auto`` on the design document ``doc`` (read once: standard input too): each
+    point sampled until it is decided, within the job budget
+    (``studies.robustness.sequential``); refused before computing when even the first round
+    (``FIRST_SAMPLES`` at every point) is over the budget."""
+    args.samples, args.auto = FIRST_SAMPLES, True
+    request = robustness_request(args, doc)  # the first round's budget, in the user's terms
+    budget = jobs.job_step_budget()
+    tick = progress(time.monotonic(), "robustness")
+    out = sequential(request, limits, budget, workers=os.cpu_count() or 1, progress=tick)
+    rounds = ", ".join(str(n) for n in out.rounds)
+    print(f"--samples auto: {out.stopped} (rounds of {rounds} samples, {out.steps} RK4 steps "
+          f"of a budget of {budget})", file=sys.stderr)  # fmt: skip
+    return out
 
 
-def sequential_study(
-    args: argparse.Namespace, doc: object, limits: dict[str, float], least: int
-) -> RobustnessResult:
-    """``--samples auto``: from the fewest samples that can prove the limits, doubled (the
-    seeded Sobol points of 2N begin with those of N) until every point is decided or
-    ``AUTO_SAMPLES`` is reached; every round studies the one document ``doc`` (read once:
-    standard input too)."""
-    n = max(least, 64)
-    while True:
-        args.samples = n
-        _, result = study(args, doc)
-        if decided(result, limits) or n >= AUTO_SAMPLES:
-            state = "decided" if decided(result, limits) else "still undecided"
-            print(f"--samples auto: {state} at {n} samples", file=sys.stderr)
-            return result
-        n *= 2
+def verdict_reasons(point: RobustnessPoint, limits: dict[str, float]) -> list[str]:
+    """The limits a point does not prove, in words: over (its lower bound above the limit) or
+    undecided (the interval holds the limit)."""
+    why = []
+    for name, limit in limits.items():
+        prob = point.probabilities[name]
+        if prob.interval is None:
+            why.append(f"P({name}) undecided: no samples")
+        elif prob.interval[0] > limit:
+            why.append(f"P({name}) lower bound {prob.interval[0]:.3g} > {limit:g} "
+                       f"({prob.count}/{prob.samples} samples)")  # fmt: skip
+        elif prob.interval[1] > limit:
+            why.append(f"P({name}) undecided: upper bound {prob.interval[1]:.3g} > {limit:g} "
+                       f"({prob.count}/{prob.samples} samples)")  # fmt: skip
+    return why
 
 
 def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
-    """``check --max-probability`` of the design document ``doc``: exit 1 where an upper bound
-    exceeds its limit; a sample count that cannot prove a limit is refused before computing
-    (``samples_needed``)."""
+    """``check --max-probability`` of the design document ``doc``: exit 1 where a point is over
+    a limit or undecided (its interval holds the limit); a sample count that cannot prove a
+    limit is refused before computing (``samples_needed``), as is a study over the job budget."""
     limits = limits_of(args.max_probability)
-    least = samples_needed(limits, args.samples)
+    samples_needed(limits, args.samples)
     if args.samples == "auto":
-        result = sequential_study(args, doc, limits, least)
+        auto = auto_study(args, doc, limits)
+        result, verdicts = auto.result, auto.verdicts
     else:
         _, result = study(args, doc)
-    why = failures(result, limits)
-    print(f"probabilities from {result.samples} samples, {result.starts_text()}")
-    for p, reasons in zip(result.points, why, strict=True):
-        verdict = "FAIL" if reasons else "PASS"
-        print(f"{verdict}: {point_name(p.shown)}" + (f" [{'; '.join(reasons)}]" if reasons else ""))
+        verdicts = [verdict(p, limits) for p in result.points]
+    why = [verdict_reasons(p, limits) for p in result.points]
+    counts = sorted({p.samples for p in result.points})
+    sampled = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
+    print(f"probabilities from {sampled} samples a point, {result.starts_text()}")
+    for p, v, reasons in zip(result.points, verdicts, why, strict=True):
+        shown = {"pass": "PASS", "fail": "FAIL", "undecided": "UNDECIDED"}[v]
+        extra = f" [{'; '.join(reasons)}]" if reasons else ""
+        print(f"{shown}: {point_name(p.shown)} ({p.samples} samples){extra}")
     if args.json:
         Path(args.json).write_text(result.model_dump_json())
     if args.junit:
         Path(args.junit).write_text(junit(result, why, f"robustness of {args.file}"))
-    failed = sum(bool(w) for w in why)
-    print(f"{'FAIL' if failed else 'PASS'}: {failed} of {len(why)} points over a probability "
-          "limit", file=sys.stderr)  # fmt: skip
-    return EXIT_FAIL if failed else EXIT_OK
+    failed, undecided = verdicts.count("fail"), verdicts.count("undecided")
+    print(f"{'FAIL' if failed or undecided else 'PASS'}: {failed} of {len(why)} points over a "
+          f"probability limit, {undecided} undecided", file=sys.stderr)  # fmt: skip
+    return EXIT_FAIL if failed or undecided else EXIT_OK

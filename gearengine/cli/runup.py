@@ -96,6 +96,15 @@ def branch_table(name: str, branch: RunupBranch, result: RunupResult) -> list[st
     return lines
 
 
+def quasi_static_lines(result: RunupResult) -> list[str]:
+    """The quasi-static jumps of the directions run ("quasi-static up: jump at 4150 rpm, 25.3
+    -> 53.7 µm"): a run-up alone has no down branch, so the loop's down jump is not its own."""
+    return [f"quasi-static {name}: jump at {j.speed_rpm:.0f} rpm, "
+            f"{j.from_um:.1f} -> {j.to_um:.1f} µm"
+            for name in ("up", "down") if getattr(result, name) is not None
+            for j in getattr(result.quasi_static, name).jumps]  # fmt: skip
+
+
 def cmd_runup(args: argparse.Namespace) -> int:
     """Run the run-up, print the tables, write --json and --plot."""
     request = runup_request(args)
@@ -104,10 +113,10 @@ def cmd_runup(args: argparse.Namespace) -> int:
         branch = getattr(result, name)
         if branch is not None:
             print("\n".join(branch_table(name, branch, result)))
-    for name in ("up", "down"):
-        for j in getattr(result.quasi_static, name).jumps:
-            print(f"quasi-static {name}: jump at {j.speed_rpm:.0f} rpm, "
-                  f"{j.from_um:.1f} -> {j.to_um:.1f} µm")  # fmt: skip
+    for line in quasi_static_lines(result):
+        print(line)
+    for note in result.notes:
+        print(f"note: {note}")
     if args.json:
         Path(args.json).write_text(dumps(result))
     if args.plot:

@@ -189,6 +189,16 @@ def near_limit(p: SweepPoint, rules: Rules) -> bool:
     return False
 
 
+def attractor_set(p: SweepPoint, rules: Rules) -> frozenset[tuple[str, int | None]]:
+    """The responses a point settles on (class and period of each attractor whose basin is
+    above ``rules.min_basin``, or of the point without basins): two neighbours whose sets
+    differ are on two sides of a bifurcation, where a window may hide between them."""
+    if p.attractors is None:
+        return frozenset({(p.classification, p.period)})
+    least = -1.0 if rules.min_basin is None else rules.min_basin
+    return frozenset((a.classification, a.period) for a in p.attractors if a.fraction > least)
+
+
 def _physical(p: SweepPoint, key: str) -> float | None:
     value = (p.physical or {}).get(key)
     return None if value is None else value.value
@@ -302,7 +312,8 @@ def refined_report(request: SweepRequest, result: SweepResult, rules: Rules,
         return report
     added = refine_points(request, [p for p in result.points if p.branch != "down"],
                           lambda p: bool(attractor_failures(p, rules)),
-                          lambda p: near_limit(p, rules), refine, workers)  # fmt: skip
+                          lambda p: near_limit(p, rules), refine, workers,
+                          lambda p: attractor_set(p, rules))  # fmt: skip
     return envelope_report(result, rules, added, resolution(request, refine, len(added)))
 
 

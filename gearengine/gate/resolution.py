@@ -3,19 +3,23 @@
 A grid of 23 speeds x 5 torques proves nothing between its points: chaos in a narrow window
 (a speed band, or a torque level between two of the five) passes unseen. The gate therefore
 states what it checked (``Resolution``: grid spacing in rpm and N*m, points, starts) and refines
-where the grid cannot be trusted: between two neighbouring points (along speed or torque) whose
-verdicts differ, or next to a point near a limit, it inserts the midpoint, and
-repeats on the halves so created, ``depth`` times, down to a finest spacing of the grid's
-/ 2**depth. Every inserted point is computed exactly as a grid point is
-(``studies.sweep.compute.points_at``) and checked by the same rules.
+where the grid cannot be trusted: a grid cell (two neighbouring speeds, or four corners of a
+speed x torque cell) whose corners' verdicts or attractor sets differ, or one of whose corners
+is near a limit, is split in halves along each axis (edge midpoints and centre), and the halves
+so created again, ``depth`` times, down to a finest spacing of the grid's / 2**depth. Splitting
+cells, not edges, reaches a window inside a cell: the TE remedy's damping twin (0.1672) of the
+z = 23/67 pair passed its 45 x 9 verification refined along edges and is chaotic from every
+start at 5,489 rpm / 6.72 N*m, inside a cell. Every inserted point is computed exactly as a
+grid point is (``studies.sweep.compute.points_at``) and checked by the same rules.
 
 "Near a limit" is ``gate.envelope.near_limit``.
 """
 
 from __future__ import annotations
 
+import itertools
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
 from concurrent.futures import ThreadPoolExecutor
 
 from pydantic import BaseModel, ConfigDict, Field
@@ -26,9 +30,12 @@ from gearengine.studies.sweep.compute import points_at
 from gearengine.studies.sweep.points import SweepPoint
 from gearengine.studies.sweep.request import SweepRequest
 
-REFINE_DEPTH = 1
-"""Default halvings of the grid spacing where neighbours differ or a point is near a limit:
-the finest spacing checked is the grid's / 2 there (a 2x finer grid's points)."""
+REFINE_DEPTH = 2
+"""Default halvings of the grid spacing where neighbours differ, a point is near a limit or the
+attractor set changes: the finest spacing checked is the grid's / 4 there. One halving missed
+chaos between a refined point near the limit and its grid neighbours (the z = 23/67 pair at
+5 N*m, 3,557 rpm, 19 % of starts; a chaotic 8.44 N*m level at 4,636 rpm, 38 %): depth 2 finds
+them at 1.6x the CPU of depth 1 on its 1,000-6,000 rpm x 5-60 N*m envelope (benchmarks)."""
 MAX_REFINE_DEPTH = 4
 
 
@@ -50,16 +57,19 @@ class Resolution(BaseModel):
     def text(self) -> str:
         """ "23 x 5 grid (227 rpm x 13.8 N*m), 16 starts a point; refined ... 7 points added"."""
         grid = f"{self.speed_points} x {self.torque_points} grid" if self.torque_points > 1 \
-            else f"{self.speed_points} speeds"  # fmt: skip
+            else f"{self.speed_points} speeds" if self.speed_points > 1 else "1 speed"  # fmt: skip
         steps = [f"{s:.4g} {u}" for s, u in ((self.speed_step_rpm, "rpm"),
                  (self.torque_step_nm, "N*m")) if s is not None]  # fmt: skip
         out = f"{grid} ({' x '.join(steps) or 'one point'}), {self.starts} starts a point"
-        if self.depth == 0:
-            return out + "; not refined between grid points"
         fine = [f"{s:.4g} {u}" for s, u in ((self.finest_speed_step_rpm, "rpm"),
                 (self.finest_torque_step_nm, "N*m")) if s is not None]  # fmt: skip
-        return (f"{out}; refined to {' x '.join(fine)} where neighbours differ or a point is "
-                f"near a limit: {self.refined_points} points added")  # fmt: skip
+        if not fine:  # one operating point: no neighbours, nothing between them
+            return out + "; no neighbours to refine between"
+        if self.depth == 0:
+            return out + "; not refined between grid points"
+        return (f"{out}; refined to {' x '.join(fine)} where neighbours differ (verdict or "
+                "attractors) or a point is near a limit: "
+                f"{self.refined_points} points added")  # fmt: skip
 
 
 def resolution(request: SweepRequest, depth: int, refined: int = 0) -> Resolution:
@@ -87,17 +97,22 @@ Lattice = tuple[int, int]
 def refine(
     request: SweepRequest, points: list[SweepPoint], fails: Callable[[SweepPoint], bool],
     near: Callable[[SweepPoint], bool], depth: int, workers: int = 1,
+    kind: Callable[[SweepPoint], Hashable] = lambda p: None,
 ) -> list[SweepPoint]:  # fmt: skip
     """The points inserted between the grid ``points`` of ``request`` (its speed axis first,
-    then a torque axis if any): midpoints of neighbour pairs that differ in ``fails`` or where
-    either is ``near``, then of the halves so made, ``depth`` times. Computed ``workers`` at a
-    time."""
+    then a torque axis if any), cell by cell: a grid cell (two neighbours on a one-axis grid,
+    four corners on a speed x torque grid) whose corners differ in ``fails`` or in ``kind``
+    (the attractor set), or one of which is ``near``, is split in halves along each axis (its
+    edges' midpoints and, in two axes, its centre: a window inside the cell is reached, not
+    only one on its edges), then the halves so made, ``depth`` times. Computed ``workers`` at
+    a time."""
     grids = request.grids()
     names = [a.parameter for a in request.axes]
     if depth <= 0 or not points:
         return []
     f = 2**depth
     sizes = [(len(g) - 1) * f for g in grids] + [0] * (2 - len(grids))
+    axes = [k for k in (0, 1) if sizes[k] > 0]  # the axes with more than one grid value
 
     def values(ij: Lattice) -> dict[str, float]:
         out = {}
@@ -106,6 +121,12 @@ def refine(
             out[name] = g[0] if len(g) == 1 else g[0] + ij[k] * (g[-1] - g[0]) / sizes[k]
         return out
 
+    def offsets(step: int) -> list[Lattice]:
+        """The lattice offsets of a cell's corners with side ``step`` (its lower one first)."""
+        return [(di if 0 in axes else 0, dj if 1 in axes else 0)
+                for di, dj in itertools.product((0, step), repeat=2)
+                if (0 in axes or di == 0) and (1 in axes or dj == 0)]  # fmt: skip
+
     known: dict[Lattice, SweepPoint] = {}
     index = {round(v, 9): i for i, v in enumerate(grids[0])}
     index2 = {round(v, 9): i for i, v in enumerate(grids[1])} if len(grids) > 1 else {}
@@ -113,28 +134,34 @@ def refine(
         i = index[round(p.values[names[0]], 9)] * f
         j = index2[round(p.values[names[1]], 9)] * f if len(names) > 1 else 0
         known[(i, j)] = p
-    pairs = [((i, j), (i + f, j)) for (i, j) in known if (i + f, j) in known]
-    pairs += [((i, j), (i, j + f)) for (i, j) in known if (i, j + f) in known]
-    added: list[SweepPoint] = []
-    flags: dict[Lattice, tuple[bool, bool]] = {}
+    flags: dict[Lattice, tuple[bool, bool, Hashable]] = {}
 
-    def flag(ij: Lattice) -> tuple[bool, bool]:
+    def flag(ij: Lattice) -> tuple[bool, bool, Hashable]:
         if ij not in flags:
-            flags[ij] = (fails(known[ij]), near(known[ij]))
+            flags[ij] = (fails(known[ij]), near(known[ij]), kind(known[ij]))
         return flags[ij]
 
+    def corners(cell: Lattice, step: int) -> list[Lattice]:
+        return [(cell[0] + di, cell[1] + dj) for di, dj in offsets(step)]
+
+    def chosen(cell: Lattice, step: int) -> bool:
+        found = [flag(c) for c in corners(cell, step)]
+        return (len({x[0] for x in found}) > 1 or any(x[1] for x in found)
+                or len({x[2] for x in found}) > 1)  # fmt: skip
+
+    cells = [c for c in known if axes and all(x in known for x in corners(c, f))]
+    added: list[SweepPoint] = []
     h = f
-    while h > 1 and pairs:
-        chosen = [(a, b) for a, b in pairs
-                  if flag(a)[0] != flag(b)[0] or flag(a)[1] or flag(b)[1]]  # fmt: skip
-        mids = {(a, b): ((a[0] + b[0]) // 2, (a[1] + b[1]) // 2) for a, b in chosen}
-        todo = list(dict.fromkeys(m for m in mids.values() if m not in known))
+    while h > 1 and cells:
+        split = [c for c in cells if chosen(c, h)]
+        halves = [(c[0] + di, c[1] + dj) for c in split for di, dj in offsets(h // 2)]
+        new = {x for c in halves for x in corners(c, h // 2)} - known.keys()
+        todo = sorted(new, key=lambda ij: (ij[1], ij[0]))
         for ij, p in zip(todo, _compute(request, [values(ij) for ij in todo], workers),
                          strict=True):  # fmt: skip
             known[ij] = p
             added.append(p)
-        pairs = [half for a, b in chosen for m in [mids[(a, b)]] for half in ((a, m), (m, b))]
-        h //= 2
+        cells, h = halves, h // 2
     return added
 
 

@@ -17,6 +17,7 @@ from gearengine.gate.envelope import EnvelopeReport, FailingWindow, Rules
 from gearengine.model.units import RPM
 from gearengine.studies.runup.compute import run_local
 from gearengine.studies.runup.profile import validated
+from gearengine.studies.runup.reading import transient_chaos
 from gearengine.studies.runup.results import RunupBin, RunupResult
 from gearengine.studies.sweep.points import PhysicalValue
 from gearengine.studies.sweep.request import SweepRequest
@@ -73,6 +74,7 @@ def runup_failures(
         if "chaotic" not in rules.fail_on and rules.max_lle is None:
             continue
         flags = ["chaos" if _chaotic(b, rules) else None for b in bins]
+        transient = transient_chaos(branch, getattr(result.quasi_static, name))
         for lo, hi in runs(starts, flags).get("chaos", []):
             inside = [b for b in bins if lo <= b.speed_rpm[0] <= hi]
             seconds = sum(b.time_s[1] - b.time_s[0] for b in inside)
@@ -80,6 +82,8 @@ def runup_failures(
                 what = "FTLE clearly positive" if rules.max_lle is None else (
                     f"FTLE > {rules.max_lle:g}")  # fmt: skip
                 rule = f"run-{name}: chaotic ({what}) for {seconds:.3g} s"
+                if all(any(a <= b.speed_rpm[0] < z for a, z in transient) for b in inside):
+                    rule += " in the ramp's transient (the steady state is not chaotic there)"
                 out.append(FailingWindow(level=level, rule=rule,
                                          speeds_rpm=[lo, inside[-1].speed_rpm[1]]))  # fmt: skip
     return out

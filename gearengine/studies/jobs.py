@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import gc
 import importlib
+import os
 import threading
 from collections.abc import Callable, Iterator
 from concurrent.futures import ThreadPoolExecutor
@@ -40,6 +41,9 @@ class JobKind:
         work: ``request -> RK4 steps`` of the whole job, for the compute budget.
         compute_chunk: ``(request, index, chunk_points) -> chunk result`` as JSON text.
         assemble: ``(request, chunk results in index order) -> result document``.
+        terms: ``(request, budget in RK4 steps) -> its cost in the user's terms`` ("512 samples
+            x 1 start x 115 points = 58880 runs; the budget allows 256 samples here, or 57
+            points at 512"), said when the job is over the budget; None: steps alone.
     """
 
     name: str
@@ -49,6 +53,7 @@ class JobKind:
     work: Callable[[Any], int]
     compute_chunk: Callable[[Any, int, int], str]
     assemble: Callable[[Any, list[str]], BaseModel]
+    terms: Callable[[Any, int], str] | None = None
 
 
 def one_chunk_kind(
@@ -90,6 +95,50 @@ MAX_JOB_STEPS = 20_000_000_000
 minute on two cores."""
 
 
+BUDGET_ENV = ("GEARCHAOS_MAX_JOB_STEPS", "GEARCHAOS_MAX_SWEEP_STEPS")
+"""The environment variables of the job budget (the service's ``max_job_steps``; the second is
+its old name), read by the CLI as by the service."""
+
+
+def starts_words(lanes: int, basin_starts: int) -> str:
+    """ "17 starts (1 + 16 basin starts)", "1 start": the runs of one point in words."""
+    plural = "s" if lanes != 1 else ""
+    if not basin_starts:
+        return f"{lanes} start{plural}"
+    return f"{lanes} start{plural} ({lanes - basin_starts} + {basin_starts} basin starts)"
+
+
+def job_step_budget() -> int:
+    """The compute budget of one job in RK4 steps: ``GEARCHAOS_MAX_JOB_STEPS`` (or its old name)
+    from the environment when set, as the service reads it, else ``MAX_JOB_STEPS``.
+
+    Raises ValueError naming the variable when it is not a whole number."""
+    for name in BUDGET_ENV:
+        text = os.environ.get(name)
+        if text:
+            try:
+                return int(float(text))
+            except ValueError:
+                raise ValueError(f"{name}={text!r}: give a number of RK4 steps") from None
+    return MAX_JOB_STEPS
+
+
+def budget_refusal(name: str, request: BaseModel, noun: str, cap: int, ways: str) -> str | None:
+    """Why a job of kind ``name`` is over the budget of ``cap`` RK4 steps, else None: its steps,
+    its cost in the kind's own terms (``JobKind.terms``: samples x starts x points, what fits),
+    the minutes that would take, and ``ways`` out (in the asker's words: options or fields); the
+    one rule of the CLI and the API (``service.limits``)."""
+    job = kind(name)
+    steps = job.work(request)
+    if steps <= cap:
+        return None
+    terms = "" if job.terms is None else f" ({job.terms(request, cap)})"
+    minutes = steps / MAX_JOB_STEPS  # MAX_JOB_STEPS: about a minute on two cores
+    return (f"this {noun} needs {steps} RK4 steps{terms}, over the budget of {cap} RK4 steps "
+            f"per job (max_job_steps, environment {BUDGET_ENV[0]}); it would take about "
+            f"{minutes:.2g} min on two cores; {ways}")  # fmt: skip
+
+
 def too_many_points(points: int, noun: str) -> str | None:
     """Why a job of ``points`` operating points is over ``MAX_JOB_POINTS``, else None (checked
     first, so that no work is costed for them)."""
@@ -98,17 +147,11 @@ def too_many_points(points: int, noun: str) -> str | None:
     return None
 
 
-def over_budget(name: str, request: BaseModel, noun: str) -> str | None:
-    """Why a job of kind ``name`` is over the default budget (its work against
-    ``MAX_JOB_STEPS``), else None: the CLI refuses what the API refuses, before computing (its
+def over_budget(name: str, request: BaseModel, noun: str, ways: str) -> str | None:
+    """Why a job of kind ``name`` is over this process's budget (``budget_refusal`` against
+    ``job_step_budget``), else None: the CLI refuses what the API refuses, before computing (its
     points were counted before the request was validated, ``too_many_points``)."""
-    steps = kind(name).work(request)
-    if steps > MAX_JOB_STEPS:
-        return (
-            f"this {noun} needs {steps} RK4 steps, over the budget of {MAX_JOB_STEPS} steps "
-            f"per {noun} (max_job_steps); use fewer points, periods or steps per period"
-        )
-    return None
+    return budget_refusal(name, request, noun, job_step_budget(), ways)
 
 
 KINDS: dict[str, str] = {

@@ -69,9 +69,10 @@ class Envelope(BaseModel):
     torque_points: int = Field(5, ge=1, le=50, description="Grid torques (as the gate).")
     refine: int = Field(
         REFINE_DEPTH, ge=0, le=MAX_REFINE_DEPTH,
-        description="Halvings of the grid spacing where neighbours differ or a point is near a "
-        "limit (as the gate's --refine); a remedy's value is verified on a 2x finer grid, "
-        "refined the same way.",
+        description="Halvings of the grid spacing where neighbours differ (verdict or attractor "
+        "set) or a point is near a limit (as the gate's --refine); a remedy's value is verified "
+        "on a 2x finer grid, refined one halving more (as finely as a check of a grid 2x finer "
+        "again).",
     )  # fmt: skip
 
 

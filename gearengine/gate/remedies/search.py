@@ -50,6 +50,7 @@ from gearengine.gate.remedies.request import (
     RemediesRequest,
 )
 from gearengine.gate.remedies.results import Remedy, Sample, Unreachable
+from gearengine.gate.resolution import MAX_REFINE_DEPTH
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.homoclinic.train_reduction import melnikov_point
 from gearengine.model.design import Design
@@ -179,22 +180,34 @@ _memo_locks: dict[str, threading.Lock] = {}
 _memo_lock = threading.Lock()
 
 
-def shared_check(request: RemediesRequest, sweep: SweepRequest, finish: bool = False
-                 ) -> EnvelopeReport:  # fmt: skip
-    """``check_envelope`` of ``sweep`` under the request's rules and refinement, computed once
+def verify_depth(request: RemediesRequest) -> int:
+    """The refinement of a remedy's verification on the 2x finer grid: one halving more than
+    the search's (none if the search refines none), so that its finest spacing is that of a
+    check of a grid 2x finer again at the search's refinement. At the search's depth, the TE
+    remedy of the z = 23/67 pair over 4,500-5,700 rpm x 5-12 N*m passed its 7 x 3 grid and
+    failed ``check`` on 13 x 5 (chaotic at 4,825 rpm / 5 N*m from 38 % of starts, a point only
+    that check's refinement reached)."""
+    depth = request.envelope.refine
+    return min(MAX_REFINE_DEPTH, depth + 1) if depth > 0 else 0
+
+
+def shared_check(request: RemediesRequest, sweep: SweepRequest, finish: bool = False,
+                 depth: int | None = None) -> EnvelopeReport:  # fmt: skip
+    """``check_envelope`` of ``sweep`` under the request's rules and refinement (``depth``
+    halvings, default the request's), computed once
     per process: the design's own check that every chunk needs, and a lever's far end that the
     combination checks again, are run once however many chunks ask (threads asking for the same
     sweep wait for the first). ``finish``: refine a grid that fails too (the design's own report,
     shown to the user); else a failing grid is not refined (only pass or fail is needed)."""
     rules = request.rules()
-    key = "\n".join((sweep.model_dump_json(), rules.model_dump_json(),
-                      str(request.envelope.refine), str(finish)))  # fmt: skip
+    depth = request.envelope.refine if depth is None else depth
+    key = "\n".join((sweep.model_dump_json(), rules.model_dump_json(), str(depth),
+                      str(finish)))  # fmt: skip
     with _memo_lock:
         lock = _memo_locks.setdefault(key, threading.Lock())
     with lock:
         if key not in _memo:
-            report = check_envelope(sweep, rules, refine=request.envelope.refine,
-                                    refine_failing=finish)  # fmt: skip
+            report = check_envelope(sweep, rules, refine=depth, refine_failing=finish)
             with _memo_lock:
                 while len(_memo) >= MEMO_SIZE:
                     _memo_locks.pop(next(iter(_memo)), None)
@@ -211,11 +224,13 @@ them failing there decides the step (the envelope fails) without the rest of the
 
 
 def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeReport,
-                  check: Callable[[SweepRequest], EnvelopeReport] | None = None,
+                  check: Callable[[SweepRequest, int], EnvelopeReport] | None = None,
                   ) -> tuple[list[Remedy], list[Unreachable]]:  # fmt: skip
-    """Both bounds of one lever; ``check`` runs an envelope sweep (default ``shared_check``)."""
+    """Both bounds of one lever; ``check(sweep, depth)`` runs an envelope sweep refined
+    ``depth`` times (default ``shared_check``); the finer grid's at ``verify_depth``."""
     rules = request.rules()
-    check = check or (lambda sweep: shared_check(request, sweep))
+    check = check or (lambda sweep, depth: shared_check(request, sweep, depth=depth))
+    depths = {False: request.envelope.refine, True: verify_depth(request)}
     reports: dict[tuple[float, bool], EnvelopeReport] = {(lever.start, False): baseline}
     failed: dict[bool, list[SweepPoint]] = {  # per grid (finer or not): its failing points
         False: [p for p in baseline.sweep.points if attractor_failures(p, rules)],
@@ -225,7 +240,7 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
     def run(value: float, finer: bool = False) -> EnvelopeReport:
         if (value, finer) not in reports:
             design = design_with(request.design, {lever.path: value})
-            reports[(value, finer)] = report = check(request.sweep(design, finer))
+            reports[(value, finer)] = report = check(request.sweep(design, finer), depths[finer])
             if not report.passed:  # its grid points: a failure there is the grid's
                 failed[finer] = [p for p in report.sweep.points if attractor_failures(p, rules)]
         return reports[(value, finer)]
@@ -246,7 +261,7 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
         hints = [{n: p.values[n] for n in names} for p in failed[finer][:HINTS]]
         if hints and any(attractor_failures(p, rules) for p in points_at(sweep, hints)):
             return False
-        got = check_or_failures(sweep, rules, request.envelope.refine, hints)
+        got = check_or_failures(sweep, rules, depths[finer], hints)
         if isinstance(got, list):
             failed[finer] = got
             return False

@@ -190,6 +190,23 @@ def robustness_work(request: RobustnessRequest) -> int:
     return request.n_rows() * sum(per_point)
 
 
+def robustness_terms(request: RobustnessRequest, cap: int) -> str:
+    """The study's cost in its own terms and what ``cap`` RK4 steps allow (``JobKind.terms``):
+    "512 samples x 1 start x 115 points = 58880 runs; the budget allows 256 samples at these
+    points, or 57 points at 512 samples"."""
+    points, starts = max(1, len(request.points())), request.settings.lanes()
+    basins = request.settings.basins
+    steps, rows = robustness_work(request), request.n_rows()
+    fit = cap * request.samples // steps  # samples that fit (the work is linear in them)
+    samples = 1 << (fit.bit_length() - 1) if fit >= 2 else 0  # a power of 2
+    sobol = f" x {rows // request.samples} (Sobol indices)" if request.sensitivity else ""
+    return (f"{request.samples} samples{sobol} x "
+            f"{jobs.starts_words(starts, 0 if basins is None else basins.starts)} x "
+            f"{points} point{'s' if points != 1 else ''} = {rows * starts * points} runs; the "
+            f"budget allows {samples} samples at these points, or {cap * points // steps} "
+            f"points at {request.samples} samples")  # fmt: skip
+
+
 def _run(bp: Any, model: Any, scales: Scales) -> list[Any]:
     """One run's row: class, contact, Melnikov verdict (of a train, its mesh-mode reduction's,
     null without one), DTE [um] and dynamic factor (the one definition,
@@ -412,5 +429,6 @@ ROBUSTNESS_JOB = jobs.JobKind(
     work=robustness_work,
     compute_chunk=compute_chunk,
     assemble=assemble,
+    terms=robustness_terms,
 )
 """Robustness studies as a kind of job (``gearengine.studies.jobs.KINDS``)."""

@@ -196,6 +196,30 @@ def _quasi_branch(points: list[SweepPoint], branch: Branch, b_um: float) -> Quas
                                                      b_um))  # fmt: skip
 
 
+def transient_chaos(branch: RunupBranch, quasi: QuasiStaticBranch) -> list[list[float]]:
+    """Speed spans [rpm] of ``branch``'s chaotic bins where the steady state at the bin centre
+    (``quasi``, the continuation of the same direction) is not chaotic: the ramp's transient,
+    which a steady-state check (``gearengine check``) does not see."""
+    steady = {round(p.speed_rpm, 6): p.classification for p in quasi.points}
+    spans: list[list[float]] = []
+    for b in sorted(branch.bins, key=lambda b: b.speed_rpm[0]):
+        centre = round(0.5 * (b.speed_rpm[0] + b.speed_rpm[1]), 6)
+        if b.chaotic and steady.get(centre) not in ("chaotic", "diverged"):
+            if spans and spans[-1][1] == b.speed_rpm[0]:
+                spans[-1][1] = b.speed_rpm[1]
+            else:
+                spans.append(list(b.speed_rpm))
+    return spans
+
+
+def transient_note(name: str, spans: list[list[float]]) -> str:
+    """ "run-up: chaotic bins at 3500-3600 rpm where the steady state is not chaotic ..."."""
+    where = ", ".join(f"{lo:.0f}-{hi:.0f}" for lo, hi in spans)
+    return (f"run-{name}: chaotic bins at {where} rpm where the steady state (the quasi-static "
+            "continuation at the bin centres) is not chaotic: chaos of the ramp's transient, "
+            "which a steady-state check (gearengine check) does not find")  # fmt: skip
+
+
 def read_runup(
     request: RunupRequest, plan: RunupPlan, tables: list[list], quasi: SweepResult
 ) -> RunupResult:
@@ -232,6 +256,9 @@ def read_runup(
     ]
     if request.to_torque is not None:
         notes.append(f"the torque ramps linearly in time to {request.to_torque:g} N m")
+    for name, branch in branches.items():
+        spans = [] if branch is None else transient_chaos(branch, getattr(qs, name))
+        notes += [transient_note(name, spans)] if spans else []
     judged = melnikov_point(system)  # a train's mesh-mode reduction, when it holds
     windows = [] if judged is None else speed_windows(judged, conv.speed_rpm, lo, hi)
     if system.n > 2:

@@ -342,6 +342,15 @@ def assemble(request: SweepRequest, arrays: list[str]) -> SweepResult:
     return SweepResult.model_validate_json(text)
 
 
+def sweep_terms(request: SweepRequest, cap: int) -> str:
+    """The sweep's cost in its own terms and what ``cap`` RK4 steps allow (``JobKind.terms``):
+    "115 points x 17 starts = 1955 runs; the budget allows 80 points"."""
+    points, starts, basins = request.n_points(), request.settings.lanes(), request.settings.basins
+    words = jobs.starts_words(starts, 0 if basins is None else basins.starts)
+    return (f"{points} points x {words} = {points * starts} runs; the budget allows "
+            f"{cap * points // sweep_work(request)} points")  # fmt: skip
+
+
 SWEEP_JOB = jobs.JobKind(
     name="sweep",
     request=SweepRequest,
@@ -350,5 +359,6 @@ SWEEP_JOB = jobs.JobKind(
     work=sweep_work,
     compute_chunk=_chunk_text,
     assemble=assemble,
+    terms=sweep_terms,
 )
 """Sweeps as a kind of job (``gearengine.studies.jobs.KINDS``)."""

@@ -1,0 +1,135 @@
+"""Probability limits decided point by point: sequential sampling within a compute budget.
+
+A limit P(event) <= p at an operating point is decided when the 95 % Clopper-Pearson interval
+of the study's estimate lies on one side of it: ``pass`` when its upper bound is at or below p
+for every limit, ``fail`` when the lower bound of one is above its p; otherwise the point is
+``undecided``. ``sequential`` samples each point with 64, 128, 256, ... samples (the seeded
+Sobol points of 2N begin with those of N: a round computes only the new rows of the points not
+yet decided) until each point is decided, ``most`` samples are reached, or the next round would
+take the total work over ``budget`` RK4 steps; the points left are undecided, with their
+samples and the reason. A gate must fail an undecided point (it proves nothing).
+
+Each look's interval is 95 % at its own count; the looks are not corrected for their number.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from typing import Literal
+
+from pydantic import BaseModel, Field
+
+from gearengine.studies import jobs
+from gearengine.studies.robustness.study import (
+    DEFAULT_CHUNK_ROWS,
+    MAX_SAMPLES,
+    RobustnessPoint,
+    RobustnessRequest,
+    RobustnessResult,
+    assemble,
+    robustness_work,
+)
+from gearengine.studies.sweep.axes import axis_unit
+from gearengine.studies.sweep.request import SweepAxis
+
+FIRST_SAMPLES = 64
+"""Samples of the first round of ``sequential`` (a power of 2, a multiple of the chunk rows)."""
+
+Verdict = Literal["pass", "fail", "undecided"]
+
+
+def verdict(point: RobustnessPoint, limits: dict[str, float]) -> Verdict:
+    """``fail`` when a lower bound is above its limit, ``pass`` when every upper bound is at or
+    below its limit, else ``undecided`` (an interval holds its limit, or no samples)."""
+    intervals = [(point.probabilities[name].interval, limit) for name, limit in limits.items()]
+    if any(ci is not None and ci[0] > limit for ci, limit in intervals):
+        return "fail"
+    if all(ci is not None and ci[1] <= limit for ci, limit in intervals):
+        return "pass"
+    return "undecided"
+
+
+class SequentialResult(BaseModel):
+    """The study as sampled (each point with its own samples) and each point's verdict."""
+
+    result: RobustnessResult = Field(description="The points, each with the samples it took.")
+    verdicts: list[Verdict] = Field(description="Per point, as ``verdict``.")
+    rounds: list[int] = Field(description="Samples of each round run (64, 128, ...).")
+    steps: int = Field(description="RK4 steps run in all.")
+    stopped: str = Field(description="Why sampling stopped, in words.")
+
+
+def point_request(request: RobustnessRequest, values: dict[str, float], samples: int
+                  ) -> RobustnessRequest:  # fmt: skip
+    """``request`` at the one operating point ``values`` (SI) with ``samples`` samples and no
+    Sobol indices."""
+    axes = [SweepAxis(parameter=k, start=f"{v!r} {axis_unit(k)}", stop=f"{v!r} {axis_unit(k)}",
+                      num=1) for k, v in values.items()]  # fmt: skip
+    return request.model_copy(update={"axes": axes, "samples": samples, "sensitivity": False})
+
+
+def first_round_steps(request: RobustnessRequest, first: int = FIRST_SAMPLES) -> int:
+    """RK4 steps of the first round: ``first`` samples at every point."""
+    return robustness_work(request.model_copy(update={"samples": first, "sensitivity": False}))
+
+
+def sequential(
+    request: RobustnessRequest, limits: dict[str, float], budget: int, workers: int = 1,
+    most: int = MAX_SAMPLES, first: int = FIRST_SAMPLES,
+    progress: Callable[[int, int], None] | None = None,
+) -> SequentialResult:  # fmt: skip
+    """Sample each point of ``request`` until ``limits`` decide it (see the module), within
+    ``budget`` RK4 steps in all and ``most`` samples a point; ``workers`` threads."""
+    points = request.points() or [{}]
+    unit = [robustness_work(point_request(request, p, 1)) for p in points]
+    chunks: list[list[str]] = [[] for _ in points]
+    answers: list[RobustnessPoint | None] = [None] * len(points)
+    verdicts: list[Verdict] = ["undecided"] * len(points)
+    rounds: list[int] = []
+    spent, done, n = 0, 0, first
+    stopped = ""
+    while not stopped:
+        todo = [k for k, v in enumerate(verdicts) if v == "undecided"]
+        cost = sum(unit[k] for k in todo) * (n - done)
+        if spent + cost > budget:
+            stopped = (
+                f"the budget of {budget} RK4 steps ran out: {len(todo)} points undecided "
+                f"after {done} samples ({n} would take {spent + cost} steps in all)"
+            )
+            break  # fmt: skip
+        texts = {k: point_request(request, points[k], n).model_dump_json() for k in todo}
+        tasks = [(k, texts[k], i) for k in todo
+                 for i in range(done // DEFAULT_CHUNK_ROWS, n // DEFAULT_CHUNK_ROWS)]  # fmt: skip
+        with ThreadPoolExecutor(max(1, workers)) as pool:
+            for (k, _, _), text in zip(tasks, pool.map(_chunk, tasks), strict=True):
+                chunks[k].append(text)
+        for k in todo:
+            (answers[k],) = assemble(point_request(request, points[k], n), chunks[k]).points
+            verdicts[k] = verdict(answers[k], limits)  # type: ignore[arg-type]
+        spent, done = spent + cost, n
+        rounds.append(n)
+        if progress is not None:
+            progress(sum(v != "undecided" for v in verdicts), len(points))
+        if all(v != "undecided" for v in verdicts):
+            stopped = f"every point decided by {n} samples"
+        elif n >= most:
+            stopped = f"{verdicts.count('undecided')} points undecided at {n} samples, the most"
+        n *= 2
+    whole = assemble(request.model_copy(update={"samples": max(done, 2), "sensitivity": False}),
+                     [_empty(len(points))])  # fmt: skip
+    shown = [a if a is not None else p for a, p in zip(answers, whole.points, strict=True)]
+    result = whole.model_copy(update={"points": shown, "samples": done, "partial": False})
+    return SequentialResult(result=result, verdicts=verdicts, rounds=rounds, steps=spent,
+                            stopped=stopped)  # fmt: skip
+
+
+def _chunk(task: tuple[int, str, int]) -> str:
+    """Chunk ``task[2]`` of the point request ``task[1]`` (JSON text)."""
+    return jobs.compute_chunk_json("robustness", task[1], task[2], DEFAULT_CHUNK_ROWS)
+
+
+def _empty(points: int) -> str:
+    """A chunk with no rows (the frame of a result: its variables, model and units)."""
+    return json.dumps({"index": 0, "first_row": 0, "runs": [[] for _ in range(points)]})
