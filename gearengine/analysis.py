@@ -26,13 +26,8 @@ from gearengine.model.errors import InputError
 from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
-from gearengine.numerics.attractors import (
-    Headline,
-    coexistence,
-    headline,
-    of_starts,
-    planned_attractors,
-)
+from gearengine.numerics.attractors import planned_attractors
+from gearengine.numerics.headline import Headline, coexistence, headline, of_starts
 from gearengine.numerics.magnitudes import adverse_over, most_adverse
 from gearengine.numerics.physical import in_seconds
 from gearengine.numerics.results import Attractor, NumericsResult, WorstValue
@@ -303,7 +298,7 @@ def whose_note(num: NumericsResult, decided: Headline) -> str:
 
 def decision(num: NumericsResult, settings: SimulationSettings) -> Headline | None:
     """The worst attractor above ``settings.basins.min_fraction`` that decides the verdict
-    (``numerics.attractors.headline``); None without basins."""
+    (``numerics.headline.headline``); None without basins."""
     if num.attractors is None or num.basins is None or settings.basins is None:
         return None
     return headline(num.attractors, num.basins, settings.basins.min_fraction)

@@ -45,7 +45,7 @@ from gearengine.model.units import (
     shown,
     to_physical,
 )
-from gearengine.numerics.attractors import Headline
+from gearengine.numerics.headline import Headline
 from gearengine.numerics.magnitudes import worst_words
 from gearengine.numerics.results import NumericsResult, WorstValue
 from gearengine.systems.gear_train.modes import Modes
@@ -385,7 +385,7 @@ def engineering(
     worst: dict[str, WorstValue] | None = None,
 ) -> Engineering:
     """The engineering block of a design's Melnikov verdict (and analysis, given ``num``;
-    ``decided`` the worst attractor of its basins, ``numerics.attractors.headline``) from the
+    ``decided`` the worst attractor of its basins, ``numerics.headline.headline``) from the
     values handed to it: ``scan`` the speed windows [rpm] and the end of their scan
     (``homoclinic.boundary.design_windows``, None above the critical load).
     ``no_windows``: why the speed windows are not looked for (a train without a Melnikov

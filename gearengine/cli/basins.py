@@ -15,7 +15,7 @@ from pathlib import Path
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
 from gearengine.cli.documents import EXIT_OK, read_document, validated_input
 from gearengine.jsonio import dumps
-from gearengine.numerics.attractors import percent
+from gearengine.numerics.headline import percent
 
 
 def basins_request(args: argparse.Namespace) -> AnalysisRequest:

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -36,6 +35,7 @@ from gearengine.model.params import GearParams
 from gearengine.model.reduction import ParamsOrDesign
 from gearengine.model.units import Scales, response_values, shown, to_physical
 from gearengine.numerics.batch import run_lanes, run_verdict, simulate_batch_with, step_plans
+from gearengine.numerics.headline import of_starts
 from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint
 from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import BasinSettings, SimulationSettings
@@ -374,63 +374,6 @@ def coexisting(bp: BatchPoint, found: list[Attractor], counts: BasinCounts) -> l
     NN % of starts' (largest basin first)."""
     others = [a for a in found if not follows(bp, a)]
     return [of_starts(a.label, a.fraction) for a in sorted(others, key=lambda a: -a.count)]
-
-
-@dataclass(frozen=True)
-class Headline:
-    """The verdict an ensemble of starts decides: its worst member above the threshold."""
-
-    classification: str
-    period: int | None
-    decided_by: str
-    """Which member decided it: 'chaotic, double-sided impacts from 41 % of starts'."""
-    fraction: float
-    """Its basin fraction (of diverged starts for 'diverged')."""
-    attractor: Attractor | None = None
-    """The deciding attractor (None for divergence): its LLE and impact regime."""
-
-    @property
-    def kind(self) -> str:
-        """'periodic (1T)', 'chaotic', 'quasi-periodic', 'diverged'."""
-        if self.period:
-            return f"{self.classification} ({self.period}T)"
-        return self.classification.replace("_", "-")
-
-
-def percent(fraction: float) -> str:
-    """0.40625 -> '41 %', 0.004 -> '0.4 %'."""
-    return f"{100 * fraction:.0f} %" if fraction >= 0.01 else f"{100 * fraction:.1g} %"
-
-
-def headline(found: list[Attractor], counts: BasinCounts, min_fraction: float) -> Headline | None:
-    """The worst attractor (or divergence) whose basin fraction is above ``min_fraction``;
-    None when no start qualifies (every basin at or below it)."""
-    diverged = counts.diverged / counts.starts
-    if counts.diverged and diverged > min_fraction:
-        return Headline("diverged", None, f"diverged from {percent(diverged)} of starts", diverged)
-    for a in found:  # worst first
-        if a.fraction > min_fraction:
-            return Headline(a.classification, a.period, of_starts(a.label, a.fraction), a.fraction,
-                            a)  # fmt: skip
-    return None
-
-
-def of_starts(label: str, fraction: float) -> str:
-    """An attractor named with its basin fraction: 'chaotic, ... from 31 % of starts'."""
-    return f"{label} from {percent(fraction)} of starts"
-
-
-def coexistence(found: list[Attractor], counts: BasinCounts) -> str:
-    """'periodic 1T, no impacts from 83 % of starts; chaotic from 17 %' (largest basin first),
-    with the diverged and unsettled starts."""
-    parts = [(a.fraction, a.label) for a in sorted(found, key=lambda a: -a.count)]
-    for n, what in ((counts.diverged, "diverged"), (counts.unsettled, "unsettled")):
-        if n:
-            parts.append((n / counts.starts, what))
-    texts = [f"{label} from {percent(f)}" for f, label in parts]
-    if texts:
-        texts[0] += f" of {counts.starts} starts"
-    return "; ".join(texts)
 
 
 def of_design(

@@ -1,5 +1,5 @@
 """The magnitudes of an ensemble's answer: the verdict is the worst attractor's by class
-(``attractors.headline``); each magnitude shown or gated (DTE, dynamic factor, mesh forces) is
+(``headline.headline``); each magnitude shown or gated (DTE, dynamic factor, mesh forces) is
 the most adverse over the attractors above the basin threshold, naming the attractor it comes
 from, which need not be the one that decided the verdict (issue 30; docs/basins.md).
 """
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from gearengine.numerics.attractors import Headline, of_starts
+from gearengine.numerics.headline import Headline, of_starts
 from gearengine.numerics.results import Attractor, WorstValue
 
 ADVERSE = {

@@ -12,7 +12,7 @@ start of the settings by ``numerics.batch.simulate_batch`` (lanes of ``run_lanes
 counts as its worst start, as the single analysis does), with the Melnikov verdict beside it.
 With ``settings.basins`` every sample also runs the basin starts (``numerics.attractors``,
 every sample's starts in one ``run_lanes`` call, as a sweep's chunk) and counts as its worst
-attractor whose basin fraction is above ``basins.min_fraction`` (``numerics.attractors.headline``,
+attractor whose basin fraction is above ``basins.min_fraction`` (``numerics.headline.headline``,
 as the gate and the sweep decide a point): class, contact, DTE and dynamic factor are that
 attractor's. Without basins (the default) a sample is its settings' own start: N runs a point;
 with B basin starts N (1 + B) (the budget, ``robustness_work``, counts them).
@@ -39,8 +39,9 @@ from gearengine.model.errors import InputError, Problems
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
 from gearengine.model.units import Scales, display_unit, in_display_unit, response_values
-from gearengine.numerics.attractors import headline, points_attractors
+from gearengine.numerics.attractors import points_attractors
 from gearengine.numerics.batch import simulate_batch
+from gearengine.numerics.headline import headline
 from gearengine.numerics.magnitudes import most_adverse
 from gearengine.numerics.settings import SimulationSettings, work
 from gearengine.studies import jobs

@@ -25,12 +25,12 @@ from gearengine.model.units import (
 )
 from gearengine.numerics.attractors import (
     coexisting,
-    headline,
     points_attractors,
     verdicts_and_attractors,
 )
 from gearengine.numerics.batch import simulate_batch, threads_may_share_kernels
 from gearengine.numerics.bifurcations import PointResponse, locate_bifurcations
+from gearengine.numerics.headline import headline
 from gearengine.numerics.magnitudes import most_adverse
 from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint, FromAttractor
 from gearengine.numerics.settings import SimulationSettings
@@ -216,7 +216,7 @@ def _ensembles(request: SweepRequest, found: list[tuple[list[Attractor], BasinCo
 
 def _decided(found: list[Attractor], counts: BasinCounts, min_fraction: float) -> dict[str, Any]:
     """The point's verdict from its ensemble (docs/basins.md): the worst attractor (or the
-    divergence) whose basin fraction is above ``min_fraction`` (``numerics.attractors.headline``),
+    divergence) whose basin fraction is above ``min_fraction`` (``numerics.headline.headline``),
     its classification, period, LLE and impacts, named with its fraction in ``decided_by``; and
     the magnitudes (DTE, dynamic factor, forces: the point's ``physical`` entries, so the CSV's
     and the DataFrame's columns too) at their most adverse over the attractors above it

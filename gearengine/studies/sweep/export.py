@@ -19,7 +19,7 @@ from gearengine.model.units import (
     field_unit,
     in_display_unit,
 )
-from gearengine.numerics.attractors import of_starts
+from gearengine.numerics.headline import of_starts
 from gearengine.studies.sweep.axes import axis_unit, bare_reading, is_dimensionless
 from gearengine.studies.sweep.points import SweepBifurcation, SweepPoint
 from gearengine.studies.sweep.request import SweepAxis
