@@ -173,8 +173,8 @@ def test_samples_auto_reports_the_points_the_budget_leaves_undecided(
     assert main([*base, "--samples", "auto", "--max-probability", "separation=0.01"]) == 1
     captured = capsys.readouterr()
     assert (
-        "UNDECIDED: speed 2000 rpm (128 samples) [P(separation) undecided: upper bound "
-        "0.0284 > 0.01 (0/128 samples)]" in captured.out
+        "UNDECIDED: speed 2000 rpm (128 samples) [P(separation) undecided: upper bound at 99.3 % "
+        "0.0431 > 0.01 (0/128 samples)]" in captured.out
     )
     assert "FAIL: speed 5000 rpm (64 samples) [P(separation) lower bound" in captured.out
     assert "the budget of 3500000 RK4 steps ran out: 1 points undecided after 128" in captured.err
@@ -201,3 +201,24 @@ def test_the_api_refuses_a_study_over_the_budget_in_the_same_terms(tmp_path: Pat
     detail = r.json()["detail"]
     assert "512 samples x 1 start x 2 points = 1024 runs" in detail
     assert "max_job_steps, environment GEARCHAOS_MAX_JOB_STEPS" in detail and "axes[].num" in detail
+
+
+def test_sequential_looks_share_the_error_of_one_decision() -> None:
+    """``--samples auto`` looks at a point up to 7 times (64 ... 4,096 samples): each look at
+    95 % would give a point 7 chances to pass by luck (the expert's push on issue 30's auto
+    sampling). The 5 % is shared over the looks: 0 events in 368 samples prove P <= 1 % at 95 %
+    (one look, --samples N) but not at a look of the sequential study (561 are needed)."""
+    from gearengine.studies.robustness.sequential import decision_confidence, looks, verdict
+    from gearengine.studies.robustness.study import Probability, RobustnessPoint
+    from gearengine.studies.robustness.tolerances import probability, samples_to_prove
+
+    def point(k: int, n: int) -> RobustnessPoint:
+        return RobustnessPoint.model_construct(
+            probabilities={"chaotic": Probability(**probability(k, n))}
+        )
+
+    assert looks() == 7 and decision_confidence() == pytest.approx(1 - 0.05 / 7)
+    assert verdict(point(0, 368), {"chaotic": 0.01}) == "pass"
+    assert verdict(point(0, 368), {"chaotic": 0.01}, decision_confidence()) == "undecided"
+    assert samples_to_prove(0.01, decision_confidence()) == 561
+    assert verdict(point(0, 561), {"chaotic": 0.01}, decision_confidence()) == "pass"

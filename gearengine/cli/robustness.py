@@ -29,8 +29,11 @@ from gearengine.gate.envelope import ENVELOPE_SETTINGS, gate_settings
 from gearengine.model.units import IMPACTS_REFUSED, display_unit
 from gearengine.studies import jobs
 from gearengine.studies.robustness.sequential import (
+    ERROR,
     FIRST_SAMPLES,
     SequentialResult,
+    decision_interval,
+    looks,
     sequential,
     verdict,
 )
@@ -192,23 +195,33 @@ def auto_study(args: argparse.Namespace, doc: object, limits: dict[str, float]) 
     out = sequential(request, limits, budget, workers=os.cpu_count() or 1, progress=tick)
     rounds = ", ".join(str(n) for n in out.rounds)
     print(f"--samples auto: {out.stopped} (rounds of {rounds} samples, {out.steps} RK4 steps "
-          f"of a budget of {budget})", file=sys.stderr)  # fmt: skip
+          f"of a budget of {budget}); each look decides at {100 * out.confidence:.3g} %, the "
+          f"5 % error shared over the {looks()} looks a point may take",
+          file=sys.stderr)  # fmt: skip
     return out
 
 
-def verdict_reasons(point: RobustnessPoint, limits: dict[str, float]) -> list[str]:
+ERROR_FREE = 1.0 - ERROR
+"""The confidence of one look: the results' 95 % intervals."""
+
+
+def verdict_reasons(point: RobustnessPoint, limits: dict[str, float],
+                    confidence: float = ERROR_FREE) -> list[str]:  # fmt: skip
     """The limits a point does not prove, in words: over (its lower bound above the limit) or
-    undecided (the interval holds the limit)."""
+    undecided (the interval holds the limit); the intervals the verdict read, at ``confidence``
+    (``sequential.decision_interval``), named when not the results' 95 %."""
+    at = "" if confidence == ERROR_FREE else f" at {100 * confidence:.3g} %"
     why = []
     for name, limit in limits.items():
         prob = point.probabilities[name]
-        if prob.interval is None:
+        ci = decision_interval(prob, confidence)
+        if ci is None:
             why.append(f"P({name}) undecided: no samples")
-        elif prob.interval[0] > limit:
-            why.append(f"P({name}) lower bound {prob.interval[0]:.3g} > {limit:g} "
+        elif ci[0] > limit:
+            why.append(f"P({name}) lower bound{at} {ci[0]:.3g} > {limit:g} "
                        f"({prob.count}/{prob.samples} samples)")  # fmt: skip
-        elif prob.interval[1] > limit:
-            why.append(f"P({name}) undecided: upper bound {prob.interval[1]:.3g} > {limit:g} "
+        elif ci[1] > limit:
+            why.append(f"P({name}) undecided: upper bound{at} {ci[1]:.3g} > {limit:g} "
                        f"({prob.count}/{prob.samples} samples)")  # fmt: skip
     return why
 
@@ -219,13 +232,14 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     limit is refused before computing (``samples_needed``), as is a study over the job budget."""
     limits = limits_of(args.max_probability)
     samples_needed(limits, args.samples)
+    confidence = ERROR_FREE
     if args.samples == "auto":
         auto = auto_study(args, doc, limits)
-        result, verdicts = auto.result, auto.verdicts
+        result, verdicts, confidence = auto.result, auto.verdicts, auto.confidence
     else:
         _, result = study(args, doc)
         verdicts = [verdict(p, limits) for p in result.points]
-    why = [verdict_reasons(p, limits) for p in result.points]
+    why = [verdict_reasons(p, limits, confidence) for p in result.points]
     counts = sorted({p.samples for p in result.points})
     sampled = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
     print(f"probabilities from {sampled} samples a point, {result.starts_text()}")

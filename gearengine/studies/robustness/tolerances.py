@@ -185,8 +185,14 @@ def probability(k: int, n: int) -> dict[str, object]:
     """k of n with its Clopper-Pearson 95 % interval."""
     if n == 0:
         return {"value": None, "interval": None, "count": 0, "samples": 0}
-    ci = stats.binomtest(k, n).proportion_ci(0.95, method="exact")
-    return {"value": k / n, "interval": [float(ci.low), float(ci.high)], "count": k, "samples": n}
+    return {"value": k / n, "interval": clopper_pearson(k, n), "count": k, "samples": n}
+
+
+def clopper_pearson(k: int, n: int, confidence: float = 0.95) -> list[float]:
+    """The exact (Clopper-Pearson) two-sided interval [low, high] of a proportion, k of n > 0
+    samples, at ``confidence`` (``scipy.stats.binomtest(...).proportion_ci``)."""
+    ci = stats.binomtest(k, n).proportion_ci(confidence, method="exact")
+    return [float(ci.low), float(ci.high)]
 
 
 def samples_to_prove(limit: float, confidence: float = 0.95) -> int | None:
