@@ -83,7 +83,11 @@ def runup_failures(
                     f"FTLE > {rules.max_lle:g}")  # fmt: skip
                 rule = f"run-{name}: chaotic ({what}) for {seconds:.3g} s"
                 if all(any(a <= b.speed_rpm[0] < z for a, z in transient) for b in inside):
-                    rule += " in the ramp's transient (the steady state is not chaotic there)"
+                    rule += (
+                        " where the quasi-static continuation (one start followed from "
+                        "speed to speed) is not chaotic: the ramp's transient, or an "
+                        "attractor it does not follow"
+                    )
                 out.append(FailingWindow(level=level, rule=rule,
                                          speeds_rpm=[lo, inside[-1].speed_rpm[1]]))  # fmt: skip
     return out

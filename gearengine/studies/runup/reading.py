@@ -198,8 +198,9 @@ def _quasi_branch(points: list[SweepPoint], branch: Branch, b_um: float) -> Quas
 
 def transient_chaos(branch: RunupBranch, quasi: QuasiStaticBranch) -> list[list[float]]:
     """Speed spans [rpm] of ``branch``'s chaotic bins where the steady state at the bin centre
-    (``quasi``, the continuation of the same direction) is not chaotic: the ramp's transient,
-    which a steady-state check (``gearengine check``) does not see."""
+    (``quasi``, the continuation of the same direction: one start followed from speed to speed)
+    is not chaotic: the ramp's transient, or an attractor the continuation did not follow (a
+    check with basin starts may find chaos there: the two are not the same question)."""
     steady = {round(p.speed_rpm, 6): p.classification for p in quasi.points}
     spans: list[list[float]] = []
     for b in sorted(branch.bins, key=lambda b: b.speed_rpm[0]):
@@ -215,9 +216,10 @@ def transient_chaos(branch: RunupBranch, quasi: QuasiStaticBranch) -> list[list[
 def transient_note(name: str, spans: list[list[float]]) -> str:
     """ "run-up: chaotic bins at 3500-3600 rpm where the steady state is not chaotic ..."."""
     where = ", ".join(f"{lo:.0f}-{hi:.0f}" for lo, hi in spans)
-    return (f"run-{name}: chaotic bins at {where} rpm where the steady state (the quasi-static "
-            "continuation at the bin centres) is not chaotic: chaos of the ramp's transient, "
-            "which a steady-state check (gearengine check) does not find")  # fmt: skip
+    return (f"run-{name}: chaotic bins at {where} rpm where the quasi-static continuation (one "
+            "start followed from speed to speed, at the bin centres) is not chaotic: chaos of the "
+            "ramp's transient, or of an attractor the continuation does not follow (gearengine "
+            "check, with its basin starts, may find chaos there too)")  # fmt: skip
 
 
 def read_runup(
