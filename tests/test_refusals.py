@@ -89,3 +89,29 @@ def test_cli_check_refuses_work_over_the_job_budget(
         "40000 points x 257 starts (1 + 256 basin starts) = 10280000 runs; the budget "
         "allows 5066 points" in err
     )
+
+
+def test_a_torque_axis_through_zero_is_refused_before_any_compute() -> None:
+    """A torque range through 0 N*m passed the corner checks (-5 and 5 N*m are valid designs)
+    and crashed at its middle point, 0 N*m, where the ISO 6336 stiffness has no load (the CLI
+    printed a traceback, exit 70; the API took the job); 0:5 N*m was refused under the speed
+    axis. Both are refused naming the torque axis, the value and the way out."""
+    from gearengine.studies.sweep import validated
+    from tests.conftest import ROOT
+
+    design = json.loads((ROOT / "examples/remedies-z23-67.json").read_text())["design"]
+
+    def refusal(torque: tuple[str, str]) -> list[dict]:
+        axes = [
+            {"parameter": "speed", "start": "1000 rpm", "stop": "6000 rpm", "num": 3},
+            {"parameter": "torque", "start": torque[0], "stop": torque[1], "num": 3},
+        ]
+        with pytest.raises(ValidationError) as err:
+            validated({"design": design, "axes": axes})
+        return err.value.errors(include_url=False)
+
+    (e,) = refusal(("-5 N*m", "5 N*m"))
+    assert e["loc"] == ("axes", 1, "start") and "passes through 0" in e["msg"]
+    assert "give mesh.stiffness in N/m" in e["msg"]
+    (e,) = refusal(("0 N*m", "5 N*m"))
+    assert e["loc"] == ("axes", 1, "start") and "positive tangential load" in e["msg"]

@@ -188,7 +188,10 @@ def load_factor(tangential_load: float | None, face_width: float) -> float:
     if tangential_load is None:
         return 1.0
     if tangential_load <= 0.0:
-        raise ValueError("tangential load must be positive")
+        raise ValueError(
+            f"the ISO 6336 mesh stiffness needs a positive tangential load (F_t K_A = "
+            f"{tangential_load:.4g} N): at a mean torque of 0 give mesh.stiffness in N/m"
+        )
     specific_load = tangential_load / (face_width * 1e3)  # N/mm
     return min(1.0, (specific_load / 100.0) ** 0.25)
 

@@ -15,6 +15,7 @@ settings' initial states and points of a chunk run together in ``simulate_batch`
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Annotated, Literal
 
 import numpy as np
@@ -228,18 +229,13 @@ def request_errors(request: SweepRequest, max_points: int | None = None) -> list
                 "(stop - start) / (num - 1) is a whole number", axis.num)  # fmt: skip
     if errors:
         return errors
-    base = {a.parameter: g[0] for a, g in zip(request.axes, grids, strict=True)}
-    for i, (axis, grid) in enumerate(zip(request.axes, grids, strict=True)):
-        for end, value in (("start", grid[0]), ("stop", grid[-1])):
-            try:
-                model = request.point({**base, axis.parameter: value})
-            except ValidationError as exc:
-                e = exc.errors(include_url=False)[0]
-                where = ".".join(map(str, e["loc"]))
-                add(("axes", i, end), f"gives an invalid design: {where}: {e['msg']}", value)
-            except ValueError as exc:  # the parameter cannot be set on this design at all
-                add(("axes", i, "parameter"), str(exc), axis.parameter)
-                break
+    for own in (True, False):  # each axis on the design alone first: no other axis blamed
+        base = {} if own else {a.parameter: g[0] for a, g in zip(request.axes, grids, strict=True)}
+        for i, (axis, grid) in enumerate(zip(request.axes, grids, strict=True)):
+            model = _corner_problems(request, i, axis, grid, base, add)
+        if errors:
+            return errors
+    for i, axis in enumerate(request.axes):
         if not errors and request.continuation and isinstance(model, System) and model.n > 2:
             add(("continuation",), f"continuation carries the final state [x, v] from point to "
                 f"point; the {model.name.replace('_', ' ')} has {model.n} coordinates, whose full "
@@ -249,6 +245,42 @@ def request_errors(request: SweepRequest, max_points: int | None = None) -> list
             add(("axes", i, "parameter"), f"{axis.parameter} changes nothing in Eq. (9) for this "
                 "design (its excitation has no nonzero harmonic?)", axis.parameter)  # fmt: skip
     return errors
+
+
+def _corner_problems(
+    request: SweepRequest,
+    i: int,
+    axis: SweepAxis,
+    grid: list[float],
+    base: dict[str, float],
+    add: Callable,
+) -> GearParams | System | None:
+    """Check axis ``i`` at both ends of its ``grid`` (and at 0 when a physical range passes
+    through it: a load's admissible set may exclude 0 alone) with the other axes at ``base``,
+    adding each problem; the model at its last end checked."""
+    ends = [("start", grid[0]), ("stop", grid[-1])]
+    if request.design is not None and grid[0] * grid[-1] < 0.0:
+        ends.append(("through 0", 0.0))
+    model = None
+    for end, value in ends:
+        try:
+            model = request.point({**base, axis.parameter: value})
+        except ValidationError as exc:
+            e = exc.errors(include_url=False)[0]
+            where = ".".join(map(str, e["loc"]))
+            add(("axes", i, "start" if end == "through 0" else end),
+                f"gives an invalid design: {where}: {e['msg']}", value)  # fmt: skip
+        except ValueError as exc:
+            if end == "through 0":
+                add(("axes", i, "start"), f"the range from {axis.start} to {axis.stop} passes "
+                    f"through 0, where the design is invalid ({exc}): sweep each side of 0 on "
+                    "its own", axis.start)  # fmt: skip
+            elif is_dimensionless(axis.parameter):  # an alias this model has not at all
+                add(("axes", i, "parameter"), str(exc), axis.parameter)
+            else:  # a field of the design that cannot take this value
+                add(("axes", i, end), f"gives an invalid design: {exc}", value)
+            break
+    return model
 
 
 def _changes_nothing(request: SweepRequest, i: int, grids: list[list[float]]) -> bool:
