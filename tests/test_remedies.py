@@ -314,9 +314,10 @@ def test_the_remedy_found_passes_the_check_on_a_2x_finer_grid() -> None:
     assert report.passed, [f.model_dump() for f in report.failures]
 
 
-def _melnikov_said(blind: int, passed: bool) -> str:
+def _melnikov_said(blind: int, passed: bool, between: list[int] | None = None) -> str:
     """The answer of a lone Melnikov value judging 115 - ``blind`` of 115 points, where the
-    envelope check on a 23 x 5 grid passes or fails at 3 points."""
+    envelope check on a 23 x 5 grid passes or fails at 3 points (``between``: the criterion's
+    chaos points of the 2x finer grid)."""
     grid = Resolution(speed_points=23, torque_points=5, speed_step_rpm=227.3,
                       torque_step_nm=13.75, starts=16, depth=0,
                       finest_speed_step_rpm=227.3)  # fmt: skip
@@ -326,7 +327,7 @@ def _melnikov_said(blind: int, passed: bool) -> str:
     mel = Remedy.model_construct(lever=ACCURACY_FIELD, from_=11.3, to=4.0, unit="um",
                                  bound="melnikov", monotone=True, iso1328_class=None,
                                  not_applicable_points=blind, melnikov_points=115,
-                                 check=check)  # fmt: skip
+                                 melnikov_between=between, check=check)  # fmt: skip
     return answer_words([mel], [], None)
 
 
@@ -357,6 +358,17 @@ def test_no_melnikov_guarantee_where_the_check_fails() -> None:
     assert said.startswith("no single lever clears the envelope; ")
     assert "still fails there at 3 of 115 points (checked on 23 x 5 grid" in said
     assert "guarantees no pass" in said
+
+
+def test_no_melnikov_guarantee_where_the_criterion_allows_chaos_between_grid_points() -> None:
+    """A Melnikov value searched on the envelope's grid was offered as a guarantee though the
+    criterion still allowed chaos between the grid's torques (new-user review: damping 0.1832
+    on the z = 23/67 pair, chaos possible at 25 N*m between 18.75 and 32.5): the value is
+    judged on the 2x finer grid too, and offered only when it allows chaos nowhere there."""
+    assert "guarantee against" in _melnikov_said(69, passed=True, between=[0, 405])
+    said = _melnikov_said(69, passed=True, between=[12, 405])
+    assert "guarantee against" not in said
+    assert "still at 12 of the 405 points of the 2x finer grid between them" in said
 
 
 def test_a_class_bound_written_rounded_is_that_class() -> None:

@@ -171,8 +171,14 @@ def answer(remedies: list[Remedy], unreachable: list[Unreachable],
 
 def _guarantees(mel: Remedy) -> bool:
     """A Melnikov value is offered with its guarantee only where its criterion judges some
-    envelope point and the envelope check passes there."""
-    return _judged(mel) > 0 and mel.check.passed
+    envelope point, allows chaos at none of the 2x finer grid's points between them, and the
+    envelope check passes there."""
+    return _judged(mel) > 0 and _between(mel) == 0 and mel.check.passed
+
+
+def _between(mel: Remedy) -> int:
+    """Points of the 2x finer grid where the criterion still allows chaos at a Melnikov value."""
+    return 0 if mel.melnikov_between is None else mel.melnikov_between[0]
 
 
 def _no_guarantee(mel: Remedy) -> str:
@@ -181,6 +187,11 @@ def _no_guarantee(mel: Remedy) -> str:
     if _judged(mel) == 0:
         return (f"the Melnikov criterion allows chaos nowhere but applies at none of the "
                 f"{points} points, so it guarantees nothing")  # fmt: skip
+    if _between(mel):
+        chaos, finer = mel.melnikov_between  # type: ignore[misc]
+        return (f"the Melnikov criterion allows homoclinic chaos at none of the {points} grid "
+                f"points but still at {chaos} of the {finer} points of the 2x finer grid between "
+                "them, so it guarantees nothing between grid points")  # fmt: skip
     return (f"the Melnikov criterion allows homoclinic chaos at none of the {_judged(mel)} of "
             f"{points} points it judges, but the envelope check still fails there at "
             f"{mel.check.failing_points} of {mel.check.points} points{_checked(mel)}, so it "

@@ -49,6 +49,11 @@ class Remedy(BaseModel):
         None, description="Melnikov: envelope grid points judged at ``to``; the guarantee holds "
         "at melnikov_points - not_applicable_points of them (none: no guarantee).",
     )  # fmt: skip
+    melnikov_between: list[int] | None = Field(
+        None, description="Melnikov: [points where the criterion still allows chaos at ``to``, "
+        "points] on the envelope's 2x finer grid, between the search's grid points; a guarantee "
+        "is offered only when the first is 0.",
+    )  # fmt: skip
     contact_ratio: float | None = Field(
         None, description="With gear geometry: the transverse contact ratio at ``to`` (a "
         "profile-shift lever moves it, and with it the stiffness variation)."

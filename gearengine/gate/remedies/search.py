@@ -61,9 +61,10 @@ from gearengine.studies.sweep.request import SweepRequest
 from gearengine.systems.designs import design_model
 
 
-def envelope_points(request: RemediesRequest) -> list[dict[str, float]]:
-    """The envelope's grid points as sweep values (SI), speed fastest as in the sweep."""
-    sweep = request.sweep()
+def envelope_points(request: RemediesRequest, finer: bool = False) -> list[dict[str, float]]:
+    """The envelope's grid points as sweep values (SI), speed fastest as in the sweep; ``finer``:
+    those of the 2x finer grid a remedy is verified on."""
+    sweep = request.sweep(finer=finer)
     names = [a.parameter for a in sweep.axes]
     grids = sweep.grids()
     rows = [[]] if len(grids) == 1 else [[(names[1], t)] for t in grids[1]]
@@ -314,14 +315,16 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
         if bound == "melnikov" and to == lever.start:
             continue  # the criterion rules chaos out already: no change needed for it
         report = run(to, finer=bound == "numerical")
-        blind = None
+        blind, between = None, None
         if bound == "melnikov":
             blind = melnikov_failures(request.design, points, {lever.path: to})[1]
+            finer = envelope_points(request, finer=True)  # between the search's points
+            between = [melnikov_failures(request.design, finer, {lever.path: to})[0], len(finer)]
         remedies.append(Remedy(
             lever=lever.path, from_=lever.shown(lever.start), to=lever.shown(to),
             unit=lever.unit, bound=bound, monotone=monotone,
             bracket=[lever.shown(fail), lever.shown(to)], samples=shown,
-            not_applicable_points=blind, check=report,
+            not_applicable_points=blind, melnikov_between=between, check=report,
             melnikov_points=len(points) if bound == "melnikov" else None,
             contact_ratio=contact_ratio(design_with(request.design, {lever.path: to})),
             iso1328_class=accuracy_classes(request.design, lever, to),
