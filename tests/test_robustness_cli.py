@@ -222,3 +222,11 @@ def test_sequential_looks_share_the_error_of_one_decision() -> None:
     assert verdict(point(0, 368), {"chaotic": 0.01}, decision_confidence()) == "undecided"
     assert samples_to_prove(0.01, decision_confidence()) == 561
     assert verdict(point(0, 561), {"chaotic": 0.01}, decision_confidence()) == "pass"
+
+
+def test_samples_and_seed_without_a_probability_limit_are_refused(design_file: Path) -> None:
+    """``check --speed ... --samples 64 --seed 3`` ran the ordinary envelope gate and said
+    nothing of the two options (new-user review of issue 30): they are refused, naming
+    --max-probability."""
+    for extra in (["--samples", "64"], ["--seed", "3"]):
+        assert main(["check", str(design_file), "--speed", "2000:5000", *extra]) == 2

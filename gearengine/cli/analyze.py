@@ -121,6 +121,9 @@ def cmd_check(args: argparse.Namespace) -> int:
     """CI gate: exit 0 pass, 1 fail, 2 invalid input; one summary line. With --speed or
     --torque, the gate over the operating envelope (``cli.envelope``); with --max-probability,
     over the design's tolerances (``cli.robustness``). The document is read once, here."""
+    if not args.max_probability and (args.samples is not None or args.seed is not None):
+        raise InvalidInputError(["--samples and --seed sample a design's tolerances: give "
+                                 "--max-probability NAME=P with them"])  # fmt: skip
     doc = read_document(args.file)
     if args.max_probability:
         from gearengine.cli.robustness import cmd_probability_gate

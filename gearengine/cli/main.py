@@ -206,10 +206,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="fail where the 95 %% upper bound of P(NAME) over the design's "
         "tolerances exceeds P (chaotic, separation, back_flank; repeatable)",
     )
-    p.add_argument("--samples", type=samples_count, default=64,
+    p.add_argument("--samples", type=samples_count, default=None,
                    help="with --max-probability: N, a power of 2 (64), refused when too few "
                    "to prove a limit; or auto: double until every point is decided")  # fmt: skip
-    p.add_argument("--seed", type=int, default=0, help="with --max-probability (default 0)")
+    p.add_argument("--seed", type=int, default=None, help="with --max-probability (default 0)")
     p.set_defaults(func=lazy("gearengine.cli.analyze", "cmd_check"))
 
     p = sub.add_parser("campbell", help="modes and Campbell diagram of a gear train")

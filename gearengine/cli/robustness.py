@@ -201,6 +201,8 @@ def auto_study(args: argparse.Namespace, doc: object, limits: dict[str, float]) 
     return out
 
 
+GATE_SAMPLES = 64
+"""``check --max-probability``'s samples a point when ``--samples`` is not given."""
 ERROR_FREE = 1.0 - ERROR
 """The confidence of one look: the results' 95 % intervals."""
 
@@ -231,6 +233,8 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     a limit or undecided (its interval holds the limit); a sample count that cannot prove a
     limit is refused before computing (``samples_needed``), as is a study over the job budget."""
     limits = limits_of(args.max_probability)
+    args.samples = GATE_SAMPLES if args.samples is None else args.samples
+    args.seed = 0 if args.seed is None else args.seed
     samples_needed(limits, args.samples)
     confidence = ERROR_FREE
     if args.samples == "auto":
