@@ -403,3 +403,18 @@ def test_chaos_in_the_ramps_transient_is_said_to_be_transient() -> None:
     qs = result.quasi_static.model_copy(update={"up": steady})
     (window,) = runup_failures(result.model_copy(update={"quasi_static": qs}), Rules(), {}, 0.0)
     assert "transient" not in window.rule
+
+
+def test_a_quasi_static_jump_is_lagged_by_one_ramp_jump() -> None:
+    """A run-up reported 'jump at 4850 rpm ...; quasi-static at 4050 rpm, lag +800 rpm' for a
+    quasi-static jump already paired with the ramp's jump at 4100 rpm (new-user review of issue
+    30): each quasi-static jump is the lag of the nearest ramp jump of its sense only."""
+    from gearengine.studies.runup.reading import with_lags
+    from gearengine.studies.runup.results import RunupJump
+
+    ramp = [RunupJump(speed_rpm=4100.0, from_um=25.0, to_um=50.0),
+            RunupJump(speed_rpm=4850.0, from_um=48.6, to_um=61.1)]  # fmt: skip
+    quasi = [RunupJump(speed_rpm=4050.0, from_um=25.0, to_um=52.0)]
+    first, second = with_lags(ramp, quasi, "up")
+    assert (first.quasi_static_speed_rpm, first.lag_rpm) == (4050.0, 50.0)
+    assert second.quasi_static_speed_rpm is None and second.lag_rpm is None

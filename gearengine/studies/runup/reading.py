@@ -93,15 +93,25 @@ def jumps(speeds: Sequence[float], dte: Sequence[float | None], b_um: float) -> 
 
 
 def with_lags(ramp: list[RunupJump], quasi: list[RunupJump], branch: Branch) -> list[RunupJump]:
-    """Each ramp jump with the nearest quasi-static jump of the same sense and its lag."""
+    """Each ramp jump with the quasi-static jump of the same sense it lags, and its lag: the
+    pairs nearest in speed first, each quasi-static jump paired once (a second ramp jump near
+    an already paired one is a jump of the ramp's own, with no lag to give)."""
     sign = 1.0 if branch == "up" else -1.0
+    pairs = sorted(
+        ((abs(q.speed_rpm - j.speed_rpm), i, k) for i, j in enumerate(ramp)
+         for k, q in enumerate(quasi) if (q.to_um > q.from_um) == (j.to_um > j.from_um)),
+    )  # fmt: skip
+    lagged: dict[int, RunupJump] = {}
+    used: set[int] = set()
+    for _, i, k in pairs:
+        if i not in lagged and k not in used:
+            lagged[i], used = quasi[k], used | {k}
     out = []
-    for j in ramp:
-        same = [q for q in quasi if (q.to_um > q.from_um) == (j.to_um > j.from_um)]
-        if not same:
+    for i, j in enumerate(ramp):
+        q = lagged.get(i)
+        if q is None:
             out.append(j)
             continue
-        q = min(same, key=lambda q: abs(q.speed_rpm - j.speed_rpm))
         lag = sign * (j.speed_rpm - q.speed_rpm) + 0.0  # no -0
         out.append(j.model_copy(update={"quasi_static_speed_rpm": q.speed_rpm,
                                         "lag_rpm": shown(lag)}))  # fmt: skip
