@@ -39,7 +39,7 @@ def test_one_start_gives_the_report_of_before_basins(
                  "--refine", "0"])  # fmt: skip
     assert code == 1
     out = capsys.readouterr().out.splitlines(keepends=True)
-    assert out.pop(1).startswith("  resolution: 4 x 2 grid (500 rpm x 19 N*m), 1 starts a point")
+    assert out.pop(1).startswith("  resolution: 4 x 2 grid (500 rpm x 19 N*m), 1 start a point")
     assert "".join(out) == (GOLDEN / "report.txt").read_text()
     assert (envelope / "j.xml").read_text() == (GOLDEN / "junit.xml").read_text()
 

@@ -60,7 +60,8 @@ class Resolution(BaseModel):
             else f"{self.speed_points} speeds" if self.speed_points > 1 else "1 speed"  # fmt: skip
         steps = [f"{s:.4g} {u}" for s, u in ((self.speed_step_rpm, "rpm"),
                  (self.torque_step_nm, "N*m")) if s is not None]  # fmt: skip
-        out = f"{grid} ({' x '.join(steps) or 'one point'}), {self.starts} starts a point"
+        starts = f"{self.starts} start{'s' if self.starts != 1 else ''} a point"
+        out = f"{grid} ({' x '.join(steps) or 'one point'}), {starts}"
         fine = [f"{s:.4g} {u}" for s, u in ((self.finest_speed_step_rpm, "rpm"),
                 (self.finest_torque_step_nm, "N*m")) if s is not None]  # fmt: skip
         if not fine:  # one operating point: no neighbours, nothing between them
