@@ -352,7 +352,7 @@ def analyze(
                             verdict=verdict(mel, num, decided))  # fmt: skip
     if conv is None:
         return result
-    eng = engineering(conv, speeds, mel, scan, num, decided, no_windows, worst)
+    eng = engineering(conv, speeds, mel, scan, num, decided, no_windows, worst, request.design)
     if train is None:
         return result.model_copy(update={"params": conv.params, "engineering": eng})
     notes = [f"gear train: {train.model.size} coordinates; numerics of the train, scales of "
@@ -393,7 +393,7 @@ def answer_melnikov(request: MelnikovRequest) -> MelnikovResult:
         return mel
     speeds = request.speed_rpm_range()
     scan = design_windows(conv.params, conv.speed_rpm, speeds, mel)
-    eng = engineering(conv, speeds, mel, scan)
+    eng = engineering(conv, speeds, mel, scan, design=request.design)
     return MelnikovAnswer(**dict(mel), params=conv.params, engineering=eng)
 
 
@@ -424,4 +424,5 @@ def convert(request: DesignRequest) -> DesignReport:
     mel = melnikov(conv.params)
     speeds = request.speed_rpm_range()
     scan = design_windows(conv.params, conv.speed_rpm, speeds, mel)
-    return DesignReport(conversion=conv, engineering=engineering(conv, speeds, mel, scan))
+    eng = engineering(conv, speeds, mel, scan, design=request.design)
+    return DesignReport(conversion=conv, engineering=eng)

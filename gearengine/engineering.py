@@ -30,10 +30,11 @@ from dataclasses import dataclass
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from gearengine.homoclinic.boundary import WINDOW_BOUND
+from gearengine.homoclinic.boundary import WINDOW_BOUND, critical_torque
 from gearengine.homoclinic.coefficients import T_CRIT_WHY
 from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
 from gearengine.model.aliases import get_alias
+from gearengine.model.design import Design
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import Derived, DesignConversion
 from gearengine.model.units import (
@@ -229,15 +230,6 @@ def critical(name: str, t: ParameterThreshold, scales: Scales) -> Critical:
                     margin_to_chaos=margin, relative_margin=rel)  # fmt: skip
 
 
-def critical_torque(conv: DesignConversion, mel: MelnikovResult) -> float | None:
-    """T_crit [N m]: the mean driver torque whose static mesh force T / r_a (balanced torques,
-    Eq. 7) reaches F_crit b k_m; None without a critical load (no cubic with a, c > 0)."""
-    if mel.critical_mean_force is None:
-        return None
-    r_a = float(conv.derived["base_radius_driver"].value)  # type: ignore[arg-type]
-    return to_physical("mesh_force", mel.critical_mean_force, conv.scales) * r_a
-
-
 def load_words(conv: DesignConversion, f_crit: float, t_crit: float) -> str:
     """Why the criterion does not apply at this torque (F~_m >= F_crit), in gear words."""
     fm, b_um = conv.params.mean_force, to_physical("displacement", 1.0, conv.scales)
@@ -383,6 +375,7 @@ def engineering(
     decided: Headline | None = None,
     no_windows: str | None = None,
     worst: dict[str, WorstValue] | None = None,
+    design: Design | None = None,
 ) -> Engineering:
     """The engineering block of a design's Melnikov verdict (and analysis, given ``num``;
     ``decided`` the worst attractor of its basins, ``numerics.headline.headline``) from the
@@ -390,9 +383,10 @@ def engineering(
     (``homoclinic.boundary.design_windows``, None above the critical load).
     ``no_windows``: why the speed windows are not looked for (a train without a Melnikov
     reduction), said in their note; the range stays the scan's. ``worst``: with basins each
-    magnitude at its most adverse over the attractors (``numerics.attractors.most_adverse``)."""
+    magnitude at its most adverse over the attractors (``numerics.attractors.most_adverse``);
+    ``design`` for a load-dependent T_crit (``critical_torque``)."""
     params = conv.params
-    t_crit = critical_torque(conv, mel)
+    t_crit = critical_torque(conv, mel, design)
     crit = {
         CONTROLS[name]: critical(name, t, conv.scales)
         for name, t in mel.thresholds.items()

@@ -5,6 +5,7 @@ until they close (issue 26 item 4)."""
 from __future__ import annotations
 
 import copy
+import json
 
 import pytest
 
@@ -124,3 +125,26 @@ def test_engineering_reads_the_speed_windows_handed_to_it() -> None:
     mel = melnikov(heavy.conversion.params)
     assert design_windows(heavy.conversion.params, heavy.conversion.speed_rpm,
                           heavy.speed_rpm_range(), mel) is None  # fmt: skip
+
+
+def test_a_load_dependent_stiffness_has_one_critical_torque() -> None:
+    """With ISO 6336 stiffness k_m grows with the load, and T_crit = F_crit b k_m r_a read at
+    the design's own torque moved with it (new-user review of issue 30: 18.2 N*m at 5 N*m,
+    25.7 at 20, 27.8 at 27.5, while the envelope's verdicts change between 27.3 and 28.2 N*m).
+    T_crit is the torque where it holds at its own stiffness: the same from every design
+    torque, and the criterion applies just below it and not just above."""
+    from gearengine.analysis import DesignRequest, convert
+    from gearengine.engineering import Engineering
+    from tests.conftest import ROOT
+
+    pair = json.loads((ROOT / "examples/remedies-z23-67.json").read_text())["design"]
+
+    def engineering_at(torque: float) -> Engineering:
+        doc = {"design": {**pair, "torque": f"{torque!r} N*m"}}
+        return convert(DesignRequest.model_validate(doc)).engineering
+
+    t_crit = [engineering_at(t).critical_torque_nm for t in (5.0, 20.0, 40.0)]
+    assert max(t_crit) - min(t_crit) < 1e-6 * t_crit[0] and 27.3 < t_crit[0] < 28.2
+    below, above = engineering_at(0.999 * t_crit[0]), engineering_at(1.001 * t_crit[0])
+    assert not (below.speed_windows_note or "").startswith("not applicable")
+    assert above.speed_windows_note.startswith("not applicable above T_crit")
