@@ -233,7 +233,8 @@ def critical(name: str, t: ParameterThreshold, scales: Scales) -> Critical:
 def load_words(conv: DesignConversion, f_crit: float, t_crit: float) -> str:
     """Why the criterion does not apply at this torque (F~_m >= F_crit), in gear words."""
     fm, b_um = conv.params.mean_force, to_physical("displacement", 1.0, conv.scales)
-    torque = t_crit * abs(fm) / f_crit  # the static force is proportional to the torque
+    r_a = float(conv.derived["base_radius_driver"].value)  # type: ignore[arg-type]
+    torque = to_physical("mesh_force", abs(fm), conv.scales) * r_a  # at the design's own k_m
     return (
         f"under {torque:,.3g} N*m the mesh deflects {abs(fm) * b_um:.3g} µm statically (half "
         f"backlash {b_um:.3g} µm) and the teeth stay in contact, beyond the reach of the "

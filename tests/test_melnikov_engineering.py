@@ -148,3 +148,4 @@ def test_a_load_dependent_stiffness_has_one_critical_torque() -> None:
     below, above = engineering_at(0.999 * t_crit[0]), engineering_at(1.001 * t_crit[0])
     assert not (below.speed_windows_note or "").startswith("not applicable")
     assert above.speed_windows_note.startswith("not applicable above T_crit")
+    assert "under 40 N*m the mesh deflects" in engineering_at(40.0).summary  # its own torque
