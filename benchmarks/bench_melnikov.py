@@ -104,7 +104,7 @@ out["chaos_one"] = best_ms(lambda: chaos_possible(ONE), 200)
 out["chaos_three"] = best_ms(lambda: chaos_possible(THREE), 200)
 try:
     from gearengine.analysis import MelnikovRequest
-    from gearengine.engineering import engineering
+    from gearengine.engineering.block import engineering
 except ImportError:  # before the design conversion: no engineering block
     out["engineering"] = None
 else:

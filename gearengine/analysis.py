@@ -15,7 +15,8 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
 
-from gearengine.engineering import IMPACT_WORDS, Engineering, engineering, response
+from gearengine.engineering.block import Engineering, engineering
+from gearengine.engineering.response import IMPACT_WORDS, response
 from gearengine.homoclinic.boundary import design_windows
 from gearengine.homoclinic.coefficients import T_CRIT_WHY
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult

@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from gearengine.analysis import AnalysisRequest, analyze, answer_melnikov, convert
-from gearengine.engineering import response
+from gearengine.engineering.response import response
 from gearengine.homoclinic import melnikov
 from gearengine.homoclinic.boundary import speed_windows
 from gearengine.homoclinic.schemas import MelnikovRequest

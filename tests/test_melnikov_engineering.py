@@ -110,7 +110,7 @@ def test_engineering_reads_the_speed_windows_handed_to_it() -> None:
     """The speed-window scan runs once at the top (``homoclinic.boundary.design_windows``,
     right after the verdict) and the engineering block reads the windows handed to it; it
     scans nothing itself, and None (no saddle at this load) reads as no windows."""
-    from gearengine.engineering import engineering
+    from gearengine.engineering.block import engineering
     from gearengine.homoclinic.boundary import design_windows
 
     request = MelnikovRequest.model_validate({"design": LIGHT})
@@ -134,7 +134,7 @@ def test_a_load_dependent_stiffness_has_one_critical_torque() -> None:
     T_crit is the torque where it holds at its own stiffness: the same from every design
     torque, and the criterion applies just below it and not just above."""
     from gearengine.analysis import DesignRequest, convert
-    from gearengine.engineering import Engineering
+    from gearengine.engineering.block import Engineering
     from tests.conftest import ROOT
 
     pair = json.loads((ROOT / "examples/remedies-z23-67.json").read_text())["design"]

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 from fastapi.testclient import TestClient
 
-from gearengine.engineering import threshold_units
+from gearengine.engineering.thresholds import threshold_units
 from gearengine.homoclinic.schemas import ThresholdsRequest
 from gearengine.model.aliases import get_alias
 from gearengine.model.design import EXAMPLE_DESIGN

@@ -7,7 +7,7 @@ import argparse
 
 from gearengine.analysis import MelnikovAnswer, answer_melnikov
 from gearengine.cli.documents import EXIT_OK, read_request
-from gearengine.engineering import Engineering
+from gearengine.engineering.block import Engineering
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult, ParameterThreshold
 from gearengine.jsonio import dumps
 

@@ -14,7 +14,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from gearengine.analysis import AnalysisResult
-from gearengine.engineering import ThresholdUnits
+from gearengine.engineering.thresholds import ThresholdUnits
 from gearengine.homoclinic.schemas import ThresholdCurve
 from gearengine.numerics.results import SpectrumPeak
 from gearengine.plots.style import ImageFormat, figure_bytes, symbol

@@ -6,7 +6,7 @@ from typing import Literal
 
 from fastapi import APIRouter, Depends, Request, Response
 
-from gearengine.engineering import threshold_units
+from gearengine.engineering.thresholds import threshold_units
 from gearengine.homoclinic import ThresholdCurve
 from gearengine.homoclinic.schemas import ThresholdsRequest
 from gearengine.homoclinic.thresholds import curve_of

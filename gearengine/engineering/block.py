@@ -1,126 +1,29 @@
-"""Answers in gear-design units: the engineering block of every response to a ``design``.
-
-From the design's conversion (``model.design``) and the dimensionless verdicts this module
-gives what a gearbox engineer asks:
-
-* ``speed_windows_rpm``: the driver speeds where the Melnikov criterion allows chaos at the
-  design's torque (``homoclinic.boundary.speed_window_scan``: a change of speed scales every
-  excitation frequency together), scanned past the requested range to ``WINDOW_BOUND`` times
-  the design speed (then open-ended);
-* ``critical_torque_nm``: the mean driver torque T_crit at which the static mesh force reaches
-  F_crit of the cubic fit; above it the unperturbed system has no saddle and the criterion does
-  not apply (``docs/melnikov-under-load.md``);
-* the critical value of each control parameter in its unit, and ``margin_to_chaos``: the
-  threshold's margin in that unit, positive on the safe side, negative inside the
-  chaos-possible region (Eqs. 23, 24 generalised);
-* for analyses, the response: DTE b (x_max - x_min), the dynamic mesh force b k_m [K(t) f_h(x)
-  + 2 mu~ x'] and the dynamic factor (max force / static force F^_m), the fractions of time
-  apart (|x| <= 1) and on the back flank (x < -1), the period and dominant response frequency;
-* ``summary``: plain sentences for a design review.
-
-Every dimensionless number crosses to gear units through ``model.units.to_physical`` (the
-``OUTPUTS`` table) with the design's ``Scales``.
-"""
+"""The engineering block of a design's answer (``Engineering``): the speed windows, the
+critical torque, the thresholds and the response in gear units, and the plain sentences of a
+design review (``summary``)."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
-import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
+from gearengine.engineering.response import IMPACT_WORDS, Response, response
+from gearengine.engineering.thresholds import CONTROLS, Critical, critical
 from gearengine.homoclinic.boundary import WINDOW_BOUND, critical_torque
 from gearengine.homoclinic.coefficients import T_CRIT_WHY
-from gearengine.homoclinic.schemas import MelnikovResult, ParameterThreshold
-from gearengine.model.aliases import get_alias
+from gearengine.homoclinic.schemas import MelnikovResult
+from gearengine.model.answers import Answer
 from gearengine.model.design import Design
-from gearengine.model.params import GearParams
 from gearengine.model.reduction import Derived, DesignConversion
-from gearengine.model.units import (
-    OUTPUTS,
-    Scales,
-    display_label,
-    in_si,
-    response_values,
-    shown,
-    to_physical,
-)
+from gearengine.model.units import to_physical
 from gearengine.numerics.headline import Headline
 from gearengine.numerics.magnitudes import worst_words
 from gearengine.numerics.results import NumericsResult, WorstValue
 from gearengine.systems.gear_train.modes import Modes
-from gearengine.systems.spur_pair.forcing import contact_force_of, static_error
 
 
-class _Doc(BaseModel):
-    model_config = ConfigDict(frozen=True)
-
-
-class Critical(_Doc):
-    """The threshold of one control parameter in its physical unit."""
-
-    unit: str = Field(description="Unit of value, critical_values and margin_to_chaos.")
-    value: float | None = Field(description="The design's value.")
-    critical_values: list[float] = Field(description="Where the Melnikov verdict flips.")
-    nearest: float | None = Field(description="The critical value nearest to the design.")
-    margin_to_chaos: float | None = Field(
-        description="|value - nearest|, positive on the safe side, negative inside the "
-        "chaos-possible region (the threshold's margin in this unit)."
-    )
-    relative_margin: float | None = Field(description="margin_to_chaos / |nearest|.")
-
-
-class Contact(_Doc):
-    """How the teeth meet over the recorded response (x in units of the half backlash b)."""
-
-    regime: str | None = Field(description="no_impact | single_sided | double_sided.")
-    separation_fraction: float = Field(description="Fraction of time with |x| <= 1 (apart).")
-    back_flank_fraction: float = Field(description="Fraction of time with x < -1 (back flank).")
-
-
-class Response(_Doc):
-    """The numerical response in physical units (last recorded periods) of the recorded run:
-    the worst of the settings' own starts (``numerics.worst_case``). With settings.basins the
-    verdict is the worst attractor's (``verdict.decided_by``) and the DTE, dynamic factor and
-    forces shown and gated are ``most_adverse``'s, over the attractors."""
-
-    dte_peak_to_peak_um: float | None = Field(
-        description="Dynamic transmission error p-p [µm]: x = r_a theta_a - r_b theta_b - e(t) "
-        "(Eq. 7), the static transmission error e(t) excluded, over every step of the record."
-    )
-    te_with_static_peak_to_peak_um: float | None = Field(
-        None,
-        description="Transmission error with the static TE, p-p [µm]: r_a theta_a - r_b theta_b "
-        "= x + e(t), what a pair of shaft encoders measures; from the recorded time history.",
-    )
-    dynamic_mesh_force_max_n: float | None = Field(
-        description="Largest mesh force of the model [N]: k_m (K(t) f_h(x) + 2 mu x'), whose "
-        "damping term acts in the clearance too (nonzero while the teeth are apart)."
-    )
-    dynamic_mesh_force_min_n: float | None = Field(
-        description="Smallest mesh force of the model [N] (negative: back-flank contact, or the "
-        "damping term while apart)."
-    )
-    contact_force_max_n: float | None = Field(
-        None,
-        description="Largest tooth contact force [N]: the model's force where a flank touches "
-        "(|x| > 1; drive flank >= 0, back flank <= 0), zero while the teeth are apart; from "
-        "the recorded time history.",
-    )
-    contact_force_min_n: float | None = Field(
-        None, description="Smallest tooth contact force [N] (negative: back-flank contact)."
-    )
-    static_force_n: float = Field(description="Mean mesh force F^_m [N].")
-    dynamic_factor: float | None = Field(description="max force / static force.")
-    contact: Contact | None
-    period_ms: float | None = Field(description="Response period [ms], null if not periodic.")
-    period_mesh_periods: float | None = Field(description="Response period / mesh period.")
-    dominant_frequency_hz: float | None = Field(description="Largest spectral peak [Hz].")
-    dominant_shaft_order: float | None = Field(description="That frequency / driver speed.")
-
-
-class Engineering(_Doc):
+class Engineering(Answer):
     """The answer in gear-design units."""
 
     natural_frequency_hz: float
@@ -175,61 +78,6 @@ class Engineering(_Doc):
     )
 
 
-IMPACT_WORDS = {
-    "no_impact": "the teeth always in contact",
-    "single_sided": "tooth separation and impacts on the drive flank",
-    "double_sided": "impacts on both flanks (back-flank contact)",
-}
-
-CONTROLS = {
-    "F_e1": "transmission_error_amplitude",
-    "F_p1": "torque_fluctuation_amplitude",
-    "mu": "damping_ratio",
-    "k_p1": "stiffness_variation_amplitude",
-}
-"""Control parameter -> its output quantity (``model.units.OUTPUTS``), the engineering name."""
-
-
-@dataclass(frozen=True)
-class ThresholdUnits:
-    """A threshold figure's axes in gear units: every excitation frequency scales with the
-    driver speed, so a frequency Omega is the speed ``rpm_per_frequency * Omega``; each control
-    parameter is linear in its physical value (``model.units.to_physical``)."""
-
-    rpm_per_frequency: float
-    parameter_label: str
-    parameter_scale: float
-
-
-def threshold_units(
-    conv: DesignConversion, parameter: str, frequency_parameter: str
-) -> ThresholdUnits | None:
-    """The gear units of the threshold curves of a design (None: the swept frequency's
-    excitation is absent, so the speed of a frequency is not defined)."""
-    omega = get_alias(conv.params, frequency_parameter)
-    if not omega:
-        return None
-    output = CONTROLS[parameter]
-    label = display_label(output).replace("_", " ").replace("[um]", "[µm]")
-    return ThresholdUnits(conv.speed_rpm / omega, label, to_physical(output, 1.0, conv.scales))
-
-
-def critical(name: str, t: ParameterThreshold, scales: Scales) -> Critical:
-    """One threshold in physical units with its signed margin to chaos (the threshold's
-    margin, positive on the safe side, in this unit: every map of ``to_physical`` is linear)."""
-    output = CONTROLS[name]
-    unit = OUTPUTS[output].unit
-    crit = [to_physical(output, v, scales) for v in t.critical_values]
-    value = None if t.value is None else to_physical(output, t.value, scales)
-    nearest = None if t.nearest is None else to_physical(output, t.nearest, scales)
-    margin = rel = None
-    if value is not None and nearest is not None and t.margin is not None:
-        margin = math.copysign(abs(value - nearest), t.margin)
-        rel = margin / abs(nearest) if nearest else None
-    return Critical(unit=unit, value=value, critical_values=crit, nearest=nearest,
-                    margin_to_chaos=margin, relative_margin=rel)  # fmt: skip
-
-
 def load_words(conv: DesignConversion, f_crit: float, t_crit: float) -> str:
     """Why the criterion does not apply at this torque (F~_m >= F_crit), in gear words."""
     fm, b_um = conv.params.mean_force, to_physical("displacement", 1.0, conv.scales)
@@ -241,52 +89,6 @@ def load_words(conv: DesignConversion, f_crit: float, t_crit: float) -> str:
         f"backlash nonlinearity's saddle, which exists only below the critical torque "
         f"{t_crit:,.3g} N*m; the homoclinic mechanism of chaos does not exist at this load; the "
         "numerical verdict still applies"
-    )
-
-
-def response(params: GearParams, num: NumericsResult, conv: DesignConversion) -> Response:
-    """The response of an analysis in physical units: DTE, mesh forces and dynamic factor from
-    the kernel's extremes over every step of the record (``model.units.response_values``, as a
-    sweep point's), the contact fractions from the recorded time history."""
-    scales = conv.scales
-    hist = num.time_history
-    contact = None
-    forces = [None if f is None else to_physical("mesh_force", f, scales)
-              for f in (num.force_max, num.force_min)]  # fmt: skip
-    values = response_values(num.x_peak_to_peak, num.force_max, scales)
-    te, touching = None, [None, None]
-    if hist is not None and hist.x:
-        x = np.asarray(hist.x)
-        t, v = np.asarray(hist.t), np.asarray(hist.v)
-        te = shown(to_physical("dte", float(np.ptp(x + static_error(params, t))), scales))
-        force = contact_force_of(params, t, x, v)
-        touching = [
-            shown(to_physical("mesh_force", float(f), scales)) for f in (force.max(), force.min())
-        ]
-        contact = Contact(
-            regime=num.impact_regime,
-            separation_fraction=float(np.mean(np.abs(x) <= 1.0)),
-            back_flank_fraction=float(np.mean(x < -1.0)),
-        )
-    period = None if num.period is None else num.period * num.sampling_interval
-    period_s = None if period is None else in_si("time", period, scales)
-    peaks = num.spectrum_peaks
-    peak = to_physical("frequency", peaks[0].frequency, scales) if peaks else None
-    shaft_hz = conv.speed_rpm / 60.0
-    return Response(
-        dte_peak_to_peak_um=values["dte"],
-        dynamic_mesh_force_max_n=forces[0],
-        dynamic_mesh_force_min_n=forces[1],
-        te_with_static_peak_to_peak_um=te,
-        contact_force_max_n=touching[0],
-        contact_force_min_n=touching[1],
-        static_force_n=scales.static_force,
-        dynamic_factor=values["dynamic_factor"],
-        contact=contact,
-        period_ms=None if period is None else to_physical("time", period, scales),
-        period_mesh_periods=None if period_s is None else period_s * conv.mesh_frequency_hz,
-        dominant_frequency_hz=peak,
-        dominant_shaft_order=None if peak is None else peak / shaft_hz,
     )
 
 
