@@ -149,3 +149,19 @@ def test_a_load_dependent_stiffness_has_one_critical_torque() -> None:
     assert not (below.speed_windows_note or "").startswith("not applicable")
     assert above.speed_windows_note.startswith("not applicable above T_crit")
     assert "under 40 N*m the mesh deflects" in engineering_at(40.0).summary  # its own torque
+
+
+def test_the_stiffness_at_a_torque_is_the_conversions() -> None:
+    """T_crit's fixed point reads k_m(T) alone (``iso_mesh_stiffness``): bit for bit the
+    ``mesh_stiffness_n_per_m`` of the whole conversion of the design at that torque, below and
+    above 100 N/mm."""
+    from gearengine.model.design import Design
+    from gearengine.model.reduction import convert_design, iso_mesh_stiffness
+    from tests.conftest import ROOT
+
+    pair = json.loads((ROOT / "examples/remedies-z23-67.json").read_text())["design"]
+    design = Design.model_validate(pair)
+    for torque in (0.5, 5.0, 27.9, 400.0):
+        whole = convert_design(design.model_copy(update={"torque": torque}))
+        assert iso_mesh_stiffness(design, torque) == whole.mesh_stiffness_n_per_m
+    assert iso_mesh_stiffness(design, 0.5) < iso_mesh_stiffness(design, 5.0)

@@ -107,14 +107,14 @@ def _gear_values(design: Design, derived: dict[str, Derived]) -> dict[str, float
     return out
 
 
-def _geometry(design: Design) -> dict[str, Derived]:
-    """Quantities of ``model.geometry`` for the gears given in geometry form."""
+def _geometry(design: Design, torque: float | None = None) -> dict[str, Derived]:
+    """Quantities of ``model.geometry`` for the gears given in geometry form, the ISO 6336
+    stiffness at the mean driver torque ``torque`` [N m] (default: the design's)."""
     g1, g2 = design.driver.geometry(), design.driven.geometry()
     if g1 is not None and g2 is not None:
         radius = g1["module"] * g1["teeth"] / 2.0
-        pair = geometry.pair_from_geometry(
-            g1, g2, tangential_load=abs(design.torque) / radius, n_harmonics=ISO_HARMONICS
-        )
+        load = abs(design.torque if torque is None else torque) / radius
+        pair = geometry.pair_from_geometry(g1, g2, tangential_load=load, n_harmonics=ISO_HARMONICS)
         return {k: Derived(**v) for k, v in pair.items()}
     derived = {}
     for role, g in (("driver", g1), ("driven", g2)):
@@ -133,6 +133,14 @@ def _geometry(design: Design) -> dict[str, Derived]:
             source="solid disc with bore at the reference diameter: J = rho b pi/2 (r^4 - r_i^4)",
         )
     return derived
+
+
+def iso_mesh_stiffness(design: Design, torque: float) -> float:
+    """k_m [N/m] of a design with ``mesh.stiffness = "iso6336"`` at the mean driver torque
+    ``torque`` [N m] (the load factor of ISO 6336-1 S5 grows with it below 100 N/mm): the
+    ``mesh_stiffness_n_per_m`` that ``convert_design`` gives at that torque, without the rest
+    of the conversion."""
+    return float(_geometry(design, torque)["mesh_stiffness"].value)  # type: ignore[arg-type]
 
 
 def _stiffness(design: Design, derived: dict[str, Derived]) -> tuple[float, list]:
