@@ -16,7 +16,7 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, model_validator
 
 from gearengine.engineering.block import Engineering, engineering
-from gearengine.engineering.response import IMPACT_WORDS, response
+from gearengine.engineering.response import IMPACT_WORDS
 from gearengine.homoclinic.boundary import design_windows
 from gearengine.homoclinic.coefficients import T_CRIT_WHY
 from gearengine.homoclinic.schemas import MelnikovRequest, MelnikovResult
@@ -29,9 +29,9 @@ from gearengine.model.params import GearParams, request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
 from gearengine.numerics.attractors import planned_attractors
 from gearengine.numerics.headline import Headline, coexistence, headline, of_starts
-from gearengine.numerics.magnitudes import adverse_over, most_adverse
+from gearengine.numerics.magnitudes import attractor_runs, most_adverse
 from gearengine.numerics.physical import in_seconds
-from gearengine.numerics.results import Attractor, NumericsResult, WorstValue
+from gearengine.numerics.results import Attractor, NumericsResult
 from gearengine.numerics.runs import as_system
 from gearengine.numerics.settings import RequestSettings, SimulationSettings, plan_work
 from gearengine.numerics.simulation import simulate
@@ -257,34 +257,6 @@ def verdict(mel: MelnikovResult, num: NumericsResult, decided: Headline | None =
     )
 
 
-HISTORY_MAGNITUDES = {
-    "te_with_static": ("te_with_static_peak_to_peak_um", "um", max),
-    "contact_force_max": ("contact_force_max_n", "N", max),
-    "contact_force_min": ("contact_force_min_n", "N", min),
-}
-"""The magnitudes of ``engineering.Response`` read from a run's time history (the TE an
-encoder sees, with the static TE; the contact force, zero while apart): ``most_adverse``'s
-table for them."""
-
-
-def history_magnitudes(request: AnalysisRequest, found: list[Attractor],
-                       min_fraction: float) -> dict[str, WorstValue]:  # fmt: skip
-    """``HISTORY_MAGNITUDES`` at their most adverse over the attractors above ``min_fraction``:
-    the basin runs keep extremes, not histories, so each attractor is run again from the start
-    that reached it (the settings' lengths, one start, ~0.02-0.1 s) and read as the recorded
-    run is (``engineering.response``)."""
-    conv = request.conversion
-    assert conv is not None
-    runs = {}
-    for k, a in enumerate(found):
-        if a.fraction > min_fraction:
-            one = request.settings.model_copy(update={
-                "initial_state": a.start, "initial_states": None, "random_initial_states": None,
-                "basins": None})  # fmt: skip
-            runs[k] = response(conv.params, simulate(request.system, one), conv)
-    return adverse_over(found, runs, HISTORY_MAGNITUDES)
-
-
 def whose_note(num: NumericsResult, decided: Headline) -> str:
     """The note that says whose the numerics' detailed fields are when basins decide the
     verdict: the settings' own start's, which need not be the deciding attractor's (a periodic
@@ -338,22 +310,24 @@ def analyze(
         ts = conv.time_scale_s
         num = num.model_copy(update={"transient": in_seconds(num.transient, ts),
                                      "record": in_seconds(num.record, ts)})  # fmt: skip
-    decided, worst = None, None
+    decided, worst, runs = None, None, None
     if settings.basins is not None:  # the worst attractor above min_fraction decides
         scales = None if conv is None else conv.scales
         found, counts = planned_attractors(system, settings, request.plan, scales)
         num = num.model_copy(update={"attractors": found, "basins": counts})
         decided = headline(found, counts, settings.basins.min_fraction)
         worst = most_adverse(found, decided, settings.basins.min_fraction)  # each magnitude's
-        if worst and conv is not None and train is None:  # and those read from a history
-            worst |= history_magnitudes(request, found, settings.basins.min_fraction)
+        if worst and conv is not None and train is None:  # runs for those read from a history
+            runs = attractor_runs(system, settings, found, settings.basins.min_fraction)
         if decided is not None:
             num = num.model_copy(update={"notes": [*num.notes, whose_note(num, decided)]})
     result = AnalysisResult(melnikov=mel, numerics=num, settings=settings,
                             verdict=verdict(mel, num, decided))  # fmt: skip
     if conv is None:
         return result
-    eng = engineering(conv, speeds, mel, scan, num, decided, no_windows, worst, request.design)
+    eng = engineering(
+        conv, speeds, mel, scan, num, decided, no_windows, worst, request.design, runs
+    )
     if train is None:
         return result.model_copy(update={"params": conv.params, "engineering": eng})
     notes = [f"gear train: {train.model.size} coordinates; numerics of the train, scales of "

@@ -8,7 +8,7 @@ import math
 
 from pydantic import Field
 
-from gearengine.engineering.response import IMPACT_WORDS, Response, response
+from gearengine.engineering.response import IMPACT_WORDS, Response, history_magnitudes, response
 from gearengine.engineering.thresholds import CONTROLS, Critical, critical
 from gearengine.homoclinic.boundary import WINDOW_BOUND, critical_torque
 from gearengine.homoclinic.coefficients import T_CRIT_WHY
@@ -179,6 +179,7 @@ def engineering(
     no_windows: str | None = None,
     worst: dict[str, WorstValue] | None = None,
     design: Design | None = None,
+    runs: dict[int, NumericsResult] | None = None,
 ) -> Engineering:
     """The engineering block of a design's Melnikov verdict (and analysis, given ``num``;
     ``decided`` the worst attractor of its basins, ``numerics.headline.headline``) from the
@@ -186,16 +187,20 @@ def engineering(
     (``homoclinic.boundary.design_windows``, None above the critical load).
     ``no_windows``: why the speed windows are not looked for (a train without a Melnikov
     reduction), said in their note; the range stays the scan's. ``worst``: with basins each
-    magnitude at its most adverse over the attractors (``numerics.attractors.most_adverse``);
-    ``design`` for a load-dependent T_crit (``critical_torque``)."""
+    magnitude at its most adverse over the attractors (``numerics.magnitudes.most_adverse``);
+    ``design`` for a load-dependent T_crit (``critical_torque``); ``runs`` the attractors' own
+    runs (``numerics.magnitudes.attractor_runs``), whose histories add ``HISTORY_MAGNITUDES``
+    to ``worst``."""
     params = conv.params
+    resp = None if num is None else response(params, num, conv)
+    if runs and num is not None and num.attractors is not None and worst is not None:
+        worst = worst | history_magnitudes(conv, num.attractors, runs)
     t_crit = critical_torque(conv, mel, design)
     crit = {
         CONTROLS[name]: critical(name, t, conv.scales)
         for name, t in mel.thresholds.items()
         if name in CONTROLS and t.value is not None and (t.critical_values or t.note is None)
     }
-    resp = None if num is None else response(params, num, conv)
     note = None
     lo, hi = rpm_range
     if scan is None:  # no saddle at this load: a critical torque exists

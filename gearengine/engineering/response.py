@@ -10,7 +10,8 @@ from gearengine.model.answers import Answer
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import DesignConversion
 from gearengine.model.units import in_si, response_values, shown, to_physical
-from gearengine.numerics.results import NumericsResult
+from gearengine.numerics.magnitudes import adverse_over
+from gearengine.numerics.results import Attractor, NumericsResult, WorstValue
 from gearengine.systems.spur_pair.forcing import contact_force_of, static_error
 
 
@@ -114,3 +115,22 @@ def response(params: GearParams, num: NumericsResult, conv: DesignConversion) ->
         dominant_frequency_hz=peak,
         dominant_shaft_order=None if peak is None else peak / shaft_hz,
     )
+
+
+HISTORY_MAGNITUDES = {
+    "te_with_static": ("te_with_static_peak_to_peak_um", "um", max),
+    "contact_force_max": ("contact_force_max_n", "N", max),
+    "contact_force_min": ("contact_force_min_n", "N", min),
+}
+"""The magnitudes of ``engineering.Response`` read from a run's time history (the TE an
+encoder sees, with the static TE; the contact force, zero while apart): ``most_adverse``'s
+table for them."""
+
+
+def history_magnitudes(conv: DesignConversion, found: list[Attractor],
+                       runs: dict[int, NumericsResult]) -> dict[str, WorstValue]:  # fmt: skip
+    """``HISTORY_MAGNITUDES`` at their most adverse over ``runs`` (attractor index in
+    ``found``: its own run, ``numerics.magnitudes.attractor_runs``), each run read as the
+    recorded run is (``response``)."""
+    read = {k: response(conv.params, run, conv) for k, run in runs.items()}
+    return adverse_over(found, read, HISTORY_MAGNITUDES)

@@ -8,8 +8,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from gearengine.model.params import GearParams
 from gearengine.numerics.headline import Headline, of_starts
-from gearengine.numerics.results import Attractor, WorstValue
+from gearengine.numerics.results import Attractor, NumericsResult, WorstValue
+from gearengine.numerics.settings import SimulationSettings
+from gearengine.numerics.simulation import simulate
+from gearengine.systems.base import System
 
 ADVERSE = {
     "dte": ("dte_um", "um", max),
@@ -54,6 +58,26 @@ def adverse_over(found: list[Attractor], sources: dict[int, object],
                                    classification=a.classification,
                                    fraction=a.fraction)  # fmt: skip
     return out
+
+
+def attractor_runs(
+    system: GearParams | System,
+    settings: SimulationSettings,
+    found: list[Attractor],
+    min_fraction: float,
+) -> dict[int, NumericsResult]:
+    """Each attractor of ``found`` above ``min_fraction`` run again from the start that reached
+    it (the settings' lengths, one start, ~0.02-0.1 s), by its index: the basin runs keep
+    extremes, not histories, and the magnitudes read from a time history (the TE with the
+    static TE, the contact force: ``engineering.response.HISTORY_MAGNITUDES``) need one."""
+    runs = {}
+    for k, a in enumerate(found):
+        if a.fraction > min_fraction:
+            one = settings.model_copy(update={
+                "initial_state": a.start, "initial_states": None, "random_initial_states": None,
+                "basins": None})  # fmt: skip
+            runs[k] = simulate(system, one)
+    return runs
 
 
 def worst_words(worst: dict[str, WorstValue]) -> str:
