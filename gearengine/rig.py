@@ -31,7 +31,7 @@ import numpy as np
 
 from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.model.design import Design
-from gearengine.numerics.settings import work
+from gearengine.numerics.runs import work
 from gearengine.signals.reading import read
 from gearengine.signals.schema import LeverTrial, ModelReport, SignalResult, SpectrumLine
 from gearengine.signals.series import SignalRequest

@@ -10,8 +10,7 @@ import pytest
 
 from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.numerics import attractors as attractors_module
-from gearengine.numerics.runs import as_system
-from gearengine.numerics.settings import work
+from gearengine.numerics.runs import as_system, work
 from gearengine.studies.basins import basins_work, with_basins
 from tests.conftest import PAPER_PARAMS
 

@@ -20,7 +20,7 @@ from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.homoclinic.verdict import melnikov
 from gearengine.jsonio import error_lines
 from gearengine.model.aliases import with_aliases
-from gearengine.numerics.settings import work
+from gearengine.numerics.runs import work
 from gearengine.numerics.simulation import SimulationSettings, simulate_batch
 from gearengine.plots.sweep import sweep_figure
 from gearengine.studies.jobs import cyclic_gc_paused

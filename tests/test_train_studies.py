@@ -23,7 +23,8 @@ from gearengine.gate.remedies.request import RemediesRequest as RemediesRequest_
 from gearengine.gate.remedies.search import verify_depth
 from gearengine.model.design import Design
 from gearengine.model.train import EXAMPLE_TRAIN
-from gearengine.numerics.settings import SimulationSettings, run_steps, work
+from gearengine.numerics.runs import work
+from gearengine.numerics.settings import SimulationSettings, run_steps
 from gearengine.numerics.trains import simulate_train
 from gearengine.studies.basins import basins_work
 from gearengine.studies.robustness.study import RobustnessRequest

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 from gearengine.model.params import GearParams
 from gearengine.numerics.results import StartSummary
-from gearengine.numerics.settings import SimulationSettings
+from gearengine.numerics.settings import SimulationSettings, plan_work
 from gearengine.signals.classify import Classification, classify
 from gearengine.signals.diagnostics import impact_regime
 from gearengine.signals.lyapunov import LyapunovEstimate, benettin
@@ -50,6 +50,12 @@ def as_system(model: GearParams | System) -> System:
     """The system a numerical verdict runs: a ``System`` as given, a parameter point of Eq. (9)
     as the paper's spur pair."""
     return model if isinstance(model, System) else SpurPair(model)
+
+
+def work(params: GearParams | System, settings: SimulationSettings) -> int:
+    """RK4 steps ``simulate(params, settings)`` takes (for compute budgets): ``plan_work`` on
+    the step plan of its system (``as_system``) at ``settings.steps_per_period``."""
+    return plan_work(params, settings, as_system(params).plan(settings.steps_per_period))
 
 
 def integrate(

@@ -23,7 +23,6 @@ from gearengine.model.errors import InputError
 from gearengine.model.params import Finite, GearParams, WholeNumber, not_both, request_config
 from gearengine.model.units import QUANTITIES, parse_quantity
 from gearengine.systems.base import StepPlan, System
-from gearengine.systems.spur_pair.forcing import step_plan
 
 MAX_PERIODS = 100_000
 """Upper cap of transient_periods and record_periods."""
@@ -349,14 +348,6 @@ def run_steps(settings: SimulationSettings, steps: int) -> int:
     """RK4 steps of a run: (transient + record) periods x ``steps`` per T0 x (starts + basin
     starts)."""
     return (settings.transient_periods + settings.record_periods) * steps * settings.lanes()
-
-
-def work(params: GearParams | System, settings: SimulationSettings) -> int:
-    """RK4 steps ``simulate(params, settings)`` takes (for compute budgets): ``plan_work`` on
-    the step plan of ``params`` at ``settings.steps_per_period``."""
-    spp = settings.steps_per_period
-    plan = params.plan(spp) if isinstance(params, System) else step_plan(params, spp)
-    return plan_work(params, settings, plan)
 
 
 def plan_work(params: GearParams | System, settings: SimulationSettings, plan: StepPlan) -> int:

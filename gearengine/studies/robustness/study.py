@@ -43,7 +43,8 @@ from gearengine.numerics.attractors import points_attractors
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.headline import headline
 from gearengine.numerics.magnitudes import most_adverse
-from gearengine.numerics.settings import SimulationSettings, work
+from gearengine.numerics.runs import work
+from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies import jobs
 from gearengine.studies.robustness import sensitivity
 from gearengine.studies.robustness.tolerances import (

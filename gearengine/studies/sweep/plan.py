@@ -11,7 +11,7 @@ import itertools
 import math
 from dataclasses import dataclass
 
-from gearengine.numerics.settings import work
+from gearengine.numerics.runs import work
 from gearengine.studies.sweep.request import SweepBranch, SweepRequest
 
 DEFAULT_CHUNK_POINTS = 64
