@@ -50,3 +50,33 @@ def test_analyze_hands_the_carried_plan_to_the_attractors(
     monkeypatch.setattr(attractors_module, "step_plans", no_plans)
     result = analyze(request)
     assert result.numerics.basins is not None and result.numerics.basins.starts == 4
+
+
+def test_every_start_runs_on_the_plan_in_hand(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A train's runs share one step plan: ``simulate`` makes it once for all its starts, and
+    the attractors of a request make none (each start made its own in ``integrate``)."""
+    from gearengine.numerics.attractors import planned_attractors
+    from gearengine.numerics.simulation import simulate
+    from gearengine.systems.gear_train.system import TrainSystem
+
+    body = json.loads((ROOT / "examples/design-train.json").read_text())
+    starts = {"initial_states": [[0.01, 0.01], [0.5, 0.0], [-0.5, 0.0]]}
+    settings = {**SHORT, **starts, "basins": {"starts": 4}}
+    request = AnalysisRequest.model_validate({**body, "settings": settings})
+    made = []
+    own_plan = TrainSystem.plan
+
+    def counted(self: TrainSystem, steps_per_period: int) -> object:
+        made.append(steps_per_period)
+        return own_plan(self, steps_per_period)
+
+    monkeypatch.setattr(TrainSystem, "plan", counted)
+    plans = []
+    for n in (1, 3):  # the starts add no plan (the Floquet flow makes its own)
+        one = {"basins": None, "initial_states": starts["initial_states"][:n]}
+        simulate(request.system, request.settings.model_copy(update=one))
+        plans.append(len(made))
+        made.clear()
+    assert plans[0] == plans[1]
+    _, counts = planned_attractors(request.system, request.settings, request.plan)
+    assert made == [] and counts.starts == 4

@@ -243,7 +243,7 @@ def planned_attractors(
         return _lanes_attractors([params], settings, [scales], [plan])[0]
     basins = settings.basins or BasinSettings()
     starts = basin_starts(basins, scales)
-    runs = [run_verdict(integrate(params, settings, params.start_state(*s)), s, plan, k)
+    runs = [run_verdict(integrate(params, settings, params.start_state(*s), plan), s, plan, k)
             for k, s in enumerate(starts)]  # fmt: skip
     return _group(plan.omega0 is not None, scales, basins, starts, runs)
 

@@ -176,7 +176,7 @@ def _run_lanes(
             systems.setdefault(key, []).append(k)
         else:
             start = as_system(point).start_state(*s)
-            results[k] = run_verdict(integrate(point, settings, start), s, plan, k)
+            results[k] = run_verdict(integrate(point, settings, start, plan), s, plan, k)
     for ks in systems.values():
         for k, point in zip(ks, system_lanes(points, plans, [lanes[k] for k in ks], settings),
                             strict=True):  # fmt: skip

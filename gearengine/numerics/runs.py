@@ -19,7 +19,7 @@ from gearengine.signals.classify import Classification, classify
 from gearengine.signals.diagnostics import impact_regime
 from gearengine.signals.lyapunov import LyapunovEstimate, benettin
 from gearengine.signals.periodicity import attractor_size, detect_period
-from gearengine.systems.base import Run, System
+from gearengine.systems.base import Run, StepPlan, System
 from gearengine.systems.spur_pair.system import SpurPair
 
 MAX_HISTORY_SAMPLES = 2**15
@@ -59,11 +59,16 @@ def work(params: GearParams | System, settings: SimulationSettings) -> int:
 
 
 def integrate(
-    model: GearParams | System, settings: SimulationSettings, start: Sequence[float]
+    model: GearParams | System,
+    settings: SimulationSettings,
+    start: Sequence[float],
+    plan: StepPlan | None = None,
 ) -> Run:
-    """Integrate a system (and its tangent) from ``start`` over the transient and the record."""
+    """Integrate a system (and its tangent) from ``start`` over the transient and the record;
+    ``plan``: its step plan at ``settings.steps_per_period`` where the caller has made it
+    already (every start of a run, every basin start, shares one), else made here."""
     system = as_system(model)
-    plan = system.plan(settings.steps_per_period)
+    plan = system.plan(settings.steps_per_period) if plan is None else plan
     return system.integrate(plan, start, settings.transient_periods, settings.record_periods,
                             history_stride(settings, plan.steps))  # fmt: skip
 

@@ -74,7 +74,7 @@ def simulate(
     if physical.applies(settings, plan, system.damping_rate()):
         done, spans = physical_runs(system, plan, settings, starts)
     else:
-        done = [integrate(system, settings, start) for start in starts]
+        done = [integrate(system, settings, start, plan) for start in starts]
         fixed = (settings.transient_periods, "fixed", settings.record_periods, "fixed")
         spans = [fixed] * len(starts)
     for run, start in zip(done, starts, strict=True):

@@ -63,7 +63,7 @@ def respond(system: TrainSystem, settings: SimulationSettings) -> TrainResponse:
     commensurate = plan.omega0 is not None
     runs = []
     for start in settings.starts():
-        run = integrate(system, settings, system.start_state(*start))
+        run = integrate(system, settings, system.start_state(*start), plan)
         runs.append((run, start_verdict(run, start, plan.period, commensurate)))
     worst, verdict = max(runs, key=lambda rv: severity(rv[1].classification, rv[1].period))
     if worst.diverged:
