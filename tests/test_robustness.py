@@ -245,3 +245,17 @@ def test_a_cancelled_study_gives_a_partial_result_of_its_finished_chunks(tmp_pat
         assert p["separation"]["count"] == sum(r[1] in (1, 2) for r in runs)
         assert p["chaotic"]["count"] == sum(r[0] == 2 for r in runs)
         assert p["separation"]["samples"] == 16
+
+
+def test_the_checks_convert_the_nominal_design_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``checked`` converts the pair once for itself and its axes (it converted it again for
+    each axis)."""
+    from gearengine.studies.robustness import study as study_module
+
+    made = []
+    convert = study_module.convert_design
+    monkeypatch.setattr(study_module, "convert_design", lambda d: made.append(d) or convert(d))
+    axes = [{"parameter": "speed", "start": "3000 rpm", "stop": "5000 rpm", "num": 2},
+            {"parameter": "torque", "start": "4 N*m", "stop": "6 N*m", "num": 2}]  # fmt: skip
+    request = checked(RobustnessRequest.model_validate(doc(axes=axes)))
+    assert len(made) == 1 and len(request.points()) == 4

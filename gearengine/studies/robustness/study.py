@@ -146,7 +146,7 @@ def request_errors(request: RobustnessRequest) -> list[InitErrorDetails]:
     if request.samples & (request.samples - 1):
         problems.add(("samples",), "give a power of 2 (the Sobol points' balance)", 0)
     try:  # the pair itself, before its axes: a geometry that does not mesh is the design's
-        convert_design(request.design)
+        pair = convert_design(request.design)
     except InputError as exc:  # naming its field (design.driven.base_radius, ...)
         problems.add_error(exc, None)
         return problems.details
@@ -157,8 +157,8 @@ def request_errors(request: RobustnessRequest) -> list[InitErrorDetails]:
         if is_dimensionless(axis.parameter):
             problems.add(("axes", i, "parameter"), "a physical field of the design", 0)
             continue
-        problem = axis_problem(convert_design(request.design).params, request.design,
-                               axis.parameter, axis.start, axis.stop, {})  # fmt: skip
+        problem = axis_problem(pair.params, request.design, axis.parameter, axis.start,
+                               axis.stop, {})  # fmt: skip
         if problem is not None:
             problems.add(("axes", i, problem[0]), problem[1], axis.parameter)
     return problems.details
