@@ -114,12 +114,19 @@ class SweepAxis(BaseModel):
             return [float(v) for v in np.linspace(float(lo), float(hi), self.num)]
         assert design is not None
         (a, unit), (b, same) = _written(lo), _written(hi)
-        if unit is None or unit != same:  # ends in two units (or unreadable): spaced in SI
-            lo, hi = (si_value(design, self.parameter, v) for v in (lo, hi))
-            return [float(v) for v in np.linspace(lo, hi, self.num)]
-        spaced = [float(v) for v in np.linspace(a, b, self.num)]
-        shown = [v if i in (0, self.num - 1) else float(f"{v:.15g}") for i, v in enumerate(spaced)]
-        return [si_value(design, self.parameter, f"{v!r} {unit}" if unit else v) for v in shown]
+        if unit and unit == same:
+            shown = _shown(np.linspace(a, b, self.num))
+            return [si_value(design, self.parameter, f"{v!r} {unit}") for v in shown]
+        lo, hi = (si_value(design, self.parameter, v) for v in (lo, hi))
+        spaced = np.linspace(lo, hi, self.num)  # bare numbers (SI already), or two units
+        return _shown(spaced) if unit == same == "" else [float(v) for v in spaced]
+
+
+def _shown(spaced: np.ndarray) -> list[float]:
+    """Evenly spaced values, each inner one as the decimal it shows (15 significant digits:
+    3999.9999999999995 is 4000), the ends as given."""
+    last = len(spaced) - 1
+    return [float(v) if i in (0, last) else float(f"{v:.15g}") for i, v in enumerate(spaced)]
 
 
 _WRITTEN = re.compile(rf"\s*({NUMBER})\s*(.*?)\s*")
