@@ -81,7 +81,7 @@ def test_service_stores_compressed_chunks_and_streams_compact_results(working) -
     local = run_local(validated(doc)).model_dump(mode="json", include=keep)
     assert result["points"] == local["points"]
     text = c.get(f"/v1/sweeps/{job_id}/result?format=csv").text
-    assert text.splitlines()[0] == "F_e1,Omega_e,branch,classification,period,lle"
+    assert text.splitlines()[0] == "F_e1,Omega_e,branch,classification,period,lle [1/tau]"
     with sqlite3.connect(data / DB_FILE) as db:
         stored = db.execute("SELECT result_json FROM chunks WHERE job_id = ?", (job_id,)).fetchall()
     assert stored and all(isinstance(row[0], bytes) for row in stored)

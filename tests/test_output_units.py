@@ -72,3 +72,15 @@ def test_a_bare_number_on_a_physical_axis_is_read_with_a_note() -> None:
 
 def test_axes_with_units_carry_no_notes(sweep) -> None:
     assert sweep.notes is None
+
+
+def test_the_lle_columns_name_their_unit_per_unit_tau(sweep) -> None:
+    """The CSV's and the DataFrame's ``lle`` had no unit (review of issue 30): the LLE is per
+    unit of the dimensionless time tau = omega_n t, titled ``lle [1/tau]`` as docs/units.md
+    says, and equal to the JSON's ``lle``."""
+    header = next(iter(to_csv(sweep, design=True))).strip().split(",")
+    assert {"lle [1/tau]", "lle_stderr [1/tau]"} <= set(header) and "lle" not in header
+    frame = sweep.to_pandas()
+    assert list(frame["lle [1/tau]"]) == [p.lle for p in sweep.points]
+    units = (ROOT / "docs" / "units.md").read_text()
+    assert "`lle [1/tau]`" in units

@@ -115,3 +115,39 @@ def test_a_torque_axis_through_zero_is_refused_before_any_compute() -> None:
     assert "give mesh.stiffness in N/m" in e["msg"]
     (e,) = refusal(("0 N*m", "5 N*m"))
     assert e["loc"] == ("axes", 1, "start") and "positive tangential load" in e["msg"]
+
+
+CLASS_WORDS = "ISO 1328-1:2013 flank tolerance class is a whole number from 1 (finest) to 11"
+
+
+def test_an_accuracy_class_as_text_is_refused_saying_what_is_accepted(
+    client, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``"accuracy_class": "7"`` got pydantic's "Input should be a valid integer" (review of issue
+    30): the library, the API (422 naming the field) and the CLI say that a class is a whole
+    number 1..11 written as a number; so does the robustness tolerances' ``class``."""
+    doc = {**copy.deepcopy(GEOMETRY), "transmission_error": {"accuracy_class": "7"}}
+    (error,) = _errors(doc)
+    assert error["loc"] == ("transmission_error", "accuracy_class")
+    assert CLASS_WORDS in error["msg"] and "the number 7, not the text '7'" in error["msg"]
+    for bad in (12, 7.5, True):
+        doc["transmission_error"]["accuracy_class"] = bad
+        assert CLASS_WORDS in _errors(doc)[0]["msg"]
+    doc["transmission_error"]["accuracy_class"] = 7.0  # a whole number, as JSON Schema counts
+    assert Design.model_validate(doc).transmission_error.harmonics is not None
+    doc["transmission_error"]["accuracy_class"] = "7"
+    answer = client.post("/v1/conversions/design", json={"design": doc})
+    assert answer.status_code == 422
+    assert answer.headers["content-type"].startswith("application/problem+json")
+    (problem,) = answer.json()["errors"]
+    assert problem["path"] == "design.transmission_error.accuracy_class"
+    assert CLASS_WORDS in problem["message"]
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": doc}))
+    assert main(["convert", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "design.transmission_error.accuracy_class" in err and CLASS_WORDS in err
+    robust = copy.deepcopy(DESIGN)
+    robust["tolerances"]["accuracy"]["class"] = "7"
+    answer = client.post("/v1/robustness", json={"design": robust, "samples": 8})
+    assert answer.status_code == 422 and CLASS_WORDS in answer.json()["errors"][0]["message"]

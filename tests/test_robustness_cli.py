@@ -107,10 +107,10 @@ def test_the_answers_say_how_many_starts_decided_each_sample(
     base = ["check", str(design_file), "--speed", "5000:5000", "--speed-points", "1",
             "--samples", "8", "--max-probability", "back_flank=0.5"]  # fmt: skip
     assert main([*base, "--json", str(out)]) == 0
-    assert json.loads(out.read_text())["starts_per_sample"] == 1
+    assert json.loads(out.read_text())["result"]["starts_per_sample"] == 1
     assert "8 samples a point, 1 start a sample" in capsys.readouterr().out
     assert main([*base, "--starts", "4", "--json", str(out)]) == 0
-    assert json.loads(out.read_text())["starts_per_sample"] == 4
+    assert json.loads(out.read_text())["verdicts"][0]["starts_per_sample"] == 4
     assert "8 samples a point, 4 starts a sample (settings.basins)" in capsys.readouterr().out
     args = [str(design_file), "--speed", "5000:5000", "--speed-points", "1", "--samples", "8"]
     assert main(["robustness", *args]) == 0
@@ -178,7 +178,7 @@ def test_samples_auto_reports_the_points_the_budget_leaves_undecided(
     )
     assert "FAIL: speed 5000 rpm (64 samples) [P(separation) lower bound" in captured.out
     assert "the budget of 3500000 RK4 steps ran out: 1 points undecided after 128" in captured.err
-    assert "FAIL: 1 of 2 points over a probability limit, 1 undecided" in captured.err
+    assert "FAIL: 1 of 2 points over a probability limit, 1 undecided" in captured.out
 
 
 def test_the_api_refuses_a_study_over_the_budget_in_the_same_terms(tmp_path: Path) -> None:
@@ -230,3 +230,48 @@ def test_samples_and_seed_without_a_probability_limit_are_refused(design_file: P
     --max-probability."""
     for extra in (["--samples", "64"], ["--seed", "3"]):
         assert main(["check", str(design_file), "--speed", "2000:5000", *extra]) == 2
+
+
+def test_the_gates_json_is_its_report_at_the_confidence_it_decided_at(
+    design_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:  # fmt: skip
+    """The probability gate's ``--json`` was the bare robustness result: no verdicts, limits or
+    reasons, and 95 % intervals while ``--samples auto`` decided at 99.3 %; its PASS/FAIL line
+    went to stderr, the envelope gate's to stdout (review of issue 30). Now the report has per
+    point the verdict, the reasons and the interval read at the confidence decided at, the
+    limits and the overall verdict, with the robustness result inside."""
+    from gearengine.studies.robustness.tolerances import clopper_pearson
+
+    monkeypatch.setenv("GEARCHAOS_MAX_JOB_STEPS", "3500000")
+    out = tmp_path / "gate.json"
+    base = ["check", str(design_file), "--speed", "2000:5000", "--speed-points", "2"]
+    assert main([*base, "--samples", "auto", "--max-probability", "separation=0.01",
+                 "--json", str(out)]) == 1  # fmt: skip
+    captured = capsys.readouterr()
+    assert "FAIL: 1 of 2 points over a probability limit, 1 undecided" in captured.out
+    assert "points over a probability limit" not in captured.err
+    report = json.loads(out.read_text())
+    assert (report["passed"], report["limits"]) == (False, {"separation": 0.01})
+    assert (report["failing_points"], report["undecided_points"]) == (1, 1)
+    assert report["confidence"] == pytest.approx(1 - 0.05 / 7)
+    slow, fast = report["verdicts"]
+    assert slow["point"] == {"speed": {"value": 2000.0, "unit": "rpm"}}
+    assert (slow["verdict"], fast["verdict"]) == ("undecided", "fail")
+    assert slow["samples"] == 128 and slow["starts_per_sample"] == 1
+    assert slow["reasons"] == [
+        "P(separation) undecided: upper bound at 99.3 % 0.0431 > 0.01 (0/128 samples)"
+    ]
+    read = slow["limits"]["separation"]
+    assert (read["count"], read["samples"], read["verdict"]) == (0, 128, "undecided")
+    assert read["interval"] == pytest.approx(clopper_pearson(0, 128, 1 - 0.05 / 7))
+    kept = report["result"]["points"][0]["probabilities"]["separation"]
+    assert kept["interval"][1] < read["interval"][1]  # the result's own 95 % interval, kept
+    assert "every point decided" not in report["notes"][0]
+    assert report["notes"][0].startswith("--samples auto: the budget of 3500000 RK4 steps")
+    assert main([*base, "--samples", "8", "--max-probability", "back_flank=0.5",
+                 "--json", str(out)]) == 0  # fmt: skip
+    assert "PASS: 0 of 2 points over a probability limit" in capsys.readouterr().out
+    report = json.loads(out.read_text())
+    assert report["passed"] and report["confidence"] == 0.95 and report["notes"] == []
+    assert [v["verdict"] for v in report["verdicts"]] == ["pass", "pass"]

@@ -169,15 +169,16 @@ def test_csv_numbers_read_as_the_json_writes_them() -> None:
     result.points.append(small)  # numbers that repr writes in another form (1e-05, 1e-07)
     rows = list(csv.reader(io.StringIO("".join(to_csv(result)))))
     header = rows[0]
-    assert rows[-1][header.index("lle")] == "0.00001"
+    assert rows[-1][header.index("lle [1/tau]")] == "0.00001"
     assert rows[-1][header.index("poincare_x")] == "1e-7 0.25"
     for row, point in zip(rows[1:], result.points, strict=True):
         doc = point.model_dump_json()
         cells = dict(zip(header, row, strict=True))
         for name in ("lle", "lle_stderr"):
             if getattr(point, name) is not None:
-                assert f'"{name}":{cells[name]},' in doc
-                assert float(cells[name]) == getattr(point, name)
+                cell = cells[f"{name} [1/tau]"]
+                assert f'"{name}":{cell},' in doc
+                assert float(cell) == getattr(point, name)
         tokens = cells["poincare_x"].split()
         assert "[" + ",".join(tokens) + "]" in doc
         assert [float(t) for t in tokens] == point.poincare_x

@@ -290,3 +290,24 @@ def test_a_sweep_is_chunked_for_its_workers_unless_the_size_is_set(
         assert c.post("/v1/sweeps", json=body(num=4000)).status_code == 202
         claims = app.state.jobs.store.claim("test-worker", 60.0, 3, 10_000)
     assert {cl.chunk_points for cl in claims} == {stored} and len(claims) == 4000 // stored
+
+
+def test_a_basins_sweep_csv_from_the_service_has_each_attractors_columns(
+    working: TestClient,
+) -> None:
+    """With settings.basins each attractor has its own columns (class, period, fraction with
+    its interval, LLE per unit tau, magnitudes in gear units), as many as a point has at most:
+    the service reads its stored points once for that count, and writes the CLI's CSV."""
+    doc = json.loads((Path(__file__).parents[1] / "examples" / "envelope-map.json").read_text())
+    doc["settings"] = {**SHORT, "basins": {"starts": 4}}
+    doc["axes"][0]["num"], doc["axes"][1]["num"] = 2, 1
+    job = wait(working, working.post("/v1/sweeps", json=doc).json()["id"])
+    assert job["status"] == "succeeded"
+    text = working.get(f"/v1/sweeps/{job['id']}/result", params={"format": "csv"}).text
+    points = working.get(f"/v1/sweeps/{job['id']}/result").json()["points"]
+    most = max(len(p["attractors"]) for p in points)
+    header = text.splitlines()[0].split(",")
+    assert f"attractor_{most}_class" in header and f"attractor_{most + 1}_class" not in header
+    assert "attractor_1_lle [1/tau]" in header and "attractor_1_dte [um]" in header
+    request = validated(doc)
+    assert text == "".join(to_csv(run_local(request), request.outputs, design=True))

@@ -113,9 +113,14 @@ def test_sweep_point_and_windows_follow_the_worst_attractor(sweep):
 
 
 def test_csv_and_dataframe_rows_have_the_verdict_and_every_attractor(sweep):
+    """Every attractor in its own columns, worst first, with units where they have them: the
+    CSV had one ``attractors`` string of labels and bare fractions (review of issue 30)."""
     rows = list(to_csv(sweep, design=True))
     header = rows[0].strip().split(",")
-    assert header[-8:] == [
+    found = sweep.points[0].attractors
+    assert len(found) == 3
+    first = header.index("attractor_1_class")
+    assert header[first - 7 : first] == [
         "dte_from",
         "dynamic_factor_from",
         "force_max_from",
@@ -123,18 +128,29 @@ def test_csv_and_dataframe_rows_have_the_verdict_and_every_attractor(sweep):
         "decided_by",
         "decided_fraction",
         "basin_starts",
-        "attractors",
     ]
+    each = ["class", "period", "impact_regime", "fraction", "fraction_low", "fraction_high",
+            "lle [1/tau]", "dte [um]", "dynamic_factor", "force_max [N]",
+            "force_min [N]"]  # fmt: skip
+    assert header[first:] == [f"attractor_{k}_{name}" for k in (1, 2, 3) for name in each]
+    assert "attractors" not in header
     frame = sweep.to_pandas()
+    assert list(frame.columns) == header
     row = frame.iloc[0]
     assert row["classification"] == "chaotic"
     assert row["decided_by"] == sweep.points[0].decided_by
     assert row["decided_fraction"] == pytest.approx(9 / 16)
     assert row["basin_starts"] == 16
-    listed = [part.rsplit(": ", 1) for part in row["attractors"].split("; ")]
-    assert [(label, float(f)) for label, f in listed] == [
-        (a.label, pytest.approx(a.fraction)) for a in sweep.points[0].attractors
-    ]
+    for k, a in enumerate(found, start=1):
+        assert row[f"attractor_{k}_class"] == a.classification
+        assert row[f"attractor_{k}_fraction"] == a.fraction
+        assert [row[f"attractor_{k}_fraction_{e}"] for e in ("low", "high")] == a.interval
+        assert row[f"attractor_{k}_lle [1/tau]"] == a.lle
+        assert row[f"attractor_{k}_dte [um]"] == a.dte_um
+        assert row[f"attractor_{k}_force_min [N]"] == a.force_min_n
+    assert found[0].period is None and row.isna()["attractor_1_period"]
+    assert row["attractor_2_period"] == found[1].period
+    assert row["attractor_2_impact_regime"] == found[1].impact_regime
 
 
 def test_csv_and_dataframe_magnitudes_are_the_largest_over_the_attractors_named(sweep):
@@ -162,7 +178,8 @@ def test_csv_and_dataframe_magnitudes_are_the_largest_over_the_attractors_named(
     assert row["classification"] == "chaotic" and row["decided_fraction"] == pytest.approx(9 / 16)
     # the service writes the CSV from stored points (JSON objects): the same rows
     stored = [json.loads(q.model_dump_json()) for q in sweep.points]
-    assert list(csv_rows(sweep.axes, stored, None, True, True)) == list(to_csv(sweep, design=True))
+    rows = csv_rows(sweep.axes, stored, None, True, True, len(found))
+    assert list(rows) == list(to_csv(sweep, design=True))
 
 
 def test_the_z23_67_point_gives_one_dte_in_headline_check_json_and_gate():

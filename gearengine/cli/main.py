@@ -184,7 +184,8 @@ def build_parser() -> argparse.ArgumentParser:
         "file", help='JSON file holding {"params" or "design": {...}, "settings": {...}}, or -'
     )
     envelope_options(p)
-    p.add_argument("--json", metavar="FILE", help="write the envelope report (JSON)")
+    p.add_argument("--json", metavar="FILE", help="write the gate's report (JSON): the "
+                   "envelope's, or with --max-probability the probability gate's")  # fmt: skip
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
     p.add_argument("--server", metavar="URL", help="run the envelope on a running service "
                    "(API key from GEARCHAOS_API_KEY)")  # fmt: skip

@@ -1,8 +1,9 @@
 """``gearengine robustness FILE --speed LOW:HIGH --torque LOW:HIGH --samples N``: a robustness
 study here, no server (the same registry as the service: ``--json`` writes the API's document
 byte for byte), and the probability gate of ``gearengine check ... --max-probability
-chaotic=0.01``: it fails where the 95 % upper bound of a probability exceeds its limit, naming
-the points (and in JUnit, one test case per point).
+chaotic=0.01``: it fails where the 95 % upper bound of a probability exceeds its limit (at
+99.3 % a look with ``--samples auto``), naming the points (and in JUnit, one test case per
+point); its ``--json`` is the gate's report (``gate.probability``), the study inside it.
 """
 
 from __future__ import annotations
@@ -26,19 +27,17 @@ from gearengine.cli.envelope import budget_refusal, option_axes
 from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import ENVELOPE_SETTINGS, gate_settings
+from gearengine.gate.probability import ONE_LOOK, ProbabilityReport, probability_report
+from gearengine.jsonio import dumps
 from gearengine.model.units import IMPACTS_REFUSED, display_unit
 from gearengine.studies import jobs
 from gearengine.studies.robustness.sequential import (
-    ERROR,
     FIRST_SAMPLES,
     SequentialResult,
-    decision_interval,
     looks,
     sequential,
-    verdict,
 )
 from gearengine.studies.robustness.study import (
-    RobustnessPoint,
     RobustnessRequest,
     RobustnessResult,
     checked,
@@ -125,10 +124,10 @@ def limits_of(texts: list[str]) -> dict[str, float]:
     return out
 
 
-def junit(result: RobustnessResult, why: list[list[str]], name: str) -> str:
+def junit(report: ProbabilityReport, name: str) -> str:
     """JUnit XML: one test case per operating point, failed once with its reasons."""
-    cases = [Case(point_name(p.shown), reasons, [r.split(")")[0] + ")" for r in reasons])
-             for p, reasons in zip(result.points, why, strict=True)]  # fmt: skip
+    cases = [Case(point_name(p.shown), v.reasons, [r.split(")")[0] + ")" for r in v.reasons])
+             for p, v in zip(report.result.points, report.verdicts, strict=True)]  # fmt: skip
     return junit_xml("gearchaos robustness", name, "robustness", cases)
 
 
@@ -183,49 +182,26 @@ def _power_of_two(n: int) -> int:
     return 1 << max(0, (int(n) - 1).bit_length())
 
 
-def auto_study(args: argparse.Namespace, doc: object, limits: dict[str, float]) -> SequentialResult:
+def auto_study(args: argparse.Namespace, doc: object, limits: dict[str, float]
+               ) -> tuple[SequentialResult, str]:  # fmt: skip
     """``--samples auto`` on the design document ``doc`` (read once: standard input too): each
     point sampled until it is decided, within the job budget
     (``studies.robustness.sequential``); refused before computing when even the first round
-    (``FIRST_SAMPLES`` at every point) is over the budget."""
+    (``FIRST_SAMPLES`` at every point) is over the budget. With how it stopped, in words."""
     args.samples, args.auto = FIRST_SAMPLES, True
     request = robustness_request(args, doc)  # the first round's budget, in the user's terms
     budget = jobs.job_step_budget()
     tick = progress(time.monotonic(), "robustness")
     out = sequential(request, limits, budget, workers=os.cpu_count() or 1, progress=tick)
     rounds = ", ".join(str(n) for n in out.rounds)
-    print(f"--samples auto: {out.stopped} (rounds of {rounds} samples, {out.steps} RK4 steps "
-          f"of a budget of {budget}); each look decides at {100 * out.confidence:.3g} %, the "
-          f"5 % error shared over the {looks()} looks a point may take",
-          file=sys.stderr)  # fmt: skip
-    return out
+    note = (f"--samples auto: {out.stopped} (rounds of {rounds} samples, {out.steps} RK4 steps "
+            f"of a budget of {budget}); each look decides at {100 * out.confidence:.3g} %, the "
+            f"5 % error shared over the {looks()} looks a point may take")  # fmt: skip
+    return out, note
 
 
 GATE_SAMPLES = 64
 """``check --max-probability``'s samples a point when ``--samples`` is not given."""
-ERROR_FREE = 1.0 - ERROR
-"""The confidence of one look: the results' 95 % intervals."""
-
-
-def verdict_reasons(point: RobustnessPoint, limits: dict[str, float],
-                    confidence: float = ERROR_FREE) -> list[str]:  # fmt: skip
-    """The limits a point does not prove, in words: over (its lower bound above the limit) or
-    undecided (the interval holds the limit); the intervals the verdict read, at ``confidence``
-    (``sequential.decision_interval``), named when not the results' 95 %."""
-    at = "" if confidence == ERROR_FREE else f" at {100 * confidence:.3g} %"
-    why = []
-    for name, limit in limits.items():
-        prob = point.probabilities[name]
-        ci = decision_interval(prob, confidence)
-        if ci is None:
-            why.append(f"P({name}) undecided: no samples")
-        elif ci[0] > limit:
-            why.append(f"P({name}) lower bound{at} {ci[0]:.3g} > {limit:g} "
-                       f"({prob.count}/{prob.samples} samples)")  # fmt: skip
-        elif ci[1] > limit:
-            why.append(f"P({name}) undecided: upper bound{at} {ci[1]:.3g} > {limit:g} "
-                       f"({prob.count}/{prob.samples} samples)")  # fmt: skip
-    return why
 
 
 def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
@@ -236,26 +212,25 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     args.samples = GATE_SAMPLES if args.samples is None else args.samples
     args.seed = 0 if args.seed is None else args.seed
     samples_needed(limits, args.samples)
-    confidence = ERROR_FREE
+    confidence, notes = ONE_LOOK, []
     if args.samples == "auto":
-        auto = auto_study(args, doc, limits)
-        result, verdicts, confidence = auto.result, auto.verdicts, auto.confidence
+        auto, note = auto_study(args, doc, limits)
+        result, confidence, notes = auto.result, auto.confidence, [note]
+        print(note, file=sys.stderr)
     else:
         _, result = study(args, doc)
-        verdicts = [verdict(p, limits) for p in result.points]
-    why = [verdict_reasons(p, limits, confidence) for p in result.points]
+    report = probability_report(result, limits, confidence, notes)
     counts = sorted({p.samples for p in result.points})
     sampled = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
     print(f"probabilities from {sampled} samples a point, {result.starts_text()}")
-    for p, v, reasons in zip(result.points, verdicts, why, strict=True):
-        shown = {"pass": "PASS", "fail": "FAIL", "undecided": "UNDECIDED"}[v]
-        extra = f" [{'; '.join(reasons)}]" if reasons else ""
-        print(f"{shown}: {point_name(p.shown)} ({p.samples} samples){extra}")
+    for p, v in zip(result.points, report.verdicts, strict=True):
+        shown = {"pass": "PASS", "fail": "FAIL", "undecided": "UNDECIDED"}[v.verdict]
+        extra = f" [{'; '.join(v.reasons)}]" if v.reasons else ""
+        print(f"{shown}: {point_name(p.shown)} ({v.samples} samples){extra}")
     if args.json:
-        Path(args.json).write_text(result.model_dump_json())
+        Path(args.json).write_text(dumps(report))
     if args.junit:
-        Path(args.junit).write_text(junit(result, why, f"robustness of {args.file}"))
-    failed, undecided = verdicts.count("fail"), verdicts.count("undecided")
-    print(f"{'FAIL' if failed or undecided else 'PASS'}: {failed} of {len(why)} points over a "
-          f"probability limit, {undecided} undecided", file=sys.stderr)  # fmt: skip
-    return EXIT_FAIL if failed or undecided else EXIT_OK
+        Path(args.junit).write_text(junit(report, f"robustness of {args.file}"))
+    print(f"{'PASS' if report.passed else 'FAIL'}: {report.failing_points} of {report.points} "
+          f"points over a probability limit, {report.undecided_points} undecided")  # fmt: skip
+    return EXIT_OK if report.passed else EXIT_FAIL

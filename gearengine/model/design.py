@@ -210,7 +210,7 @@ class TransmissionError(StrictModel):
     harmonics: list[ErrorHarmonic] | None = Field(
         None, max_length=MAX_HARMONICS, description="The harmonics e_r; or give accuracy_class."
     )
-    accuracy_class: WholeNumber | None = Field(
+    accuracy_class: iso1328.AccuracyClass | None = Field(
         None,
         ge=1,
         le=11,

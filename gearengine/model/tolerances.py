@@ -23,6 +23,7 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from gearengine.model.params import request_config
+from gearengine.model.standards.iso1328 import AccuracyClass
 from gearengine.model.units import Length
 
 Value = Annotated[float, Field(allow_inf_nan=False)] | str
@@ -72,7 +73,7 @@ class Accuracy(BaseModel):
     )
 
     standard: Literal["ISO 1328-1:2013"] = Field(description="The standard.")
-    tolerance_class: int = Field(
+    tolerance_class: AccuracyClass = Field(
         alias="class", ge=1, le=11, description="Flank tolerance class A, 1 (finest) to 11."
     )
 

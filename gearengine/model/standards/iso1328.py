@@ -25,7 +25,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Annotated, Protocol
+
+from pydantic import BeforeValidator
 
 from gearengine.model.errors import InputError
 
@@ -48,6 +50,27 @@ FIELDS: dict[str, str] = {
     "face_width": "{gear}.face_width",
 }
 """The design's field (under ``design``) each input of clause 1 comes from (d = m_n z)."""
+
+
+def class_number(value: object) -> int:
+    """A flank tolerance class as a whole number of ``RANGES["class"]`` (7.0 read as 7);
+    anything else refused saying what is accepted, a string too ("7": a class is written as the
+    number, as every count of a request is), where pydantic's words named only the type."""
+    low, high = RANGES["class"]
+    if isinstance(value, float) and value.is_integer():
+        value = int(value)
+    if isinstance(value, int) and not isinstance(value, bool) and low <= value <= high:
+        return value
+    text = f"not {value!r}"
+    if isinstance(value, str) and value.strip().isdigit() and low <= int(value) <= high:
+        text = f"write it as the number {int(value)}, not the text {value!r}"
+    raise ValueError(f"an {STANDARD} flank tolerance class is a whole number from {low:g} "
+                     f"(finest) to {high:g}, e.g. 7; {text}")  # fmt: skip
+
+
+AccuracyClass = Annotated[int, BeforeValidator(class_number)]
+"""An ISO 1328-1:2013 flank tolerance class (``class_number``); a field of it sets ``ge`` and
+``le`` from ``RANGES["class"]`` for its JSON Schema (``minimum``, ``maximum``)."""
 
 
 def class_step(tolerance_class: int) -> float:

@@ -20,6 +20,7 @@ from gearengine.model.units import (
     in_display_unit,
 )
 from gearengine.numerics.headline import of_starts
+from gearengine.numerics.magnitudes import ADVERSE
 from gearengine.studies.sweep.axes import axis_unit, bare_reading, is_dimensionless
 from gearengine.studies.sweep.points import SweepBifurcation, SweepPoint
 from gearengine.studies.sweep.request import SweepAxis
@@ -125,10 +126,17 @@ CSV_FIELDS = (
 )
 """The CSV's columns after the axes, the long Poincaré column last."""
 
-BASIN_COLUMNS = ("decided_by", "decided_fraction", "basin_starts", "attractors")
-"""The CSV's last columns with settings.basins: who decided the verdict columns (the worst
-attractor above basins.min_fraction) and its fraction, the starts run, and every attractor with
-its basin fraction, worst first ('chaotic, double-sided impacts: 0.3125; periodic 1T, ...')."""
+LLE_UNIT = "1/tau"
+"""The unit of an LLE: per unit of the dimensionless time tau = omega_n t (docs/units.md)."""
+TITLES = {"lle": f"lle [{LLE_UNIT}]", "lle_stderr": f"lle_stderr [{LLE_UNIT}]"}
+"""The CSV titles of the ``CSV_FIELDS`` that have a unit."""
+BASIN_COLUMNS = ("decided_by", "decided_fraction", "basin_starts")
+"""The CSV's columns with settings.basins, before the ``attractor_columns``: who decided the
+verdict columns (the worst attractor above basins.min_fraction), its fraction, the starts run."""
+ATTRACTOR_COLUMNS = ("class", "period", "impact_regime", "fraction", "fraction_low",
+                     "fraction_high", f"lle [{LLE_UNIT}]")  # fmt: skip
+"""Each attractor's columns with settings.basins (``attractor_columns``): its class, period (in
+T0), contact regime, basin fraction with its 95 % Wilson interval, and LLE."""
 FROM_COLUMNS = tuple(f"{key}_from" for key in POINT_OUTPUTS)
 """With settings.basins and a design's magnitude columns, before ``BASIN_COLUMNS``: the
 attractor each magnitude column comes from (``SweepPoint.magnitudes_from``, 'periodic 1T, ...
@@ -142,6 +150,7 @@ def csv_rows(
     outputs: Sequence[str] | None = None,
     design: bool = False,
     basins: bool = False,
+    attractors: int = 0,
 ) -> Iterator[str]:
     """CSV rows (header first): one column per axis, a design's field in SI units and titled
     with its unit (``speed [rad/s]``, ``torque [N*m]``); with a ``design`` (a sweep of a design
@@ -149,23 +158,29 @@ def csv_rows(
     and, unless ``outputs`` leaves ``physical`` out, the DTE, the dynamic factor and the mesh
     forces in N (``dte [um]``, ``dynamic_factor``, ``force_max [N]``, ``force_min [N]``, from the
     point's ``physical``; the unitless ``force_max`` and ``force_min`` in units of b k_m are
-    then left out: with basins they would be another start's); then the verdicts, and
-    poincare_x as space-separated numbers. Empty cells are nulls; booleans are true/false. Axis
-    cells are plain decimals (``_axis_cell``: 500, 0.000001, never 500.0 beside 1e-6), rounded
-    to the 15 significant digits they were given with (``_grid_value``); every other number is
-    written as the JSON result writes it (``_json_numbers``). With ``outputs``
-    (``SweepRequest.outputs``) only the columns it names (and branch) are written. Rows are
-    yielded one by one, so a streamed response never holds the whole table. With ``basins`` (a
-    sweep with settings.basins, whose verdict columns are the worst attractor's) the
-    ``FROM_COLUMNS`` (with the magnitude columns) and the ``BASIN_COLUMNS`` follow."""
+    then left out: with basins they would be another start's); then the verdicts (the LLE per
+    unit tau: ``lle [1/tau]``), and poincare_x as space-separated numbers. Empty cells are
+    nulls; booleans are true/false. Axis cells are plain decimals (``_axis_cell``: 500,
+    0.000001, never 500.0 beside 1e-6), rounded to the 15 significant digits they were given
+    with (``_grid_value``); every other number is written as the JSON result writes it
+    (``_json_numbers``). With ``outputs`` (``SweepRequest.outputs``) only the columns it names
+    (and branch) are written. Rows are yielded one by one, so a streamed response never holds
+    the whole table. With ``basins`` (a sweep with settings.basins, whose verdict columns are
+    the worst attractor's) the ``FROM_COLUMNS`` (with the magnitude columns) and the
+    ``BASIN_COLUMNS`` follow, then the columns of ``attractors`` attractors, worst first
+    (``attractor_columns``; the most any point has), empty where a point has fewer."""
     names = [a.parameter for a in axes]
     extra = _physical_columns(names, outputs) if design else []
     magnitudes = [key for key, _, axis in extra if not axis]
     fields = [f for f in CSV_FIELDS if (outputs is None or f == "branch" or f in outputs)
               and not (f in RECORD_FORCES and f in magnitudes)]  # fmt: skip
-    header = [*map(_axis_title, names), *(title for _, title, _ in extra), *fields]
+    header = [*map(_axis_title, names), *(title for _, title, _ in extra),
+              *(TITLES.get(f, f) for f in fields)]  # fmt: skip
     named = basins and bool(magnitudes)
-    header += (*(FROM_COLUMNS if named else ()), *BASIN_COLUMNS) if basins else ()
+    found = attractors if basins else 0
+    if basins:
+        header += [*(FROM_COLUMNS if named else ()), *BASIN_COLUMNS,
+                   *attractor_columns(found, named)]  # fmt: skip
     yield ",".join(_text_cell(c) for c in header) + "\n"
     shown = [(key, axis) for key, _, axis in extra]
     for p in points:
@@ -174,7 +189,47 @@ def csv_rows(
             fields_of = p.__dict__ if isinstance(p, SweepPoint) else p
             cells += _from_cells(fields_of) if named else []
             cells += _basin_cells(fields_of)
+            cells += _attractor_cells(fields_of, found, named)
         yield ",".join(cells) + "\n"
+
+
+def attractor_columns(count: int, magnitudes: bool) -> list[str]:
+    """The titles of ``count`` attractors' columns, ``attractor_1_class``, ...,
+    ``attractor_1_lle [1/tau]``, then ``attractor_2_class``, ... (1 the worst, as a point's
+    ``attractors``): the ``ATTRACTOR_COLUMNS``, with ``magnitudes`` (a design's sweep) also its
+    ``dte [um]``, ``dynamic_factor``, ``force_max [N]``, ``force_min [N]``."""
+    names = [*ATTRACTOR_COLUMNS, *(display_label(key) for key in ADVERSE if magnitudes)]
+    return [f"attractor_{k}_{name}" for k in range(1, count + 1) for name in names]
+
+
+def _attractor_cells(p: PointFields, count: int, magnitudes: bool) -> list[str]:
+    """The cells of ``attractor_columns`` of a point (empty past its own attractors)."""
+    found = p.get("attractors") or []
+    width = len(attractor_columns(1, magnitudes))
+    cells: list[str] = []
+    for k in range(count):
+        if k >= len(found):
+            cells += [""] * width
+            continue
+        a = found[k] if isinstance(found[k], Mapping) else found[k].__dict__
+        low, high = a["interval"]
+        shown = [a[key] for key, _, _ in ADVERSE.values()] if magnitudes else []
+        values = [a["classification"], a["period"], a["impact_regime"], a["fraction"], low,
+                  high, a["lle"], *shown]  # fmt: skip
+        cells += [_value_cell(v) for v in values]
+    return cells
+
+
+def _value_cell(value: object) -> str:
+    """A cell of one value: empty for null, a text or a whole number as it is, a float as the
+    JSON writes it."""
+    if value is None:
+        return ""
+    if isinstance(value, str):
+        return _text_cell(value)
+    if isinstance(value, int):
+        return str(value)
+    return _json_numbers([float(value)])[0]  # type: ignore[arg-type]
 
 
 def _from_cells(p: PointFields) -> list[str]:
@@ -195,19 +250,14 @@ def _from_cells(p: PointFields) -> list[str]:
 
 def _basin_cells(p: PointFields) -> list[str]:
     """The ``BASIN_COLUMNS`` cells of a point (empty where it has no basins)."""
-
-    def field(item: Any, key: str) -> Any:
-        return item[key] if isinstance(item, Mapping) else getattr(item, key)
-
-    found = p.get("attractors")
     counts = p.get("basins")
     fraction = p.get("decided_fraction")
-    listed = "; ".join(f"{field(a, 'label')}: {field(a, 'fraction'):.6g}" for a in found or [])
+    starts = None if counts is None else (
+        counts["starts"] if isinstance(counts, Mapping) else counts.starts)  # fmt: skip
     return [
         "" if p.get("decided_by") is None else _text_cell(str(p["decided_by"])),
         "" if fraction is None else _json_numbers([float(fraction)])[0],
-        "" if counts is None else str(field(counts, "starts")),
-        _text_cell(listed) if listed else "",
+        "" if starts is None else str(starts),
     ]
 
 

@@ -15,6 +15,7 @@ settings' initial states and points of a chunk run together in ``simulate_batch`
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
 from typing import Annotated, Literal
 
@@ -28,6 +29,7 @@ from gearengine.model.examples import PAPER_SECTION_41
 from gearengine.model.params import GearParams, WholeNumber, request_config
 from gearengine.model.reduction import ParamsOrDesign
 from gearengine.model.units import Scales
+from gearengine.model.units.quantities import NUMBER
 from gearengine.numerics.settings import RequestSettings, SimulationSettings
 from gearengine.studies.sweep.axes import (
     axis_problem,
@@ -102,12 +104,41 @@ class SweepAxis(BaseModel):
 
     def values(self, design: Design | None = None) -> list[float]:
         """The ``num`` values, start to stop (``numpy.linspace``), in SI units for a physical
-        field of ``design``."""
+        field of ``design``. A physical axis whose ends are written in one unit is spaced in
+        that unit ("1000 rpm" to "6000 rpm": in rpm), each inner value taken as the decimal it
+        shows (15 significant digits) and converted as that value alone would be: a point is
+        the same float on every grid it is on (4750 rpm of 1000:6000 in 5 points was one ulp
+        from a one-point axis at 4750 rpm, and its robustness counts could differ)."""
         lo, hi = self.start, self.stop
-        if not is_dimensionless(self.parameter):
-            assert design is not None
-            lo, hi = (si_value(design, self.parameter, v) for v in (lo, hi))
-        return [float(v) for v in np.linspace(float(lo), float(hi), self.num)]
+        if is_dimensionless(self.parameter):
+            return [float(v) for v in np.linspace(float(lo), float(hi), self.num)]
+        assert design is not None
+        (a, unit), (b, same) = _written(lo), _written(hi)
+        if unit and unit == same:
+            shown = _shown(np.linspace(a, b, self.num))
+            return [si_value(design, self.parameter, f"{v!r} {unit}") for v in shown]
+        lo, hi = (si_value(design, self.parameter, v) for v in (lo, hi))
+        spaced = np.linspace(lo, hi, self.num)  # bare numbers (SI already), or two units
+        return _shown(spaced) if unit == same == "" else [float(v) for v in spaced]
+
+
+def _shown(spaced: np.ndarray) -> list[float]:
+    """Evenly spaced values, each inner one as the decimal it shows (15 significant digits:
+    3999.9999999999995 is 4000), the ends as given."""
+    last = len(spaced) - 1
+    return [float(v) if i in (0, last) else float(f"{v:.15g}") for i, v in enumerate(spaced)]
+
+
+_WRITTEN = re.compile(rf"\s*({NUMBER})\s*(.*?)\s*")
+
+
+def _written(value: float | str) -> tuple[float, str | None]:
+    """An axis end as (number, unit as written): a bare number's unit is SI (""), a string's
+    the text after its number; None for a string that does not start with a number."""
+    if not isinstance(value, str):
+        return float(value), ""
+    found = _WRITTEN.fullmatch(value)
+    return (0.0, None) if found is None else (float(found.group(1)), found.group(4))
 
 
 class SweepRequest(ParamsOrDesign):

@@ -77,9 +77,11 @@ class SweepResult(BaseModel):
 def to_csv(
     result: SweepResult, outputs: Sequence[str] | None = None, design: bool = False
 ) -> Iterator[str]:
-    """CSV rows of a result (see ``csv_rows``; the basin columns when its points have basins)."""
+    """CSV rows of a result (see ``csv_rows``; the basin columns when its points have basins,
+    with as many attractors' columns as a point has attractors at most)."""
     basins = any(p.attractors is not None for p in result.points)
-    return csv_rows(result.axes, result.points, outputs, design, basins)
+    most = max((len(p.attractors or []) for p in result.points), default=0)
+    return csv_rows(result.axes, result.points, outputs, design, basins, most)
 
 
 def to_pandas(result: SweepResult) -> Any:

@@ -88,6 +88,12 @@ def _stored_points(jobs: JobQueue, job_id: str) -> Iterator[dict[str, object]]:
         yield from points_of_chunk(array)
 
 
+def _most_attractors(jobs: JobQueue, job_id: str) -> int:
+    """The most attractors a stored point has (a sweep with settings.basins): the CSV's
+    header has that many attractors' columns, so the points are read once before it."""
+    return max((len(p.get("attractors") or []) for p in _stored_points(jobs, job_id)), default=0)
+
+
 def _points(jobs: JobQueue, job_id: str) -> Iterator[SweepPoint]:
     for array in jobs.store.chunk_results(job_id):
         for item in points_of_chunk(array):
@@ -139,10 +145,11 @@ def get_result(
     if format == "csv":
         designed = sweep.design is not None
         basins = sweep.settings.basins is not None
+        most = _most_attractors(jobs, job_id) if basins else 0
         name = f"sweep-{job_id}{'-partial' if missing else ''}.csv"
         return StreamingResponse(
             text_blocks(
-                csv_rows(axes, _stored_points(jobs, job_id), sweep.outputs, designed, basins)
+                csv_rows(axes, _stored_points(jobs, job_id), sweep.outputs, designed, basins, most)
             ),
             media_type=CSV,
             headers={"Content-Disposition": f'attachment; filename="{name}"', **headers},

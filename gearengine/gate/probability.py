@@ -1,0 +1,127 @@
+"""The probability gate's report (``gearengine check ... --max-probability chaotic=0.01``): per
+operating point its verdict (pass, fail or undecided), the reasons, and for each limit the
+Clopper-Pearson interval the verdict read at the confidence it decided at (95 % for a fixed
+``--samples N``, one look; 1 - 0.05 / looks for ``--samples auto``, ``sequential``), with the
+robustness result it was read from, as the envelope gate's report carries its sweep.
+"""
+
+from __future__ import annotations
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from gearengine.model.units import display_unit
+from gearengine.studies.robustness.sequential import ERROR, Verdict, decision_interval, verdict
+from gearengine.studies.robustness.study import RobustnessPoint, RobustnessResult
+from gearengine.studies.sweep.points import PhysicalValue
+
+ONE_LOOK = 1.0 - ERROR
+"""The confidence of one look (a fixed sample count): the results' 95 % intervals."""
+
+
+class LimitVerdict(BaseModel):
+    """One probability limit at one operating point, as the verdict read it."""
+
+    model_config = ConfigDict(frozen=True)
+
+    limit: float = Field(description="The largest probability allowed.")
+    verdict: Verdict = Field(
+        description="pass: the upper bound is at or below the limit; fail: the lower bound is "
+        "above it; undecided: the interval holds the limit (or no samples)."
+    )
+    count: int = Field(description="Samples k with the outcome.")
+    samples: int = Field(description="Samples n counted.")
+    interval: list[float] | None = Field(
+        description="The Clopper-Pearson interval [low, high] the verdict read, at confidence "
+        "(null without samples)."
+    )
+    confidence: float = Field(
+        description="The confidence of interval: 0.95 for a fixed sample count, 0.993 for a "
+        "look of --samples auto (the 5 % error shared over its looks)."
+    )
+
+
+class PointVerdict(BaseModel):
+    """The gate's verdict at one operating point."""
+
+    model_config = ConfigDict(frozen=True)
+
+    point: dict[str, PhysicalValue] = Field(description="The operating point in gear units.")
+    verdict: Verdict = Field(
+        description="fail: a limit's lower bound is above it; pass: every upper bound is at or "
+        "below its limit; else undecided (fails the gate: it proves nothing)."
+    )
+    reasons: list[str] = Field(description="The limits not proved, in words (as the text).")
+    limits: dict[str, LimitVerdict] = Field(description="Per limited probability.")
+    samples: int = Field(description="Samples counted at this point.")
+    starts_per_sample: int = Field(description="Initial states each sample ran.")
+
+
+class ProbabilityReport(BaseModel):
+    """The verdict of the probability gate (``gearengine check --max-probability``)."""
+
+    model_config = ConfigDict(frozen=True)
+
+    passed: bool = Field(description="True when every point passes (none fails or is undecided).")
+    limits: dict[str, float] = Field(description="The largest probability allowed, per event.")
+    confidence: float = Field(description="The confidence every verdict decided at.")
+    points: int = Field(description="Operating points checked.")
+    failing_points: int = Field(description="Points over a limit.")
+    undecided_points: int = Field(description="Points whose intervals hold a limit.")
+    verdicts: list[PointVerdict] = Field(description="Per operating point, as result.points.")
+    notes: list[str] = Field([], description="How the samples were taken, where it needs saying.")
+    result: RobustnessResult = Field(description="The robustness result (95 % intervals).")
+
+
+def verdict_reasons(point: RobustnessPoint, limits: dict[str, float],
+                    confidence: float = ONE_LOOK) -> list[str]:  # fmt: skip
+    """The limits a point does not prove, in words: over (its lower bound above the limit) or
+    undecided (the interval holds the limit); the intervals the verdict read, at ``confidence``
+    (``sequential.decision_interval``), named when not the results' 95 %."""
+    at = "" if confidence == ONE_LOOK else f" at {100 * confidence:.3g} %"
+    why = []
+    for name, limit in limits.items():
+        prob = point.probabilities[name]
+        ci = decision_interval(prob, confidence)
+        if ci is None:
+            why.append(f"P({name}) undecided: no samples")
+        elif ci[0] > limit:
+            why.append(f"P({name}) lower bound{at} {ci[0]:.3g} > {limit:g} "
+                       f"({prob.count}/{prob.samples} samples)")  # fmt: skip
+        elif ci[1] > limit:
+            why.append(f"P({name}) undecided: upper bound{at} {ci[1]:.3g} > {limit:g} "
+                       f"({prob.count}/{prob.samples} samples)")  # fmt: skip
+    return why
+
+
+def point_verdict(point: RobustnessPoint, limits: dict[str, float], confidence: float,
+                  starts: int, units: dict[str, str] | None) -> PointVerdict:  # fmt: skip
+    """One point's verdict under ``limits`` at ``confidence`` (``sequential.verdict``), its
+    values in ``units`` (the result's ``shown_units``, else ``display_unit``)."""
+    read = {}
+    for name, limit in limits.items():
+        prob = point.probabilities[name]
+        read[name] = LimitVerdict(
+            limit=limit, verdict=verdict(point, {name: limit}, confidence), count=prob.count,
+            samples=prob.samples, interval=decision_interval(prob, confidence),
+            confidence=confidence,
+        )  # fmt: skip
+    shown = {k: PhysicalValue(value=v, unit=(units or {}).get(k) or display_unit(k)[0])
+             for k, v in point.shown.items()}  # fmt: skip
+    return PointVerdict(point=shown, verdict=verdict(point, limits, confidence),
+                        reasons=verdict_reasons(point, limits, confidence), limits=read,
+                        samples=point.samples, starts_per_sample=starts)  # fmt: skip
+
+
+def probability_report(result: RobustnessResult, limits: dict[str, float],
+                       confidence: float = ONE_LOOK, notes: list[str] | None = None
+                       ) -> ProbabilityReport:  # fmt: skip
+    """The gate's report of ``result`` under ``limits``, each verdict read at ``confidence``."""
+    verdicts = [point_verdict(p, limits, confidence, result.starts_per_sample,
+                              result.shown_units) for p in result.points]  # fmt: skip
+    said = [v.verdict for v in verdicts]
+    return ProbabilityReport(
+        passed=all(v == "pass" for v in said), limits=limits, confidence=confidence,
+        points=len(said), failing_points=said.count("fail"),
+        undecided_points=said.count("undecided"), verdicts=verdicts, notes=notes or [],
+        result=result,
+    )  # fmt: skip
