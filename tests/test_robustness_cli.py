@@ -10,6 +10,7 @@ from xml.etree import ElementTree
 import pytest
 
 from gearengine.cli.main import main
+from gearengine.cli.robustness import ONE_START
 from gearengine.gate.envelope import ENVELOPE_SETTINGS
 from gearengine.studies.robustness.study import RobustnessRequest, run_local
 from tests.test_robustness import DESIGN
@@ -107,11 +108,18 @@ def test_the_answers_say_how_many_starts_decided_each_sample(
     base = ["check", str(design_file), "--speed", "5000:5000", "--speed-points", "1",
             "--samples", "8", "--max-probability", "back_flank=0.5"]  # fmt: skip
     assert main([*base, "--json", str(out)]) == 0
-    assert json.loads(out.read_text())["result"]["starts_per_sample"] == 1
-    assert "8 samples a point, 1 start a sample" in capsys.readouterr().out
+    report, text = json.loads(out.read_text()), capsys.readouterr().out
+    assert report["result"]["starts_per_sample"] == 1
+    assert "8 samples a point, 1 start a sample" in text
+    # one start is the gate's default, unlike the envelope check's 16: said where it is read
+    # (review of issue 30), with the way to the envelope's rule and its cost
+    assert ONE_START in text and ONE_START in report["notes"]
+    assert "worst attractor of the 16 starts" in ONE_START and "--starts 16" in ONE_START
     assert main([*base, "--starts", "4", "--json", str(out)]) == 0
-    assert json.loads(out.read_text())["verdicts"][0]["starts_per_sample"] == 4
-    assert "8 samples a point, 4 starts a sample (settings.basins)" in capsys.readouterr().out
+    report, text = json.loads(out.read_text()), capsys.readouterr().out
+    assert report["verdicts"][0]["starts_per_sample"] == 4
+    assert "8 samples a point, 4 starts a sample (settings.basins)" in text
+    assert ONE_START not in text and ONE_START not in report["notes"]
     args = [str(design_file), "--speed", "5000:5000", "--speed-points", "1", "--samples", "8"]
     assert main(["robustness", *args]) == 0
     assert "(8 samples, 1 start a sample)" in capsys.readouterr().out
@@ -273,5 +281,5 @@ def test_the_gates_json_is_its_report_at_the_confidence_it_decided_at(
                  "--json", str(out)]) == 0  # fmt: skip
     assert "PASS: 0 of 2 points over a probability limit" in capsys.readouterr().out
     report = json.loads(out.read_text())
-    assert report["passed"] and report["confidence"] == 0.95 and report["notes"] == []
+    assert report["passed"] and report["confidence"] == 0.95 and report["notes"] == [ONE_START]
     assert [v["verdict"] for v in report["verdicts"]] == ["pass", "pass"]

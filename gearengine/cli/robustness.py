@@ -204,6 +204,14 @@ GATE_SAMPLES = 64
 """``check --max-probability``'s samples a point when ``--samples`` is not given."""
 
 
+ONE_START = (
+    "each sample is judged from the settings' own start, not as the worst attractor of the 16 "
+    "starts the envelope check runs a point: another attractor of a sample may be chaotic; "
+    "--starts 16 judges each sample by its worst of 16 starts, at 17x the work"
+)
+"""The probability gate's words for one start a sample (its default, chosen for its cost)."""
+
+
 def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     """``check --max-probability`` of the design document ``doc``: exit 1 where a point is over
     a limit or undecided (its interval holds the limit); a sample count that cannot prove a
@@ -219,10 +227,14 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
         print(note, file=sys.stderr)
     else:
         _, result = study(args, doc)
+    if result.starts_per_sample == 1:
+        notes.append(ONE_START)
     report = probability_report(result, limits, confidence, notes)
     counts = sorted({p.samples for p in result.points})
     sampled = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
     print(f"probabilities from {sampled} samples a point, {result.starts_text()}")
+    if result.starts_per_sample == 1:
+        print(ONE_START)
     for p, v in zip(result.points, report.verdicts, strict=True):
         shown = {"pass": "PASS", "fail": "FAIL", "undecided": "UNDECIDED"}[v.verdict]
         extra = f" [{'; '.join(v.reasons)}]" if v.reasons else ""
