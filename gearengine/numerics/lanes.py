@@ -74,10 +74,12 @@ def last_strobes(out: tuple, lanes: list[int]) -> list[list]:
 
 
 def lane_point(
-    out: tuple, lane: int, start_index: int, verdict: tuple, strobes: list
-) -> BatchPoint:
+    out: tuple, lane: int, start_index: int, verdict: tuple, strobes: list,
+    periods_run: int | None = None,
+) -> BatchPoint:  # fmt: skip
     """The ``BatchPoint`` of ``lane`` (as ``batch.run_verdict`` gives it), numbered
-    ``start_index``, with that lane's last ``strobes``."""
+    ``start_index``, with that lane's last ``strobes``; ``periods_run`` when the lane ran more
+    than this call's intervals (``batch.physical_lanes``: its transient), else this call's."""
     _, _, _, xmin, xmax, fmin, fmax, done, _, diverged, xf, vf = out
     classification, period, lle, stderr = verdict
     dead = bool(diverged[lane])
@@ -93,7 +95,7 @@ def lane_point(
         poincare=strobes,
         start_index=start_index,
         x_peak_to_peak=None if dead else finite_or_none(hi - lo),
-        periods_run=int(done[lane]),
+        periods_run=int(done[lane]) if periods_run is None else periods_run,
         force_max=None if dead else finite_or_none(float(fmax[lane])),
         force_min=None if dead else finite_or_none(float(fmin[lane])),
     )
