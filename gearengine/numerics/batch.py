@@ -163,9 +163,11 @@ def _run_lanes(
     lanes: Sequence[Lane],
     settings: SimulationSettings,
     numbers: Sequence[int],
+    x_only: bool = False,
 ) -> list[BatchPoint]:
     """``run_lanes`` with each lane's ``start_index`` given (``numbers``, shape (L,)), so no
-    verdict is copied to be renumbered (three copies a point cost ~0.05 ms)."""
+    verdict is copied to be renumbered (three copies a point cost ~0.05 ms); with ``x_only``
+    the lock-step lanes keep the x of their last strobes alone (``lanes.last_strobes``)."""
     results: list[BatchPoint | None] = [None] * len(lanes)
     groups: dict[tuple[str, int], list[int]] = {}
     systems: dict[tuple, list[int]] = {}
@@ -205,7 +207,8 @@ def _run_lanes(
         if physical.applies(settings, plans[members[0]], 0.0):
             group = (lanes_of, laws, inverse, packed, mu, tabled, per, N)
             mine = [numbers[k] for k in ks]
-            for k, point in zip(ks, physical_lanes(group, x0, v0, settings, mine), strict=True):
+            got = physical_lanes(group, x0, v0, settings, mine, x_only)
+            for k, point in zip(ks, got, strict=True):
                 results[k] = point
             continue
         streams = max(1, min(numba.get_num_threads(), -(-len(ks) // kernels.LANES)))
@@ -213,9 +216,9 @@ def _run_lanes(
                   settings.adaptive, streams, *lle_tolerances(settings))  # fmt: skip
         out = lanes_of(laws, inverse, packed, mu, x0, v0, tabled, shared, fresh_carry(len(ks)))
         verdicts = lane_verdicts(out, per)
-        strobes = last_strobes(out, list(range(len(ks))))
+        strobes = last_strobes(out, list(range(len(ks))), x_only)
         for j, k in enumerate(ks):
-            results[k] = lane_point(out, j, numbers[k], verdicts[j], strobes[j])
+            results[k] = lane_point(out, j, numbers[k], verdicts[j], strobes[j], x_only=x_only)
     return results  # type: ignore[return-value]
 
 
@@ -246,7 +249,7 @@ def system_lanes(
 
 def physical_lanes(
     group: tuple, x0: np.ndarray, v0: np.ndarray, settings: SimulationSettings,
-    numbers: Sequence[int],
+    numbers: Sequence[int], x_only: bool = False,
 ) -> list[BatchPoint]:  # fmt: skip
     """The ``BatchPoint`` of every lane of one lock-step group, its lengths decided in physical
     time (``numerics.physical``): the transient and the record run in chunks through the same
@@ -260,6 +263,7 @@ def physical_lanes(
         x0, v0: the lanes' starts, shape (L,).
         settings: caps and tolerances.
         numbers: the ``start_index`` of each lane's ``BatchPoint``, shape (L,).
+        x_only: keep the x of the last strobes alone (``lanes.last_strobes``).
     """
     lanes_of, laws, inverse, packed, mu, tabled, per, N = group
 
@@ -299,7 +303,7 @@ def physical_lanes(
     outs = {id(s.keep[0]): s.keep[0] for s in spans}
     strobes: dict[tuple[int, int], list] = {}
     for key, out in outs.items():
-        got = last_strobes(out, rows[key])
+        got = last_strobes(out, rows[key], x_only)
         strobes.update({(key, j): w for j, w in zip(rows[key], got, strict=True)})
     points = []
     for s, number in zip(spans, numbers, strict=True):
@@ -307,7 +311,7 @@ def physical_lanes(
         n = out[0].shape[1]
         before = s.transient - (n if s.transient_reason == "diverged" else 0)
         points.append(lane_point(out, j, number, verdicts[id(out)][j], strobes[(id(out), j)],
-                                 before + int(out[7][j])))  # fmt: skip
+                                 before + int(out[7][j]), x_only))  # fmt: skip
     return points
 
 
@@ -336,25 +340,27 @@ def lle_tolerances(settings: SimulationSettings) -> tuple[float, float]:
 
 
 def simulate_batch(
-    points: Sequence[Point], settings: SimulationSettings | None = None
+    points: Sequence[Point], settings: SimulationSettings | None = None, x_only: bool = False
 ) -> list[BatchPoint]:
     """Verdict (period, LLE, final state, last strobes) for each parameter point of a sweep.
 
     Each point runs from every start of ``settings.starts()``, one lane per point and start
     (``run_lanes``); the point's verdict is its worst start's (``classify.severity``, the first
     such start on a tie), whose index in ``settings.starts()`` is ``start_index``. Numbers equal
-    those of ``simulate`` for the same point and start.
+    those of ``simulate`` for the same point and start. ``x_only``: the lock-step lanes keep
+    the x of their last strobes alone, in ``poincare_x`` (what a map's points show).
     """
-    return simulate_batch_with(points, settings or SimulationSettings(), [])[0]
+    return simulate_batch_with(points, settings or SimulationSettings(), [], x_only)[0]
 
 
 def simulate_batch_with(
-    points: Sequence[Point], settings: SimulationSettings, more: Sequence[Lane]
-) -> tuple[list[BatchPoint], list[BatchPoint]]:
+    points: Sequence[Point], settings: SimulationSettings, more: Sequence[Lane],
+    x_only: bool = False,
+) -> tuple[list[BatchPoint], list[BatchPoint]]:  # fmt: skip
     """``simulate_batch`` of ``points`` and ``run_lanes`` of ``more`` lanes of the same points
     (a chunk's basin starts), in one call of the kernels: one forcing table a point and one
     pass of the lock-step chunks for both. The same numbers as two calls: a lane's run does
-    not depend on the lanes beside it."""
+    not depend on the lanes beside it; ``x_only`` as ``simulate_batch``'s."""
     starts = settings.starts()
     plans = step_plans(points, settings.steps_per_period)
     for plan in plans:
@@ -362,7 +368,7 @@ def simulate_batch_with(
     lanes = [(i, s) for i in range(len(points)) for s in starts]
     S = len(starts)
     numbers = [*(j for _ in points for j in range(S)), *range(len(more))]
-    per_lane = _run_lanes(points, plans, [*lanes, *more], settings, numbers)
+    per_lane = _run_lanes(points, plans, [*lanes, *more], settings, numbers, x_only)
     worst = []
     for i in range(len(points)):
         block = per_lane[i * S : (i + 1) * S]
