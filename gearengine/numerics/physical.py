@@ -213,12 +213,12 @@ def _settle(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, 
         ran += n
         x[idx], v[idx] = c.xf, c.vf
         history.append((idx, c))
-        lanes = idx.tolist()
-        for j in np.flatnonzero(c.diverged).tolist():
+        lanes, dead = idx.tolist(), np.asarray(c.diverged, dtype=bool)
+        for j in np.flatnonzero(dead).tolist():
             s = out[lanes[j]]
             s.transient, s.transient_reason, s.keep = ran, "diverged", c.keep[j]
-        active[idx[c.diverged]] = False
-        checked = idx[np.logical_and(np.logical_not(c.diverged), n_min[idx] <= ran)]
+        active[idx[dead]] = False
+        checked = idx[np.logical_and(np.logical_not(dead), n_min[idx] <= ran)]
         for lane, p in _periods(history, checked, ran, r):
             s = out[lane]
             s.transient, s.period, s.transient_reason = ran, p, "settled"
