@@ -192,7 +192,7 @@ def _settle(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, 
 
     A lane still running has run every round so far (the active lanes only ever shrink) and
     the rounds are the same for every lane, so the window of strobes a check reads is the same
-    rounds for every lane: gathered once a round for all of them (``_windows``)."""
+    rounds for every lane: gathered once a round for all of them (``_periods``)."""
     cap = settings.transient_periods
     floor = np.ceil(DAMPING_TIMES / (np.maximum(mu, 1e-12) * period))
     n_min = np.minimum(floor, cap).astype(np.int64)
