@@ -140,11 +140,15 @@ def test_ensembles_inherit_it_through_their_settings() -> None:
     assert f.periods_run == 120 and a.periods_run < 40
 
 
+DIVERGING = GearParams.model_validate(
+    {"damping": 0.01, "backlash": {"model": "cubic", "a": -1.0, "c": -1.0},
+     "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 20.0}]}}
+)  # fmt: skip
+"""A softening law driven hard: leaves the divergence bound in its transient."""
+
+
 def test_diverging_run_stops_where_it_leaves_the_bound() -> None:
-    bad = GearParams.model_validate(
-        {"damping": 0.01, "backlash": {"model": "cubic", "a": -1.0, "c": -1.0},
-         "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 20.0}]}}
-    )  # fmt: skip
+    bad = DIVERGING
     r = simulate(bad)
     assert r.classification == "diverged" and r.transient.reason == "diverged"
     (b,) = simulate_batch([bad], SimulationSettings())
@@ -175,3 +179,18 @@ def test_a_record_run_on_is_the_longer_record_run_at_once(
     monkeypatch.setattr(physical, "lengths", lambda *args: lengths(*args[:7]))  # run again
     (again,) = simulate_batch([point])
     assert again.model_dump() == b.model_dump()
+
+
+@pytest.mark.parametrize("settings", [SimulationSettings(), FIXED], ids=["physical", "fixed"])
+def test_x_only_strobes_are_the_strobes_x(settings: SimulationSettings) -> None:
+    """``simulate_batch(x_only=True)`` (a map's points) gives the same verdicts with the x of
+    the last strobes in ``poincare_x`` instead of the [x, v] pairs (a diverging point too)."""
+    points = [paper(0.1), paper(0.5), QUASI_PERIODIC, DIVERGING]
+    full = simulate_batch(points, settings)
+    short = simulate_batch(points, settings, x_only=True)
+    assert full[-1].classification == "diverged"
+    for f, s in zip(full, short, strict=True):
+        assert s.poincare == [] and f.poincare_x is None
+        assert s.poincare_x == [x for x, _ in f.poincare]
+        keep = set(type(f).model_fields) - {"poincare", "poincare_x"}
+        assert s.model_dump(include=keep) == f.model_dump(include=keep)

@@ -65,6 +65,8 @@ def commensurability(
     freqs = sorted({f for f in frequencies if f > 0.0})
     if not freqs:
         return 0.0, 1.0
+    if len(freqs) == 1:  # its ratio to itself is 1 = 1 / 1, as below without the search
+        return 1.0, 1.0
     ratios = [rational(f / freqs[-1], max_denominator) for f in freqs]
     if None in ratios:
         return 0.0, 1.0

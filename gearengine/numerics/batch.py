@@ -154,7 +154,7 @@ def run_lanes(
     """
     settings = settings or SimulationSettings()
     plans = step_plans(points, settings.steps_per_period) if plans is None else plans
-    return _run_lanes(points, plans, lanes, settings)
+    return _run_lanes(points, plans, lanes, settings, range(len(lanes)))
 
 
 def _run_lanes(
@@ -162,7 +162,12 @@ def _run_lanes(
     plans: list[StepPlan],
     lanes: Sequence[Lane],
     settings: SimulationSettings,
+    numbers: Sequence[int],
+    x_only: bool = False,
 ) -> list[BatchPoint]:
+    """``run_lanes`` with each lane's ``start_index`` given (``numbers``, shape (L,)), so no
+    verdict is copied to be renumbered (three copies a point cost ~0.05 ms); with ``x_only``
+    the lock-step lanes keep the x of their last strobes alone (``lanes.last_strobes``)."""
     results: list[BatchPoint | None] = [None] * len(lanes)
     groups: dict[tuple[str, int], list[int]] = {}
     systems: dict[tuple, list[int]] = {}
@@ -176,11 +181,11 @@ def _run_lanes(
             systems.setdefault(key, []).append(k)
         else:
             start = as_system(point).start_state(*s)
-            results[k] = run_verdict(integrate(point, settings, start, plan), s, plan, k)
+            results[k] = run_verdict(integrate(point, settings, start, plan), s, plan, numbers[k])
     for ks in systems.values():
         for k, point in zip(ks, system_lanes(points, plans, [lanes[k] for k in ks], settings),
                             strict=True):  # fmt: skip
-            results[k] = point.model_copy(update={"start_index": k})
+            results[k] = point.model_copy(update={"start_index": numbers[k]})
     for (name, N), ks in groups.items():
         owner = np.array([lanes[k][0] for k in ks], dtype=np.int64)
         members, inverse = np.unique(owner, return_inverse=True)
@@ -201,17 +206,19 @@ def _run_lanes(
         laws = [law(points[i]) for i in members.tolist()]
         if physical.applies(settings, plans[members[0]], 0.0):
             group = (lanes_of, laws, inverse, packed, mu, tabled, per, N)
-            for k, point in zip(ks, physical_lanes(group, x0, v0, settings), strict=True):
-                results[k] = point.model_copy(update={"start_index": k})
+            mine = [numbers[k] for k in ks]
+            got = physical_lanes(group, x0, v0, settings, mine, x_only)
+            for k, point in zip(ks, got, strict=True):
+                results[k] = point
             continue
         streams = max(1, min(numba.get_num_threads(), -(-len(ks) // kernels.LANES)))
         shared = (per, N, settings.transient_periods, settings.record_periods, DIVERGENCE_BOUND,
                   settings.adaptive, streams, *lle_tolerances(settings))  # fmt: skip
         out = lanes_of(laws, inverse, packed, mu, x0, v0, tabled, shared, fresh_carry(len(ks)))
         verdicts = lane_verdicts(out, per)
-        strobes = last_strobes(out, list(range(len(ks))))
+        strobes = last_strobes(out, list(range(len(ks))), x_only)
         for j, k in enumerate(ks):
-            results[k] = lane_point(out, j, k, verdicts[j], strobes[j])
+            results[k] = lane_point(out, j, numbers[k], verdicts[j], strobes[j], x_only=x_only)
     return results  # type: ignore[return-value]
 
 
@@ -241,8 +248,9 @@ def system_lanes(
 
 
 def physical_lanes(
-    group: tuple, x0: np.ndarray, v0: np.ndarray, settings: SimulationSettings
-) -> list[BatchPoint]:
+    group: tuple, x0: np.ndarray, v0: np.ndarray, settings: SimulationSettings,
+    numbers: Sequence[int], x_only: bool = False,
+) -> list[BatchPoint]:  # fmt: skip
     """The ``BatchPoint`` of every lane of one lock-step group, its lengths decided in physical
     time (``numerics.physical``): the transient and the record run in chunks through the same
     lock-step kernel (no early stopping inside it), a longer record on from the end of the
@@ -254,6 +262,8 @@ def physical_lanes(
             damping (L,), forcing tables, T0 (L,), steps N per T0), as ``_run_lanes`` has them.
         x0, v0: the lanes' starts, shape (L,).
         settings: caps and tolerances.
+        numbers: the ``start_index`` of each lane's ``BatchPoint``, shape (L,).
+        x_only: keep the x of the last strobes alone (``lanes.last_strobes``).
     """
     lanes_of, laws, inverse, packed, mu, tabled, per, N = group
 
@@ -293,15 +303,15 @@ def physical_lanes(
     outs = {id(s.keep[0]): s.keep[0] for s in spans}
     strobes: dict[tuple[int, int], list] = {}
     for key, out in outs.items():
-        got = last_strobes(out, rows[key])
+        got = last_strobes(out, rows[key], x_only)
         strobes.update({(key, j): w for j, w in zip(rows[key], got, strict=True)})
     points = []
-    for s in spans:
+    for s, number in zip(spans, numbers, strict=True):
         out, j, _, _ = s.keep
-        point = lane_point(out, j, 0, verdicts[id(out)][j], strobes[(id(out), j)])
         n = out[0].shape[1]
         before = s.transient - (n if s.transient_reason == "diverged" else 0)
-        points.append(point.model_copy(update={"periods_run": before + int(out[7][j])}))
+        points.append(lane_point(out, j, number, verdicts[id(out)][j], strobes[(id(out), j)],
+                                 before + int(out[7][j]), x_only))  # fmt: skip
     return points
 
 
@@ -330,39 +340,41 @@ def lle_tolerances(settings: SimulationSettings) -> tuple[float, float]:
 
 
 def simulate_batch(
-    points: Sequence[Point], settings: SimulationSettings | None = None
+    points: Sequence[Point], settings: SimulationSettings | None = None, x_only: bool = False
 ) -> list[BatchPoint]:
     """Verdict (period, LLE, final state, last strobes) for each parameter point of a sweep.
 
     Each point runs from every start of ``settings.starts()``, one lane per point and start
     (``run_lanes``); the point's verdict is its worst start's (``classify.severity``, the first
     such start on a tie), whose index in ``settings.starts()`` is ``start_index``. Numbers equal
-    those of ``simulate`` for the same point and start.
+    those of ``simulate`` for the same point and start. ``x_only``: the lock-step lanes keep
+    the x of their last strobes alone, in ``poincare_x`` (what a map's points show).
     """
-    return simulate_batch_with(points, settings or SimulationSettings(), [])[0]
+    return simulate_batch_with(points, settings or SimulationSettings(), [], x_only)[0]
 
 
 def simulate_batch_with(
-    points: Sequence[Point], settings: SimulationSettings, more: Sequence[Lane]
-) -> tuple[list[BatchPoint], list[BatchPoint]]:
+    points: Sequence[Point], settings: SimulationSettings, more: Sequence[Lane],
+    x_only: bool = False,
+) -> tuple[list[BatchPoint], list[BatchPoint]]:  # fmt: skip
     """``simulate_batch`` of ``points`` and ``run_lanes`` of ``more`` lanes of the same points
     (a chunk's basin starts), in one call of the kernels: one forcing table a point and one
     pass of the lock-step chunks for both. The same numbers as two calls: a lane's run does
-    not depend on the lanes beside it."""
+    not depend on the lanes beside it; ``x_only`` as ``simulate_batch``'s."""
     starts = settings.starts()
     plans = step_plans(points, settings.steps_per_period)
     for plan in plans:
         check_work(settings, plan.steps)
     lanes = [(i, s) for i in range(len(points)) for s in starts]
-    per_lane = _run_lanes(points, plans, [*lanes, *more], settings)
     S = len(starts)
+    numbers = [*(j for _ in points for j in range(S)), *range(len(more))]
+    per_lane = _run_lanes(points, plans, [*lanes, *more], settings, numbers, x_only)
     worst = []
     for i in range(len(points)):
         block = per_lane[i * S : (i + 1) * S]
         j = max(range(S), key=lambda j: severity(block[j].classification, block[j].period))
-        worst.append(block[j].model_copy(update={"start_index": j}))
-    rest = [bp.model_copy(update={"start_index": k}) for k, bp in enumerate(per_lane[len(lanes) :])]
-    return worst, rest
+        worst.append(block[j])
+    return worst, per_lane[len(lanes) :]
 
 
 def threads_may_share_kernels() -> bool:

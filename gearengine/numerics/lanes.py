@@ -54,9 +54,11 @@ def lane_verdicts(out: tuple, per: np.ndarray) -> list[tuple]:
     return verdicts
 
 
-def last_strobes(out: tuple, lanes: list[int]) -> list[list]:
+def last_strobes(out: tuple, lanes: list[int], x_only: bool = False) -> list[list]:
     """The last ``BATCH_POINCARE`` recorded strobes [x, v] of each of ``lanes`` (fewer when the
-    record is shorter), one gather and one ``tolist`` for the lanes with a full window."""
+    record is shorter), one gather and one ``tolist`` for the lanes with a full window; with
+    ``x_only`` their x alone, one flat list a lane (64 small lists a lane cost ~0.1 ms, mostly
+    in the garbage collector, whose full passes they trigger and lengthen)."""
     xs, vs, rec = out[0], out[1], out[8]
     n_ok = rec[lanes].astype(np.int64)
     strobes: list[list] = [[] for _ in lanes]
@@ -64,20 +66,24 @@ def last_strobes(out: tuple, lanes: list[int]) -> list[list]:
     if full.size:
         rows = np.asarray(lanes)[full][:, None]
         cols = n_ok[full][:, None] - BATCH_POINCARE + np.arange(BATCH_POINCARE)
-        window = np.stack([xs[rows, cols], vs[rows, cols]], axis=2).tolist()
-        for k, w in zip(full.tolist(), window, strict=True):
+        window = xs[rows, cols] if x_only else np.stack([xs[rows, cols], vs[rows, cols]], axis=2)
+        for k, w in zip(full.tolist(), window.tolist(), strict=True):
             strobes[k] = w
     for k in np.flatnonzero(n_ok < BATCH_POINCARE).tolist():
         lane, n = lanes[k], int(n_ok[k])
-        strobes[k] = np.column_stack([xs[lane, :n], vs[lane, :n]]).tolist()
+        short = xs[lane, :n] if x_only else np.column_stack([xs[lane, :n], vs[lane, :n]])
+        strobes[k] = short.tolist()
     return strobes
 
 
 def lane_point(
-    out: tuple, lane: int, start_index: int, verdict: tuple, strobes: list
-) -> BatchPoint:
+    out: tuple, lane: int, start_index: int, verdict: tuple, strobes: list,
+    periods_run: int | None = None, x_only: bool = False,
+) -> BatchPoint:  # fmt: skip
     """The ``BatchPoint`` of ``lane`` (as ``batch.run_verdict`` gives it), numbered
-    ``start_index``, with that lane's last ``strobes``."""
+    ``start_index``, with that lane's last ``strobes`` (``last_strobes``: their x alone in
+    ``poincare_x`` with ``x_only``); ``periods_run`` when the lane ran more than this call's
+    intervals (``batch.physical_lanes``: its transient), else this call's."""
     _, _, _, xmin, xmax, fmin, fmax, done, _, diverged, xf, vf = out
     classification, period, lle, stderr = verdict
     dead = bool(diverged[lane])
@@ -90,10 +96,11 @@ def lane_point(
         lle_stderr=None if dead else finite_or_none(stderr),
         final_state=None if dead or None in final else final,
         impact_regime=None if dead else impact_regime(lo, hi),
-        poincare=strobes,
+        poincare=[] if x_only else strobes,
+        poincare_x=strobes if x_only else None,
         start_index=start_index,
         x_peak_to_peak=None if dead else finite_or_none(hi - lo),
-        periods_run=int(done[lane]),
+        periods_run=int(done[lane]) if periods_run is None else periods_run,
         force_max=None if dead else finite_or_none(float(fmax[lane])),
         force_min=None if dead else finite_or_none(float(fmin[lane])),
     )

@@ -56,7 +56,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -157,8 +157,6 @@ class Lengths:
     record_reason: str = ""
     keep: Any = None
     period: int | None = None
-    stats: list[tuple[float, int, float, float]] = field(default_factory=list)
-    strobes: list[np.ndarray] = field(default_factory=list)
 
 
 def lengths(
@@ -190,7 +188,11 @@ def lengths(
 
 def _settle(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, mu: np.ndarray,
             r: float, settings: SimulationSettings, out: list[Lengths]) -> tuple:  # fmt: skip
-    """The transient of every lane; returns the states at its end."""
+    """The transient of every lane; returns the states at its end.
+
+    A lane still running has run every round so far (the active lanes only ever shrink) and
+    the rounds are the same for every lane, so the window of strobes a check reads is the same
+    rounds for every lane: gathered once a round for all of them (``_periods``)."""
     cap = settings.transient_periods
     floor = np.ceil(DAMPING_TIMES / (np.maximum(mu, 1e-12) * period))
     n_min = np.minimum(floor, cap).astype(np.int64)
@@ -201,6 +203,7 @@ def _settle(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, 
         for s in out:
             s.transient_reason = "cap"
     ran, rounds = 0, 0
+    history: list[tuple[np.ndarray, Chunk]] = []  # each round's lanes and chunk
     while active.any():
         idx = np.flatnonzero(active)
         # the same chunk boundaries for a lane in any company: 1, 1, 2, 2, 4, 4, 4 ... chunks
@@ -208,44 +211,53 @@ def _settle(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, 
         rounds += 1
         c = advance(idx, x[idx], v[idx], n)
         ran += n
-        sums, pairs = c.logs.sum(axis=1), np.stack([c.xs, c.vs], axis=2)
-        for j, lane in enumerate(idx.tolist()):
+        x[idx], v[idx] = c.xf, c.vf
+        history.append((idx, c))
+        lanes, dead = idx.tolist(), np.asarray(c.diverged, dtype=bool)
+        for j in np.flatnonzero(dead).tolist():
+            s = out[lanes[j]]
+            s.transient, s.transient_reason, s.keep = ran, "diverged", c.keep[j]
+        active[idx[dead]] = False
+        checked = idx[np.logical_and(np.logical_not(dead), n_min[idx] <= ran)]
+        for lane, p in _periods(history, checked, ran, r):
             s = out[lane]
-            s.transient = ran
-            x[lane], v[lane] = c.xf[j], c.vf[j]
-            if c.diverged[j]:
-                s.transient_reason, s.keep, active[lane] = "diverged", c.keep[j], False
-                continue
-            s.stats.append((float(sums[j]), n, float(c.xmin[j]), float(c.xmax[j])))
-            s.strobes.append(pairs[j])
-            why = _settled(s, ran, int(n_min[lane]), r)
-            if why is None and ran >= cap:
-                why = "cap"
-            if why is not None:
-                s.transient_reason, active[lane] = why, False
-                s.stats, s.strobes = [], []
+            s.transient, s.period, s.transient_reason = ran, p, "settled"
+            active[lane] = False
+        if ran >= cap:
+            for lane in np.flatnonzero(active).tolist():
+                out[lane].transient, out[lane].transient_reason = ran, "cap"
+            active[:] = False
     return x, v
 
 
-def _settled(s: Lengths, ran: int, n_min: int, r: float) -> str | None:
-    """ "settled" when the transient of a lane may end here, else None."""
-    if ran < n_min:
-        return None
+def _periods(history: list[tuple[np.ndarray, Chunk]], lanes: np.ndarray, ran: int, r: float
+             ) -> list[tuple[int, int]]:  # fmt: skip
+    """(lane, period) of each of ``lanes`` (still running after ``ran`` intervals of rounds
+    ``history``) whose transient may end here: the T0 strobes of its last rounds repeat with a
+    period p and approach their cycle (``_converged``)."""
     want = max(3, math.ceil(SETTLE_WINDOW_MESH / r), min(ran // 2, 3 * SETTLE_MAX_PERIOD))
-    k, got = len(s.strobes), 0
+    k, got = len(history), 0
     while k > 0 and got < want:
         k -= 1
-        got += s.strobes[k].shape[0]
-    if got >= 3:
-        window = np.concatenate(s.strobes[k:])
-        lo = min(st[2] for st in s.stats[k:])
-        hi = max(st[3] for st in s.stats[k:])
-        p = detect_period(window[:, 0], window[:, 1], attractor_size(lo, hi),
-                          max_period=min(SETTLE_MAX_PERIOD, window.shape[0] // 3))  # fmt: skip
-        if p is not None and _converged(window, p, attractor_size(lo, hi)):
-            s.period = p
-            return "settled"
-    return None
+        got += history[k][1].xs.shape[1]
+    if got < 3 or lanes.size == 0:
+        return []
+    parts, lo, hi = [], [], []
+    for idx, c in history[k:]:
+        j = np.searchsorted(idx, lanes)  # the lanes' rows in that round
+        parts.append(np.stack([c.xs[j], c.vs[j]], axis=2))
+        lo.append(c.xmin[j])
+        hi.append(c.xmax[j])
+    window = np.concatenate(parts, axis=1)  # (lanes, got, 2)
+    lows, highs = np.stack(lo).T.tolist(), np.stack(hi).T.tolist()
+    found = []
+    for i, lane in enumerate(lanes.tolist()):
+        size = attractor_size(min(lows[i]), max(highs[i]))
+        w = window[i]
+        p = detect_period(w[:, 0], w[:, 1], size, max_period=min(SETTLE_MAX_PERIOD, got // 3))
+        if p is not None and _converged(w, p, size):
+            found.append((lane, p))
+    return found
 
 
 def _converged(window: np.ndarray, p: int, size: float) -> bool:

@@ -255,7 +255,15 @@ class BatchPoint(FiniteAnswer):
     lle_stderr: float | None
     final_state: list[float] | None
     impact_regime: str | None = Field(description="no_impact | single_sided | double_sided.")
-    poincare: list[list[float]] = Field(description=f"Last <= {BATCH_POINCARE} strobes.")
+    poincare: list[list[float]] = Field(
+        description=f"Last <= {BATCH_POINCARE} strobes; empty when only their x was asked for "
+        "(poincare_x)."
+    )
+    poincare_x: list[float] | None = Field(
+        None,
+        description="x of the last strobes when only those were asked for (``x_only`` of "
+        "``simulate_batch``: a map's points), else null.",
+    )
     start_index: int = Field(description="Index of the worst start in settings.starts().")
     x_peak_to_peak: float | None = Field(
         None, description="max x - min x over the record (units of b), null if diverged."

@@ -113,7 +113,7 @@ def _point(
         branch=branch,
         **{**verdict, **basins.pop("verdict", {})},
         melnikov_chaos_possible=None if possible is None else bool(possible),
-        poincare_x=[s[0] for s in bp.poincare],
+        poincare_x=[s[0] for s in bp.poincare] if bp.poincare_x is None else bp.poincare_x,
         x_peak_to_peak=bp.x_peak_to_peak,
         periods_run=bp.periods_run,
         force_max=bp.force_max,
@@ -175,7 +175,8 @@ def _points(request: SweepRequest, values: list[dict[str, float]], branch: Sweep
                                                   [sc for _, sc in scaled])  # fmt: skip
         ensembles = _ensembles(request, found, verdicts)
     else:
-        verdicts = simulate_batch(designs, request.settings) if verdicts is None else verdicts
+        if verdicts is None:  # only the strobes' x is shown: no [x, v] lists to build
+            verdicts = simulate_batch(designs, request.settings, x_only=True)
         ensembles = _basins(request, scaled, verdicts)
     return [
         _point(v, branch, params, scales, bp, e)
