@@ -76,7 +76,8 @@ def test_probabilities_equal_the_single_analysis_of_each_sample(
         runs, sample_values(request.variables(), request.unit_rows()), strict=True
     ):
         design = sample_design(base, values).model_dump(exclude={"tolerances"})
-        one = analyze(AnalysisRequest.model_validate({"design": design, "settings": SHORT}))
+        settings = request.settings.model_dump(exclude_none=True)  # SHORT over the light ones
+        one = analyze(AnalysisRequest.model_validate({"design": design, "settings": settings}))
         response = one.engineering.response  # type: ignore[union-attr]
         assert run[3:] == [response.dte_peak_to_peak_um, response.dynamic_factor]
         counts[one.numerics.classification] = counts.get(one.numerics.classification, 0) + 1
@@ -99,7 +100,8 @@ def test_plain_monte_carlo_with_another_seed_agrees_within_the_intervals(
     apart = 0
     for values in sample_values(request.variables(), rng.random((16, 3))):
         design = sample_design(base, values).model_dump(exclude={"tolerances"})
-        one = analyze(AnalysisRequest.model_validate({"design": design, "settings": SHORT}))
+        settings = request.settings.model_dump(exclude_none=True)  # SHORT over the light ones
+        one = analyze(AnalysisRequest.model_validate({"design": design, "settings": settings}))
         apart += one.numerics.impact_regime in ("single_sided", "double_sided")
     qmc, mc = result.points[0].probabilities["separation"], probability(apart, 16)
     assert qmc.interval[0] <= mc["value"] <= qmc.interval[1]

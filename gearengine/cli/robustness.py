@@ -26,7 +26,7 @@ from gearengine.cli.documents import (
 from gearengine.cli.envelope import budget_refusal, option_axes
 from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
-from gearengine.gate.envelope import ENVELOPE_SETTINGS, gate_settings
+from gearengine.gate.envelope import gate_settings
 from gearengine.gate.probability import ONE_LOOK, ProbabilityReport, probability_report
 from gearengine.jsonio import dumps
 from gearengine.model.units import IMPACTS_REFUSED, display_unit
@@ -51,8 +51,8 @@ GATED = ("chaotic", "quasi_periodic", "diverged", "separation", "back_flank",
 
 
 def robustness_request(args: argparse.Namespace, doc: object) -> RobustnessRequest:
-    """The study of the design document ``doc`` (``args.file`` read; its tolerances; light
-    settings unless the file gives its own; axes from --speed/--torque)."""
+    """The study of the design document ``doc`` (``args.file`` read; its tolerances; its
+    settings, merged over the request's light ones; axes from --speed/--torque)."""
     if not isinstance(doc, dict) or "design" not in doc:
         raise InvalidInputError([f'{args.file}: a robustness study needs {{"design": {{...}}}}'])
     axes = option_axes(args)
@@ -62,7 +62,7 @@ def robustness_request(args: argparse.Namespace, doc: object) -> RobustnessReque
     if getattr(args, "starts", None) is not None:  # check --starts: starts per sample too
         settings = gate_settings(settings, args.starts)
     body = {**{k: v for k, v in doc.items() if k not in ("params",)},
-            "settings": {**ENVELOPE_SETTINGS, **settings}, "axes": axes or doc.get("axes", []),
+            "settings": settings, "axes": axes or doc.get("axes", []),
             "samples": args.samples, "seed": args.seed}  # fmt: skip
     if getattr(args, "sensitivity", False):
         body["sensitivity"] = True
@@ -143,6 +143,8 @@ def cmd_robustness(args: argparse.Namespace) -> int:
         print(f"{point_name(p.shown)}: {words} ({p.samples} samples, {result.starts_text()})")
         for line in p.ranking or []:
             print(f"  {line}")
+    if result.settings is not None:
+        print(f"settings: {result.settings.run_text()}")
     if args.json:
         Path(args.json).write_text(result.model_dump_json())
     if args.plot:

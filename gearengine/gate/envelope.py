@@ -27,6 +27,7 @@ from gearengine.gate.resolution import REFINE_DEPTH, Resolution, resolution
 from gearengine.gate.resolution import refine as refine_points
 from gearengine.model.errors import InputError
 from gearengine.model.units import IMPACTS_REFUSED, OUTPUTS, POINT_OUTPUTS
+from gearengine.numerics.settings import ENVELOPE_SETTINGS
 from gearengine.signals.classify import SEVERITY
 from gearengine.studies import jobs
 from gearengine.studies.sweep.compute import run_local
@@ -202,11 +203,6 @@ def attractor_set(p: SweepPoint, rules: Rules) -> frozenset[tuple[str, int | Non
 def _physical(p: SweepPoint, key: str) -> float | None:
     value = (p.physical or {}).get(key)
     return None if value is None else value.value
-
-
-ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
-"""Light integration settings of an envelope check; a design file's ``settings`` are merged
-over them (adding ``random_initial_states`` keeps the 60 + 60 periods)."""
 
 
 GATE_STARTS = 16

@@ -184,6 +184,18 @@ def box_end(end: float | str, kind: str) -> float:
     return end
 
 
+ENVELOPE_SETTINGS = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
+"""Light integration settings of studies that run many designs (an envelope check, a robustness
+study, a remedies search): a request's or a design file's ``settings`` are merged over them
+(``over_light``; adding ``random_initial_states`` keeps the 60 + 60 periods)."""
+
+
+def over_light(given: object) -> object:
+    """``given`` settings (an object, before validation) merged over ``ENVELOPE_SETTINGS``;
+    anything else (a ``SimulationSettings``, a wrong type) as it is, for the model to judge."""
+    return {**ENVELOPE_SETTINGS, **given} if isinstance(given, dict) else given
+
+
 class SimulationSettings(BaseModel):
     """How to integrate and analyse Eq. (9). Times are in sampling intervals T0."""
 
@@ -309,6 +321,11 @@ class SimulationSettings(BaseModel):
         time "<= 500 + 500 periods (ended when settled)" (they are upper bounds then)."""
         text = f"{self.transient_periods} + {self.record_periods} periods"
         return f"<= {text} (ended when settled)" if self.adaptive and self.physical_time else text
+
+    def run_text(self) -> str:
+        """The lengths (``lengths_text``) and steps a period of every run: "<= 60 + 60 periods
+        (ended when settled), 128 steps a period"."""
+        return f"{self.lengths_text()}, {self.steps_per_period} steps a period"
 
     def starts(self) -> list[tuple[float, float]]:
         """Initial states (x0, v0) in order: initial_states, random ones, or initial_state."""

@@ -29,7 +29,7 @@ import math
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, Field, field_validator
 from pydantic_core import InitErrorDetails
 
 from gearengine.homoclinic.thresholds import chaos_possible
@@ -44,7 +44,7 @@ from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.headline import headline
 from gearengine.numerics.magnitudes import most_adverse
 from gearengine.numerics.runs import work
-from gearengine.numerics.settings import SimulationSettings
+from gearengine.numerics.settings import ENVELOPE_SETTINGS, SimulationSettings, over_light
 from gearengine.studies import jobs
 from gearengine.studies.robustness import sensitivity
 from gearengine.studies.robustness.tolerances import (
@@ -89,7 +89,9 @@ class RobustnessRequest(BaseModel):
     label: str | None = Field(None, max_length=200, description="Free text shown with the job.")
     design: Design = Field(description="The nominal pair, with its tolerances.")
     settings: SimulationSettings = Field(
-        default_factory=SimulationSettings, description="Integration settings of every run."
+        default_factory=lambda: SimulationSettings.model_validate(ENVELOPE_SETTINGS),
+        description="Integration settings of every run, merged over the light settings of the "
+        "envelope check (60 + 60 periods, 128 steps a period), as in gearengine robustness.",
     )
     samples: int = Field(
         256, ge=2, le=MAX_SAMPLES, description="Samples N of the tolerances (a power of 2).",
@@ -109,6 +111,11 @@ class RobustnessRequest(BaseModel):
         description="Operating envelope: physical fields of the design (speed, torque, ...); "
         "none: the design's operating point.",
     )
+
+    @field_validator("settings", mode="before")
+    @classmethod
+    def _over_light(cls, given: object) -> object:
+        return over_light(given)
 
     def variables(self) -> list[Variable]:
         """The toleranced fields (``studies.robustness.tolerances.variables``)."""
@@ -318,6 +325,7 @@ class RobustnessResult(BaseModel):
         None, description="The unit of each axis in the points' shown values (speed rpm).",
         examples=[{"speed": "rpm", "torque": "N*m"}],
     )  # fmt: skip
+    settings: SimulationSettings | None = Field(None, description="The settings every run used.")
     starts_per_sample: int = Field(
         1, description="Initial states each sample ran: settings.basins' starts (the sample "
         "counts as its worst attractor above basins.min_fraction), else the settings' own "
@@ -410,6 +418,7 @@ def assemble(request: RobustnessRequest, chunks: list[str]) -> RobustnessResult:
         variables=[RobustnessVariable(path=v.path, distribution=v.words) for v in variables_],
         partial=not complete,
         model=ASSUMPTIONS + ([] if basins is None else [basin_assumption(basins)]),
+        settings=request.settings,
         starts_per_sample=len(request.settings.starts()) if basins is None else basins.starts,
         values_units={a.parameter: axis_unit(a.parameter) for a in request.axes},
         shown_units={a.parameter: display_unit(a.parameter)[0] for a in request.axes},
