@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import copy
 import json
+import math
 
 import pytest
 from pydantic import ValidationError
@@ -14,6 +15,7 @@ from pydantic import ValidationError
 from gearengine.cli.main import main
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.reduction import convert_design
+from gearengine.studies.runup.request import RunupRequest
 from gearengine.studies.sweep.axes import design_with
 
 
@@ -103,3 +105,31 @@ def test_a_damping_ratio_in_percent_is_refused_as_a_plain_number(client) -> None
     (problem,) = answer.json()["errors"]
     assert problem["path"] == "design.mesh.damping_ratio"
     assert "write 0.05 for 5 %" in problem["message"]
+
+
+def test_a_speed_in_hz_is_refused_naming_the_field_everywhere(client, tmp_path, capsys) -> None:
+    """pint reads a radian as dimensionless, so "50 Hz" was 50 rad/s (477 rpm) without a word
+    where a shaft's 50 Hz is 50 rev/s (3000 rpm): a frequency with no angle is refused naming
+    the field and both readings, in the API, the library and the CLI (and a run-up's rate)."""
+    said = "'50 Hz' has no angle"
+    answer = client.post("/v1/analyses", json={"design": _design(speed="50 Hz")})
+    assert answer.status_code == 422
+    (error,) = answer.json()["errors"]
+    assert error["path"] == "design.speed"
+    assert said in error["message"] and "'3000 rpm' or '50 rev/s'" in error["message"]
+    for speed in ("50 Hz", "3000 1/min", "0.05 kHz"):
+        with pytest.raises(ValidationError, match="has no angle") as err:
+            Design.model_validate(_design(speed=speed))
+        assert err.value.errors()[0]["loc"] == ("speed",)
+    with pytest.raises(ValidationError, match="'600 rpm/s' or '10 rev/s\\^2'"):
+        RunupRequest.model_validate({"design": _design(), "from_speed": "1000 rpm",
+                                     "to_speed": "2000 rpm", "rate": "10 Hz/s"})  # fmt: skip
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": _design()}))
+    assert main(["check", str(path), "--speed", "10Hz:100Hz", "--starts", "1"]) == 2
+    assert "--speed (its low end): '10Hz' has no angle" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("speed", ["3000 rev/min", "50 rev/s", "50 rps", "314.159265 rad/s"])
+def test_revolutions_per_time_are_read_as_written(speed: str) -> None:
+    assert Design.model_validate(_design(speed=speed)).speed == pytest.approx(100 * math.pi)

@@ -29,12 +29,15 @@ if TYPE_CHECKING:
 
 @cache
 def registry() -> pint.UnitRegistry:
-    """The one pint registry of the engine (rpm = revolution per minute, µm and um alike),
+    """The one pint registry of the engine (rpm = rev/min = revolution per minute, µm and um
+    alike),
     made when a quantity is first read: importing pint costs ~0.15 s, which every command and
     the service's start-up would otherwise pay for designs given as plain numbers."""
     import pint
 
-    return pint.UnitRegistry()
+    ureg = pint.UnitRegistry()
+    ureg.define("rev = revolution")  # "3000 rev/min", "50 rev/s" as engineers write them
+    return ureg
 
 
 @dataclass(frozen=True)
@@ -221,10 +224,33 @@ def parse_quantity(
                 f"a {kind.name} needs a unit of dimension {kind.dimensionality}, e.g. "
                 f"{kind.example!r}"
             )
+        _angle_given(quantity, value, kind)
         si = float(quantity.to(kind.unit).magnitude)
     else:
         return _bare(float(value), value, kind, allow_zero, field)
     return _plausible(si, value, kind, allow_zero)
+
+
+ANGULAR_RATES = frozenset({"rad/s", "rad/s^2"})
+"""SI units of the kinds that are an angle per time (a shaft speed, its rate of change)."""
+
+
+def _angle_given(quantity: Any, value: str, kind: QuantityKind) -> None:
+    """Refuse a frequency with no angle (Hz, kHz, 1/s, 1/min) for an angle per time: pint
+    treats the radian as dimensionless and reads "50 Hz" as 50 rad/s (477 rpm) where a shaft's
+    50 Hz means 50 rev/s (3000 rpm). The message gives both readings in units with an angle."""
+    if kind.unit not in ANGULAR_RATES or "radian" in dict(quantity.to_root_units().unit_items()):
+        return
+    ureg, shown = registry(), kind.example.split(maxsplit=1)[-1]
+    turns = (quantity * ureg.revolution).to(shown).magnitude
+    radians = (quantity * ureg.radian).to(kind.unit).magnitude
+    per = kind.unit.removeprefix("rad")
+    raise ValueError(
+        f"{value!r} has no angle (pint would read Hz and 1/s as rad/s): a {kind.name} needs "
+        f"one; write "
+        f"'{turns:.6g} {shown}' or '{quantity.to('1' + per).magnitude:.6g} rev{per}' for "
+        f"revolutions, '{radians:.6g} {kind.unit}' for radians"
+    )
 
 
 SHARES = frozenset({"percent", "permille", "ppm"})
