@@ -52,6 +52,14 @@ MIN_EVENTS = 10
 estimators share out the variance of a handful of samples (indices of 0 or 2, meaningless)."""
 
 
+def bootstrap_seed(seed: int) -> int:
+    """The seed SALib's bootstrap intervals get for the request's ``seed``: SALib seeds them
+    only when ``if seed:`` holds, so seed 0 left them to numpy's global generator (one seed, two
+    error bars: "90 % +- 16 %" then "+- 15 %"); 0 becomes 2**32, a seed no request gives (they
+    stop at 2**32 - 1), and every other seed is itself."""
+    return seed or 2**32
+
+
 def indices(names: list[str], y: np.ndarray, seed: int) -> dict[str, dict[str, float]] | None:
     """Sobol first-order and total indices of output ``y`` (one value per Saltelli row) for the
     fields ``names``, with their 95 % bootstrap half-widths; None when ``y`` does not vary, has
@@ -63,9 +71,8 @@ def indices(names: list[str], y: np.ndarray, seed: int) -> dict[str, dict[str, f
         return None
     with warnings.catch_warnings(), np.errstate(all="ignore"):
         warnings.simplefilter("ignore")
-        s = sobol_analysis.analyze(
-            _problem(len(names)), y, calc_second_order=False, seed=seed, print_to_console=False
-        )
+        s = sobol_analysis.analyze(_problem(len(names)), y, calc_second_order=False,
+                                   seed=bootstrap_seed(seed), print_to_console=False)  # fmt: skip
 
     def clean(x: float) -> float | None:
         return None if not math.isfinite(x) else round(float(x), 4)
