@@ -52,7 +52,7 @@ def test_a_sweep_as_a_dataframe_and_numpy_grids(design: dict) -> None:
     frame = result.to_pandas()
     assert isinstance(frame, pd.DataFrame) and len(frame) == 6
     assert list(frame.columns) == next(to_csv(result, design=True)).rstrip("\n").split(",")
-    assert frame["poincare_x"][0] == result.points[0].poincare_x
+    assert frame["poincare_x [b]"][0] == result.points[0].poincare_x
     axes, dte = result.grid("dte")
     assert [a.shape for a in axes] == [(3,), (2,)] and dte.shape == (2, 3)
     assert axes[0][-1] == pytest.approx(3000 * 2 * np.pi / 60)

@@ -155,7 +155,7 @@ def test_csv_has_a_row_per_point_and_axis_columns() -> None:
     rows = list(csv.DictReader(io.StringIO("".join(to_csv(result)))))
     assert len(rows) == 6 and float(rows[4]["Omega_e"]) == 0.6 and float(rows[4]["F_e1"]) == 0.15
     assert rows[0]["melnikov_chaos_possible"] in ("true", "false")
-    assert [float(x) for x in rows[1]["poincare_x"].split()] == result.points[1].poincare_x
+    assert [float(x) for x in rows[1]["poincare_x [b]"].split()] == result.points[1].poincare_x
     counts = agreement_table(result.points)
     assert sum(counts.model_dump().values()) == 6
 
@@ -170,7 +170,7 @@ def test_csv_numbers_read_as_the_json_writes_them() -> None:
     rows = list(csv.reader(io.StringIO("".join(to_csv(result)))))
     header = rows[0]
     assert rows[-1][header.index("lle [1/tau]")] == "0.00001"
-    assert rows[-1][header.index("poincare_x")] == "1e-7 0.25"
+    assert rows[-1][header.index("poincare_x [b]")] == "1e-7 0.25"
     for row, point in zip(rows[1:], result.points, strict=True):
         doc = point.model_dump_json()
         cells = dict(zip(header, row, strict=True))
@@ -179,7 +179,7 @@ def test_csv_numbers_read_as_the_json_writes_them() -> None:
                 cell = cells[f"{name} [1/tau]"]
                 assert f'"{name}":{cell},' in doc
                 assert float(cell) == getattr(point, name)
-        tokens = cells["poincare_x"].split()
+        tokens = cells["poincare_x [b]"].split()
         assert "[" + ",".join(tokens) + "]" in doc
         assert [float(t) for t in tokens] == point.poincare_x
 

@@ -307,7 +307,7 @@ def test_a_basins_sweep_csv_from_the_service_has_each_attractors_columns(
     points = working.get(f"/v1/sweeps/{job['id']}/result").json()["points"]
     most = max(len(p["attractors"]) for p in points)
     header = text.splitlines()[0].split(",")
-    assert f"attractor_{most}_class" in header and f"attractor_{most + 1}_class" not in header
-    assert "attractor_1_lle [1/tau]" in header and "attractor_1_dte [um]" in header
+    assert f"attractor_{most - 1}_class" in header and f"attractor_{most}_class" not in header
+    assert "attractor_0_lle [1/tau]" in header and "attractor_0_dte [um]" in header
     request = validated(doc)
     assert text == "".join(to_csv(run_local(request), request.outputs, design=True))

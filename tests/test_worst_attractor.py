@@ -119,8 +119,8 @@ def test_csv_and_dataframe_rows_have_the_verdict_and_every_attractor(sweep):
     header = rows[0].strip().split(",")
     found = sweep.points[0].attractors
     assert len(found) == 3
-    first = header.index("attractor_1_class")
-    assert header[first - 7 : first] == [
+    first = header.index("attractor_0_class")
+    assert header[first - 8 : first] == [
         "dte_from",
         "dynamic_factor_from",
         "force_max_from",
@@ -128,11 +128,12 @@ def test_csv_and_dataframe_rows_have_the_verdict_and_every_attractor(sweep):
         "decided_by",
         "decided_fraction",
         "basin_starts",
+        "record_from",
     ]
     each = ["class", "period", "impact_regime", "fraction", "fraction_low", "fraction_high",
             "lle [1/tau]", "dte [um]", "dynamic_factor", "force_max [N]",
             "force_min [N]"]  # fmt: skip
-    assert header[first:] == [f"attractor_{k}_{name}" for k in (1, 2, 3) for name in each]
+    assert header[first:] == [f"attractor_{k}_{name}" for k in (0, 1, 2) for name in each]
     assert "attractors" not in header
     frame = sweep.to_pandas()
     assert list(frame.columns) == header
@@ -141,16 +142,24 @@ def test_csv_and_dataframe_rows_have_the_verdict_and_every_attractor(sweep):
     assert row["decided_by"] == sweep.points[0].decided_by
     assert row["decided_fraction"] == pytest.approx(9 / 16)
     assert row["basin_starts"] == 16
-    for k, a in enumerate(found, start=1):
+    # the record columns are the settings' start's run, in half backlashes, and say so
+    assert row["record_from"] == "worst of the settings' own starts"
+    assert row["x_peak_to_peak [b]"] == sweep.points[0].x_peak_to_peak
+    assert row["poincare_x [b]"] == sweep.points[0].poincare_x
+    # one numbering: magnitudes_from's attractor k is the CSV's attractor_k group
+    dte_from = sweep.points[0].magnitudes_from["dte"]
+    assert row[f"attractor_{dte_from.attractor}_dte [um]"] == row["dte [um]"]
+    assert row[f"attractor_{dte_from.attractor}_class"] == found[dte_from.attractor].classification
+    for k, a in enumerate(found):
         assert row[f"attractor_{k}_class"] == a.classification
         assert row[f"attractor_{k}_fraction"] == a.fraction
         assert [row[f"attractor_{k}_fraction_{e}"] for e in ("low", "high")] == a.interval
         assert row[f"attractor_{k}_lle [1/tau]"] == a.lle
         assert row[f"attractor_{k}_dte [um]"] == a.dte_um
         assert row[f"attractor_{k}_force_min [N]"] == a.force_min_n
-    assert found[0].period is None and row.isna()["attractor_1_period"]
-    assert row["attractor_2_period"] == found[1].period
-    assert row["attractor_2_impact_regime"] == found[1].impact_regime
+    assert found[0].period is None and row.isna()["attractor_0_period"]
+    assert row["attractor_1_period"] == found[1].period
+    assert row["attractor_1_impact_regime"] == found[1].impact_regime
 
 
 def test_csv_and_dataframe_magnitudes_are_the_largest_over_the_attractors_named(sweep):

@@ -123,7 +123,9 @@ class Attractor(FiniteAnswer):
 class FromAttractor(FiniteAnswer):
     """The attractor a shown magnitude comes from (``numerics.attractors.most_adverse``)."""
 
-    attractor: int = Field(description="Its index in attractors (worst first).")
+    attractor: int = Field(
+        description="Its index in attractors (worst first, from 0; the CSV's attractor_K_ columns)."
+    )
     label: str = Field(description="Its label, as attractors[attractor].label.")
     classification: str = Field(description="periodic | chaotic | quasi_periodic.")
     fraction: float = Field(description="Its basin fraction.")

@@ -128,11 +128,23 @@ CSV_FIELDS = (
 
 LLE_UNIT = "1/tau"
 """The unit of an LLE: per unit of the dimensionless time tau = omega_n t (docs/units.md)."""
-TITLES = {"lle": f"lle [{LLE_UNIT}]", "lle_stderr": f"lle_stderr [{LLE_UNIT}]"}
+X_UNIT = "b"
+"""The unit of x: half backlashes (dimensionless, docs/units.md)."""
+TITLES = {
+    "lle": f"lle [{LLE_UNIT}]",
+    "lle_stderr": f"lle_stderr [{LLE_UNIT}]",
+    "x_peak_to_peak": f"x_peak_to_peak [{X_UNIT}]",
+    "poincare_x": f"poincare_x [{X_UNIT}]",
+}
 """The CSV titles of the ``CSV_FIELDS`` that have a unit."""
-BASIN_COLUMNS = ("decided_by", "decided_fraction", "basin_starts")
+BASIN_COLUMNS = ("decided_by", "decided_fraction", "basin_starts", "record_from")
 """The CSV's columns with settings.basins, before the ``attractor_columns``: who decided the
-verdict columns (the worst attractor above basins.min_fraction), its fraction, the starts run."""
+verdict columns (the worst attractor above basins.min_fraction), its fraction, the starts run,
+and whose run the record columns (x_peak_to_peak, poincare_x, the unitless forces) are
+(``RECORD_FROM``): not the verdict's attractor, which may differ (chaotic beside a constant
+poincare_x)."""
+RECORD_FROM = "worst of the settings' own starts"
+"""The ``record_from`` cell of a point with basins (``SweepPoint.attractors``' description)."""
 ATTRACTOR_COLUMNS = ("class", "period", "impact_regime", "fraction", "fraction_low",
                      "fraction_high", f"lle [{LLE_UNIT}]")  # fmt: skip
 """Each attractor's columns with settings.basins (``attractor_columns``): its class, period (in
@@ -194,12 +206,13 @@ def csv_rows(
 
 
 def attractor_columns(count: int, magnitudes: bool) -> list[str]:
-    """The titles of ``count`` attractors' columns, ``attractor_1_class``, ...,
-    ``attractor_1_lle [1/tau]``, then ``attractor_2_class``, ... (1 the worst, as a point's
-    ``attractors``): the ``ATTRACTOR_COLUMNS``, with ``magnitudes`` (a design's sweep) also its
-    ``dte [um]``, ``dynamic_factor``, ``force_max [N]``, ``force_min [N]``."""
+    """The titles of ``count`` attractors' columns, ``attractor_0_class``, ...,
+    ``attractor_0_lle [1/tau]``, then ``attractor_1_class``, ...: numbered as the JSON indexes
+    a point's ``attractors`` (0 the worst; ``magnitudes_from``'s ``attractor`` is that index):
+    the ``ATTRACTOR_COLUMNS``, with ``magnitudes`` (a design's sweep) also its ``dte [um]``,
+    ``dynamic_factor``, ``force_max [N]``, ``force_min [N]``."""
     names = [*ATTRACTOR_COLUMNS, *(display_label(key) for key in ADVERSE if magnitudes)]
-    return [f"attractor_{k}_{name}" for k in range(1, count + 1) for name in names]
+    return [f"attractor_{k}_{name}" for k in range(count) for name in names]
 
 
 def _attractor_cells(p: PointFields, count: int, magnitudes: bool) -> list[str]:
@@ -258,6 +271,7 @@ def _basin_cells(p: PointFields) -> list[str]:
         "" if p.get("decided_by") is None else _text_cell(str(p["decided_by"])),
         "" if fraction is None else _json_numbers([float(fraction)])[0],
         "" if starts is None else str(starts),
+        "" if counts is None else _text_cell(RECORD_FROM),
     ]
 
 

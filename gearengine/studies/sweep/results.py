@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-from gearengine.studies.sweep.export import csv_rows
+from gearengine.studies.sweep.export import TITLES, csv_rows
 from gearengine.studies.sweep.points import SpeedWindows, SweepBifurcation, SweepPoint
 from gearengine.studies.sweep.request import SweepAxis
 from gearengine.studies.sweep.windows import response_label
@@ -87,8 +87,8 @@ def to_csv(
 def to_pandas(result: SweepResult) -> Any:
     """A ``pandas.DataFrame``, one row per point and branch, with exactly the columns of the
     sweep's CSV (``studies.sweep.export.csv_rows``: axes in SI, a design's axes in display units as
-    ``speed [rpm]``, ``dte [um]``, ``dynamic_factor``, the verdicts); ``poincare_x`` holds a list
-    of floats per row (units of b)."""
+    ``speed [rpm]``, ``dte [um]``, ``dynamic_factor``, the verdicts); ``poincare_x [b]`` holds a
+    list of floats per row (units of b)."""
     try:
         import pandas as pd
     except ImportError:
@@ -97,10 +97,11 @@ def to_pandas(result: SweepResult) -> Any:
         ) from None
     design = any(p.physical for p in result.points)
     frame = pd.read_csv(io.StringIO("".join(to_csv(result, design=design))))
-    if "poincare_x" in frame:
-        frame["poincare_x"] = [
+    column = TITLES["poincare_x"]
+    if column in frame:
+        frame[column] = [
             [float(v) for v in cell.split()] if isinstance(cell, str) else []
-            for cell in frame["poincare_x"]
+            for cell in frame[column]
         ]
     return frame
 
