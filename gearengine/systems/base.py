@@ -47,6 +47,12 @@ import numpy as np
 
 from gearengine.model.params import GearParams
 
+H_OMEGA = 0.5
+"""Largest h omega_max of an RK4 step against a system's fastest oscillation (RK4's stability
+limit is 2.83; 0.5 keeps its phase error per step near 1e-4, and the LLE of the contact's damped
+oscillation within 0.1 %: 16 steps per natural period gave -0.04003 for -0.04, 8 steps -0.0417,
+2 steps a blow-up, for the design-geometry pair at 400 rpm)."""
+
 
 @dataclass(frozen=True)
 class StepPlan:
@@ -71,6 +77,21 @@ class StepPlan:
     def h(self) -> float:
         """RK4 step h = T0 / N (time units)."""
         return self.period / self.steps
+
+
+def resolving(plan: StepPlan, omega_max: float, what: str) -> StepPlan:
+    """``plan`` with at least T0 omega_max / ``H_OMEGA`` steps per T0: an explicit step must
+    resolve the system's fastest oscillation (``omega_max`` in units of omega_n), not only its
+    forcing; at low speed one forcing period holds many natural periods. ``what`` names that
+    oscillation in the plan's note."""
+    need = math.ceil(plan.period * omega_max / H_OMEGA)
+    if need <= plan.steps:
+        return plan
+    note = (
+        f"{what} (omega = {omega_max:.4g} omega_n) needs {need} RK4 steps per T0 "
+        f"(h omega <= {H_OMEGA}); {plan.steps} were asked"
+    )
+    return StepPlan(plan.omega0, plan.period, need, plan.omega_ref, (*plan.notes, note))
 
 
 @dataclass(frozen=True)

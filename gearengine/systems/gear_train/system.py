@@ -24,7 +24,7 @@ import numpy as np
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import DesignConversion
 from gearengine.signals.classify import DIVERGENCE_BOUND
-from gearengine.systems.base import Run, StepPlan, StroboscopicFlow, System
+from gearengine.systems.base import H_OMEGA, Run, StepPlan, StroboscopicFlow, System, resolving
 from gearengine.systems.gear_train import ramp as train_ramp
 from gearengine.systems.gear_train.kernel import flow_train, forcing_table, run_train, train_forcing
 from gearengine.systems.gear_train.lanes import run_train_lanes
@@ -40,10 +40,6 @@ from gearengine.systems.spur_pair.laws import law
 TRAIN_STEP_COST = 3
 """A train's RK4 step in steps of the pair's analysis, for compute budgets: the median ratio of a
 train's analysis to the pair's at the same steps (``benchmarks/bench_train.py``: 3.18)."""
-
-H_OMEGA = 0.5
-"""Largest h omega_max of the RK4 step against the train's fastest mode (RK4's stability limit
-is 2.83; 0.5 keeps a fast mode's phase error per step near 1e-4)."""
 
 
 @dataclass(frozen=True)
@@ -74,15 +70,8 @@ class TrainSystem(System):
 
     def plan(self, steps_per_period: int) -> StepPlan:
         """The pair's step plan, with at least T0 omega_max / ``H_OMEGA`` steps per T0."""
-        plan = step_plan(self.params, steps_per_period)
-        need = math.ceil(plan.period * self.omega_max / H_OMEGA)
-        if need <= plan.steps:
-            return plan
-        note = (
-            f"the train's fastest mode (omega = {self.omega_max:.4g} omega_n) needs {need} RK4 "
-            f"steps per T0 (h omega <= {H_OMEGA}); {plan.steps} were asked"
-        )
-        return StepPlan(plan.omega0, plan.period, need, plan.omega_ref, (*plan.notes, note))
+        return resolving(step_plan(self.params, steps_per_period), self.omega_max,
+                         "the train's fastest mode")  # fmt: skip
 
     name = "gear_train"
     step_cost = TRAIN_STEP_COST
