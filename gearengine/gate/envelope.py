@@ -277,8 +277,11 @@ def check_or_failures(request: SweepRequest, rules: Rules, refine: int = REFINE_
     """Pass or fail of an envelope sweep with the least work, where only that is needed (a
     bisection step): the chunks of ``check_envelope`` (one worker) one by one, those holding a
     grid point of ``first`` (values expected to fail) before the others, stopping at the first
-    chunk with a failing point: its failing points are returned. A grid that passes gives
-    ``check_envelope``'s report (refined), the same bits: the same chunks, assembled alike."""
+    chunk with a failing point: its failing points are returned. A grid that passes is
+    refined batch by batch, the points of ``first`` first, to the first batch with a failing
+    point (``gate.resolution.refine``'s ``stop``): the refined points that failed are returned.
+    A check that passes gives ``check_envelope``'s report (refined), the same bits: the same
+    chunks and refined points, assembled alike."""
     job = jobs.kind("sweep")
     size = balanced_chunk_points(request.n_points(), 1, smallest=1)
     plan = SweepPlan(request, size)
@@ -299,7 +302,9 @@ def check_or_failures(request: SweepRequest, rules: Rules, refine: int = REFINE_
             return failing
     result = job.assemble(request, outputs)
     assert isinstance(result, SweepResult)
-    return refined_report(request, result, rules, refine, refine_failing=False)
+    added = _refined(request, result, rules, refine, stop=True, first=first)
+    failing = [p for p in added if attractor_failures(p, rules)]
+    return failing or envelope_report(result, rules, added, resolution(request, refine, len(added)))
 
 
 def refined_report(request: SweepRequest, result: SweepResult, rules: Rules,
@@ -310,11 +315,23 @@ def refined_report(request: SweepRequest, result: SweepResult, rules: Rules,
     report = envelope_report(result, rules, resolution=resolution(request, 0))
     if refine <= 0 or (not refine_failing and not report.passed):
         return report
-    added = refine_points(request, [p for p in result.points if p.branch != "down"],
-                          lambda p: bool(attractor_failures(p, rules)),
-                          lambda p: near_limit(p, rules), refine, workers,
-                          lambda p: attractor_set(p, rules))  # fmt: skip
+    added = _refined(request, result, rules, refine, workers)
     return envelope_report(result, rules, added, resolution(request, refine, len(added)))
+
+
+def _refined(request: SweepRequest, result: SweepResult, rules: Rules, depth: int,
+             workers: int = 1, stop: bool = False, first: Sequence[dict[str, float]] = ()
+             ) -> list[SweepPoint]:  # fmt: skip
+    """The points ``gate.resolution.refine`` inserts ``depth`` times between the grid points of
+    ``result``; ``stop``: to the first batch with a failing point (the points of ``first``
+    first), where only pass or fail is needed."""
+    if depth <= 0:
+        return []
+    fails = lambda p: bool(attractor_failures(p, rules))  # noqa: E731
+    return refine_points(request, [p for p in result.points if p.branch != "down"], fails,
+                         lambda p: near_limit(p, rules), depth, workers,
+                         lambda p: attractor_set(p, rules), fails if stop else None,
+                         first)  # fmt: skip
 
 
 class FailingWindow(BaseModel):

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import itertools
 import os
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 
 from pydantic import BaseModel, ConfigDict, Field
@@ -37,6 +37,10 @@ chaos between a refined point near the limit and its grid neighbours (the z = 23
 5 N*m, 3,557 rpm, 19 % of starts; a chaotic 8.44 N*m level at 4,636 rpm, 38 %): depth 2 finds
 them at 1.6x the CPU of depth 1 on its 1,000-6,000 rpm x 5-60 N*m envelope (benchmarks)."""
 MAX_REFINE_DEPTH = 4
+STOP_BATCH = 4
+"""Points computed together by a refinement that stops at its first failure (``refine``'s
+``stop``): 64 runs with 16 basin starts, enough to keep the kernel's lanes full, few enough
+that a failure early in a level leaves the rest of it unrun."""
 
 
 class Resolution(BaseModel):
@@ -99,6 +103,8 @@ def refine(
     request: SweepRequest, points: list[SweepPoint], fails: Callable[[SweepPoint], bool],
     near: Callable[[SweepPoint], bool], depth: int, workers: int = 1,
     kind: Callable[[SweepPoint], Hashable] = lambda p: None,
+    stop: Callable[[SweepPoint], bool] | None = None,
+    first: Sequence[dict[str, float]] = (),
 ) -> list[SweepPoint]:  # fmt: skip
     """The points inserted between the grid ``points`` of ``request`` (its speed axis first,
     then a torque axis if any), cell by cell: a grid cell (two neighbours on a one-axis grid,
@@ -136,6 +142,7 @@ def refine(
         j = index2[round(p.values[names[1]], 9)] * f if len(names) > 1 else 0
         known[(i, j)] = p
     flags: dict[Lattice, tuple[bool, bool, Hashable]] = {}
+    expected = {_key(v) for v in first}
 
     def flag(ij: Lattice) -> tuple[bool, bool, Hashable]:
         if ij not in flags:
@@ -158,12 +165,24 @@ def refine(
         halves = [(c[0] + di, c[1] + dj) for c in split for di, dj in offsets(h // 2)]
         new = {x for c in halves for x in corners(c, h // 2)} - known.keys()
         todo = sorted(new, key=lambda ij: (ij[1], ij[0]))
-        for ij, p in zip(todo, _compute(request, [values(ij) for ij in todo], workers),
-                         strict=True):  # fmt: skip
-            known[ij] = p
-            added.append(p)
+        if stop is None:
+            batches = [todo]
+        else:
+            order = sorted(todo, key=lambda ij: _key(values(ij)) not in expected)
+            batches = [order[k : k + STOP_BATCH] for k in range(0, len(order), STOP_BATCH)]
+        for batch in batches:
+            got = _compute(request, [values(ij) for ij in batch], workers)
+            known.update(zip(batch, got, strict=True))
+            if stop is not None and any(stop(p) for p in got):
+                return [*added, *(known[ij] for ij in todo if ij in known)]
+        added += [known[ij] for ij in todo]
         cells, h = halves, h // 2
     return added
+
+
+def _key(values: dict[str, float]) -> tuple[float, ...]:
+    """A point's values as a key that survives the lattice arithmetic (9 decimals, SI)."""
+    return tuple(round(v, 9) for _, v in sorted(values.items()))
 
 
 def _compute(request: SweepRequest, values: list[dict[str, float]], workers: int
