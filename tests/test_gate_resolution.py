@@ -196,10 +196,11 @@ def test_a_refinement_for_pass_or_fail_stops_at_its_first_failure(
     """Where only pass or fail is needed (a remedies bisection step), the refinement stops at
     the first batch with a failing point, the points expected to fail (``first``) first; one
     that does not stop computes the points of the full refinement, the same bits, however it
-    is batched. The case of the test above: 3,613.6 rpm (level 1) passes, 3,556.8 and 3,670.5
-    rpm (level 2) fail."""
+    is batched; a failing point is found from its grid cell alone (``fails_toward``). The case
+    of the test above: 3,613.6 rpm (level 1) passes, 3,556.8 and 3,670.5 rpm (level 2)
+    fail."""
     from gearengine.gate import resolution
-    from gearengine.gate.envelope import attractor_failures
+    from gearengine.gate.envelope import attractor_failures, fails_toward
 
     request = sweep(11.3, "3500:3727.2727272727", 2)
     result = run_local(request, chunk_points=1)
@@ -218,3 +219,6 @@ def test_a_refinement_for_pass_or_fail_stops_at_its_first_failure(
                                                      full[2].model_dump_json()]  # fmt: skip
     never = resolution.refine(request, result.points, fails, near, 2, stop=lambda p: False)
     assert [p.model_dump_json() for p in never] == [p.model_dump_json() for p in full]
+    # from the failing point's grid cell alone, before the rest of the grid: found
+    assert fails_toward(request, rules, 2, [full[2].values])
+    assert not fails_toward(request, Rules(fail_on=["diverged"]), 2, [full[2].values])

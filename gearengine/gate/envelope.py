@@ -17,6 +17,7 @@ the attractors that broke it with their fractions.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Sequence
 from typing import Literal
@@ -29,7 +30,7 @@ from gearengine.model.errors import InputError
 from gearengine.model.units import IMPACTS_REFUSED, OUTPUTS, POINT_OUTPUTS
 from gearengine.signals.classify import SEVERITY
 from gearengine.studies import jobs
-from gearengine.studies.sweep.compute import run_local
+from gearengine.studies.sweep.compute import points_at, run_local
 from gearengine.studies.sweep.export import points_of_chunk
 from gearengine.studies.sweep.plan import SweepPlan, balanced_chunk_points
 from gearengine.studies.sweep.points import PhysicalValue, SpeedWindows, SweepPoint
@@ -305,6 +306,43 @@ def check_or_failures(request: SweepRequest, rules: Rules, refine: int = REFINE_
     added = _refined(request, result, rules, refine, stop=True, first=first)
     failing = [p for p in added if attractor_failures(p, rules)]
     return failing or envelope_report(result, rules, added, resolution(request, refine, len(added)))
+
+
+def fails_toward(request: SweepRequest, rules: Rules, refine: int,
+                 at: Sequence[dict[str, float]]) -> bool:  # fmt: skip
+    """Does the check of ``request`` (refined ``refine`` times) fail, as found from the grid
+    cells holding the values ``at`` alone (points between grid points where a refinement
+    failed before)? Their corners, then the way down toward each through the cells holding
+    it while each is split (``gate.resolution.refine``'s ``first``). A failure so found fails
+    the whole check: a failing corner fails the grid, and a refined point reached through
+    split cells is one the check's refinement reaches when its grid passes (a cell is split
+    on its own corners alone). False says nothing of the rest of the check."""
+    names, grids = [a.parameter for a in request.axes], request.grids()
+
+    def span(g: list[float], v: float) -> list[float]:  # the grid values either side of v
+        return (
+            g
+            if len(g) == 1
+            else next(
+                g[k : k + 2]
+                for k in range(len(g) - 1)
+                if min(g[k], g[k + 1]) <= v <= max(g[k], g[k + 1])
+            )
+        )
+
+    corners: list[dict[str, float]] = []
+    for v in at:
+        spans = [span(g, v[n]) for n, g in zip(names, grids, strict=True)]
+        cell = [dict(zip(names, x, strict=True)) for x in itertools.product(*spans)]
+        corners += [c for c in cell if c not in corners]
+    points = points_at(request, corners)
+    fails = lambda p: bool(attractor_failures(p, rules))  # noqa: E731
+    if any(fails(p) for p in points):
+        return True
+    found = refine_points(request, points, fails, lambda p: near_limit(p, rules), refine,
+                          kind=lambda p: attractor_set(p, rules), stop=fails, first=at,
+                          levels=False)  # fmt: skip
+    return any(fails(p) for p in found)
 
 
 def refined_report(request: SweepRequest, result: SweepResult, rules: Rules,

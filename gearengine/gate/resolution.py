@@ -106,6 +106,7 @@ def refine(
     kind: Callable[[SweepPoint], Hashable] = lambda p: None,
     stop: Callable[[SweepPoint], bool] | None = None,
     first: Sequence[dict[str, float]] = (),
+    levels: bool = True,
 ) -> list[SweepPoint]:  # fmt: skip
     """The points inserted between the grid ``points`` of ``request`` (its speed axis first,
     then a torque axis if any), cell by cell: a grid cell (two neighbours on a one-axis grid,
@@ -118,7 +119,8 @@ def refine(
     holding it while each is split, then level by level, ``STOP_BATCH`` points at a time,
     and ends at the first computed point that ``stop`` accepts (the points computed are
     returned). Every point computed is one the refinement computes: one that never stops
-    returns the same points in the same order, the same bits."""
+    returns the same points in the same order, the same bits. ``levels`` False: the way down
+    toward ``first`` alone (the points it computed)."""
     grids = request.grids()
     names = [a.parameter for a in request.axes]
     if depth <= 0 or not points:
@@ -194,6 +196,8 @@ def refine(
         for target in (_lattice(v, names, grids, sizes) for v in first):
             if target is not None and descend(target):
                 return [p for ij, p in known.items() if ij not in grid]
+    if not levels:
+        return [p for ij, p in known.items() if ij not in grid]
     cells = [c for c in grid if axes and all(x in known for x in corners(c, f))]
     added: list[SweepPoint] = []
     placed = set(grid)

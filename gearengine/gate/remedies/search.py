@@ -40,6 +40,7 @@ from gearengine.gate.envelope import (
     attractor_failures,
     check_envelope,
     check_or_failures,
+    fails_toward,
 )
 from gearengine.gate.remedies.levers import accuracy_classes, contact_ratio
 from gearengine.gate.remedies.request import (
@@ -267,6 +268,9 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
         last = [{n: p.values[n] for n in names} for p in failed[finer]]
         hints = [h for h in last if tuple(h[n] for n in names) in grid][:HINTS]
         if hints and any(attractor_failures(p, rules) for p in points_at(sweep, hints)):
+            return False
+        between = [h for h in last if tuple(h[n] for n in names) not in grid][:HINTS]
+        if between and fails_toward(sweep, rules, depths[finer], between):
             return False
         got = check_or_failures(sweep, rules, depths[finer], last)
         if isinstance(got, list):
