@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from gearengine.cli.junit import envelope_junit
 from gearengine.gate.envelope import (
     Rules,
@@ -186,3 +188,37 @@ def test_refinement_reaches_inside_a_cell() -> None:
     (window,) = report.failures
     assert window.level["torque"].value == 6.71875
     assert [round(v, 2) for v in window.speeds_rpm] == [5488.64, 5488.64]
+
+
+def test_a_refinement_for_pass_or_fail_stops_at_its_first_failure(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Where only pass or fail is needed (a remedies bisection step), the refinement stops at
+    the first batch with a failing point, the points expected to fail (``first``) first; one
+    that does not stop computes the points of the full refinement, the same bits, however it
+    is batched; a failing point is found from its grid cell alone (``fails_toward``). The case
+    of the test above: 3,613.6 rpm (level 1) passes, 3,556.8 and 3,670.5 rpm (level 2)
+    fail."""
+    from gearengine.gate import resolution
+    from gearengine.gate.envelope import attractor_failures, fails_toward
+
+    request = sweep(11.3, "3500:3727.2727272727", 2)
+    result = run_local(request, chunk_points=1)
+    rules = Rules()
+    fails = lambda p: bool(attractor_failures(p, rules))  # noqa: E731
+    near = lambda p: near_limit(p, rules)  # noqa: E731
+    full = resolution.refine(request, result.points, fails, near, 2)
+    assert [round(p.physical["speed"].value, 1) for p in full] == [3613.6, 3556.8, 3670.5]
+    assert [fails(p) for p in full] == [False, True, True]
+    monkeypatch.setattr(resolution, "STOP_BATCH", 1)
+    stopped = resolution.refine(request, result.points, fails, near, 2, stop=fails)
+    assert [p.model_dump_json() for p in stopped] == [p.model_dump_json() for p in full[:2]]
+    hinted = resolution.refine(request, result.points, fails, near, 2, stop=fails,
+                               first=[full[2].values])  # fmt: skip
+    assert [p.model_dump_json() for p in hinted] == [full[0].model_dump_json(),
+                                                     full[2].model_dump_json()]  # fmt: skip
+    never = resolution.refine(request, result.points, fails, near, 2, stop=lambda p: False)
+    assert [p.model_dump_json() for p in never] == [p.model_dump_json() for p in full]
+    # from the failing point's grid cell alone, before the rest of the grid: found
+    assert fails_toward(request, rules, 2, [full[2].values])
+    assert not fails_toward(request, Rules(fail_on=["diverged"]), 2, [full[2].values])

@@ -314,6 +314,37 @@ def test_the_remedy_found_passes_the_check_on_a_2x_finer_grid() -> None:
     assert report.passed, [f.model_dump() for f in report.failures]
 
 
+def test_the_budget_counts_the_refinement_and_the_verification(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The job's estimate before computing (``REMEDIES_JOB.work``) is at least the RK4 steps
+    the search then runs, and at most 4 times them: every point computed (grid, refined,
+    verification) counted at its sweep's mean steps a point, as the estimate counts them. The
+    case of the test above; main's estimate, which left out the refinement of every check and
+    of the verification, was 0.13 of the steps run."""
+    from gearengine.gate.remedies.compute import REMEDIES_JOB
+    from gearengine.studies.sweep import compute
+    from gearengine.studies.sweep.plan import sweep_work
+
+    doc = json.loads((ROOT / "examples" / "remedies-z23-67.json").read_text())
+    request = RemediesRequest.model_validate({
+        "fail_on": ["chaotic"], "starts": 4, "design": doc["design"], "tolerance": 0.1,
+        "envelope": {"speed": "4500:5700", "torque": "5:12", "speed_points": 2,
+                     "torque_points": 2},
+        "levers": [{"lever": ACCURACY_FIELD, "bounds": ["0 um", "11.3 um"]}],
+    })  # fmt: skip
+    ran = [0]
+    points = compute._points
+
+    def counted(sweep, values, *args, **kwargs):  # type: ignore[no-untyped-def]
+        ran[0] += len(values) * sweep_work(sweep) // sweep.n_points()
+        return points(sweep, values, *args, **kwargs)
+
+    monkeypatch.setattr(compute, "_points", counted)
+    assert remedies(request).remedies  # a remedy found: the search and its verification ran
+    assert ran[0] <= REMEDIES_JOB.work(request) <= 4 * ran[0]
+
+
 def _melnikov_said(blind: int, passed: bool, between: list[int] | None = None) -> str:
     """The answer of a lone Melnikov value judging 115 - ``blind`` of 115 points, where the
     envelope check on a 23 x 5 grid passes or fails at 3 points (``between``: the criterion's

@@ -17,6 +17,7 @@ the attractors that broke it with their fractions.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Sequence
 from typing import Literal
@@ -30,7 +31,7 @@ from gearengine.model.units import IMPACTS_REFUSED, OUTPUTS, POINT_OUTPUTS
 from gearengine.numerics.settings import ENVELOPE_SETTINGS
 from gearengine.signals.classify import SEVERITY
 from gearengine.studies import jobs
-from gearengine.studies.sweep.compute import run_local
+from gearengine.studies.sweep.compute import points_at, run_local
 from gearengine.studies.sweep.export import points_of_chunk
 from gearengine.studies.sweep.plan import SweepPlan, balanced_chunk_points
 from gearengine.studies.sweep.points import PhysicalValue, SpeedWindows, SweepPoint
@@ -273,8 +274,11 @@ def check_or_failures(request: SweepRequest, rules: Rules, refine: int = REFINE_
     """Pass or fail of an envelope sweep with the least work, where only that is needed (a
     bisection step): the chunks of ``check_envelope`` (one worker) one by one, those holding a
     grid point of ``first`` (values expected to fail) before the others, stopping at the first
-    chunk with a failing point: its failing points are returned. A grid that passes gives
-    ``check_envelope``'s report (refined), the same bits: the same chunks, assembled alike."""
+    chunk with a failing point: its failing points are returned. A grid that passes is
+    refined batch by batch, the points of ``first`` first, to the first batch with a failing
+    point (``gate.resolution.refine``'s ``stop``): the refined points that failed are returned.
+    A check that passes gives ``check_envelope``'s report (refined), the same bits: the same
+    chunks and refined points, assembled alike."""
     job = jobs.kind("sweep")
     size = balanced_chunk_points(request.n_points(), 1, smallest=1)
     plan = SweepPlan(request, size)
@@ -295,7 +299,46 @@ def check_or_failures(request: SweepRequest, rules: Rules, refine: int = REFINE_
             return failing
     result = job.assemble(request, outputs)
     assert isinstance(result, SweepResult)
-    return refined_report(request, result, rules, refine, refine_failing=False)
+    added = _refined(request, result, rules, refine, stop=True, first=first)
+    failing = [p for p in added if attractor_failures(p, rules)]
+    return failing or envelope_report(result, rules, added, resolution(request, refine, len(added)))
+
+
+def fails_toward(request: SweepRequest, rules: Rules, refine: int,
+                 at: Sequence[dict[str, float]]) -> bool:  # fmt: skip
+    """Does the check of ``request`` (refined ``refine`` times) fail, as found from the grid
+    cells holding the values ``at`` alone (points between grid points where a refinement
+    failed before)? Their corners, then the way down toward each through the cells holding
+    it while each is split (``gate.resolution.refine``'s ``first``). A failure so found fails
+    the whole check: a failing corner fails the grid, and a refined point reached through
+    split cells is one the check's refinement reaches when its grid passes (a cell is split
+    on its own corners alone). False says nothing of the rest of the check."""
+    names, grids = [a.parameter for a in request.axes], request.grids()
+
+    def span(g: list[float], v: float) -> list[float]:  # the grid values either side of v
+        return (
+            g
+            if len(g) == 1
+            else next(
+                g[k : k + 2]
+                for k in range(len(g) - 1)
+                if min(g[k], g[k + 1]) <= v <= max(g[k], g[k + 1])
+            )
+        )
+
+    corners: list[dict[str, float]] = []
+    for v in at:
+        spans = [span(g, v[n]) for n, g in zip(names, grids, strict=True)]
+        cell = [dict(zip(names, x, strict=True)) for x in itertools.product(*spans)]
+        corners += [c for c in cell if c not in corners]
+    points = points_at(request, corners)
+    fails = lambda p: bool(attractor_failures(p, rules))  # noqa: E731
+    if any(fails(p) for p in points):
+        return True
+    found = refine_points(request, points, fails, lambda p: near_limit(p, rules), refine,
+                          kind=lambda p: attractor_set(p, rules), stop=fails, first=at,
+                          levels=False)  # fmt: skip
+    return any(fails(p) for p in found)
 
 
 def refined_report(request: SweepRequest, result: SweepResult, rules: Rules,
@@ -306,11 +349,23 @@ def refined_report(request: SweepRequest, result: SweepResult, rules: Rules,
     report = envelope_report(result, rules, resolution=resolution(request, 0))
     if refine <= 0 or (not refine_failing and not report.passed):
         return report
-    added = refine_points(request, [p for p in result.points if p.branch != "down"],
-                          lambda p: bool(attractor_failures(p, rules)),
-                          lambda p: near_limit(p, rules), refine, workers,
-                          lambda p: attractor_set(p, rules))  # fmt: skip
+    added = _refined(request, result, rules, refine, workers)
     return envelope_report(result, rules, added, resolution(request, refine, len(added)))
+
+
+def _refined(request: SweepRequest, result: SweepResult, rules: Rules, depth: int,
+             workers: int = 1, stop: bool = False, first: Sequence[dict[str, float]] = ()
+             ) -> list[SweepPoint]:  # fmt: skip
+    """The points ``gate.resolution.refine`` inserts ``depth`` times between the grid points of
+    ``result``; ``stop``: to the first batch with a failing point (the points of ``first``
+    first), where only pass or fail is needed."""
+    if depth <= 0:
+        return []
+    fails = lambda p: bool(attractor_failures(p, rules))  # noqa: E731
+    return refine_points(request, [p for p in result.points if p.branch != "down"], fails,
+                         lambda p: near_limit(p, rules), depth, workers,
+                         lambda p: attractor_set(p, rules), fails if stop else None,
+                         first)  # fmt: skip
 
 
 class FailingWindow(BaseModel):

@@ -3,6 +3,7 @@ combination, assembled into the ranked answer; ``remedies()`` runs it in process
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 from gearengine.gate.remedies.request import (
@@ -28,11 +29,13 @@ from gearengine.gate.remedies.search import (
     lever_words,
     melnikov_failures,
     shared_check,
+    verify_depth,
 )
 from gearengine.numerics.batch import threads_may_share_kernels
 from gearengine.studies import jobs
 from gearengine.studies.sweep.axes import design_with
 from gearengine.studies.sweep.plan import sweep_work
+from gearengine.studies.sweep.request import SweepRequest
 
 
 def _chunk(request: RemediesRequest, index: int, chunk_points: int = 1) -> str:
@@ -212,15 +215,34 @@ def _judged(mel: Remedy) -> int:
 FINER_RUNS = 2
 """Runs on the 2x finer grid (about 4x the points) a numerical remedy's verification takes in
 the budget: its value, and one more when it fails there."""
+BOUNDARY_POINTS = 3
+"""Points a check's refinement adds, in the budget, per grid cell a boundary across the
+envelope crosses (n - 1 + m - 1 cells of an n x m grid) and per cell of each deeper halving
+(2, 4, ... cells): a split cell adds up to 5, shared with its neighbours. On the z = 23/67 pair
+over 1,000-6,000 rpm x 5-60 N*m (23 x 5, 16 starts) this is 234 points at two halvings (the
+design's own check added 82, its Melnikov value's 275) and 1,092 on the 45 x 9 verification
+at three (a failing one added 378 on average)."""
+
+
+def checked_work(sweep: SweepRequest, depth: int) -> int:
+    """RK4 steps, about, of an envelope check of ``sweep`` refined ``depth`` times: its grid's,
+    and its refinement's (``BOUNDARY_POINTS``; at most every point of the grid ``2**depth``
+    times finer) at the grid's mean steps a point."""
+    cells = [len(g) - 1 for g in sweep.grids()]
+    every = math.prod(c * 2**depth + 1 for c in cells) - sweep.n_points()
+    refined = min(every, BOUNDARY_POINTS * sum(cells) * (2**depth - 1))
+    return sweep_work(sweep) * (sweep.n_points() + refined) // sweep.n_points()
 
 
 def _work(request: RemediesRequest) -> int:
-    """RK4 steps, about: per lever its samples, bisections, the Melnikov bound's run and the
-    verification on the finer grid; the combination's far ends and grid; the baseline."""
+    """RK4 steps, about: per lever its samples, bisections and the Melnikov bound's run, each
+    refined as the check is, and the verification on the finer grid refined one halving deeper
+    (``verify_depth``); the combination's far ends and grid; the baseline."""
     n = len(request_levers(request))
-    runs = n * (1 + SAMPLES + MAX_BISECTIONS + 1 + 4 * FINER_RUNS) + 1 + n
-    runs += len(COMBINATION_GRID) ** 2
-    return runs * sweep_work(request.sweep())
+    runs = n * (1 + SAMPLES + MAX_BISECTIONS + 1) + 1 + n + len(COMBINATION_GRID) ** 2
+    coarse = checked_work(request.sweep(), request.envelope.refine)
+    return runs * coarse + n * FINER_RUNS * checked_work(request.sweep(finer=True),
+                                                         verify_depth(request))  # fmt: skip
 
 
 REMEDIES_JOB = jobs.JobKind(

@@ -30,6 +30,7 @@ for the combination; a chunk depends only on (request, index).
 
 from __future__ import annotations
 
+import itertools
 import math
 import threading
 from collections.abc import Callable
@@ -39,6 +40,7 @@ from gearengine.gate.envelope import (
     attractor_failures,
     check_envelope,
     check_or_failures,
+    fails_toward,
 )
 from gearengine.gate.remedies.levers import accuracy_classes, contact_ratio
 from gearengine.gate.remedies.request import (
@@ -252,24 +254,30 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
 
     def passes_at(value: float, finer: bool = False) -> bool:
         """Pass or fail at ``value``: the grid points that failed last run first (``HINTS``),
-        then the grid chunk by chunk, theirs first, to the first chunk with a failing point
-        (``check_or_failures``); one failing fails the grid, the answer the full check would
-        give. A grid that passes leaves its full report, refined."""
+        then the grid chunk by chunk, theirs first, to the first chunk with a failing point,
+        then the refinement batch by batch, the refined points that failed last first, to
+        the first failing one (``check_or_failures``); one failing fails the check, the answer
+        the full check would give. A grid that passes leaves its full report, refined. Only
+        grid points are tried ahead of the check: a refined point fails it only where the
+        refinement at ``value`` reaches."""
         if (value, finer) in reports:
             return reports[(value, finer)].passed
         sweep = request.sweep(design_with(request.design, {lever.path: value}), finer)
         names = [a.parameter for a in sweep.axes]
-        hints = [{n: p.values[n] for n in names} for p in failed[finer][:HINTS]]
+        grid = set(itertools.product(*sweep.grids()))
+        last = [{n: p.values[n] for n in names} for p in failed[finer]]
+        hints = [h for h in last if tuple(h[n] for n in names) in grid][:HINTS]
         if hints and any(attractor_failures(p, rules) for p in points_at(sweep, hints)):
             return False
-        got = check_or_failures(sweep, rules, depths[finer], hints)
+        between = [h for h in last if tuple(h[n] for n in names) not in grid][:HINTS]
+        if between and fails_toward(sweep, rules, depths[finer], between):
+            return False
+        got = check_or_failures(sweep, rules, depths[finer], last)
         if isinstance(got, list):
             failed[finer] = got
             return False
         reports[(value, finer)] = got
-        if not got.passed:  # its refined points failed: the grid's failing points are none
-            failed[finer] = [p for p in got.sweep.points if attractor_failures(p, rules)]
-        return got.passed
+        return True
 
     def snapped(value: float) -> float:
         """``value`` as the answer prints it (``SHOWN_DIGITS``, rounded toward the far end),
