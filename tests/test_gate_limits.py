@@ -10,10 +10,12 @@ from pathlib import Path
 import pytest
 
 from gearengine.cli.documents import InvalidInputError, read_document
-from gearengine.cli.envelope import envelope_request
+from gearengine.cli.envelope import envelope_request, windows_summary
 from gearengine.cli.main import build_parser, main
-from gearengine.gate.envelope import Rules, point_failures, verdict_failures
-from gearengine.studies.sweep.points import PhysicalValue, SweepPoint
+from gearengine.gate.envelope import Rules, attractor_failures, point_failures, verdict_failures
+from gearengine.gate.runup import bin_failures
+from gearengine.studies.runup.results import RunupBin
+from gearengine.studies.sweep.points import PhysicalValue, SpeedWindows, SweepPoint
 from tests.conftest import PAPER_PARAMS, ROOT
 
 LIGHT = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
@@ -149,3 +151,46 @@ def test_a_bad_option_is_named_by_the_option(
     assert main(["check", str(ROOT / "examples" / "ci" / "design.json"), *options]) == 2
     err = capsys.readouterr().err
     assert named in err and "axes[" not in err
+
+
+def _diverged_point(attractors: list | None) -> SweepPoint:
+    """The point the review found: 16 basin starts, every one diverged (no attractor)."""
+    return SweepPoint(values={"speed": 31.4}, branch=None, classification="diverged",
+                      attractors=attractors, decided_by="diverged from 100 % of starts",
+                      physical={"speed": PhysicalValue(value=300.0, unit="rpm")})  # fmt: skip
+
+
+def test_a_point_whose_every_start_diverged_fails_the_envelope() -> None:
+    """With basins the gate checked each attractor above --min-basin, and a point where every
+    start diverged has none: it passed ('PASS: 0 of 1' at 300 rpm of design-geometry.json, its
+    classification diverged), where --starts 1 failed it. It is judged by its own verdict,
+    and a diverged verdict fails whatever --fail-on says."""
+    point = _diverged_point([])
+    for rules in (Rules(), Rules(fail_on=["separation"]), Rules(fail_on=["back_flank"])):
+        assert attractor_failures(point, rules) == [("diverged", "diverged from 100 % of starts")]
+        assert point_failures(_diverged_point(None), rules) == ["diverged"]
+    # the single-design check judges the same verdict words
+    assert verdict_failures(Rules(fail_on=["separation"]), "diverged", None, None, None) == [
+        "diverged"
+    ]
+
+
+def test_the_windows_never_call_a_diverged_speed_in_contact() -> None:
+    """'teeth always in contact' was printed for a level whose one point diverged."""
+    level = {"torque": PhysicalValue(value=60.0, unit="N*m")}
+    w = SpeedWindows(level=level, response={"diverged": [[300.0, 300.0]]}, contact={},
+                     melnikov=[])  # fmt: skip
+    (line,) = windows_summary([w])
+    assert "teeth always in contact" not in line
+    assert "diverged (contact unknown) 300 rpm" in line
+
+
+def test_a_diverged_runup_bin_fails_whatever_the_rules() -> None:
+    """A bin where a member diverged (no LLE, no contact) failed only a chaos rule, and only
+    after 0.05 s of them: under --fail-on separation it passed."""
+    values = dict.fromkeys(RunupBin.model_fields)
+    diverged = RunupBin(**{**values, "speed_rpm": [300.0, 350.0], "time_s": [0.0, 0.1]})
+    assert bin_failures(diverged, Rules(fail_on=["separation"])) == ["diverged"]
+    followed = diverged.model_copy(update={"lle": -0.1, "contact": "drive_flank",
+                                           "separation_fraction": 0.0})  # fmt: skip
+    assert bin_failures(followed, Rules(fail_on=["separation"])) == []

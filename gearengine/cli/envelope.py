@@ -258,13 +258,17 @@ def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit",
                     refined: dict[str, str] | None = None) -> list[str]:  # fmt: skip
     """Per level of the other axis, the impact and Melnikov windows in rpm, pass or fail:
     "windows at torque 40 N*m: tooth separation 500-1100 rpm; Melnikov:
-    chaos possible nowhere"; ``reason`` says why Melnikov does not apply where it does not
-    (``not_judged_reason``); ``refined`` (``refined_levels``) says over which speeds a level
-    refined between the grid's was checked: "windows at torque 8.44 N*m (refined level, checked
-    at 3 speeds in 4636-4864 rpm): ..."."""
+    chaos possible nowhere" ("teeth always in contact" only where no point diverged: a
+    diverged point has no contact verdict); ``reason`` says why Melnikov does not apply where
+    it does not (``not_judged_reason``); ``refined`` (``refined_levels``) says over which
+    speeds a level refined between the grid's was checked: "windows at torque 8.44 N*m
+    (refined level, checked at 3 speeds in 4636-4864 rpm): ..."."""
     out = []
     for w in windows:
-        contact = "; ".join(f"{CONTACT_LABELS[k]} {spans_text(v)}" for k, v in w.contact.items())
+        parts = [f"{CONTACT_LABELS[k]} {spans_text(v)}" for k, v in w.contact.items()]
+        if "diverged" in w.response:  # no contact verdict there: never "always in contact"
+            parts.append(f"diverged (contact unknown) {spans_text(w.response['diverged'])}")
+        contact = "; ".join(parts)
         melnikov = f"chaos possible {spans_text(w.melnikov) if w.melnikov else 'nowhere'}"
         if w.melnikov_not_applicable:
             na = f"not applicable at {spans_text(w.melnikov_not_applicable)} ({reason})"

@@ -27,6 +27,7 @@ from gearengine.gate.resolution import REFINE_DEPTH, Resolution, resolution
 from gearengine.gate.resolution import refine as refine_points
 from gearengine.model.errors import InputError
 from gearengine.model.units import IMPACTS_REFUSED, OUTPUTS, POINT_OUTPUTS
+from gearengine.numerics.results import Attractor
 from gearengine.signals.classify import SEVERITY
 from gearengine.studies import jobs
 from gearengine.studies.sweep.compute import run_local
@@ -102,12 +103,15 @@ def verdict_failures(
 ) -> list[str]:
     """The rules one verdict breaks, as short labels ("chaotic", "DTE > 20 µm", ...): a sweep
     point's (``point_failures``) or one analysis's (``gearengine check``); a limit on a value
-    that is missing (no design, diverged) fails."""
+    that is missing (no design, diverged) fails, and a diverged verdict fails whatever
+    ``fail_on`` says: the gate cannot vouch for a response the model could not follow."""
     out = []
     for name in rules.fail_on:
         if name in SEVERITY and SEVERITY[classification] >= SEVERITY[name]:
             out.append(classification.replace("_", "-"))
             break
+    if classification == "diverged" and not out:  # whatever fail_on: nothing to vouch for
+        out.append("diverged")
     if "melnikov" in rules.fail_on and melnikov_chaos_possible:
         out.append("Melnikov: chaos possible")
     if "back_flank" in rules.fail_on and impact_regime == "double_sided":
@@ -128,14 +132,17 @@ def verdict_failures(
 def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
     """(rule, who) of each rule a point breaks: with basins each attractor above
     ``rules.min_basin`` is checked as if it were the point ("chaotic, double-sided impacts
-    from 41 % of starts" is who broke it); without, the point itself (who is empty)."""
+    from 41 % of starts" is who broke it), and the point's own verdict too where those
+    attractors do not decide it (``judged_alone``: its starts diverged, or no basin is above
+    ``min_basin``), named by its ``decided_by``; without basins, the point itself (who is
+    empty)."""
     if p.attractors is None:
         return [(rule, "") for rule in point_failures(p, rules)]
     out = []
-    least = -1.0 if rules.min_basin is None else rules.min_basin
-    for a in p.attractors:
-        if a.fraction <= least:
-            continue
+    if judged_alone(p, rules):
+        who = p.decided_by or "the settings' own start (no basin above --min-basin)"
+        out += [(rule, who) for rule in point_failures(p, rules)]
+    for a in _checked(p, rules):
         physical = dict(p.physical or {})
         for key, value in (("dte", a.dte_um), ("dynamic_factor", a.dynamic_factor)):
             physical.pop(key, None)
@@ -147,6 +154,20 @@ def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
         who = f"{a.label} from {100 * a.fraction:.0f} % of starts"
         out += [(rule, who) for rule in point_failures(alone, rules)]
     return out
+
+
+def _checked(p: SweepPoint, rules: Rules) -> list[Attractor]:
+    """The attractors of ``p`` whose basin fraction is above ``rules.min_basin``."""
+    least = -1.0 if rules.min_basin is None else rules.min_basin
+    return [a for a in p.attractors or [] if a.fraction > least]
+
+
+def judged_alone(p: SweepPoint, rules: Rules) -> bool:
+    """Whether a point with basins is judged by its own verdict beside its attractors': when
+    no attractor above ``rules.min_basin`` decided it, a divergence did (every start may have
+    diverged: no attractor at all) or the settings' own start did (no basin above it)."""
+    return p.attractors is not None and (p.classification == "diverged"
+                                         or not _checked(p, rules))  # fmt: skip
 
 
 NEAR_LLE = 0.6
@@ -193,10 +214,11 @@ def attractor_set(p: SweepPoint, rules: Rules) -> frozenset[tuple[str, int | Non
     """The responses a point settles on (class and period of each attractor whose basin is
     above ``rules.min_basin``, or of the point without basins): two neighbours whose sets
     differ are on two sides of a bifurcation, where a window may hide between them."""
+    own = {(p.classification, p.period)}
     if p.attractors is None:
-        return frozenset({(p.classification, p.period)})
-    least = -1.0 if rules.min_basin is None else rules.min_basin
-    return frozenset((a.classification, a.period) for a in p.attractors if a.fraction > least)
+        return frozenset(own)
+    found = {(a.classification, a.period) for a in _checked(p, rules)}
+    return frozenset(found | own if judged_alone(p, rules) else found)
 
 
 def _physical(p: SweepPoint, key: str) -> float | None:

@@ -30,8 +30,10 @@ GATE_ENSEMBLE = 4
 
 
 def bin_failures(b: RunupBin, rules: Rules) -> list[str]:
-    """The per-bin rules a bin breaks (chaos is judged over runs, see ``runup_failures``)."""
-    out = []
+    """The per-bin rules a bin breaks (chaos is judged over runs, see ``runup_failures``); a
+    bin where a member diverged (no LLE, or no contact verdict) fails whatever ``fail_on``
+    says: the gate cannot vouch for a response the model could not follow."""
+    out = ["diverged"] if b.lle is None or b.contact is None else []
     if "back_flank" in rules.fail_on and (b.back_flank_impacts or 0) > 0:
         out.append("back-flank impacts")
     if "separation" in rules.fail_on and (b.separation_fraction or 0) > 0:
