@@ -186,7 +186,10 @@ def test_samples_auto_reports_the_points_the_budget_leaves_undecided(
     )
     assert "FAIL: speed 5000 rpm (64 samples) [P(separation) lower bound" in captured.out
     assert "the budget of 3500000 RK4 steps ran out: 1 points undecided after 128" in captured.err
-    assert "FAIL: 1 of 2 points over a probability limit, 1 undecided" in captured.out
+    assert (
+        "FAIL: 1 of 2 points over a probability limit (P(separation) <= 0.01), 1 undecided"
+        in captured.out
+    )
 
 
 def test_the_api_refuses_a_study_over_the_budget_in_the_same_terms(tmp_path: Path) -> None:
@@ -257,7 +260,10 @@ def test_the_gates_json_is_its_report_at_the_confidence_it_decided_at(
     assert main([*base, "--samples", "auto", "--max-probability", "separation=0.01",
                  "--json", str(out)]) == 1  # fmt: skip
     captured = capsys.readouterr()
-    assert "FAIL: 1 of 2 points over a probability limit, 1 undecided" in captured.out
+    assert (
+        "FAIL: 1 of 2 points over a probability limit (P(separation) <= 0.01), 1 undecided"
+        in captured.out
+    )
     assert "points over a probability limit" not in captured.err
     report = json.loads(out.read_text())
     assert (report["passed"], report["limits"]) == (False, {"separation": 0.01})
@@ -279,7 +285,31 @@ def test_the_gates_json_is_its_report_at_the_confidence_it_decided_at(
     assert report["notes"][0].startswith("--samples auto: the budget of 3500000 RK4 steps")
     assert main([*base, "--samples", "8", "--max-probability", "back_flank=0.5",
                  "--json", str(out)]) == 0  # fmt: skip
-    assert "PASS: 0 of 2 points over a probability limit" in capsys.readouterr().out
+    assert "PASS: 0 of 2 points over a probability limit (P(back_flank) <= 0.5), 0 undecided" in (
+        capsys.readouterr().out
+    )
     report = json.loads(out.read_text())
     assert report["passed"] and report["confidence"] == 0.95 and report["notes"] == [ONE_START]
     assert [v["verdict"] for v in report["verdicts"]] == ["pass", "pass"]
+
+
+def test_the_probability_gate_refuses_the_envelope_rules_it_would_ignore(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check --max-probability chaotic=0.1 --max-dte 0.001um --fail-on separation --runup
+    1000 --refine 3`` passed: the probability gate read none of the envelope's rules and
+    options (new-user review, finding 2). Refused before computing, naming them; a limit given
+    twice kept the last one silently, and is refused too."""
+    base = ["check", str(design_file), "--speed", "2000:5000", "--speed-points", "2",
+            "--samples", "64"]  # fmt: skip
+    extra = ["--max-dte", "0.001um", "--fail-on", "separation", "--runup", "1000", "--refine",
+             "3", "--max-lle", "0", "--max-dynamic-factor", "1.1", "--min-basin", "0.1",
+             "--server", "http://localhost:1", "--min-stability-margin", "0.1"]  # fmt: skip
+    assert main([*base, "--max-probability", "chaotic=0.1", *extra]) == 2
+    err = capsys.readouterr().err
+    for option in extra[::2]:
+        assert option in err
+    assert "run it as a second check without --max-probability" in err
+    twice = ["--max-probability", "chaotic=0.05", "--max-probability", "chaotic=0.5"]
+    assert main([*base, *twice]) == 2
+    assert "P(chaotic) is limited twice (chaotic=0.05 before)" in capsys.readouterr().err

@@ -106,8 +106,9 @@ def point_name(values: dict[str, float]) -> str:
 
 
 def limits_of(texts: list[str]) -> dict[str, float]:
-    """``["chaotic=0.01", ...]`` as {name: limit}; InvalidInputError naming a bad one, and
-    the old word ``impacts`` saying which two words to write (``IMPACTS_REFUSED``)."""
+    """``["chaotic=0.01", ...]`` as {name: limit}; InvalidInputError naming a bad one or a
+    name given twice, and the old word ``impacts`` saying which two words to write
+    (``IMPACTS_REFUSED``)."""
     out = {}
     for text in texts:
         name, _, value = text.partition("=")
@@ -120,6 +121,10 @@ def limits_of(texts: list[str]) -> dict[str, float]:
         if name not in GATED or not 0.0 <= limit <= 1.0:
             raise InvalidInputError([f"--max-probability {text}: give NAME=P with P in [0, 1] "
                                      f"and NAME one of {', '.join(GATED)}"])  # fmt: skip
+        if name in out:
+            raise InvalidInputError([f"--max-probability {text}: P({name}) is limited twice "
+                                     f"({name}={out[name]:g} before); give one limit a "
+                                     "name"])  # fmt: skip
         out[name] = limit
     return out
 
@@ -243,6 +248,8 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
         Path(args.json).write_text(dumps(report))
     if args.junit:
         Path(args.junit).write_text(junit(report, f"robustness of {args.file}"))
+    named = ", ".join(f"P({k}) <= {v:g}" for k, v in limits.items())
     print(f"{'PASS' if report.passed else 'FAIL'}: {report.failing_points} of {report.points} "
-          f"points over a probability limit, {report.undecided_points} undecided")  # fmt: skip
+          f"points over a probability limit ({named}), {report.undecided_points} "
+          "undecided")  # fmt: skip
     return EXIT_OK if report.passed else EXIT_FAIL
