@@ -194,3 +194,26 @@ def test_a_diverged_runup_bin_fails_whatever_the_rules() -> None:
     followed = diverged.model_copy(update={"lle": -0.1, "contact": "drive_flank",
                                            "separation_fraction": 0.0})  # fmt: skip
     assert bin_failures(followed, Rules(fail_on=["separation"])) == []
+
+
+@pytest.mark.parametrize(
+    "option",
+    ["--max-dynamic-factor", "--max-lle", "--max-dte", "--min-basin", "--min-stability-margin",
+     "--runup"],
+)  # fmt: skip
+def test_non_finite_limits_are_refused_naming_the_option(
+    option: str, capsys: pytest.CaptureFixture
+) -> None:
+    """``check --max-dynamic-factor nan`` passed (no comparison with nan is true) and
+    ``--max-dte nan`` printed '(--max-dte nan µm)' (new-user review, finding 3): nan and inf
+    are refused by the parser (exit 2), naming the option; the library's Rules refuse them."""
+    for value in ("nan", "inf", "-inf"):
+        with pytest.raises(SystemExit) as stopped:
+            build_parser().parse_args(["check", "x.json", f"{option}={value}"])
+        assert stopped.value.code == 2
+        assert f"argument {option}: '{value}': give a finite number" in capsys.readouterr().err
+    field = {"--max-dynamic-factor": "max_dynamic_factor", "--max-lle": "max_lle",
+             "--max-dte": "max_dte_um"}.get(option)  # fmt: skip
+    if field is not None:
+        with pytest.raises(ValueError, match="finite number"):
+            Rules(**{field: float("nan")})

@@ -42,7 +42,8 @@ FailOn = Literal["chaotic", "quasi_periodic", "diverged", "melnikov", "back_flan
 
 
 class Rules(BaseModel):
-    """What fails the gate at a grid point."""
+    """What fails the gate at a grid point; a limit is a finite number (nan, with which no
+    comparison is true, passed every point)."""
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
@@ -53,10 +54,16 @@ class Rules(BaseModel):
         "robustness probabilities name them. The old word impacts is refused: write back_flank "
         "or separation.",
     )
-    max_lle: float | None = Field(None, description="Largest LLE allowed, per unit tau.")
-    max_dte_um: float | None = Field(None, description="Largest DTE peak to peak [µm].")
+    max_lle: float | None = Field(
+        None, allow_inf_nan=False, description="Largest LLE allowed, per unit tau."
+    )
+    max_dte_um: float | None = Field(
+        None, allow_inf_nan=False, description="Largest DTE peak to peak [µm]."
+    )
     max_dynamic_factor: float | None = Field(
-        None, description="Largest dynamic factor allowed: max mesh force / static force."
+        None,
+        allow_inf_nan=False,
+        description="Largest dynamic factor allowed: max mesh force / static force.",
     )
     min_basin: float | None = Field(
         None,
