@@ -12,6 +12,7 @@ import pytest
 from gearengine.cli.main import main
 from gearengine.cli.robustness import ONE_START
 from gearengine.gate.envelope import ENVELOPE_SETTINGS
+from gearengine.gate.probability import ONE_LOOK
 from gearengine.studies.robustness.study import RobustnessRequest, run_local
 from tests.test_robustness import DESIGN
 
@@ -313,3 +314,46 @@ def test_the_probability_gate_refuses_the_envelope_rules_it_would_ignore(
     twice = ["--max-probability", "chaotic=0.05", "--max-probability", "chaotic=0.5"]
     assert main([*base, *twice]) == 2
     assert "P(chaotic) is limited twice (chaotic=0.05 before)" in capsys.readouterr().err
+
+
+def test_diverged_samples_never_pass_a_limit_they_could_break() -> None:
+    """``robustness --speed 100:100`` had 128 of 128 samples diverged, printed 'chaotic 0.000'
+    and the gate passed chaotic=0.05 (new-user review, finding 4): a diverged sample has no
+    class or contact. A limit passes when it holds with the diverged samples counted as the
+    outcome (a few of many do not matter), else the point is undecided, saying why; the
+    lower bound (a fail) counts the followed events alone."""
+    from gearengine.gate.probability import point_verdict
+    from gearengine.studies.robustness.study import Probability, RobustnessPoint
+    from gearengine.studies.robustness.tolerances import probability
+
+    def point(diverged: int, chaotic: int, n: int = 64) -> RobustnessPoint:
+        probs = {"chaotic": probability(chaotic, n), "diverged": probability(diverged, n),
+                 "melnikov_chaos_possible": probability(0, n)}  # fmt: skip
+        shown = {k: Probability(**v) for k, v in probs.items()}
+        return RobustnessPoint(values={}, shown={"speed": 100.0}, samples=n, dte_um={},
+                               probabilities=shown)  # fmt: skip
+
+    every = point_verdict(point(64, 0), {"chaotic": 0.1}, ONE_LOOK, 1, None)
+    assert every.verdict == "undecided" and every.limits["chaotic"].verdict == "undecided"
+    assert every.reasons == [
+        "P(chaotic) undecided: 64 of 64 samples diverged (the model could not follow them); "
+        "counted as chaotic, the upper bound is 1 > 0.1"
+    ]
+    # the verdicts P(diverged) and Melnikov read are known for every sample
+    assert point_verdict(point(64, 0), {"melnikov_chaos_possible": 0.1}, ONE_LOOK, 1,
+                         None).verdict == "pass"  # fmt: skip
+    assert point_verdict(point(64, 0), {"diverged": 0.5}, ONE_LOOK, 1, None).verdict == "fail"
+    # one diverged sample of 64 under a 10 % limit: 1/64 still proves it (upper bound 0.084)
+    assert point_verdict(point(1, 0), {"chaotic": 0.1}, ONE_LOOK, 1, None).verdict == "pass"
+    assert point_verdict(point(1, 20), {"chaotic": 0.1}, ONE_LOOK, 1, None).verdict == "fail"
+
+
+def test_the_study_text_shows_diverged_samples(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """At 100 rpm every sample of the robustness example diverges: the line said 'chaotic
+    0.000 [0.000, 0.028]' and nothing of it."""
+    argv = ["robustness", str(design_file), "--speed", "100:100", "--speed-points", "1",
+            "--samples", "8"]  # fmt: skip
+    assert main(argv) == 0
+    assert "diverged 8 of 8 (8 samples" in capsys.readouterr().out

@@ -145,6 +145,8 @@ def cmd_robustness(args: argparse.Namespace) -> int:
             f"{k} {pr[k].value:.3f} [{pr[k].interval[0]:.3f}, {pr[k].interval[1]:.3f}]"
             for k in ("chaotic", "separation", "back_flank")
         )
+        if pr["diverged"].count:  # no class or contact known for them: never hidden
+            words += f", diverged {pr['diverged'].count} of {p.samples}"
         print(f"{point_name(p.shown)}: {words} ({p.samples} samples, {result.starts_text()})")
         for line in p.ranking or []:
             print(f"  {line}")
