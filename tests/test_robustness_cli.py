@@ -357,3 +357,19 @@ def test_the_study_text_shows_diverged_samples(
             "--samples", "8"]  # fmt: skip
     assert main(argv) == 0
     assert "diverged 8 of 8 (8 samples" in capsys.readouterr().out
+
+
+def test_the_gate_refuses_fewer_than_one_sample(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check --max-probability chaotic=0.05 --samples 0`` raised ZeroDivisionError (exit 70,
+    a traceback) in samples_needed (new-user review, finding 5): refused by the parser."""
+    for count in ("0", "-4"):
+        argv = ["check", str(design_file), "--max-probability", "chaotic=0.05",
+                f"--samples={count}"]  # fmt: skip
+        with pytest.raises(SystemExit) as stopped:
+            main(argv)
+        assert stopped.value.code == 2
+        assert f"argument --samples: '{count}': give a whole number of at least 1" in (
+            capsys.readouterr().err
+        )

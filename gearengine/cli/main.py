@@ -108,13 +108,18 @@ def _finite(value: float, text: str) -> float:
 
 
 def samples_count(text: str) -> int | str:
-    """``--samples`` of the probability gate: a whole number, or ``auto``."""
+    """``--samples`` of the probability gate: a whole number of at least 1, or ``auto``
+    (``--samples 0`` divided by zero in ``samples_needed``)."""
     if text == "auto":
         return text
     try:
-        return int(text)
+        count = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError("give a whole number (a power of 2) or auto") from None
+        count = 0
+    if count < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: give a whole number of at least 1 (a power "
+                                         "of 2) or auto")  # fmt: skip
+    return count
 
 
 def fail_on_word(text: str) -> str:
