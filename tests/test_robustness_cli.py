@@ -373,3 +373,26 @@ def test_the_gate_refuses_fewer_than_one_sample(
         assert f"argument --samples: '{count}': give a whole number of at least 1" in (
             capsys.readouterr().err
         )
+
+
+def test_the_envelope_check_says_it_judges_the_nominal_design_of_a_toleranced_one(
+    design_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check robustness-gears.json --speed 4000:6000 ...`` passed with notes [] while the
+    probability gate failed every point (new-user review, finding 6): the envelope check of a
+    design with tolerances says, in its text and its report, that it judged the nominal
+    design and which option judges the tolerances."""
+    from gearengine.cli.envelope import NOMINAL_ONLY
+
+    out = tmp_path / "e.json"
+    argv = ["check", str(design_file), "--speed", "2000:2000", "--speed-points", "1",
+            "--starts", "1", "--refine", "0", "--json", str(out)]  # fmt: skip
+    main(argv)
+    assert f"  note: {NOMINAL_ONLY}" in capsys.readouterr().out
+    assert json.loads(out.read_text())["notes"] == [NOMINAL_ONLY]
+    nominal = tmp_path / "nominal.json"
+    nominal.write_text(json.dumps({"design": {k: v for k, v in DESIGN.items()
+                                              if k != "tolerances"}}))  # fmt: skip
+    main([*argv[:1], str(nominal), *argv[2:]])
+    assert "note:" not in capsys.readouterr().out
+    assert json.loads(out.read_text())["notes"] == []

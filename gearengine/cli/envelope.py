@@ -293,6 +293,14 @@ def spans_text(spans: list[list[float]]) -> str:
     return ", ".join(f"{a:g}" if a == b else f"{a:g}-{b:g}" for a, b in spans) + " rpm"
 
 
+NOMINAL_ONLY = (
+    "the design has tolerances: this check judges the nominal design only; --max-probability "
+    "NAME=P (a second check) judges the tolerances, e.g. --max-probability chaotic=0.05"
+)
+"""The envelope check's note on a design with tolerances (it passed while the probability
+gate failed every point, and said nothing of them)."""
+
+
 def cmd_envelope(args: argparse.Namespace, doc: object) -> int:
     """The envelope gate of the design document ``doc``; exit 0 pass, 1 fail, 2 invalid
     input."""
@@ -318,6 +326,8 @@ def cmd_envelope(args: argparse.Namespace, doc: object) -> int:
         from gearengine.gate.runup import gate_envelope
 
         report = validated_input(lambda r: gate_envelope(report, request, r), args.runup, "--runup")
+    if request.design is not None and request.design.tolerances is not None:
+        report = report.model_copy(update={"notes": [*report.notes, NOMINAL_ONLY]})
     print_report(report, request.design)
     if args.json:
         Path(args.json).write_text(dumps(report))
