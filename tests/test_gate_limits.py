@@ -85,7 +85,8 @@ def test_one_verdict_is_judged_by_the_rules_of_a_point() -> None:
     rules = Rules(fail_on=["chaotic", "melnikov"], max_lle=0.0, max_dte_um=20.0,
                   max_dynamic_factor=1.5)  # fmt: skip
     verdict = ("chaotic", 0.05, "double_sided", True)
-    expected = ["chaotic", "Melnikov: chaos possible", "LLE > 0", "DTE > 20 µm"]
+    # the LLE limit names its unit: '[LLE > -1000]' said none (new-user review, finding 7)
+    expected = ["chaotic", "Melnikov: chaos possible", "LLE > 0 per unit tau", "DTE > 20 µm"]
     assert verdict_failures(rules, *verdict, dte_um=25.0, dynamic_factor=1.2) == expected
     # a limit on a value the verdict does not have (dimensionless, diverged) fails
     assert verdict_failures(rules, "periodic", -0.1, "no_impact", False)[-2:] == [
@@ -217,3 +218,17 @@ def test_non_finite_limits_are_refused_naming_the_option(
     if field is not None:
         with pytest.raises(ValueError, match="finite number"):
             Rules(**{field: float("nan")})
+
+
+def test_no_melnikov_window_reads_nowhere_in_the_scanned_range(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """The summary said 'Melnikov chaos possible at nowhere rpm' (new-user review, finding 7)
+    for the robustness example, whose criterion allows chaos at no speed it scanned."""
+    doc = json.loads((ROOT / "examples" / "robustness-gears.json").read_text())
+    path = tmp_path / "gears.json"
+    path.write_text(json.dumps({**doc, "settings": LIGHT}))
+    main(["check", str(path), "--max-lle", "-1000"])
+    out = capsys.readouterr().out
+    assert "Melnikov chaos possible nowhere in 10-18,000 rpm (scanned)" in out
+    assert "nowhere rpm" not in out and "[LLE > -1000 per unit tau]" in out

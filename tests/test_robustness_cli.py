@@ -49,9 +49,16 @@ def test_the_gate_fails_on_the_upper_bound_and_names_the_points(
     cases = ElementTree.parse(junit).getroot().findall("testsuite/testcase")
     assert [c.get("name") for c in cases] == ["speed 2000 rpm", "speed 5000 rpm"]
     assert [c.find("failure") is not None for c in cases] == [False, True]
+    out = capsys.readouterr().out
+    # a fixed count's reasons name its 95 % as auto's name 99.3 %, and a pass names the bound
+    # that proves it (new-user review, finding 7)
     assert (
-        "FAIL: speed 5000 rpm (8 samples) [P(separation) lower bound 0.473 > 0.4 (7/8 "
-        "samples)]" in capsys.readouterr().out
+        "FAIL: speed 5000 rpm (8 samples) [P(separation) lower bound at 95 % 0.473 > 0.4 (7/8 "
+        "samples)]" in out
+    )
+    assert (
+        "PASS: speed 2000 rpm (8 samples) [P(separation) upper bound at 95 % 0.369 <= 0.4 (0/8 "
+        "samples)]" in out
     )
     assert main([*base, "--samples", "8", "--max-probability", "back_flank=0.5"]) == 0
     assert main([*base, "--max-probability", "nonsense=0.1"]) == 2
@@ -337,7 +344,7 @@ def test_diverged_samples_never_pass_a_limit_they_could_break() -> None:
     assert every.verdict == "undecided" and every.limits["chaotic"].verdict == "undecided"
     assert every.reasons == [
         "P(chaotic) undecided: 64 of 64 samples diverged (the model could not follow them); "
-        "counted as chaotic, the upper bound is 1 > 0.1"
+        "counted as chaotic, the upper bound at 95 % is 1 > 0.1"
     ]
     # the verdicts P(diverged) and Melnikov read are known for every sample
     assert point_verdict(point(64, 0), {"melnikov_chaos_possible": 0.1}, ONE_LOOK, 1,

@@ -179,7 +179,7 @@ def rules_text(rules: Rules) -> str:
     """The rules as options: "--fail-on chaotic, --max-dte 20 µm"."""
     parts = [f"--fail-on {f}" for f in rules.fail_on]
     if rules.max_lle is not None:
-        parts.append(f"--max-lle {rules.max_lle:g}")
+        parts.append(f"--max-lle {rules.max_lle:g} per unit tau")
     if rules.max_dte_um is not None:
         parts.append(f"--max-dte {rules.max_dte_um:g} µm")
     if rules.max_dynamic_factor is not None:

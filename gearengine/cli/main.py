@@ -151,7 +151,13 @@ def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -
     p.add_argument("--max-dynamic-factor", type=finite, default=None, metavar="F",
                    help="fail where the largest dynamic mesh force exceeds F times the static "
                    "force")  # fmt: skip
-    p.add_argument("--max-lle", type=finite, default=None, help="fail when the LLE exceeds V")
+    p.add_argument(
+        "--max-lle",
+        type=finite,
+        default=None,
+        help="fail when the LLE exceeds V per unit tau (tau = omega_n t; "
+        "check prints it in 1/s too)",
+    )
     p.add_argument("--starts", type=int, default=None, metavar="N",
                    help="envelope checks: basin starts per operating point (default 16; 1: "
                    "the settings' own start only)")  # fmt: skip

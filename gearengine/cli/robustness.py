@@ -27,7 +27,7 @@ from gearengine.cli.envelope import budget_refusal, option_axes
 from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import ENVELOPE_SETTINGS, gate_settings
-from gearengine.gate.probability import ONE_LOOK, ProbabilityReport, probability_report
+from gearengine.gate.probability import ONE_LOOK, ProbabilityReport, probability_report, proofs
 from gearengine.jsonio import dumps
 from gearengine.model.units import IMPACTS_REFUSED, display_unit
 from gearengine.studies import jobs
@@ -95,7 +95,7 @@ PROBABILITY_WAYS = (
 
 def study(args: argparse.Namespace, doc: object) -> tuple[RobustnessRequest, RobustnessResult]:
     request = robustness_request(args, doc)
-    tick = progress(time.monotonic(), "robustness")
+    tick = progress(time.monotonic(), "robustness", "runs")  # a sample at a point: one run
     return request, run_local(request, tick, workers=os.cpu_count() or 1)
 
 
@@ -198,7 +198,7 @@ def auto_study(args: argparse.Namespace, doc: object, limits: dict[str, float]
     args.samples, args.auto = FIRST_SAMPLES, True
     request = robustness_request(args, doc)  # the first round's budget, in the user's terms
     budget = jobs.job_step_budget()
-    tick = progress(time.monotonic(), "robustness")
+    tick = progress(time.monotonic(), "robustness", "points decided")
     out = sequential(request, limits, budget, workers=os.cpu_count() or 1, progress=tick)
     rounds = ", ".join(str(n) for n in out.rounds)
     note = (f"--samples auto: {out.stopped} (rounds of {rounds} samples, {out.steps} RK4 steps "
@@ -244,7 +244,8 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
         print(ONE_START)
     for p, v in zip(result.points, report.verdicts, strict=True):
         shown = {"pass": "PASS", "fail": "FAIL", "undecided": "UNDECIDED"}[v.verdict]
-        extra = f" [{'; '.join(v.reasons)}]" if v.reasons else ""
+        said = v.reasons or proofs(p, v)  # a pass names the bounds that prove it
+        extra = f" [{'; '.join(said)}]" if said else ""
         print(f"{shown}: {point_name(p.shown)} ({v.samples} samples){extra}")
     if args.json:
         Path(args.json).write_text(dumps(report))

@@ -126,7 +126,7 @@ def verdict_failures(
     if "separation" in rules.fail_on and impact_regime in SEPARATING:
         out.append("tooth separation")
     if rules.max_lle is not None and (lle is None or lle > rules.max_lle):
-        out.append(f"LLE > {rules.max_lle:g}")
+        out.append(f"LLE > {rules.max_lle:g} per unit tau")
     if rules.max_dte_um is not None and (dte_um is None or dte_um > rules.max_dte_um):
         out.append(f"DTE > {rules.max_dte_um:g} µm")
     if rules.max_dynamic_factor is not None and (

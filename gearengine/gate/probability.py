@@ -78,6 +78,24 @@ class ProbabilityReport(BaseModel):
     result: RobustnessResult = Field(description="The robustness result (95 % intervals).")
 
 
+def at_confidence(confidence: float) -> str:
+    """ " at 95 %", " at 99.3 %": the confidence a bound was read at, in the reasons."""
+    return f" at {100 * confidence:.3g} %"
+
+
+def proofs(point: RobustnessPoint, verdict: PointVerdict) -> list[str]:
+    """The upper bounds that prove a passing point's limits, in words: "P(chaotic) upper
+    bound at 95 % 0.0457 <= 0.05 (0/64 samples)" (a pass said nothing of its bound)."""
+    out = []
+    for name, read in verdict.limits.items():
+        if read.verdict == "pass" and read.interval is not None:
+            prob = point.probabilities[name]
+            out.append(f"P({name}) upper bound{at_confidence(read.confidence)} "
+                       f"{read.interval[1]:.3g} <= {read.limit:g} ({prob.count}/{prob.samples} "
+                       "samples)")  # fmt: skip
+    return out
+
+
 def unfollowed(point: RobustnessPoint, name: str, limit: float,
                confidence: float = ONE_LOOK) -> str | None:  # fmt: skip
     """Why a limit the followed samples prove is not proved: its diverged samples, counted as
@@ -93,18 +111,17 @@ def unfollowed(point: RobustnessPoint, name: str, limit: float,
     high = decision_interval(worst, confidence)[1]  # type: ignore[index]
     if high <= limit:
         return None
-    at = "" if confidence == ONE_LOOK else f" at {100 * confidence:.3g} %"
     return (f"P({name}) undecided: {d} of {prob.samples} samples diverged (the model could not "
-            f"follow them); counted as {name}, the upper bound{at} is {high:.3g} > "
-            f"{limit:g}")  # fmt: skip
+            f"follow them); counted as {name}, the upper bound{at_confidence(confidence)} is "
+            f"{high:.3g} > {limit:g}")  # fmt: skip
 
 
 def verdict_reasons(point: RobustnessPoint, limits: dict[str, float],
                     confidence: float = ONE_LOOK) -> list[str]:  # fmt: skip
     """The limits a point does not prove, in words: over (its lower bound above the limit) or
     undecided (the interval holds the limit); the intervals the verdict read, at ``confidence``
-    (``sequential.decision_interval``), named when not the results' 95 %."""
-    at = "" if confidence == ONE_LOOK else f" at {100 * confidence:.3g} %"
+    (``sequential.decision_interval``), named (a fixed count's 95 % too)."""
+    at = at_confidence(confidence)
     why = []
     for name, limit in limits.items():
         prob = point.probabilities[name]

@@ -82,7 +82,7 @@ def runup_failures(
             seconds = sum(b.time_s[1] - b.time_s[0] for b in inside)
             if seconds > chaos_seconds:
                 what = "FTLE clearly positive" if rules.max_lle is None else (
-                    f"FTLE > {rules.max_lle:g}")  # fmt: skip
+                    f"FTLE > {rules.max_lle:g} per unit tau")  # fmt: skip
                 rule = f"run-{name}: chaotic ({what}) for {seconds:.3g} s"
                 if all(any(a <= b.speed_rpm[0] < z for a, z in transient) for b in inside):
                     rule += (
