@@ -403,3 +403,19 @@ def test_the_envelope_check_says_it_judges_the_nominal_design_of_a_toleranced_on
     main([*argv[:1], str(nominal), *argv[2:]])
     assert "note:" not in capsys.readouterr().out
     assert json.loads(out.read_text())["notes"] == []
+
+
+def test_the_help_and_the_refusal_list_the_same_probability_names(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The refusal of a bad --max-probability listed 7 names, --help 3 (new-user review,
+    finding 7): both list every name the gate limits."""
+    from gearengine.cli.documents import GATED
+    from gearengine.cli.main import build_parser
+
+    check = next(a for a in build_parser()._subparsers._group_actions[0].choices.items()
+                 if a[0] == "check")[1]  # fmt: skip
+    helped = " ".join(check.format_help().split())
+    assert f"NAME one of {', '.join(GATED)}" in helped
+    assert main(["check", str(design_file), "--max-probability", "nonsense=0.1"]) == 2
+    assert f"NAME one of {', '.join(GATED)}" in capsys.readouterr().err

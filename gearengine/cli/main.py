@@ -40,7 +40,13 @@ from collections.abc import Callable, Sequence
 from importlib.metadata import entry_points
 from typing import NoReturn
 
-from gearengine.cli.documents import EXIT_INTERNAL, EXIT_INVALID, EXIT_PIPE, InvalidInputError
+from gearengine.cli.documents import (
+    EXIT_INTERNAL,
+    EXIT_INVALID,
+    EXIT_PIPE,
+    GATED,
+    InvalidInputError,
+)
 from gearengine.model.units import IMPACTS_REFUSED, QUANTITIES, parse_quantity
 
 PLUGIN_GROUP = "gearengine.commands"
@@ -233,7 +239,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="append",
         metavar="NAME=P",
         help="fail where the 95 %% upper bound of P(NAME) over the design's "
-        "tolerances exceeds P (chaotic, separation, back_flank; repeatable)",
+        f"tolerances exceeds P (NAME one of {', '.join(GATED)}; repeatable, one limit a name)",
     )
     p.add_argument("--samples", type=samples_count, default=None,
                    help="with --max-probability: N, a power of 2 (64), refused when too few "

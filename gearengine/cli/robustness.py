@@ -17,6 +17,7 @@ from pathlib import Path
 from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
+    GATED,
     InvalidInputError,
     axis_options,
     counted_points,
@@ -44,10 +45,6 @@ from gearengine.studies.robustness.study import (
     run_local,
 )
 from gearengine.studies.robustness.tolerances import samples_to_prove
-
-GATED = ("chaotic", "quasi_periodic", "diverged", "separation", "back_flank",
-         "dynamic_factor_above_limit", "melnikov_chaos_possible")  # fmt: skip
-"""Probabilities a gate may limit (the old word ``impacts`` refused: ``IMPACTS_REFUSED``)."""
 
 
 def robustness_request(args: argparse.Namespace, doc: object) -> RobustnessRequest:
