@@ -419,3 +419,21 @@ def test_the_help_and_the_refusal_list_the_same_probability_names(
     assert f"NAME one of {', '.join(GATED)}" in helped
     assert main(["check", str(design_file), "--max-probability", "nonsense=0.1"]) == 2
     assert f"NAME one of {', '.join(GATED)}" in capsys.readouterr().err
+
+
+def test_a_gate_on_one_design_names_its_speed_and_torque(
+    design_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A gate without --speed/--torque called its point 'operating point' and its report's
+    point was {} (new-user review, finding 7): it is the design's own 4000 rpm and 5 N*m."""
+    out = tmp_path / "one.json"
+    argv = ["check", str(design_file), "--samples", "8", "--max-probability", "back_flank=0.5",
+            "--json", str(out), "--junit", str(tmp_path / "j.xml")]  # fmt: skip
+    assert main(argv) == 0
+    assert "PASS: speed 4000 rpm, torque 5 N*m (8 samples)" in capsys.readouterr().out
+    assert json.loads(out.read_text())["verdicts"][0]["point"] == {
+        "speed": {"value": 4000.0, "unit": "rpm"},
+        "torque": {"value": 5.0, "unit": "N*m"},
+    }
+    case = ElementTree.parse(tmp_path / "j.xml").getroot().find("testsuite/testcase")
+    assert case is not None and case.get("name") == "speed 4000 rpm, torque 5 N*m"

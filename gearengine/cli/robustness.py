@@ -27,10 +27,12 @@ from gearengine.cli.documents import (
 from gearengine.cli.envelope import budget_refusal, option_axes
 from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
-from gearengine.gate.envelope import ENVELOPE_SETTINGS, gate_settings
+from gearengine.gate.envelope import ENVELOPE_SETTINGS, gate_settings, level_text
 from gearengine.gate.probability import ONE_LOOK, ProbabilityReport, probability_report, proofs
 from gearengine.jsonio import dumps
+from gearengine.model.design import Design
 from gearengine.model.units import IMPACTS_REFUSED, display_unit
+from gearengine.model.units import shown as rounded
 from gearengine.studies import jobs
 from gearengine.studies.robustness.sequential import (
     FIRST_SAMPLES,
@@ -45,6 +47,7 @@ from gearengine.studies.robustness.study import (
     run_local,
 )
 from gearengine.studies.robustness.tolerances import samples_to_prove
+from gearengine.studies.sweep.points import PhysicalValue
 
 
 def robustness_request(args: argparse.Namespace, doc: object) -> RobustnessRequest:
@@ -128,8 +131,8 @@ def limits_of(texts: list[str]) -> dict[str, float]:
 
 def junit(report: ProbabilityReport, name: str) -> str:
     """JUnit XML: one test case per operating point, failed once with its reasons."""
-    cases = [Case(point_name(p.shown), v.reasons, [r.split(")")[0] + ")" for r in v.reasons])
-             for p, v in zip(report.result.points, report.verdicts, strict=True)]  # fmt: skip
+    cases = [Case(level_text(v.point), v.reasons, [r.split(")")[0] + ")" for r in v.reasons])
+             for v in report.verdicts]  # fmt: skip
     return junit_xml("gearchaos robustness", name, "robustness", cases)
 
 
@@ -204,6 +207,17 @@ def auto_study(args: argparse.Namespace, doc: object, limits: dict[str, float]
     return out, note
 
 
+def own_point(doc: dict) -> dict[str, PhysicalValue]:
+    """The design's own speed and torque in gear units: the point a study without axes
+    samples (the gate named it 'operating point', its report's point {})."""
+    design = Design.model_validate(doc["design"])
+    out = {}
+    for name in ("speed", "torque"):
+        unit, factor = display_unit(name)
+        out[name] = PhysicalValue(value=rounded(getattr(design, name) * factor), unit=unit)
+    return out
+
+
 GATE_SAMPLES = 64
 """``check --max-probability``'s samples a point when ``--samples`` is not given."""
 
@@ -233,7 +247,7 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
         _, result = study(args, doc)
     if result.starts_per_sample == 1:
         notes.append(ONE_START)
-    report = probability_report(result, limits, confidence, notes)
+    report = probability_report(result, limits, confidence, notes, own_point(doc))
     counts = sorted({p.samples for p in result.points})
     sampled = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
     print(f"probabilities from {sampled} samples a point, {result.starts_text()}")
@@ -243,7 +257,7 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
         shown = {"pass": "PASS", "fail": "FAIL", "undecided": "UNDECIDED"}[v.verdict]
         said = v.reasons or proofs(p, v)  # a pass names the bounds that prove it
         extra = f" [{'; '.join(said)}]" if said else ""
-        print(f"{shown}: {point_name(p.shown)} ({v.samples} samples){extra}")
+        print(f"{shown}: {level_text(v.point)} ({v.samples} samples){extra}")
     if args.json:
         Path(args.json).write_text(dumps(report))
     if args.junit:

@@ -140,10 +140,12 @@ def verdict_reasons(point: RobustnessPoint, limits: dict[str, float],
 
 
 def point_verdict(point: RobustnessPoint, limits: dict[str, float], confidence: float,
-                  starts: int, units: dict[str, str] | None) -> PointVerdict:  # fmt: skip
+                  starts: int, units: dict[str, str] | None,
+                  own: dict[str, PhysicalValue] | None = None) -> PointVerdict:  # fmt: skip
     """One point's verdict under ``limits`` at ``confidence`` (``sequential.verdict``), a pass
     undecided where diverged samples could break it (``unfollowed``), its values in ``units``
-    (the result's ``shown_units``, else ``display_unit``)."""
+    (the result's ``shown_units``, else ``display_unit``); a study without axes named by
+    ``own`` (the design's speed and torque) instead of an empty point."""
     read = {}
     for name, limit in limits.items():
         prob = point.probabilities[name]
@@ -155,7 +157,7 @@ def point_verdict(point: RobustnessPoint, limits: dict[str, float], confidence: 
             interval=decision_interval(prob, confidence), confidence=confidence,
         )  # fmt: skip
     shown = {k: PhysicalValue(value=v, unit=(units or {}).get(k) or display_unit(k)[0])
-             for k, v in point.shown.items()}  # fmt: skip
+             for k, v in point.shown.items()} or dict(own or {})  # fmt: skip
     overall = verdict(point, limits, confidence)
     if overall == "pass" and any(r.verdict == "undecided" for r in read.values()):
         overall = "undecided"  # proved on the followed samples, not on the diverged ones
@@ -165,11 +167,13 @@ def point_verdict(point: RobustnessPoint, limits: dict[str, float], confidence: 
 
 
 def probability_report(result: RobustnessResult, limits: dict[str, float],
-                       confidence: float = ONE_LOOK, notes: list[str] | None = None
+                       confidence: float = ONE_LOOK, notes: list[str] | None = None,
+                       own: dict[str, PhysicalValue] | None = None
                        ) -> ProbabilityReport:  # fmt: skip
-    """The gate's report of ``result`` under ``limits``, each verdict read at ``confidence``."""
+    """The gate's report of ``result`` under ``limits``, each verdict read at ``confidence``;
+    ``own`` names the point of a study without axes (``point_verdict``)."""
     verdicts = [point_verdict(p, limits, confidence, result.starts_per_sample,
-                              result.shown_units) for p in result.points]  # fmt: skip
+                              result.shown_units, own) for p in result.points]  # fmt: skip
     said = [v.verdict for v in verdicts]
     return ProbabilityReport(
         passed=all(v == "pass" for v in said), limits=limits, confidence=confidence,
