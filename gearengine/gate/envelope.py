@@ -139,15 +139,14 @@ def verdict_failures(
 def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
     """(rule, who) of each rule a point breaks: with basins each attractor above
     ``rules.min_basin`` is checked as if it were the point ("chaotic, double-sided impacts
-    from 41 % of starts" is who broke it), and the point's own verdict too where those
-    attractors do not decide it (``judged_alone``: its starts diverged, or no basin is above
-    ``min_basin``), named by its ``decided_by``; without basins, the point itself (who is
-    empty)."""
+    from 41 % of starts" is who broke it), and the point's own verdict too where no attractor
+    decides it (``judged_alone``: it diverged, or no start reached an attractor), named by its
+    ``decided_by``; without basins, the point itself (who is empty)."""
     if p.attractors is None:
         return [(rule, "") for rule in point_failures(p, rules)]
     out = []
-    if judged_alone(p, rules):
-        who = p.decided_by or "the settings' own start (no basin above --min-basin)"
+    if judged_alone(p):
+        who = p.decided_by or "the settings' own start (no start reached an attractor)"
         out += [(rule, who) for rule in point_failures(p, rules)]
     for a in _checked(p, rules):
         physical = dict(p.physical or {})
@@ -169,12 +168,12 @@ def _checked(p: SweepPoint, rules: Rules) -> list[Attractor]:
     return [a for a in p.attractors or [] if a.fraction > least]
 
 
-def judged_alone(p: SweepPoint, rules: Rules) -> bool:
+def judged_alone(p: SweepPoint) -> bool:
     """Whether a point with basins is judged by its own verdict beside its attractors': when
-    no attractor above ``rules.min_basin`` decided it, a divergence did (every start may have
-    diverged: no attractor at all) or the settings' own start did (no basin above it)."""
-    return p.attractors is not None and (p.classification == "diverged"
-                                         or not _checked(p, rules))  # fmt: skip
+    it diverged (a divergence above the basin threshold decided it, or the settings' own start
+    diverged) or no start reached an attractor (every one diverged or unsettled). A point whose
+    attractors are all at or under ``min_basin`` is not: the rules leave them out by choice."""
+    return p.attractors is not None and (p.classification == "diverged" or not p.attractors)
 
 
 NEAR_LLE = 0.6
@@ -225,7 +224,7 @@ def attractor_set(p: SweepPoint, rules: Rules) -> frozenset[tuple[str, int | Non
     if p.attractors is None:
         return frozenset(own)
     found = {(a.classification, a.period) for a in _checked(p, rules)}
-    return frozenset(found | own if judged_alone(p, rules) else found)
+    return frozenset(found | own if judged_alone(p) else found)
 
 
 def _physical(p: SweepPoint, key: str) -> float | None:
