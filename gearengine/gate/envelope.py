@@ -12,7 +12,9 @@ which add to the classes instead of replacing them: ``max_lle`` (per unit tau), 
 (dynamic transmission error peak to peak, µm), ``max_dynamic_factor`` (largest mesh force over
 the static force F~_m). With basins (``settings.basins``) every attractor of a point whose
 basin fraction is above ``min_basin`` is checked against the rules, and a failing window names
-the attractors that broke it with their fractions.
+the attractors that broke it with their fractions; a point that diverged, or whose starts
+reached no attractor, is judged by its own verdict too. A diverged verdict fails whatever the
+rules: the gate cannot vouch for a response the model could not follow.
 """
 
 from __future__ import annotations
