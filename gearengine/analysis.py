@@ -165,13 +165,14 @@ class AnalysisResult(BaseModel):
         if eng is not None:
             line += magnitudes_text(eng, None if decided is num else decided.attractor)
             lo, hi = eng.speed_range_rpm
-            spans = ", ".join(f"{a:,.0f}-{b:,.0f}" for a, b in eng.speed_windows_rpm) or "nowhere"
-            scanned = f"{spans} rpm (scanned {lo:,.0f}-{hi:,.0f} rpm)"
+            spans = ", ".join(f"{a:,.0f}-{b:,.0f}" for a, b in eng.speed_windows_rpm)
+            scanned = (f"at {spans} rpm (scanned {lo:,.0f}-{hi:,.0f} rpm)" if spans
+                       else f"nowhere in {lo:,.0f}-{hi:,.0f} rpm (scanned)")  # fmt: skip
             if eng.speed_windows_note and not eng.speed_windows_rpm:  # why T_crit: the block's
                 note = eng.speed_windows_note.removesuffix(f": {T_CRIT_WHY}")
                 line += f"; Melnikov speed windows: {note}"
             else:
-                line += f"; Melnikov chaos possible at {scanned}"
+                line += f"; Melnikov chaos possible {scanned}"
         return line
 
     def __repr__(self) -> str:  # the full document is ~85 kB (time history, spectrum)

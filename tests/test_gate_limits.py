@@ -10,10 +10,12 @@ from pathlib import Path
 import pytest
 
 from gearengine.cli.documents import InvalidInputError, read_document
-from gearengine.cli.envelope import envelope_request
+from gearengine.cli.envelope import envelope_request, windows_summary
 from gearengine.cli.main import build_parser, main
-from gearengine.gate.envelope import Rules, point_failures, verdict_failures
-from gearengine.studies.sweep.points import PhysicalValue, SweepPoint
+from gearengine.gate.envelope import Rules, attractor_failures, point_failures, verdict_failures
+from gearengine.gate.runup import bin_failures
+from gearengine.studies.runup.results import RunupBin
+from gearengine.studies.sweep.points import PhysicalValue, SpeedWindows, SweepPoint
 from tests.conftest import PAPER_PARAMS, ROOT
 
 LIGHT = {"transient_periods": 60, "record_periods": 60, "steps_per_period": 128}
@@ -83,7 +85,8 @@ def test_one_verdict_is_judged_by_the_rules_of_a_point() -> None:
     rules = Rules(fail_on=["chaotic", "melnikov"], max_lle=0.0, max_dte_um=20.0,
                   max_dynamic_factor=1.5)  # fmt: skip
     verdict = ("chaotic", 0.05, "double_sided", True)
-    expected = ["chaotic", "Melnikov: chaos possible", "LLE > 0", "DTE > 20 µm"]
+    # the LLE limit names its unit: '[LLE > -1000]' said none (new-user review, finding 7)
+    expected = ["chaotic", "Melnikov: chaos possible", "LLE > 0 per unit tau", "DTE > 20 µm"]
     assert verdict_failures(rules, *verdict, dte_um=25.0, dynamic_factor=1.2) == expected
     # a limit on a value the verdict does not have (dimensionless, diverged) fails
     assert verdict_failures(rules, "periodic", -0.1, "no_impact", False)[-2:] == [
@@ -149,3 +152,83 @@ def test_a_bad_option_is_named_by_the_option(
     assert main(["check", str(ROOT / "examples" / "ci" / "design.json"), *options]) == 2
     err = capsys.readouterr().err
     assert named in err and "axes[" not in err
+
+
+def _diverged_point(attractors: list | None) -> SweepPoint:
+    """The point the review found: 16 basin starts, every one diverged (no attractor)."""
+    return SweepPoint(values={"speed": 31.4}, branch=None, classification="diverged",
+                      attractors=attractors, decided_by="diverged from 100 % of starts",
+                      physical={"speed": PhysicalValue(value=300.0, unit="rpm")})  # fmt: skip
+
+
+def test_a_point_whose_every_start_diverged_fails_the_envelope() -> None:
+    """With basins the gate checked each attractor above --min-basin, and a point where every
+    start diverged has none: it passed ('PASS: 0 of 1' at 300 rpm of design-geometry.json, its
+    classification diverged), where --starts 1 failed it. It is judged by its own verdict,
+    and a diverged verdict fails whatever --fail-on says."""
+    point = _diverged_point([])
+    for rules in (Rules(), Rules(fail_on=["separation"]), Rules(fail_on=["back_flank"])):
+        assert attractor_failures(point, rules) == [("diverged", "diverged from 100 % of starts")]
+        assert point_failures(_diverged_point(None), rules) == ["diverged"]
+    # the single-design check judges the same verdict words
+    assert verdict_failures(Rules(fail_on=["separation"]), "diverged", None, None, None) == [
+        "diverged"
+    ]
+
+
+def test_the_windows_never_call_a_diverged_speed_in_contact() -> None:
+    """'teeth always in contact' was printed for a level whose one point diverged."""
+    level = {"torque": PhysicalValue(value=60.0, unit="N*m")}
+    w = SpeedWindows(level=level, response={"diverged": [[300.0, 300.0]]}, contact={},
+                     melnikov=[])  # fmt: skip
+    (line,) = windows_summary([w])
+    assert "teeth always in contact" not in line
+    assert "diverged (contact unknown) 300 rpm" in line
+
+
+def test_a_diverged_runup_bin_fails_whatever_the_rules() -> None:
+    """A bin where a member diverged (no LLE, no contact) failed only a chaos rule, and only
+    after 0.05 s of them: under --fail-on separation it passed."""
+    values = dict.fromkeys(RunupBin.model_fields)
+    diverged = RunupBin(**{**values, "speed_rpm": [300.0, 350.0], "time_s": [0.0, 0.1]})
+    assert bin_failures(diverged, Rules(fail_on=["separation"])) == ["diverged"]
+    followed = diverged.model_copy(update={"lle": -0.1, "contact": "drive_flank",
+                                           "separation_fraction": 0.0})  # fmt: skip
+    assert bin_failures(followed, Rules(fail_on=["separation"])) == []
+
+
+@pytest.mark.parametrize(
+    "option",
+    ["--max-dynamic-factor", "--max-lle", "--max-dte", "--min-basin", "--min-stability-margin",
+     "--runup"],
+)  # fmt: skip
+def test_non_finite_limits_are_refused_naming_the_option(
+    option: str, capsys: pytest.CaptureFixture
+) -> None:
+    """``check --max-dynamic-factor nan`` passed (no comparison with nan is true) and
+    ``--max-dte nan`` printed '(--max-dte nan µm)' (new-user review, finding 3): nan and inf
+    are refused by the parser (exit 2), naming the option; the library's Rules refuse them."""
+    for value in ("nan", "inf", "-inf"):
+        with pytest.raises(SystemExit) as stopped:
+            build_parser().parse_args(["check", "x.json", f"{option}={value}"])
+        assert stopped.value.code == 2
+        assert f"argument {option}: '{value}': give a finite number" in capsys.readouterr().err
+    field = {"--max-dynamic-factor": "max_dynamic_factor", "--max-lle": "max_lle",
+             "--max-dte": "max_dte_um"}.get(option)  # fmt: skip
+    if field is not None:
+        with pytest.raises(ValueError, match="finite number"):
+            Rules(**{field: float("nan")})
+
+
+def test_no_melnikov_window_reads_nowhere_in_the_scanned_range(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """The summary said 'Melnikov chaos possible at nowhere rpm' (new-user review, finding 7)
+    for the robustness example, whose criterion allows chaos at no speed it scanned."""
+    doc = json.loads((ROOT / "examples" / "robustness-gears.json").read_text())
+    path = tmp_path / "gears.json"
+    path.write_text(json.dumps({**doc, "settings": LIGHT}))
+    main(["check", str(path), "--max-lle", "-1000"])
+    out = capsys.readouterr().out
+    assert "Melnikov chaos possible nowhere in 10-18,000 rpm (scanned)" in out
+    assert "nowhere rpm" not in out and "[LLE > -1000 per unit tau]" in out

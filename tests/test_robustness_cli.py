@@ -12,6 +12,7 @@ import pytest
 from gearengine.cli.main import main
 from gearengine.cli.robustness import ONE_START
 from gearengine.gate.envelope import ENVELOPE_SETTINGS
+from gearengine.gate.probability import ONE_LOOK
 from gearengine.studies.robustness.study import RobustnessRequest, run_local
 from tests.test_robustness import DESIGN
 
@@ -57,9 +58,16 @@ def test_the_gate_fails_on_the_upper_bound_and_names_the_points(
     cases = ElementTree.parse(junit).getroot().findall("testsuite/testcase")
     assert [c.get("name") for c in cases] == ["speed 2000 rpm", "speed 5000 rpm"]
     assert [c.find("failure") is not None for c in cases] == [False, True]
+    out = capsys.readouterr().out
+    # a fixed count's reasons name its 95 % as auto's name 99.3 %, and a pass names the bound
+    # that proves it (new-user review, finding 7)
     assert (
-        "FAIL: speed 5000 rpm (8 samples) [P(separation) lower bound 0.473 > 0.4 (7/8 "
-        "samples)]" in capsys.readouterr().out
+        "FAIL: speed 5000 rpm (8 samples) [P(separation) lower bound at 95 % 0.473 > 0.4 (7/8 "
+        "samples)]" in out
+    )
+    assert (
+        "PASS: speed 2000 rpm (8 samples) [P(separation) upper bound at 95 % 0.369 <= 0.4 (0/8 "
+        "samples)]" in out
     )
     assert main([*base, "--samples", "8", "--max-probability", "back_flank=0.5"]) == 0
     assert main([*base, "--max-probability", "nonsense=0.1"]) == 2
@@ -195,7 +203,10 @@ def test_samples_auto_reports_the_points_the_budget_leaves_undecided(
     )
     assert "FAIL: speed 5000 rpm (64 samples) [P(separation) lower bound" in captured.out
     assert "the budget of 3500000 RK4 steps ran out: 1 points undecided after 128" in captured.err
-    assert "FAIL: 1 of 2 points over a probability limit, 1 undecided" in captured.out
+    assert (
+        "FAIL: 1 of 2 points over a probability limit (P(separation) <= 0.01), 1 undecided"
+        in captured.out
+    )
 
 
 def test_the_api_refuses_a_study_over_the_budget_in_the_same_terms(tmp_path: Path) -> None:
@@ -266,7 +277,10 @@ def test_the_gates_json_is_its_report_at_the_confidence_it_decided_at(
     assert main([*base, "--samples", "auto", "--max-probability", "separation=0.01",
                  "--json", str(out)]) == 1  # fmt: skip
     captured = capsys.readouterr()
-    assert "FAIL: 1 of 2 points over a probability limit, 1 undecided" in captured.out
+    assert (
+        "FAIL: 1 of 2 points over a probability limit (P(separation) <= 0.01), 1 undecided"
+        in captured.out
+    )
     assert "points over a probability limit" not in captured.err
     report = json.loads(out.read_text())
     assert (report["passed"], report["limits"]) == (False, {"separation": 0.01})
@@ -288,7 +302,147 @@ def test_the_gates_json_is_its_report_at_the_confidence_it_decided_at(
     assert report["notes"][0].startswith("--samples auto: the budget of 3500000 RK4 steps")
     assert main([*base, "--samples", "8", "--max-probability", "back_flank=0.5",
                  "--json", str(out)]) == 0  # fmt: skip
-    assert "PASS: 0 of 2 points over a probability limit" in capsys.readouterr().out
+    assert "PASS: 0 of 2 points over a probability limit (P(back_flank) <= 0.5), 0 undecided" in (
+        capsys.readouterr().out
+    )
     report = json.loads(out.read_text())
     assert report["passed"] and report["confidence"] == 0.95 and report["notes"] == [ONE_START]
     assert [v["verdict"] for v in report["verdicts"]] == ["pass", "pass"]
+
+
+def test_the_probability_gate_refuses_the_envelope_rules_it_would_ignore(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check --max-probability chaotic=0.1 --max-dte 0.001um --fail-on separation --runup
+    1000 --refine 3`` passed: the probability gate read none of the envelope's rules and
+    options (new-user review, finding 2). Refused before computing, naming them; a limit given
+    twice kept the last one silently, and is refused too."""
+    base = ["check", str(design_file), "--speed", "2000:5000", "--speed-points", "2",
+            "--samples", "64"]  # fmt: skip
+    extra = ["--max-dte", "0.001um", "--fail-on", "separation", "--runup", "1000", "--refine",
+             "3", "--max-lle", "0", "--max-dynamic-factor", "1.1", "--min-basin", "0.1",
+             "--server", "http://localhost:1", "--min-stability-margin", "0.1"]  # fmt: skip
+    assert main([*base, "--max-probability", "chaotic=0.1", *extra]) == 2
+    err = capsys.readouterr().err
+    for option in extra[::2]:
+        assert option in err
+    assert "run it as a second check without --max-probability" in err
+    twice = ["--max-probability", "chaotic=0.05", "--max-probability", "chaotic=0.5"]
+    assert main([*base, *twice]) == 2
+    assert "P(chaotic) is limited twice (chaotic=0.05 before)" in capsys.readouterr().err
+
+
+def test_diverged_samples_never_pass_a_limit_they_could_break() -> None:
+    """``robustness --speed 100:100`` had 128 of 128 samples diverged, printed 'chaotic 0.000'
+    and the gate passed chaotic=0.05 (new-user review, finding 4): a diverged sample has no
+    class or contact. A limit passes when it holds with the diverged samples counted as the
+    outcome (a few of many do not matter), else the point is undecided, saying why; the
+    lower bound (a fail) counts the followed events alone."""
+    from gearengine.gate.probability import point_verdict
+    from gearengine.studies.robustness.study import Probability, RobustnessPoint
+    from gearengine.studies.robustness.tolerances import probability
+
+    def point(diverged: int, chaotic: int, n: int = 64) -> RobustnessPoint:
+        probs = {"chaotic": probability(chaotic, n), "diverged": probability(diverged, n),
+                 "melnikov_chaos_possible": probability(0, n)}  # fmt: skip
+        shown = {k: Probability(**v) for k, v in probs.items()}
+        return RobustnessPoint(values={}, shown={"speed": 100.0}, samples=n, dte_um={},
+                               probabilities=shown)  # fmt: skip
+
+    every = point_verdict(point(64, 0), {"chaotic": 0.1}, ONE_LOOK, 1, None)
+    assert every.verdict == "undecided" and every.limits["chaotic"].verdict == "undecided"
+    assert every.reasons == [
+        "P(chaotic) undecided: 64 of 64 samples diverged (the model could not follow them); "
+        "counted as chaotic, the upper bound at 95 % is 1 > 0.1"
+    ]
+    # the verdicts P(diverged) and Melnikov read are known for every sample
+    assert point_verdict(point(64, 0), {"melnikov_chaos_possible": 0.1}, ONE_LOOK, 1,
+                         None).verdict == "pass"  # fmt: skip
+    assert point_verdict(point(64, 0), {"diverged": 0.5}, ONE_LOOK, 1, None).verdict == "fail"
+    # one diverged sample of 64 under a 10 % limit: 1/64 still proves it (upper bound 0.084)
+    assert point_verdict(point(1, 0), {"chaotic": 0.1}, ONE_LOOK, 1, None).verdict == "pass"
+    assert point_verdict(point(1, 20), {"chaotic": 0.1}, ONE_LOOK, 1, None).verdict == "fail"
+
+
+def test_the_study_text_shows_diverged_samples(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """At 100 rpm every sample of the robustness example diverges: the line said 'chaotic
+    0.000 [0.000, 0.028]' and nothing of it."""
+    argv = ["robustness", str(design_file), "--speed", "100:100", "--speed-points", "1",
+            "--samples", "8"]  # fmt: skip
+    assert main(argv) == 0
+    assert "diverged 8 of 8 (8 samples" in capsys.readouterr().out
+
+
+def test_the_gate_refuses_fewer_than_one_sample(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check --max-probability chaotic=0.05 --samples 0`` raised ZeroDivisionError (exit 70,
+    a traceback) in samples_needed (new-user review, finding 5): refused by the parser."""
+    for count in ("0", "-4"):
+        argv = ["check", str(design_file), "--max-probability", "chaotic=0.05",
+                f"--samples={count}"]  # fmt: skip
+        with pytest.raises(SystemExit) as stopped:
+            main(argv)
+        assert stopped.value.code == 2
+        assert f"argument --samples: '{count}': give a whole number of at least 1" in (
+            capsys.readouterr().err
+        )
+
+
+def test_the_envelope_check_says_it_judges_the_nominal_design_of_a_toleranced_one(
+    design_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check robustness-gears.json --speed 4000:6000 ...`` passed with notes [] while the
+    probability gate failed every point (new-user review, finding 6): the envelope check of a
+    design with tolerances says, in its text and its report, that it judged the nominal
+    design and which option judges the tolerances."""
+    from gearengine.cli.envelope import NOMINAL_ONLY
+
+    out = tmp_path / "e.json"
+    argv = ["check", str(design_file), "--speed", "2000:2000", "--speed-points", "1",
+            "--starts", "1", "--refine", "0", "--json", str(out)]  # fmt: skip
+    main(argv)
+    assert f"  note: {NOMINAL_ONLY}" in capsys.readouterr().out
+    assert json.loads(out.read_text())["notes"] == [NOMINAL_ONLY]
+    nominal = tmp_path / "nominal.json"
+    nominal.write_text(json.dumps({"design": {k: v for k, v in DESIGN.items()
+                                              if k != "tolerances"}}))  # fmt: skip
+    main([*argv[:1], str(nominal), *argv[2:]])
+    assert "note:" not in capsys.readouterr().out
+    assert json.loads(out.read_text())["notes"] == []
+
+
+def test_the_help_and_the_refusal_list_the_same_probability_names(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The refusal of a bad --max-probability listed 7 names, --help 3 (new-user review,
+    finding 7): both list every name the gate limits."""
+    from gearengine.cli.documents import GATED
+    from gearengine.cli.main import build_parser
+
+    check = next(a for a in build_parser()._subparsers._group_actions[0].choices.items()
+                 if a[0] == "check")[1]  # fmt: skip
+    helped = " ".join(check.format_help().split())
+    assert f"NAME one of {', '.join(GATED)}" in helped
+    assert main(["check", str(design_file), "--max-probability", "nonsense=0.1"]) == 2
+    assert f"NAME one of {', '.join(GATED)}" in capsys.readouterr().err
+
+
+def test_a_gate_on_one_design_names_its_speed_and_torque(
+    design_file: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A gate without --speed/--torque called its point 'operating point' and its report's
+    point was {} (new-user review, finding 7): it is the design's own 4000 rpm and 5 N*m."""
+    out = tmp_path / "one.json"
+    argv = ["check", str(design_file), "--samples", "8", "--max-probability", "back_flank=0.5",
+            "--json", str(out), "--junit", str(tmp_path / "j.xml")]  # fmt: skip
+    assert main(argv) == 0
+    assert "PASS: speed 4000 rpm, torque 5 N*m (8 samples)" in capsys.readouterr().out
+    assert json.loads(out.read_text())["verdicts"][0]["point"] == {
+        "speed": {"value": 4000.0, "unit": "rpm"},
+        "torque": {"value": 5.0, "unit": "N*m"},
+    }
+    case = ElementTree.parse(tmp_path / "j.xml").getroot().find("testsuite/testcase")
+    assert case is not None and case.get("name") == "speed 4000 rpm, torque 5 N*m"

@@ -117,13 +117,34 @@ def failures(r: AnalysisResult, rules: Rules, min_margin: float | None = None) -
     return reasons
 
 
+ENVELOPE_ONLY = {"fail_on": "--fail-on", "max_lle": "--max-lle", "max_dte": "--max-dte",
+                 "max_dynamic_factor": "--max-dynamic-factor", "min_basin": "--min-basin",
+                 "min_stability_margin": "--min-stability-margin", "refine": "--refine",
+                 "runup": "--runup", "server": "--server"}  # fmt: skip
+"""The options of ``check`` that the probability gate (``--max-probability``) does not read."""
+
+
+def envelope_only(args: argparse.Namespace) -> list[str]:
+    """The options given that the probability gate would ignore (``ENVELOPE_ONLY``)."""
+    return [option for name, option in ENVELOPE_ONLY.items() if getattr(args, name) is not None]
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     """CI gate: exit 0 pass, 1 fail, 2 invalid input; one summary line. With --speed or
     --torque, the gate over the operating envelope (``cli.envelope``); with --max-probability,
-    over the design's tolerances (``cli.robustness``). The document is read once, here."""
+    over the design's tolerances (``cli.robustness``), refused with the envelope's rules and
+    options, which it would ignore (``envelope_only``). The document is read once, here."""
     if not args.max_probability and (args.samples is not None or args.seed is not None):
         raise InvalidInputError(["--samples and --seed sample a design's tolerances: give "
                                  "--max-probability NAME=P with them"])  # fmt: skip
+    if args.max_probability:
+        ignored = envelope_only(args)
+        if ignored:
+            raise InvalidInputError([
+                f"{', '.join(ignored)} judge the envelope check (the nominal design), which "
+                "--max-probability does not run: run it as a second check without "
+                "--max-probability"
+            ])  # fmt: skip
     doc = read_document(args.file)
     if args.max_probability:
         from gearengine.cli.robustness import cmd_probability_gate

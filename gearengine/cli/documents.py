@@ -26,6 +26,12 @@ EXIT_INTERNAL = 70
 R = TypeVar("R", bound=BaseModel)
 
 
+GATED = ("chaotic", "quasi_periodic", "diverged", "separation", "back_flank",
+         "dynamic_factor_above_limit", "melnikov_chaos_possible")  # fmt: skip
+"""Probabilities ``check --max-probability`` may limit, as its help and its refusal list them
+(the old word ``impacts`` refused: ``IMPACTS_REFUSED``)."""
+
+
 class InvalidInputError(Exception):
     """Input that cannot be used; carries one message line per problem."""
 

@@ -179,7 +179,7 @@ def rules_text(rules: Rules) -> str:
     """The rules as options: "--fail-on chaotic, --max-dte 20 µm"."""
     parts = [f"--fail-on {f}" for f in rules.fail_on]
     if rules.max_lle is not None:
-        parts.append(f"--max-lle {rules.max_lle:g}")
+        parts.append(f"--max-lle {rules.max_lle:g} per unit tau")
     if rules.max_dte_um is not None:
         parts.append(f"--max-dte {rules.max_dte_um:g} µm")
     if rules.max_dynamic_factor is not None:
@@ -258,13 +258,17 @@ def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit",
                     refined: dict[str, str] | None = None) -> list[str]:  # fmt: skip
     """Per level of the other axis, the impact and Melnikov windows in rpm, pass or fail:
     "windows at torque 40 N*m: tooth separation 500-1100 rpm; Melnikov:
-    chaos possible nowhere"; ``reason`` says why Melnikov does not apply where it does not
-    (``not_judged_reason``); ``refined`` (``refined_levels``) says over which speeds a level
-    refined between the grid's was checked: "windows at torque 8.44 N*m (refined level, checked
-    at 3 speeds in 4636-4864 rpm): ..."."""
+    chaos possible nowhere" ("teeth always in contact" only where no point diverged: a
+    diverged point has no contact verdict); ``reason`` says why Melnikov does not apply where
+    it does not (``not_judged_reason``); ``refined`` (``refined_levels``) says over which
+    speeds a level refined between the grid's was checked: "windows at torque 8.44 N*m
+    (refined level, checked at 3 speeds in 4636-4864 rpm): ..."."""
     out = []
     for w in windows:
-        contact = "; ".join(f"{CONTACT_LABELS[k]} {spans_text(v)}" for k, v in w.contact.items())
+        parts = [f"{CONTACT_LABELS[k]} {spans_text(v)}" for k, v in w.contact.items()]
+        if "diverged" in w.response:  # no contact verdict there: never "always in contact"
+            parts.append(f"diverged (contact unknown) {spans_text(w.response['diverged'])}")
+        contact = "; ".join(parts)
         melnikov = f"chaos possible {spans_text(w.melnikov) if w.melnikov else 'nowhere'}"
         if w.melnikov_not_applicable:
             na = f"not applicable at {spans_text(w.melnikov_not_applicable)} ({reason})"
@@ -287,6 +291,14 @@ CONTACT_LABELS = {
 def spans_text(spans: list[list[float]]) -> str:
     """ "500-1100, 3000 rpm": speed runs [first, last] in rpm."""
     return ", ".join(f"{a:g}" if a == b else f"{a:g}-{b:g}" for a, b in spans) + " rpm"
+
+
+NOMINAL_ONLY = (
+    "the design has tolerances: this check judges the nominal design only; --max-probability "
+    "NAME=P (a second check) judges the tolerances, e.g. --max-probability chaotic=0.05"
+)
+"""The envelope check's note on a design with tolerances (it passed while the probability
+gate failed every point, and said nothing of them)."""
 
 
 def cmd_envelope(args: argparse.Namespace, doc: object) -> int:
@@ -314,6 +326,8 @@ def cmd_envelope(args: argparse.Namespace, doc: object) -> int:
         from gearengine.gate.runup import gate_envelope
 
         report = validated_input(lambda r: gate_envelope(report, request, r), args.runup, "--runup")
+    if request.design is not None and request.design.tolerances is not None:
+        report = report.model_copy(update={"notes": [*report.notes, NOMINAL_ONLY]})
     print_report(report, request.design)
     if args.json:
         Path(args.json).write_text(dumps(report))

@@ -32,6 +32,7 @@ import argparse
 import gc
 import importlib
 import logging
+import math
 import os
 import sys
 import traceback
@@ -39,7 +40,13 @@ from collections.abc import Callable, Sequence
 from importlib.metadata import entry_points
 from typing import NoReturn
 
-from gearengine.cli.documents import EXIT_INTERNAL, EXIT_INVALID, EXIT_PIPE, InvalidInputError
+from gearengine.cli.documents import (
+    EXIT_INTERNAL,
+    EXIT_INVALID,
+    EXIT_PIPE,
+    GATED,
+    InvalidInputError,
+)
 from gearengine.model.units import IMPACTS_REFUSED, QUANTITIES, parse_quantity
 
 PLUGIN_GROUP = "gearengine.commands"
@@ -78,26 +85,47 @@ def _number_or_text(text: str) -> float | str:
         return text
 
 
-def micrometres(text: str) -> float:
-    """A length option in µm: a bare number is µm, "0.02 mm" is read with its unit."""
+def finite(text: str) -> float:
+    """A number option (a limit, a rate): nan and inf are refused, argparse naming the option
+    (``--max-dynamic-factor nan`` passed every point: no comparison with nan is true)."""
     try:
-        return float(text)
+        return _finite(float(text), text)
     except ValueError:
-        pass
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+
+
+def micrometres(text: str) -> float:
+    """A length option in µm: a bare number is µm, "0.02 mm" is read with its unit; nan and
+    inf refused (``finite``)."""
     try:
-        return parse_quantity(text, QUANTITIES["error"]) * 1e6
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+        value = float(text)
+    except ValueError:
+        try:
+            value = parse_quantity(text, QUANTITIES["error"]) * 1e6
+        except ValueError as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+    return _finite(value, text)
+
+
+def _finite(value: float, text: str) -> float:
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r}: give a finite number")
+    return value
 
 
 def samples_count(text: str) -> int | str:
-    """``--samples`` of the probability gate: a whole number, or ``auto``."""
+    """``--samples`` of the probability gate: a whole number of at least 1, or ``auto``
+    (``--samples 0`` divided by zero in ``samples_needed``)."""
     if text == "auto":
         return text
     try:
-        return int(text)
+        count = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError("give a whole number (a power of 2) or auto") from None
+        count = 0
+    if count < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: give a whole number of at least 1 (a power "
+                                         "of 2) or auto")  # fmt: skip
+    return count
 
 
 def fail_on_word(text: str) -> str:
@@ -126,14 +154,20 @@ def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -
     p.add_argument("--max-dte", type=micrometres, default=None, metavar="E",
                    help="fail where the dynamic transmission error (peak to peak) exceeds E "
                    "(µm, or with a unit: 20um, 0.02mm)")  # fmt: skip
-    p.add_argument("--max-dynamic-factor", type=float, default=None, metavar="F",
+    p.add_argument("--max-dynamic-factor", type=finite, default=None, metavar="F",
                    help="fail where the largest dynamic mesh force exceeds F times the static "
                    "force")  # fmt: skip
-    p.add_argument("--max-lle", type=float, default=None, help="fail when the LLE exceeds V")
+    p.add_argument(
+        "--max-lle",
+        type=finite,
+        default=None,
+        help="fail when the LLE exceeds V per unit tau (tau = omega_n t; "
+        "check prints it in 1/s too)",
+    )
     p.add_argument("--starts", type=int, default=None, metavar="N",
                    help="envelope checks: basin starts per operating point (default 16; 1: "
                    "the settings' own start only)")  # fmt: skip
-    p.add_argument("--min-basin", type=float, default=None, metavar="F",
+    p.add_argument("--min-basin", type=finite, default=None, metavar="F",
                    help="envelope checks: check only attractors whose basin fraction is above "
                    "F (default: every attractor found)")  # fmt: skip
     p.add_argument("--refine", type=int, default=None, metavar="N", choices=range(5),
@@ -189,12 +223,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
     p.add_argument("--server", metavar="URL", help="run the envelope on a running service "
                    "(API key from GEARCHAOS_API_KEY)")  # fmt: skip
-    p.add_argument("--runup", type=float, default=None, metavar="RATE",
+    p.add_argument("--runup", type=finite, default=None, metavar="RATE",
                    help="envelope checks: also run up and down through --speed at RATE rpm/s "
                    "at each torque level (same rules; chaos fails after 0.05 s)")  # fmt: skip
     p.add_argument(
         "--min-stability-margin",
-        type=float,
+        type=finite,
         default=None,
         metavar="X",
         help="fail when the response is periodic and its Floquet stability margin "
@@ -205,7 +239,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="append",
         metavar="NAME=P",
         help="fail where the 95 %% upper bound of P(NAME) over the design's "
-        "tolerances exceeds P (chaotic, separation, back_flank; repeatable)",
+        f"tolerances exceeds P (NAME one of {', '.join(GATED)}; repeatable, one limit a name)",
     )
     p.add_argument("--samples", type=samples_count, default=None,
                    help="with --max-probability: N, a power of 2 (64), refused when too few "
@@ -272,7 +306,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rate", metavar="RATE", help="ramp rate (rpm/s)")
     p.add_argument("--duration", metavar="T", help="duration of each leg instead (s)")
     p.add_argument("--direction", choices=["up", "down", "up_down"], default=None)
-    p.add_argument("--bin", type=float, default=None, metavar="RPM", help="bin width (50)")
+    p.add_argument("--bin", type=finite, default=None, metavar="RPM", help="bin width (50)")
     p.add_argument("--to-torque", metavar="TORQUE", help="torque at the end (N m)")
     p.add_argument("--ensemble", type=int, default=None, metavar="N", help="FTLE members (8)")
     p.add_argument("--json", metavar="OUT", help="write the API's document")

@@ -17,6 +17,7 @@ from pathlib import Path
 from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
+    GATED,
     InvalidInputError,
     axis_options,
     counted_points,
@@ -26,10 +27,12 @@ from gearengine.cli.documents import (
 from gearengine.cli.envelope import budget_refusal, option_axes
 from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
-from gearengine.gate.envelope import gate_settings
-from gearengine.gate.probability import ONE_LOOK, ProbabilityReport, probability_report
+from gearengine.gate.envelope import gate_settings, level_text
+from gearengine.gate.probability import ONE_LOOK, ProbabilityReport, probability_report, proofs
 from gearengine.jsonio import dumps
+from gearengine.model.design import Design
 from gearengine.model.units import IMPACTS_REFUSED, display_unit
+from gearengine.model.units import shown as rounded
 from gearengine.studies import jobs
 from gearengine.studies.robustness.sequential import (
     FIRST_SAMPLES,
@@ -44,10 +47,7 @@ from gearengine.studies.robustness.study import (
     run_local,
 )
 from gearengine.studies.robustness.tolerances import samples_to_prove
-
-GATED = ("chaotic", "quasi_periodic", "diverged", "separation", "back_flank",
-         "dynamic_factor_above_limit", "melnikov_chaos_possible")  # fmt: skip
-"""Probabilities a gate may limit (the old word ``impacts`` refused: ``IMPACTS_REFUSED``)."""
+from gearengine.studies.sweep.points import PhysicalValue
 
 
 def robustness_request(args: argparse.Namespace, doc: object) -> RobustnessRequest:
@@ -95,7 +95,7 @@ PROBABILITY_WAYS = (
 
 def study(args: argparse.Namespace, doc: object) -> tuple[RobustnessRequest, RobustnessResult]:
     request = robustness_request(args, doc)
-    tick = progress(time.monotonic(), "robustness")
+    tick = progress(time.monotonic(), "robustness", "runs")  # a sample at a point: one run
     return request, run_local(request, tick, workers=os.cpu_count() or 1)
 
 
@@ -106,8 +106,9 @@ def point_name(values: dict[str, float]) -> str:
 
 
 def limits_of(texts: list[str]) -> dict[str, float]:
-    """``["chaotic=0.01", ...]`` as {name: limit}; InvalidInputError naming a bad one, and
-    the old word ``impacts`` saying which two words to write (``IMPACTS_REFUSED``)."""
+    """``["chaotic=0.01", ...]`` as {name: limit}; InvalidInputError naming a bad one or a
+    name given twice, and the old word ``impacts`` saying which two words to write
+    (``IMPACTS_REFUSED``)."""
     out = {}
     for text in texts:
         name, _, value = text.partition("=")
@@ -120,14 +121,18 @@ def limits_of(texts: list[str]) -> dict[str, float]:
         if name not in GATED or not 0.0 <= limit <= 1.0:
             raise InvalidInputError([f"--max-probability {text}: give NAME=P with P in [0, 1] "
                                      f"and NAME one of {', '.join(GATED)}"])  # fmt: skip
+        if name in out:
+            raise InvalidInputError([f"--max-probability {text}: P({name}) is limited twice "
+                                     f"({name}={out[name]:g} before); give one limit a "
+                                     "name"])  # fmt: skip
         out[name] = limit
     return out
 
 
 def junit(report: ProbabilityReport, name: str) -> str:
     """JUnit XML: one test case per operating point, failed once with its reasons."""
-    cases = [Case(point_name(p.shown), v.reasons, [r.split(")")[0] + ")" for r in v.reasons])
-             for p, v in zip(report.result.points, report.verdicts, strict=True)]  # fmt: skip
+    cases = [Case(level_text(v.point), v.reasons, [r.split(")")[0] + ")" for r in v.reasons])
+             for v in report.verdicts]  # fmt: skip
     return junit_xml("gearchaos robustness", name, "robustness", cases)
 
 
@@ -140,6 +145,8 @@ def cmd_robustness(args: argparse.Namespace) -> int:
             f"{k} {pr[k].value:.3f} [{pr[k].interval[0]:.3f}, {pr[k].interval[1]:.3f}]"
             for k in ("chaotic", "separation", "back_flank")
         )
+        if pr["diverged"].count:  # no class or contact known for them: never hidden
+            words += f", diverged {pr['diverged'].count} of {p.samples}"
         print(f"{point_name(p.shown)}: {words} ({p.samples} samples, {result.starts_text()})")
         for line in p.ranking or []:
             print(f"  {line}")
@@ -193,13 +200,24 @@ def auto_study(args: argparse.Namespace, doc: object, limits: dict[str, float]
     args.samples, args.auto = FIRST_SAMPLES, True
     request = robustness_request(args, doc)  # the first round's budget, in the user's terms
     budget = jobs.job_step_budget()
-    tick = progress(time.monotonic(), "robustness")
+    tick = progress(time.monotonic(), "robustness", "points decided")
     out = sequential(request, limits, budget, workers=os.cpu_count() or 1, progress=tick)
     rounds = ", ".join(str(n) for n in out.rounds)
     note = (f"--samples auto: {out.stopped} (rounds of {rounds} samples, {out.steps} RK4 steps "
             f"of a budget of {budget}); each look decides at {100 * out.confidence:.3g} %, the "
             f"5 % error shared over the {looks()} looks a point may take")  # fmt: skip
     return out, note
+
+
+def own_point(doc: dict) -> dict[str, PhysicalValue]:
+    """The design's own speed and torque in gear units: the point a study without axes
+    samples (the gate named it 'operating point', its report's point {})."""
+    design = Design.model_validate(doc["design"])
+    out = {}
+    for name in ("speed", "torque"):
+        unit, factor = display_unit(name)
+        out[name] = PhysicalValue(value=rounded(getattr(design, name) * factor), unit=unit)
+    return out
 
 
 GATE_SAMPLES = 64
@@ -231,7 +249,7 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
         _, result = study(args, doc)
     if result.starts_per_sample == 1:
         notes.append(ONE_START)
-    report = probability_report(result, limits, confidence, notes)
+    report = probability_report(result, limits, confidence, notes, own_point(doc))
     counts = sorted({p.samples for p in result.points})
     sampled = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
     print(f"probabilities from {sampled} samples a point, {result.starts_text()}")
@@ -239,12 +257,15 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
         print(ONE_START)
     for p, v in zip(result.points, report.verdicts, strict=True):
         shown = {"pass": "PASS", "fail": "FAIL", "undecided": "UNDECIDED"}[v.verdict]
-        extra = f" [{'; '.join(v.reasons)}]" if v.reasons else ""
-        print(f"{shown}: {point_name(p.shown)} ({v.samples} samples){extra}")
+        said = v.reasons or proofs(p, v)  # a pass names the bounds that prove it
+        extra = f" [{'; '.join(said)}]" if said else ""
+        print(f"{shown}: {level_text(v.point)} ({v.samples} samples){extra}")
     if args.json:
         Path(args.json).write_text(dumps(report))
     if args.junit:
         Path(args.junit).write_text(junit(report, f"robustness of {args.file}"))
+    named = ", ".join(f"P({k}) <= {v:g}" for k, v in limits.items())
     print(f"{'PASS' if report.passed else 'FAIL'}: {report.failing_points} of {report.points} "
-          f"points over a probability limit, {report.undecided_points} undecided")  # fmt: skip
+          f"points over a probability limit ({named}), {report.undecided_points} "
+          "undecided")  # fmt: skip
     return EXIT_OK if report.passed else EXIT_FAIL

@@ -12,7 +12,9 @@ which add to the classes instead of replacing them: ``max_lle`` (per unit tau), 
 (dynamic transmission error peak to peak, µm), ``max_dynamic_factor`` (largest mesh force over
 the static force F~_m). With basins (``settings.basins``) every attractor of a point whose
 basin fraction is above ``min_basin`` is checked against the rules, and a failing window names
-the attractors that broke it with their fractions.
+the attractors that broke it with their fractions; a point that diverged, or whose starts
+reached no attractor, is judged by its own verdict too. A diverged verdict fails whatever the
+rules: the gate cannot vouch for a response the model could not follow.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ from gearengine.gate.resolution import REFINE_DEPTH, Resolution, resolution
 from gearengine.gate.resolution import refine as refine_points
 from gearengine.model.errors import InputError
 from gearengine.model.units import IMPACTS_REFUSED, OUTPUTS, POINT_OUTPUTS
+from gearengine.numerics.results import Attractor
 from gearengine.numerics.settings import ENVELOPE_SETTINGS
 from gearengine.signals.classify import SEVERITY
 from gearengine.studies import jobs
@@ -43,7 +46,8 @@ FailOn = Literal["chaotic", "quasi_periodic", "diverged", "melnikov", "back_flan
 
 
 class Rules(BaseModel):
-    """What fails the gate at a grid point."""
+    """What fails the gate at a grid point; a limit is a finite number (nan, with which no
+    comparison is true, passed every point)."""
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
@@ -54,10 +58,16 @@ class Rules(BaseModel):
         "robustness probabilities name them. The old word impacts is refused: write back_flank "
         "or separation.",
     )
-    max_lle: float | None = Field(None, description="Largest LLE allowed, per unit tau.")
-    max_dte_um: float | None = Field(None, description="Largest DTE peak to peak [µm].")
+    max_lle: float | None = Field(
+        None, allow_inf_nan=False, description="Largest LLE allowed, per unit tau."
+    )
+    max_dte_um: float | None = Field(
+        None, allow_inf_nan=False, description="Largest DTE peak to peak [µm]."
+    )
     max_dynamic_factor: float | None = Field(
-        None, description="Largest dynamic factor allowed: max mesh force / static force."
+        None,
+        allow_inf_nan=False,
+        description="Largest dynamic factor allowed: max mesh force / static force.",
     )
     min_basin: float | None = Field(
         None,
@@ -104,12 +114,15 @@ def verdict_failures(
 ) -> list[str]:
     """The rules one verdict breaks, as short labels ("chaotic", "DTE > 20 µm", ...): a sweep
     point's (``point_failures``) or one analysis's (``gearengine check``); a limit on a value
-    that is missing (no design, diverged) fails."""
+    that is missing (no design, diverged) fails, and a diverged verdict fails whatever
+    ``fail_on`` says: the gate cannot vouch for a response the model could not follow."""
     out = []
     for name in rules.fail_on:
         if name in SEVERITY and SEVERITY[classification] >= SEVERITY[name]:
             out.append(classification.replace("_", "-"))
             break
+    if classification == "diverged" and not out:  # whatever fail_on: nothing to vouch for
+        out.append("diverged")
     if "melnikov" in rules.fail_on and melnikov_chaos_possible:
         out.append("Melnikov: chaos possible")
     if "back_flank" in rules.fail_on and impact_regime == "double_sided":
@@ -117,7 +130,7 @@ def verdict_failures(
     if "separation" in rules.fail_on and impact_regime in SEPARATING:
         out.append("tooth separation")
     if rules.max_lle is not None and (lle is None or lle > rules.max_lle):
-        out.append(f"LLE > {rules.max_lle:g}")
+        out.append(f"LLE > {rules.max_lle:g} per unit tau")
     if rules.max_dte_um is not None and (dte_um is None or dte_um > rules.max_dte_um):
         out.append(f"DTE > {rules.max_dte_um:g} µm")
     if rules.max_dynamic_factor is not None and (
@@ -130,14 +143,16 @@ def verdict_failures(
 def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
     """(rule, who) of each rule a point breaks: with basins each attractor above
     ``rules.min_basin`` is checked as if it were the point ("chaotic, double-sided impacts
-    from 41 % of starts" is who broke it); without, the point itself (who is empty)."""
+    from 41 % of starts" is who broke it), and the point's own verdict too where no attractor
+    decides it (``judged_alone``: it diverged, or no start reached an attractor), named by its
+    ``decided_by``; without basins, the point itself (who is empty)."""
     if p.attractors is None:
         return [(rule, "") for rule in point_failures(p, rules)]
     out = []
-    least = -1.0 if rules.min_basin is None else rules.min_basin
-    for a in p.attractors:
-        if a.fraction <= least:
-            continue
+    if judged_alone(p):
+        who = p.decided_by or "the settings' own start (no start reached an attractor)"
+        out += [(rule, who) for rule in point_failures(p, rules)]
+    for a in _checked(p, rules):
         physical = dict(p.physical or {})
         for key, value in (("dte", a.dte_um), ("dynamic_factor", a.dynamic_factor)):
             physical.pop(key, None)
@@ -149,6 +164,20 @@ def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
         who = f"{a.label} from {100 * a.fraction:.0f} % of starts"
         out += [(rule, who) for rule in point_failures(alone, rules)]
     return out
+
+
+def _checked(p: SweepPoint, rules: Rules) -> list[Attractor]:
+    """The attractors of ``p`` whose basin fraction is above ``rules.min_basin``."""
+    least = -1.0 if rules.min_basin is None else rules.min_basin
+    return [a for a in p.attractors or [] if a.fraction > least]
+
+
+def judged_alone(p: SweepPoint) -> bool:
+    """Whether a point with basins is judged by its own verdict beside its attractors': when
+    it diverged (a divergence above the basin threshold decided it, or the settings' own start
+    diverged) or no start reached an attractor (every one diverged or unsettled). A point whose
+    attractors are all at or under ``min_basin`` is not: the rules leave them out by choice."""
+    return p.attractors is not None and (p.classification == "diverged" or not p.attractors)
 
 
 NEAR_LLE = 0.6
@@ -195,10 +224,11 @@ def attractor_set(p: SweepPoint, rules: Rules) -> frozenset[tuple[str, int | Non
     """The responses a point settles on (class and period of each attractor whose basin is
     above ``rules.min_basin``, or of the point without basins): two neighbours whose sets
     differ are on two sides of a bifurcation, where a window may hide between them."""
+    own = {(p.classification, p.period)}
     if p.attractors is None:
-        return frozenset({(p.classification, p.period)})
-    least = -1.0 if rules.min_basin is None else rules.min_basin
-    return frozenset((a.classification, a.period) for a in p.attractors if a.fraction > least)
+        return frozenset(own)
+    found = {(a.classification, a.period) for a in _checked(p, rules)}
+    return frozenset(found | own if judged_alone(p) else found)
 
 
 def _physical(p: SweepPoint, key: str) -> float | None:

@@ -11,11 +11,16 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.model.units import display_unit
 from gearengine.studies.robustness.sequential import ERROR, Verdict, decision_interval, verdict
-from gearengine.studies.robustness.study import RobustnessPoint, RobustnessResult
+from gearengine.studies.robustness.study import Probability, RobustnessPoint, RobustnessResult
+from gearengine.studies.robustness.tolerances import probability
 from gearengine.studies.sweep.points import PhysicalValue
 
 ONE_LOOK = 1.0 - ERROR
 """The confidence of one look (a fixed sample count): the results' 95 % intervals."""
+FOLLOWED_ONLY = ("periodic", "quasi_periodic", "chaotic", "separation", "back_flank",
+                 "dynamic_factor_above_limit")  # fmt: skip
+"""Outcomes a diverged sample leaves unknown (no class, contact or force: the model could not
+follow it); P(diverged) and P(melnikov_chaos_possible) are known for every sample."""
 
 
 class LimitVerdict(BaseModel):
@@ -25,8 +30,9 @@ class LimitVerdict(BaseModel):
 
     limit: float = Field(description="The largest probability allowed.")
     verdict: Verdict = Field(
-        description="pass: the upper bound is at or below the limit; fail: the lower bound is "
-        "above it; undecided: the interval holds the limit (or no samples)."
+        description="pass: the upper bound is at or below the limit, diverged samples counted "
+        "as the outcome; fail: the lower bound is above it; undecided: the interval holds the "
+        "limit (or no samples), or the diverged samples could break it."
     )
     count: int = Field(description="Samples k with the outcome.")
     samples: int = Field(description="Samples n counted.")
@@ -72,12 +78,50 @@ class ProbabilityReport(BaseModel):
     result: RobustnessResult = Field(description="The robustness result (95 % intervals).")
 
 
+def at_confidence(confidence: float) -> str:
+    """ " at 95 %", " at 99.3 %": the confidence a bound was read at, in the reasons."""
+    return f" at {100 * confidence:.3g} %"
+
+
+def proofs(point: RobustnessPoint, verdict: PointVerdict) -> list[str]:
+    """The upper bounds that prove a passing point's limits, in words: "P(chaotic) upper
+    bound at 95 % 0.0457 <= 0.05 (0/64 samples)" (a pass said nothing of its bound)."""
+    out = []
+    for name, read in verdict.limits.items():
+        if read.verdict == "pass" and read.interval is not None:
+            prob = point.probabilities[name]
+            out.append(f"P({name}) upper bound{at_confidence(read.confidence)} "
+                       f"{read.interval[1]:.3g} <= {read.limit:g} ({prob.count}/{prob.samples} "
+                       "samples)")  # fmt: skip
+    return out
+
+
+def unfollowed(point: RobustnessPoint, name: str, limit: float,
+               confidence: float = ONE_LOOK) -> str | None:  # fmt: skip
+    """Why a limit the followed samples prove is not proved: its diverged samples, counted as
+    the outcome (``FOLLOWED_ONLY``: whatever they did, unseen), put the upper bound above the
+    limit; None when no sample diverged, the outcome is known for them, the limit is not
+    proved anyway, or proved even were every diverged sample the outcome. A diverged sample
+    never turns a fail into a pass: the lower bound counts the followed events alone."""
+    d, prob = point.probabilities["diverged"].count, point.probabilities[name]
+    ci = decision_interval(prob, confidence)
+    if not d or name not in FOLLOWED_ONLY or ci is None or ci[1] > limit:
+        return None
+    worst = Probability.model_validate(probability(prob.count + d, prob.samples))
+    high = decision_interval(worst, confidence)[1]  # type: ignore[index]
+    if high <= limit:
+        return None
+    return (f"P({name}) undecided: {d} of {prob.samples} samples diverged (the model could not "
+            f"follow them); counted as {name}, the upper bound{at_confidence(confidence)} is "
+            f"{high:.3g} > {limit:g}")  # fmt: skip
+
+
 def verdict_reasons(point: RobustnessPoint, limits: dict[str, float],
                     confidence: float = ONE_LOOK) -> list[str]:  # fmt: skip
     """The limits a point does not prove, in words: over (its lower bound above the limit) or
     undecided (the interval holds the limit); the intervals the verdict read, at ``confidence``
-    (``sequential.decision_interval``), named when not the results' 95 %."""
-    at = "" if confidence == ONE_LOOK else f" at {100 * confidence:.3g} %"
+    (``sequential.decision_interval``), named (a fixed count's 95 % too)."""
+    at = at_confidence(confidence)
     why = []
     for name, limit in limits.items():
         prob = point.probabilities[name]
@@ -90,34 +134,46 @@ def verdict_reasons(point: RobustnessPoint, limits: dict[str, float],
         elif ci[1] > limit:
             why.append(f"P({name}) undecided: upper bound{at} {ci[1]:.3g} > {limit:g} "
                        f"({prob.count}/{prob.samples} samples)")  # fmt: skip
+        elif (diverged := unfollowed(point, name, limit, confidence)) is not None:
+            why.append(diverged)
     return why
 
 
 def point_verdict(point: RobustnessPoint, limits: dict[str, float], confidence: float,
-                  starts: int, units: dict[str, str] | None) -> PointVerdict:  # fmt: skip
-    """One point's verdict under ``limits`` at ``confidence`` (``sequential.verdict``), its
-    values in ``units`` (the result's ``shown_units``, else ``display_unit``)."""
+                  starts: int, units: dict[str, str] | None,
+                  own: dict[str, PhysicalValue] | None = None) -> PointVerdict:  # fmt: skip
+    """One point's verdict under ``limits`` at ``confidence`` (``sequential.verdict``), a pass
+    undecided where diverged samples could break it (``unfollowed``), its values in ``units``
+    (the result's ``shown_units``, else ``display_unit``); a study without axes named by
+    ``own`` (the design's speed and torque) instead of an empty point."""
     read = {}
     for name, limit in limits.items():
         prob = point.probabilities[name]
+        said = verdict(point, {name: limit}, confidence)
+        if unfollowed(point, name, limit, confidence) is not None:
+            said = "undecided"
         read[name] = LimitVerdict(
-            limit=limit, verdict=verdict(point, {name: limit}, confidence), count=prob.count,
-            samples=prob.samples, interval=decision_interval(prob, confidence),
-            confidence=confidence,
+            limit=limit, verdict=said, count=prob.count, samples=prob.samples,
+            interval=decision_interval(prob, confidence), confidence=confidence,
         )  # fmt: skip
     shown = {k: PhysicalValue(value=v, unit=(units or {}).get(k) or display_unit(k)[0])
-             for k, v in point.shown.items()}  # fmt: skip
-    return PointVerdict(point=shown, verdict=verdict(point, limits, confidence),
+             for k, v in point.shown.items()} or dict(own or {})  # fmt: skip
+    overall = verdict(point, limits, confidence)
+    if overall == "pass" and any(r.verdict == "undecided" for r in read.values()):
+        overall = "undecided"  # proved on the followed samples, not on the diverged ones
+    return PointVerdict(point=shown, verdict=overall,
                         reasons=verdict_reasons(point, limits, confidence), limits=read,
                         samples=point.samples, starts_per_sample=starts)  # fmt: skip
 
 
 def probability_report(result: RobustnessResult, limits: dict[str, float],
-                       confidence: float = ONE_LOOK, notes: list[str] | None = None
+                       confidence: float = ONE_LOOK, notes: list[str] | None = None,
+                       own: dict[str, PhysicalValue] | None = None
                        ) -> ProbabilityReport:  # fmt: skip
-    """The gate's report of ``result`` under ``limits``, each verdict read at ``confidence``."""
+    """The gate's report of ``result`` under ``limits``, each verdict read at ``confidence``;
+    ``own`` names the point of a study without axes (``point_verdict``)."""
     verdicts = [point_verdict(p, limits, confidence, result.starts_per_sample,
-                              result.shown_units) for p in result.points]  # fmt: skip
+                              result.shown_units, own) for p in result.points]  # fmt: skip
     said = [v.verdict for v in verdicts]
     return ProbabilityReport(
         passed=all(v == "pass" for v in said), limits=limits, confidence=confidence,

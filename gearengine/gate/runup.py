@@ -30,8 +30,10 @@ GATE_ENSEMBLE = 4
 
 
 def bin_failures(b: RunupBin, rules: Rules) -> list[str]:
-    """The per-bin rules a bin breaks (chaos is judged over runs, see ``runup_failures``)."""
-    out = []
+    """The per-bin rules a bin breaks (chaos is judged over runs, see ``runup_failures``); a
+    bin where a member diverged (no LLE, or no contact verdict) fails whatever ``fail_on``
+    says: the gate cannot vouch for a response the model could not follow."""
+    out = ["diverged"] if b.lle is None or b.contact is None else []
     if "back_flank" in rules.fail_on and (b.back_flank_impacts or 0) > 0:
         out.append("back-flank impacts")
     if "separation" in rules.fail_on and (b.separation_fraction or 0) > 0:
@@ -80,7 +82,7 @@ def runup_failures(
             seconds = sum(b.time_s[1] - b.time_s[0] for b in inside)
             if seconds > chaos_seconds:
                 what = "FTLE clearly positive" if rules.max_lle is None else (
-                    f"FTLE > {rules.max_lle:g}")  # fmt: skip
+                    f"FTLE > {rules.max_lle:g} per unit tau")  # fmt: skip
                 rule = f"run-{name}: chaotic ({what}) for {seconds:.3g} s"
                 if all(any(a <= b.speed_rpm[0] < z for a, z in transient) for b in inside):
                     rule += (
