@@ -23,7 +23,8 @@ import sys
 import common  # benchmarks/common.py
 from report import write_section  # benchmarks/report.py (the script's own folder)
 
-from gearengine.gate.envelope import ENVELOPE_SETTINGS, Rules, check_envelope
+from gearengine.gate.envelope import ENVELOPE_SETTINGS, check_envelope
+from gearengine.gate.rules import Rules
 from gearengine.studies.sweep import validated
 
 RUNS = 3

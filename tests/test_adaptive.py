@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gearengine.gate.envelope import Rules, envelope_report
+from gearengine.gate.envelope import envelope_report
+from gearengine.gate.rules import Rules
 from gearengine.model.params import GearParams
 from gearengine.numerics.batch import simulate_batch
 from gearengine.numerics.settings import SimulationSettings

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from gearengine.gate.envelope import Rules, point_failures
+from gearengine.gate.rules import Rules, point_failures
 from gearengine.model.params import GearParams, PiecewiseBacklash
 from gearengine.studies.robustness.study import RobustnessRequest, run_local
 from gearengine.studies.sweep.points import SweepPoint

@@ -17,7 +17,8 @@ import xmlschema
 from pydantic import ValidationError
 
 from gearengine.analysis import AnalysisRequest, analyze
-from gearengine.gate.envelope import Rules, check_envelope, check_or_failures, envelope_report
+from gearengine.gate.envelope import check_envelope, check_or_failures, envelope_report
+from gearengine.gate.rules import Rules
 from gearengine.homoclinic import melnikov
 from gearengine.homoclinic.boundary import flips
 from gearengine.model.design import EXAMPLE_DESIGN

@@ -15,14 +15,8 @@ import json
 import pytest
 
 from gearengine.cli.junit import envelope_junit
-from gearengine.gate.envelope import (
-    Rules,
-    envelope_axis,
-    envelope_sweep,
-    gate_settings,
-    near_limit,
-    refined_report,
-)
+from gearengine.gate.envelope import envelope_axis, envelope_sweep, gate_settings, refined_report
+from gearengine.gate.rules import Rules, near_limit
 from gearengine.studies.sweep import run_local, validated
 from tests.conftest import ROOT
 
@@ -61,8 +55,8 @@ def test_refinement_finds_chaos_between_passing_grid_points() -> None:
 def test_a_point_far_from_every_limit_is_not_refined() -> None:
     """Two passing grid points, both contracting near the linear rate: nothing is inserted for
     the limits (their attractor sets differ, 2T beside 1T: the gate refines there for that)."""
-    from gearengine.gate.envelope import attractor_failures
     from gearengine.gate.resolution import refine
+    from gearengine.gate.rules import attractor_failures
 
     request = sweep(4.591, "4500:4625", 2)
     result = run_local(request, chunk_points=1)
@@ -200,7 +194,8 @@ def test_a_refinement_for_pass_or_fail_stops_at_its_first_failure(
     of the test above: 3,613.6 rpm (level 1) passes, 3,556.8 and 3,670.5 rpm (level 2)
     fail."""
     from gearengine.gate import resolution
-    from gearengine.gate.envelope import attractor_failures, fails_toward
+    from gearengine.gate.envelope import fails_toward
+    from gearengine.gate.rules import attractor_failures
 
     request = sweep(11.3, "3500:3727.2727272727", 2)
     result = run_local(request, chunk_points=1)

@@ -7,7 +7,8 @@ from __future__ import annotations
 import pytest
 from fastapi.testclient import TestClient
 
-from gearengine.gate.envelope import Rules, envelope_report
+from gearengine.gate.envelope import envelope_report
+from gearengine.gate.rules import Rules
 from gearengine.homoclinic.coefficients import critical_mean_force
 from gearengine.studies.sweep import run_local, validated
 from tests.conftest import PAPER_PARAMS

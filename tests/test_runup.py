@@ -19,7 +19,7 @@ from pydantic import ValidationError
 from scipy.integrate import solve_ivp
 
 from gearengine.cli.main import main
-from gearengine.gate.envelope import Rules
+from gearengine.gate.rules import Rules
 from gearengine.gate.runup import runup_failures
 from gearengine.jsonio import dumps, error_lines
 from gearengine.model.units import RPM

@@ -93,7 +93,7 @@ def test_the_single_point_check_judges_what_the_summary_says(analysis):
     (chaotic), the DTE the largest over the attractors; it judged the settings' periodic start
     (PASS under --fail-on chaotic while the line it printed said chaotic)."""
     from gearengine.cli.analyze import failures
-    from gearengine.gate.envelope import Rules
+    from gearengine.gate.rules import Rules
 
     dte = _largest(analysis.numerics.attractors, "dte_um")[0]
     assert failures(analysis, Rules()) == ["chaotic"]
@@ -196,7 +196,8 @@ def test_the_z23_67_point_gives_one_dte_in_headline_check_json_and_gate():
     starts): the verdict is the chaotic attractor's (31 %), the DTE shown in the check JSON is
     the periodic attractor's 62 µm (69 %), on which --max-dte 30um fails; it showed the chaotic
     one's 20.4 µm, and the settings' start's force_max."""
-    from gearengine.gate.envelope import Rules, check_envelope, envelope_sweep, gate_settings
+    from gearengine.gate.envelope import check_envelope, envelope_sweep, gate_settings
+    from gearengine.gate.rules import Rules
 
     design = json.loads((ROOT / "examples" / "remedies-z23-67.json").read_text())["design"]
     axes = [{"parameter": "speed", "start": "5000 rpm", "stop": "5000 rpm", "num": 1},

@@ -21,7 +21,7 @@ from gearengine.cli.documents import (
 )
 from gearengine.cli.envelope import cmd_envelope, physical_limits, rules_of
 from gearengine.cli.melnikov import fmt_value, render_engineering, render_melnikov
-from gearengine.gate.envelope import Rules, verdict_failures
+from gearengine.gate.rules import Rules, verdict_failures
 from gearengine.jsonio import dumps
 
 
@@ -95,7 +95,7 @@ def margin_failure(r: AnalysisResult, min_margin: float) -> str | None:
 
 def failures(r: AnalysisResult, rules: Rules, min_margin: float | None = None) -> list[str]:
     """Reasons the design fails the gate (empty: pass): the envelope's rules judging its one
-    verdict (``gate.envelope.verdict_failures``: its worst start's, with basins its worst
+    verdict (``gate.rules.verdict_failures``: its worst start's, with basins its worst
     attractor's; its DTE and dynamic factor in µm and 1, with basins the largest over the
     attractors, as the summary line gives them), and the Floquet stability margin."""
     run = r.numerics.worst_case

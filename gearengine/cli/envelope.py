@@ -38,7 +38,6 @@ from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import (
     REFINE_DEPTH,
     EnvelopeReport,
-    Rules,
     check_envelope,
     envelope_axis,
     envelope_sweep,
@@ -47,6 +46,7 @@ from gearengine.gate.envelope import (
     refined_report,
     window_text,
 )
+from gearengine.gate.rules import Rules
 from gearengine.jsonio import dumps
 from gearengine.model.units import POINT_OUTPUTS
 from gearengine.numerics.settings import SimulationSettings

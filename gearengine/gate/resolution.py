@@ -12,7 +12,7 @@ z = 23/67 pair passed its 45 x 9 verification refined along edges and is chaotic
 start at 5,489 rpm / 6.72 N*m, inside a cell. Every inserted point is computed exactly as a
 grid point is (``studies.sweep.compute.points_at``) and checked by the same rules.
 
-"Near a limit" is ``gate.envelope.near_limit``.
+"Near a limit" is ``gate.rules.near_limit``.
 """
 
 from __future__ import annotations

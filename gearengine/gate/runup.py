@@ -1,7 +1,7 @@
 """The run-up in the CI gate (``gearengine check ... --runup 1000``): a run-up and run-down
 through the envelope's speed range at each torque level, failing on the envelope's rules.
 
-Rules on the bins of each branch (``gate.envelope.Rules``): ``chaotic`` in ``fail_on`` fails a
+Rules on the bins of each branch (``gate.rules.Rules``): ``chaotic`` in ``fail_on`` fails a
 run of chaotic bins (ensemble FTLE clearly positive, or above ``max_lle`` when given) that lasts
 longer than ``chaos_seconds``: a ramp crossing a chaotic window quickly may pass, one lingering
 in it fails. ``back_flank`` (or ``impacts``) fails back-flank impacts, ``separation`` any loss
@@ -13,7 +13,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from gearengine.gate.envelope import EnvelopeReport, FailingWindow, Rules
+from gearengine.gate.envelope import EnvelopeReport, FailingWindow
+from gearengine.gate.rules import Rules
 from gearengine.model.units import RPM
 from gearengine.studies.runup.compute import run_local
 from gearengine.studies.runup.profile import validated

@@ -18,12 +18,12 @@ from pydantic_core import InitErrorDetails
 from gearengine.gate.envelope import (
     ENVELOPE_SETTINGS,
     GATE_STARTS,
-    Rules,
     envelope_axis,
     envelope_sweep,
     gate_settings,
 )
 from gearengine.gate.resolution import MAX_REFINE_DEPTH, REFINE_DEPTH
+from gearengine.gate.rules import Rules
 from gearengine.jsonio import message
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.errors import Problems

@@ -35,13 +35,7 @@ import math
 import threading
 from collections.abc import Callable
 
-from gearengine.gate.envelope import (
-    EnvelopeReport,
-    attractor_failures,
-    check_envelope,
-    check_or_failures,
-    fails_toward,
-)
+from gearengine.gate.envelope import EnvelopeReport, check_envelope, check_or_failures, fails_toward
 from gearengine.gate.remedies.levers import accuracy_classes, contact_ratio
 from gearengine.gate.remedies.request import (
     MAX_BISECTIONS,
@@ -53,6 +47,7 @@ from gearengine.gate.remedies.request import (
 )
 from gearengine.gate.remedies.results import Remedy, Sample, Unreachable
 from gearengine.gate.resolution import MAX_REFINE_DEPTH
+from gearengine.gate.rules import attractor_failures
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.homoclinic.train_reduction import melnikov_point
 from gearengine.model.design import Design
