@@ -84,3 +84,21 @@ def test_the_lle_columns_name_their_unit_per_unit_tau(sweep) -> None:
     assert list(frame["lle [1/tau]"]) == [p.lle for p in sweep.points]
     units = (ROOT / "docs" / "units.md").read_text()
     assert "`lle [1/tau]`" in units
+
+
+def test_a_one_design_check_reads_the_designs_bare_speed_in_its_si_unit(tmp_path) -> None:
+    """``check FILE --torque ...`` takes the design's own speed as the speed axis; a bare number
+    there is the design's rad/s (the JSON's SI), while a bare number on the command line is rpm:
+    418.879 rad/s was checked at 418.879 rpm (noticed in a review of issue 30)."""
+    import math
+
+    from gearengine.cli.main import main
+
+    doc = json.loads((ROOT / "examples" / "remedies-z23-67.json").read_text())
+    doc["design"]["speed"] = 4000.0 * 2.0 * math.pi / 60.0
+    design, out = tmp_path / "design.json", tmp_path / "report.json"
+    design.write_text(json.dumps(doc))
+    main(["check", str(design), "--torque", "10:10", "--torque-points", "1", "--starts", "1",
+          "--json", str(out)])  # fmt: skip
+    point = json.loads(out.read_text())["sweep"]["points"][0]
+    assert point["physical"]["speed"] == {"value": pytest.approx(4000.0), "unit": "rpm"}

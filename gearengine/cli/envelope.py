@@ -51,6 +51,7 @@ from gearengine.jsonio import dumps
 from gearengine.model.units import POINT_OUTPUTS
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies import jobs
+from gearengine.studies.sweep.axes import axis_unit
 from gearengine.studies.sweep.points import SpeedWindows
 from gearengine.studies.sweep.request import SweepRequest, validated
 from gearengine.studies.sweep.results import SweepResult
@@ -125,10 +126,14 @@ def budget_refusal(kind: str, request: object, noun: str, ways: str) -> str | No
 
 
 def _here(design: dict, name: str) -> str:
-    """The design's own value as a one-point range (when only the other axis is given)."""
+    """The design's own value as a one-point range (when only the other axis is given); a bare
+    number is the design's, in the field's SI unit (speed rad/s), which the range says, since
+    a bare number on the command line is read in gear units (rpm)."""
     value = design.get(name)
     if value is None:
         raise InvalidInputError([f"--{name}: give a range, the design has no {name}"])
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        value = f"{value} {axis_unit(name)}"
     return f"{value}:{value}"
 
 
