@@ -85,6 +85,23 @@ def mid_chunk(data_dir: Path, job_id: str, done: int) -> Any:
     return lambda job: job["progress"]["done"] >= done and leased(data_dir, job_id) > 0
 
 
+def stopped_mid_chunk(srv: Server, url: str, data_dir: Path, job_id: str) -> list[psutil.Process]:
+    """SIGSTOP the server and its pool at a moment a chunk is leased (``mid_chunk``), read after
+    the stop: under load a chunk seen in flight could be committed, and no next one leased yet,
+    before a kill -9 landed ('no chunk was in flight at the crash', a CI run at load 4-5).
+    Returns the (stopped) pool processes."""
+    while True:
+        poll_url(url, mid_chunk(data_dir, job_id, 2 * CHUNK_POINTS))
+        os.kill(srv.proc.pid, signal.SIGSTOP)
+        children = pool_workers(srv)
+        for child in children:
+            os.kill(child.pid, signal.SIGSTOP)
+        if leased(data_dir, job_id) > 0:
+            return children
+        for pid in (srv.proc.pid, *(c.pid for c in children)):
+            os.kill(pid, signal.SIGCONT)  # it committed in between: try again
+
+
 def submit(srv: Server) -> tuple[dict[str, Any], str]:
     """POST the sweep; returns the job and its URL."""
     job = httpx.post(srv.url + "/v1/sweeps", json=SWEEP, timeout=10).json()
@@ -176,8 +193,7 @@ def test_restart_after_kill9_reclaims_the_dead_servers_leases_at_once(
     srv = Server(data_dir, env)
     try:
         job, url = submit(srv)
-        poll_url(url, mid_chunk(data_dir, job["id"], 2 * CHUNK_POINTS))
-        children = pool_workers(srv)
+        children = stopped_mid_chunk(srv, url, data_dir, job["id"])
         os.kill(srv.proc.pid, signal.SIGKILL)
         srv.proc.wait()
         kill9(children)

@@ -87,7 +87,8 @@ def test_cli_check_refuses_work_over_the_job_budget(
     assert "over the budget of 20000000000 RK4 steps per job" in err
     assert (
         "40000 points x 257 starts (1 + 256 basin starts) = 10280000 runs; the budget "
-        "allows 5066 points" in err
+        "allows 2236 points"
+        in err  # the slow end's steps resolve the contact (test_step_resolution)
     )
 
 

@@ -94,10 +94,11 @@ class LeverRange(BaseModel):
 class RemediesRequest(Rules):
     """A failing design, its envelope and the gate's rules: what to change, by how much."""
 
-    model_config = request_config(  # 7 x 3 points: within a default server's job budget
+    model_config = request_config(  # 7 x 3 points, one lever: within a default job budget
         {"design": EXAMPLE_DESIGN, "fail_on": ["chaotic"],
          "envelope": {"speed": "500:6000", "torque": "20:200", "speed_points": 7,
-                      "torque_points": 3}}
+                      "torque_points": 3},
+         "levers": [{"lever": "mesh.damping_ratio", "bounds": [0.05, 0.3]}]}
     )  # fmt: skip
 
     design: Design = Field(description="The pair in physical units.")
