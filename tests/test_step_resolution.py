@@ -56,6 +56,10 @@ def test_a_slow_pair_in_contact_decays_at_minus_zeta(rpm: float) -> None:
     numerics = result.numerics
     assert numerics.classification == "periodic" and numerics.impact_regime == "no_impact"
     assert numerics.lle == pytest.approx(-ZETA, rel=2e-3)
+    # T0 is one mesh period here: the raised steps do not change how many mesh periods a T0
+    # holds (they read 46.9 mesh periods for 6 T0, the steps' ratio, before)
+    for length in (numerics.transient, numerics.record):
+        assert length is not None and length.mesh_periods == length.periods
     response = result.engineering.response
     assert response is not None and math.isfinite(response.dte_peak_to_peak_um)
     assert response.dte_peak_to_peak_um < 10.0

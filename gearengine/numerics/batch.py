@@ -169,14 +169,14 @@ def _run_lanes(
     verdict is copied to be renumbered (three copies a point cost ~0.05 ms); with ``x_only``
     the lock-step lanes keep the x of their last strobes alone (``lanes.last_strobes``)."""
     results: list[BatchPoint | None] = [None] * len(lanes)
-    groups: dict[tuple[str, int], list[int]] = {}
+    groups: dict[tuple[str, int, float], list[int]] = {}
     systems: dict[tuple, list[int]] = {}
     for k, (i, s) in enumerate(lanes):
         plan, point = plans[i], points[i]
         name = point.backlash.model if isinstance(point, GearParams) else ""
         key = point.lane_group(plan) if isinstance(point, System) else None
         if name and LAWS[name].lanes is not None and plan.omega0 is not None:
-            groups.setdefault((name, plan.steps), []).append(k)
+            groups.setdefault((name, plan.steps, plan.fast_periods), []).append(k)
         elif key is not None:
             systems.setdefault(key, []).append(k)
         else:
@@ -186,7 +186,7 @@ def _run_lanes(
         for k, point in zip(ks, system_lanes(points, plans, [lanes[k] for k in ks], settings),
                             strict=True):  # fmt: skip
             results[k] = point.model_copy(update={"start_index": numbers[k]})
-    for (name, N), ks in groups.items():
+    for (name, N, r), ks in groups.items():
         owner = np.array([lanes[k][0] for k in ks], dtype=np.int64)
         members, inverse = np.unique(owner, return_inverse=True)
         packed = [packed_forcing(points[i]) for i in members.tolist()]
@@ -205,7 +205,7 @@ def _run_lanes(
         assert lanes_of is not None
         laws = [law(points[i]) for i in members.tolist()]
         if physical.applies(settings, plans[members[0]], 0.0):
-            group = (lanes_of, laws, inverse, packed, mu, tabled, per, N)
+            group = (lanes_of, laws, inverse, packed, mu, tabled, per, N, r)
             mine = [numbers[k] for k in ks]
             got = physical_lanes(group, x0, v0, settings, mine, x_only)
             for k, point in zip(ks, got, strict=True):
@@ -259,13 +259,14 @@ def physical_lanes(
 
     Args:
         group: (lanes kernel, laws of the points, point of each lane (L,), packed forcing,
-            damping (L,), forcing tables, T0 (L,), steps N per T0), as ``_run_lanes`` has them.
+            damping (L,), forcing tables, T0 (L,), steps N per T0, mesh periods r per T0
+            (``StepPlan.fast_periods``)), as ``_run_lanes`` has them.
         x0, v0: the lanes' starts, shape (L,).
         settings: caps and tolerances.
         numbers: the ``start_index`` of each lane's ``BatchPoint``, shape (L,).
         x_only: keep the x of the last strobes alone (``lanes.last_strobes``).
     """
-    lanes_of, laws, inverse, packed, mu, tabled, per, N = group
+    lanes_of, laws, inverse, packed, mu, tabled, per, N, r = group
 
     def call(idx: np.ndarray, xa: np.ndarray, va: np.ndarray, n: int, carry: Carry) -> tuple:
         streams = max(1, min(numba.get_num_threads(), -(-idx.size // kernels.LANES)))
@@ -291,7 +292,7 @@ def physical_lanes(
         carry = (dx, dv, reg)  # where each record ended: the kernel runs it on from there
         return chunk(joined(rows, call(idx, xf, vf, n, carry)), carry, idx)
 
-    spans = physical.lengths(advance, x0, v0, per, mu, N / settings.steps_per_period, settings,
+    spans = physical.lengths(advance, x0, v0, per, mu, r, settings,
                              extend)  # fmt: skip
     verdicts: dict[int, list[tuple]] = {}
     rows: dict[int, list[int]] = {}

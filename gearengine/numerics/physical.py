@@ -90,11 +90,11 @@ NEGATIVE_LLE = 0.01
 """An LLE below -NEGATIVE_LLE (per tau, by 3 standard errors) with no period: unfinished."""
 
 
-def run_length(periods: int, plan: StepPlan, steps_per_period: int, reason: str) -> RunLength:
+def run_length(periods: int, plan: StepPlan, reason: str) -> RunLength:
     """``periods`` intervals T0 of ``plan`` as a ``RunLength``."""
     return RunLength(
         periods=int(periods),
-        mesh_periods=periods * plan.steps / steps_per_period,
+        mesh_periods=periods * plan.fast_periods,
         tau=periods * plan.period,
         reason=reason,
     )

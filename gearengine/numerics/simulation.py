@@ -100,11 +100,10 @@ def simulate(
     states = worst.strobes if worst.states is None else worst.states
     last = states[worst.recorded - 1] if states is not None and worst.recorded > 0 else None
     orbit, why = floquet_of(system, settings, result, last)
-    spp = settings.steps_per_period
     return result.model_copy(update={
         "floquet": orbit, "floquet_note": why,
-        "transient": physical.run_length(n_trans, plan, spp, why_trans),
-        "record": physical.run_length(n_rec, plan, spp, why_rec),
+        "transient": physical.run_length(n_trans, plan, why_trans),
+        "record": physical.run_length(n_rec, plan, why_rec),
     })  # fmt: skip
 
 
@@ -131,7 +130,7 @@ def physical_runs(
     v0 = np.array([s[1] for s in starts], dtype=np.float64)
     mu = system.damping_rate()
     assert mu is not None
-    r = plan.steps / settings.steps_per_period
+    r = plan.fast_periods
     lanes = physical.lengths(advance, x0, v0, np.full(x0.size, plan.period), np.full(x0.size, mu),
                              r, settings)  # fmt: skip
     runs, spans = [], []

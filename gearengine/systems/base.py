@@ -37,6 +37,7 @@ The spur pair of the paper (Eq. 9, ``spur_pair``) is the first system.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Sequence
@@ -65,6 +66,10 @@ class StepPlan:
         steps: RK4 steps N per sampling interval; step h = period / steps.
         omega_ref: frequency the spectrum orders refer to, 2 pi / period.
         notes: human-readable remarks on the choices made.
+        fast_periods: r = T0 / T_f, the periods of the fastest excitation in one T0 (the mesh
+            periods physical time counts in, ``numerics.physical``), as the forcing's own grid
+            counts them (its steps over ``steps_per_period``); unchanged when ``resolving``
+            raises the steps.
     """
 
     omega0: float | None
@@ -72,6 +77,7 @@ class StepPlan:
     steps: int
     omega_ref: float
     notes: tuple[str, ...]
+    fast_periods: float = 1.0
 
     @property
     def h(self) -> float:
@@ -91,7 +97,7 @@ def resolving(plan: StepPlan, omega_max: float, what: str) -> StepPlan:
         f"{what} (omega = {omega_max:.4g} omega_n) needs {need} RK4 steps per T0 "
         f"(h omega <= {H_OMEGA}); {plan.steps} were asked"
     )
-    return StepPlan(plan.omega0, plan.period, need, plan.omega_ref, (*plan.notes, note))
+    return dataclasses.replace(plan, steps=need, notes=(*plan.notes, note))
 
 
 @dataclass(frozen=True)

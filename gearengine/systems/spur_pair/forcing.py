@@ -121,4 +121,4 @@ def _forcing_plan(params: GearParams, steps_per_period: int) -> StepPlan:
     notes: tuple[str, ...] = ()
     if not math.isclose(fast / omega0, round(fast / omega0), rel_tol=1e-9):
         notes = (f"T0 is shorter than the fastest excitation period; N = {steps} steps per T0",)
-    return StepPlan(omega0, 2.0 * math.pi / omega0, steps, omega0, notes)
+    return StepPlan(omega0, 2.0 * math.pi / omega0, steps, omega0, notes, steps / steps_per_period)
