@@ -51,3 +51,19 @@ def test_out_dash_streams_to_stdout_and_progress_has_no_carriage_return(
     assert lines[0].startswith("driver.teeth") and len(lines) == 5
     assert main(["sweep", str(doc), "--out", str(tmp_path / "files")]) == 0
     assert (tmp_path / "files" / "teeth.png").read_bytes().startswith(b"\x89PNG")
+
+
+def test_a_sweep_refuses_to_overwrite_its_input(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``sweep in.json`` writes in.json, in.csv and in.png into --out (default "."): run where
+    its input lies, it replaced the input with its result (new-user review). Refused before
+    computing, the input untouched."""
+    source = tmp_path / "in.json"
+    source.write_text((ROOT / "examples" / "chaos-map.json").read_text())
+    before = source.read_bytes()
+    monkeypatch.chdir(tmp_path)
+    for argv in (["sweep", "in.json"], ["sweep", str(source), "--out", str(tmp_path)]):
+        assert main(argv) == 2
+        assert "would overwrite the input" in capsys.readouterr().err
+    assert source.read_bytes() == before and not (tmp_path / "in.csv").exists()

@@ -18,7 +18,7 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from gearengine.cli.documents import EXIT_OK, read_document, validated_input
+from gearengine.cli.documents import EXIT_OK, InvalidInputError, read_document, validated_input
 from gearengine.jsonio import dumps
 from gearengine.studies.sweep.compute import run_local
 from gearengine.studies.sweep.request import SweepRequest, validated
@@ -94,6 +94,11 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 def _sweep(args: argparse.Namespace) -> int:
     request = read_sweep(args.file)
     stem = "sweep" if args.file == "-" else Path(args.file).stem
+    if args.out != "-" and args.file != "-":
+        written = [Path(args.out) / f"{stem}.{ext}" for ext in ("json", "csv", "png")]
+        if any(w.resolve() == Path(args.file).resolve() for w in written):
+            why = f"the result {stem}.json would overwrite the input {args.file}"
+            raise InvalidInputError([f"--out {args.out}: {why}; give another --out directory"])
     result = run_local(request, progress(time.monotonic(), stem), workers=os.cpu_count() or 1)
     for text in result.notes or []:  # a bare number on a physical axis, read in SI
         print(f"note: {text}", file=sys.stderr)
