@@ -5,6 +5,7 @@ value beside the geometry form used and said so."""
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import json
 import math
@@ -133,3 +134,26 @@ def test_a_speed_in_hz_is_refused_naming_the_field_everywhere(client, tmp_path, 
 @pytest.mark.parametrize("speed", ["3000 rev/min", "50 rev/s", "50 rps", "314.159265 rad/s"])
 def test_revolutions_per_time_are_read_as_written(speed: str) -> None:
     assert Design.model_validate(_design(speed=speed)).speed == pytest.approx(100 * math.pi)
+
+
+def test_digits_split_by_a_comma_or_a_space_are_refused_everywhere(
+    client, tmp_path, capsys
+) -> None:
+    """pint read "2,5 mm" as 25 mm, "1 500 rpm" as 500 rpm, and a sweep end "12,5 N*m" as
+    12 (second new-user review): a decimal comma or a thousands space is refused naming the
+    field, in the API, the library and the CLI's options."""
+    said = "write the number with a decimal point and no separators"
+    answer = client.post("/v1/analyses", json={"design": _design(speed="1 500 rpm")})
+    assert answer.status_code == 422
+    (error,) = answer.json()["errors"]
+    assert error["path"] == "design.speed" and said in error["message"]
+    driver = {**EXAMPLE_DESIGN["driver"], "base_radius": "2,5 mm"}
+    with pytest.raises(ValidationError, match=said) as err:
+        Design.model_validate(_design(driver=driver))
+    assert err.value.errors()[0]["loc"] == ("driver", "base_radius")
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": _design()}))
+    for option in (["--torque", "12,5:30"], ["--speed", "2,5krpm:3krpm"], ["--max-dte", "1,5um"]):
+        with contextlib.suppress(SystemExit):  # argparse exits 2 on an option it refuses
+            assert main(["check", str(path), *option, "--starts", "1"]) == 2
+        assert said in capsys.readouterr().err

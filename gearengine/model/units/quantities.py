@@ -199,6 +199,12 @@ def parse_quantity(
         raise ValueError(f"give a number in {kind.unit} or a string with a unit, e.g. "
                          f"{kind.example!r}")  # fmt: skip
     if isinstance(value, str):
+        if SEPARATED.search(value):
+            raise ValueError(
+                f"{value!r}: write the number with a decimal point and no "
+                f"separators, e.g. {kind.example!r} (digits split by a comma or a "
+                "space are read as neither a decimal nor a thousands mark)"
+            )
         value = _respelled(value, kind)
         try:
             quantity = ureg.Quantity(value.strip())
@@ -299,6 +305,11 @@ def _plausible(si: float, given: object, kind: QuantityKind, allow_zero: bool) -
             break
     raise ValueError(message)
 
+
+SEPARATED = re.compile(r"\d,\d|\d\s+\d{3}(?![\d/])")
+"""Digits split by a comma ("2,5 mm") or a thousands space ("1 500 rpm"): pint reads "2,5" as
+25 and "1 500" as 500, where a user means 2.5 and 1500 (a unit that begins with a digit,
+"3000 1/min", is not a split number)."""
 
 NUMBER = r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?"
 """A decimal number as pint reads it."""
