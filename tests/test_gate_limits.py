@@ -232,3 +232,20 @@ def test_no_melnikov_window_reads_nowhere_in_the_scanned_range(
     out = capsys.readouterr().out
     assert "Melnikov chaos possible nowhere in 10-18,000 rpm (scanned)" in out
     assert "nowhere rpm" not in out and "[LLE > -1000 per unit tau]" in out
+
+
+def test_rules_that_leave_chaos_out_say_so_when_points_are_chaotic() -> None:
+    """``--fail-on melnikov`` replaces the default ``chaotic``: an envelope passed three points
+    chaotic from 50-100 % of starts and its text never said "chaotic" (second new-user
+    review). The report notes the chaotic points the rules do not judge; none when they do."""
+    from gearengine.gate.envelope import unjudged_chaos
+
+    chaotic = SweepPoint(values={"speed": 500.0}, branch=None, classification="chaotic",
+                         physical={"speed": PhysicalValue(value=4775.0, unit="rpm")})  # fmt: skip
+    calm = chaotic.model_copy(update={"classification": "periodic"})
+    (note,) = unjudged_chaos([chaotic, calm], Rules(fail_on=["melnikov"]))
+    assert note.startswith("1 of 2 points are chaotic, which these rules do not judge")
+    assert "fail_on: melnikov" in note and "add chaotic" in note
+    assert unjudged_chaos([chaotic, calm], Rules()) == []
+    assert unjudged_chaos([chaotic], Rules(fail_on=["quasi_periodic"])) == []
+    assert unjudged_chaos([calm], Rules(fail_on=["separation"])) == []

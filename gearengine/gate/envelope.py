@@ -266,6 +266,7 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
                 failures.append(FailingWindow(level=level, rule=rule, speeds_rpm=span,
                                               attractors=named))  # fmt: skip
     return EnvelopeReport(
+        notes=unjudged_chaos([p for r in rows.values() for p in r], rules),
         passed=not failures,
         rules=rules,
         points=sum(len(r) for r in rows.values()),
@@ -279,6 +280,21 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
         sweep=result,
         refined=list(refined),
     )
+
+
+def unjudged_chaos(points: Sequence[SweepPoint], rules: Rules) -> list[str]:
+    """A note when ``rules.fail_on`` leaves chaos out (``--fail-on melnikov`` replaces the
+    default ``chaotic``) and some ``points`` are chaotic: a PASS that never says "chaotic"
+    read as a design free of chaos (second new-user review)."""
+    if any(w in ("quasi_periodic", "chaotic") for w in rules.fail_on):
+        return []
+    chaotic = sum(1 for p in points if p.classification == "chaotic")
+    if not chaotic:
+        return []
+    given = ", ".join(rules.fail_on) or "none"
+    return [f"{chaotic} of {len(points)} points are chaotic, which these rules do not judge "
+            f"(fail_on: {given}; a class given replaces the default chaotic: add chaotic to "
+            "fail on it)"]  # fmt: skip
 
 
 def level_text(level: dict[str, PhysicalValue]) -> str:
