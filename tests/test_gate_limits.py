@@ -249,3 +249,16 @@ def test_rules_that_leave_chaos_out_say_so_when_points_are_chaotic() -> None:
     assert unjudged_chaos([chaotic, calm], Rules()) == []
     assert unjudged_chaos([chaotic], Rules(fail_on=["quasi_periodic"])) == []
     assert unjudged_chaos([calm], Rules(fail_on=["separation"])) == []
+
+
+@pytest.mark.parametrize("option", [["--refine", "1"], ["--runup", "100"], ["--starts", "4"]])
+def test_a_one_design_check_refuses_the_envelope_options_it_would_ignore(
+    option: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check FILE --refine 1`` and ``--runup 100`` without --speed or --torque passed (exit 0)
+    having run neither, while --starts and --json were refused (second new-user review)."""
+    from gearengine.cli.main import main
+
+    design = str(ROOT / "examples" / "design-geometry.json")
+    assert main(["check", design, *option]) == 2
+    assert f"{option[0]} checks an envelope" in capsys.readouterr().err

@@ -152,14 +152,16 @@ def cmd_check(args: argparse.Namespace) -> int:
         return cmd_probability_gate(args, doc)
     if args.speed or args.torque:
         return cmd_envelope(args, doc)
-    if args.starts is not None or args.min_basin is not None or args.json or args.junit or \
-            args.server:  # fmt: skip
-        raise InvalidInputError(
-            [
-                "--starts, --min-basin, --json, --junit and --server check an envelope: give "
-                "--speed LOW:HIGH (rpm) and/or --torque LOW:HIGH (N m)"
-            ]
-        )
+    given = [option for option, value in (
+        ("--starts", args.starts), ("--min-basin", args.min_basin), ("--json", args.json),
+        ("--junit", args.junit), ("--server", args.server), ("--refine", args.refine),
+        ("--runup", args.runup),
+    ) if value is not None and value is not False]  # fmt: skip
+    if given:
+        verb = "checks" if len(given) == 1 else "check"
+        raise InvalidInputError([f"{', '.join(given)} {verb} an envelope (one design's check "
+                                 "would ignore them): give --speed LOW:HIGH (rpm) and/or "
+                                 "--torque LOW:HIGH (N m)"])  # fmt: skip
     request = validated_input(AnalysisRequest.model_validate, doc, args.file)
     rules = rules_of(args)
     if request.design is None and physical_limits(rules):
