@@ -157,3 +157,16 @@ def test_digits_split_by_a_comma_or_a_space_are_refused_everywhere(
         with contextlib.suppress(SystemExit):  # argparse exits 2 on an option it refuses
             assert main(["check", str(path), *option, "--starts", "1"]) == 2
         assert said in capsys.readouterr().err
+
+
+def test_the_text_says_how_a_bare_design_speed_was_read(tmp_path, capsys) -> None:
+    """A bare design speed is rad/s (the JSON's SI), noted in the JSON only: ``analyze`` and
+    ``check`` said nothing in their text, where a bare --speed is rpm (second new-user
+    review). Both now say the reading."""
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": _design(speed=300)}))
+    said = "speed: the bare number 300 read as 300 rad/s = 2,864.79 rpm"
+    assert main(["analyze", str(path)]) == 0
+    assert f"note: {said}" in capsys.readouterr().out
+    main(["check", str(path)])
+    assert f"note: {said}" in capsys.readouterr().err

@@ -9,6 +9,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze, decision
 from gearengine.cli.documents import (
@@ -44,7 +45,7 @@ def cmd_analyze(args: argparse.Namespace) -> int:
         if line is not None:
             who = "" if result.verdict.decided_by is None else "of the settings' start: "
             print(f"  {who}{line}")
-        for note in result.numerics.notes:
+        for note in [*result.numerics.notes, *design_readings(request)]:
             print(f"  note: {note}")
         if result.engineering is not None:
             print(render_engineering(result.engineering))
@@ -176,4 +177,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     verdict = "FAIL" if reasons else "PASS"
     why = f" [{', '.join(reasons)}]" if reasons else ""
     print(f"{verdict}: {result.summary()}{why}")
+    for note in design_readings(request):  # stdout keeps its one summary line
+        print(f"note: {note}", file=sys.stderr)
     return EXIT_FAIL if reasons else EXIT_OK
+
+
+def design_readings(request: AnalysisRequest) -> list[str]:
+    """What was read from the design's own spellings and bare numbers (``Design.readings``:
+    "speed: the bare number 300 read as 300 rad/s = 2,864.79 rpm ..."), said in the text as
+    the JSON's ``engineering.notes`` says it."""
+    return [] if request.design is None else request.design.readings
