@@ -262,3 +262,17 @@ def test_a_one_design_check_refuses_the_envelope_options_it_would_ignore(
     design = str(ROOT / "examples" / "design-geometry.json")
     assert main(["check", design, *option]) == 2
     assert f"{option[0]} checks an envelope" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("option", ["--max-dte=-1um", "--max-dte=0", "--max-dynamic-factor=0"])
+def test_a_limit_no_point_can_meet_is_refused_naming_the_option(
+    option: str, capsys: pytest.CaptureFixture
+) -> None:
+    """``--max-dte=-1um`` failed every point ('DTE > -1 µm', second new-user review): a DTE
+    peak to peak or a dynamic factor is never below 0, so a limit at or under 0 is refused
+    (``Rules``), named by its option, before computing (it was an internal error once Rules
+    refused it, a ValidationError the CLI did not read)."""
+    from gearengine.cli.main import main
+
+    assert main(["check", str(ROOT / "examples" / "design-geometry.json"), option]) == 2
+    assert f"{option.split('=')[0]}: Input should be greater than 0" in capsys.readouterr().err

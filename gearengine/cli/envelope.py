@@ -29,6 +29,7 @@ from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
     InvalidInputError,
+    Options,
     axis_options,
     counted_points,
     validated_input,
@@ -166,12 +167,22 @@ def _call(url: str, key: str | None, body: bytes | None = None) -> dict:
         raise InvalidInputError([f"{url}: {exc.reason}"]) from None
 
 
+RULE_OPTIONS: Options = {
+    "max_lle": "--max-lle",
+    "max_dte_um": "--max-dte",
+    "max_dynamic_factor": "--max-dynamic-factor",
+    "min_basin": "--min-basin",
+}
+"""The option that gives each limit of ``Rules``, for its refusals."""
+
+
 def rules_of(args: argparse.Namespace) -> Rules:
-    """--fail-on classes (default chaotic; limits add to them, never replace them)."""
-    return Rules(fail_on=args.fail_on or ["chaotic"], max_lle=args.max_lle,
-                 max_dte_um=args.max_dte,
-                 max_dynamic_factor=args.max_dynamic_factor,
-                 min_basin=getattr(args, "min_basin", None))  # fmt: skip
+    """--fail-on classes (default chaotic; limits add to them, never replace them); a limit
+    ``Rules`` refuses (a DTE at or under 0, a basin fraction over 1) is named by its option."""
+    given = {"fail_on": args.fail_on or ["chaotic"], "max_lle": args.max_lle,
+             "max_dte_um": args.max_dte, "max_dynamic_factor": args.max_dynamic_factor,
+             "min_basin": getattr(args, "min_basin", None)}  # fmt: skip
+    return validated_input(Rules.model_validate, given, "check", RULE_OPTIONS)
 
 
 def physical_limits(rules: Rules) -> list[str]:

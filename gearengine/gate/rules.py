@@ -50,13 +50,14 @@ class Rules(BaseModel):
         None, allow_inf_nan=False, description="Largest LLE allowed, per unit tau."
     )
     max_dte_um: float | None = Field(
-        None, allow_inf_nan=False, description="Largest DTE peak to peak [µm]."
-    )
+        None, gt=0.0, allow_inf_nan=False,
+        description="Largest DTE peak to peak [µm], above 0 (a peak to peak is never below 0: "
+        "a limit at or under 0 would fail every point).",
+    )  # fmt: skip
     max_dynamic_factor: float | None = Field(
-        None,
-        allow_inf_nan=False,
-        description="Largest dynamic factor allowed: max mesh force / static force.",
-    )
+        None, gt=0.0, allow_inf_nan=False,
+        description="Largest dynamic factor allowed: max mesh force / static force, above 0.",
+    )  # fmt: skip
     min_basin: float | None = Field(
         None,
         ge=0.0,
