@@ -217,3 +217,14 @@ def test_a_refinement_for_pass_or_fail_stops_at_its_first_failure(
     # from the failing point's grid cell alone, before the rest of the grid: found
     assert fails_toward(request, rules, 2, [full[2].values])
     assert not fails_toward(request, Rules(fail_on=["diverged"]), 2, [full[2].values])
+
+
+def test_a_check_with_nothing_to_refine_says_so() -> None:
+    """It read 'refined to 62.5 rpm x ...: 0 points added' when nothing was refined (second
+    new-user review)."""
+    from gearengine.gate.resolution import Resolution
+
+    text = Resolution(speed_points=5, torque_points=1, speed_step_rpm=250.0, starts=16,
+                      depth=2, finest_speed_step_rpm=62.5, refined_points=0).text()  # fmt: skip
+    assert "0 points added" not in text and "refined to" not in text
+    assert text.endswith("nothing to refine (up to 2 halvings)")

@@ -141,8 +141,9 @@ def cmd_check(args: argparse.Namespace) -> int:
     if args.max_probability:
         ignored = envelope_only(args)
         if ignored:
+            verb = "judges" if len(ignored) == 1 else "judge"
             raise InvalidInputError([
-                f"{', '.join(ignored)} judge the envelope check (the nominal design), which "
+                f"{', '.join(ignored)} {verb} the envelope check (the nominal design), which "
                 "--max-probability does not run: run it as a second check without "
                 "--max-probability"
             ])  # fmt: skip

@@ -74,6 +74,9 @@ class Resolution(BaseModel):
             return out + "; no neighbours to refine between"
         if self.depth == 0:
             return out + "; not refined between grid points"
+        if self.refined_points == 0:  # it read "refined to ...: 0 points added"
+            return out + ("; no neighbours differ and no point is near a limit: nothing to "
+                          f"refine (up to {self.depth} halvings)")  # fmt: skip
         return (f"{out}; refined to {' x '.join(fine)} where neighbours differ (verdict or "
                 "attractors) or a point is near a limit: "
                 f"{self.refined_points} points added")  # fmt: skip
