@@ -64,13 +64,13 @@ def test_engine_commands_run_without_the_service(tmp_path: Path) -> None:
         ["melnikov", str(params), "--json"],
         ["analyze", str(design)],
         ["check", str(design)],
-        ["sweep", str(sweep), "--out", str(tmp_path)],
+        ["sweep", str(sweep), "--out", str(tmp_path / "out")],
     ]
     for argv in calls:
         code = f"from gearengine.cli import main; sys.exit(main({argv!r}))"
         out = run_blocked(code, tmp_path)
         assert out.returncode == 0, (argv, out.stderr)
-    assert (tmp_path / "sweep.png").stat().st_size > 0
+    assert (tmp_path / "out" / "sweep.png").stat().st_size > 0
     out = run_blocked("from gearengine.cli import main; sys.exit(main(['serve']))", tmp_path)
     assert out.returncode == 2 and "invalid choice: 'serve'" in out.stderr
 
