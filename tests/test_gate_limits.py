@@ -111,7 +111,10 @@ def test_envelope_pass_line_names_impact_and_melnikov_windows(
     lines = captured.out.splitlines()
     assert lines[0].startswith("PASS: 0 of 3 operating points")
     # the geometry design's load is above its critical torque: the criterion does not apply
-    assert lines[1].startswith("  resolution: 3 speeds (1000 rpm), 16 starts a point; refined")
+    assert lines[1] == (
+        "  resolution: 3 speeds (1000 rpm), 16 starts a point; no neighbours "
+        "differ and no point is near a limit: nothing to refine (up to 2 halvings)"
+    )
     assert lines[2] == (
         "  windows: teeth always in contact; "
         "Melnikov: not applicable at 1000-3000 rpm (above T_crit)"
