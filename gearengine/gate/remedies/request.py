@@ -29,7 +29,7 @@ from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.errors import Problems
 from gearengine.model.params import request_config
 from gearengine.model.units import display_unit, in_display_unit
-from gearengine.numerics.settings import SimulationSettings
+from gearengine.numerics.settings import SimulationSettings, over_light
 from gearengine.studies.sweep.axes import field_value, si_value
 from gearengine.studies.sweep.request import SweepRequest, validated
 
@@ -127,7 +127,7 @@ class RemediesRequest(Rules):
     @field_validator("settings", mode="before")
     @classmethod
     def _over_the_gates(cls, given: object) -> object:
-        return {**ENVELOPE_SETTINGS, **given} if isinstance(given, dict) else given
+        return over_light(given)
 
     @model_validator(mode="after")
     def _checked(self) -> RemediesRequest:
