@@ -89,12 +89,12 @@ def stopped_mid_chunk(srv: Server, url: str, data_dir: Path, job_id: str) -> lis
     """SIGSTOP the server and its pool at a moment a chunk is leased (``mid_chunk``), read after
     the stop: under load a chunk seen in flight could be committed, and no next one leased yet,
     before a kill -9 landed ('no chunk was in flight at the crash', a CI run at load 4-5).
-    Returns the (stopped) pool processes."""
+    Returns the server's (stopped) processes, to be killed with it."""
     while True:
         poll_url(url, mid_chunk(data_dir, job_id, 2 * CHUNK_POINTS))
         os.kill(srv.proc.pid, signal.SIGSTOP)
-        children = pool_workers(srv)
-        for child in children:
+        children = psutil.Process(srv.proc.pid).children(recursive=True)
+        for child in children:  # every process of the server, not its pool alone
             os.kill(child.pid, signal.SIGSTOP)
         if leased(data_dir, job_id) > 0:
             return children
