@@ -130,7 +130,7 @@ def test_envelope_settings_merge_over_the_light_defaults(tmp_path: Path) -> None
     path = tmp_path / "starts.json"
     path.write_text(json.dumps({**doc, "settings": {"random_initial_states": starts}}))
     args = argparse.Namespace(file=str(path), speed="1000:2000", speed_points=3, torque=None,
-                              starts=1)  # fmt: skip
+                              torque_points=None, starts=1)  # fmt: skip
     settings = envelope_request(args, read_document(str(path))).settings
     assert (settings.transient_periods, settings.record_periods) == (60, 60)
     assert settings.steps_per_period == 128 and settings.random_initial_states.count == 4
@@ -254,7 +254,16 @@ def test_rules_that_leave_chaos_out_say_so_when_points_are_chaotic() -> None:
     assert unjudged_chaos([calm], Rules(fail_on=["separation"])) == []
 
 
-@pytest.mark.parametrize("option", [["--refine", "1"], ["--runup", "100"], ["--starts", "4"]])
+@pytest.mark.parametrize(
+    "option",
+    [
+        ["--refine", "1"],
+        ["--runup", "100"],
+        ["--starts", "4"],
+        ["--speed-points", "5"],
+        ["--torque-points", "3"],
+    ],
+)
 def test_a_one_design_check_refuses_the_envelope_options_it_would_ignore(
     option: list[str], capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -265,6 +274,24 @@ def test_a_one_design_check_refuses_the_envelope_options_it_would_ignore(
     design = str(ROOT / "examples" / "design-geometry.json")
     assert main(["check", design, *option]) == 2
     assert f"{option[0]} checks an envelope" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("axis", ["speed", "torque"])
+def test_a_grid_without_its_range_is_refused(axis: str, capsys: pytest.CaptureFixture) -> None:
+    """``check FILE --torque 5:20 --speed-points 5`` checked the torque levels at the design's
+    speed and passed with the 5 speeds unrun, unsaid (third stop-39 leftover): a grid's point
+    count without its range is refused in check, remedies and robustness alike."""
+    from gearengine.cli.main import main
+
+    design = str(ROOT / "examples" / "design-geometry.json")
+    other = {"speed": ["--torque", "5:20"], "torque": ["--speed", "1000:2000"]}[axis]
+    for command in (["check", design, *other], ["remedies", design, *other],
+                    ["robustness", design]):  # fmt: skip
+        if command[0] == "remedies" and axis == "speed":
+            continue  # remedies require --speed
+        assert main([*command, f"--{axis}-points", "3"]) == 2
+        err = capsys.readouterr().err
+        assert f"--{axis}-points: counts the points of a {axis} range, and none is given" in err
 
 
 @pytest.mark.parametrize("option", ["--max-dte=-1um", "--max-dte=0", "--max-dynamic-factor=0"])

@@ -157,12 +157,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     given = [option for option, value in (
         ("--starts", args.starts), ("--min-basin", args.min_basin), ("--json", args.json),
         ("--junit", args.junit), ("--server", args.server), ("--refine", args.refine),
-        ("--runup", args.runup),
+        ("--runup", args.runup), ("--speed-points", args.speed_points),
+        ("--torque-points", args.torque_points),
     ) if value is not None and value is not False]  # fmt: skip
     if given:
-        verb = "checks" if len(given) == 1 else "check"
+        verb, them = ("checks", "it") if len(given) == 1 else ("check", "them")
         raise InvalidInputError([f"{', '.join(given)} {verb} an envelope (one design's check "
-                                 "would ignore them): give --speed LOW:HIGH (rpm) and/or "
+                                 f"would ignore {them}): give --speed LOW:HIGH (rpm) and/or "
                                  "--torque LOW:HIGH (N m)"])  # fmt: skip
     request = validated_input(AnalysisRequest.model_validate, doc, args.file)
     rules = rules_of(args)

@@ -47,6 +47,7 @@ from gearengine.gate.envelope import (
     refined_report,
     window_text,
 )
+from gearengine.gate.resolution import GRID_POINTS
 from gearengine.gate.rules import Rules
 from gearengine.jsonio import dumps
 from gearengine.model.units import POINT_OUTPUTS
@@ -72,12 +73,17 @@ def option_axes(args: argparse.Namespace, design: dict | None = None) -> list[di
     """The axes that --speed and --torque give (``gate.envelope.envelope_axis``), an error
     naming its option; with a ``design`` and no --speed, the design's own speed as one point."""
     given = {name: getattr(args, name) for name in OPTION_UNITS}
-    here = design is not None and not args.speed
-    if here:
-        given["speed"] = _here(design, "speed")
+    nums = {name: getattr(args, f"{name}_points") for name in OPTION_UNITS}
+    unused = [f"--{name}-points: counts the points of a {name} range, and none is given "
+              f"(--{name} LOW:HIGH)"
+              for name, num in nums.items() if num is not None and not given[name]]  # fmt: skip
+    if unused:
+        raise InvalidInputError(unused)
+    if design is not None and not args.speed:
+        given["speed"], nums["speed"] = _here(design, "speed"), 1
     axes = []
     for name, text in ((n, t) for n, t in given.items() if t):
-        num = 1 if here and name == "speed" else getattr(args, f"{name}_points")
+        num = GRID_POINTS[name] if nums[name] is None else nums[name]
         try:
             axes.append(envelope_axis(name, text, OPTION_UNITS[name], num))
         except ValueError as exc:

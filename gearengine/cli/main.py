@@ -136,6 +136,13 @@ def fail_on_word(text: str) -> str:
     return text
 
 
+def grid_options(p: argparse.ArgumentParser) -> None:
+    """--speed-points and --torque-points, left None when not given, so that a command they
+    do not apply to can refuse them (``gate.resolution.GRID_POINTS`` fills them in)."""
+    p.add_argument("--speed-points", type=int, default=None, metavar="N", help="default 23")
+    p.add_argument("--torque-points", type=int, default=None, metavar="N", help="default 5")
+
+
 def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -> None:
     """The gate's rules and envelope options, shared by ``check`` and ``remedies``."""
     p.add_argument(
@@ -149,8 +156,7 @@ def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -
     p.add_argument("--speed", metavar="LOW:HIGH", required=speed_required,
                    help="driver speeds: rpm, or with units")  # fmt: skip
     p.add_argument("--torque", metavar="LOW:HIGH", help="mean driver torques: N m, or with units")
-    p.add_argument("--speed-points", type=int, default=23, metavar="N", help="default 23")
-    p.add_argument("--torque-points", type=int, default=5, metavar="N", help="default 5")
+    grid_options(p)
     p.add_argument("--max-dte", type=micrometres, default=None, metavar="E",
                    help="fail where the dynamic transmission error (peak to peak) exceeds E "
                    "(µm, or with a unit: 20um, 0.02mm)")  # fmt: skip
@@ -282,8 +288,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("file", help='JSON file holding {"design": {..., "tolerances": {...}}}, or -')
     p.add_argument("--speed", metavar="LOW:HIGH", help="driver speeds: rpm, or with units")
     p.add_argument("--torque", metavar="LOW:HIGH", help="mean driver torques: N m, or with units")
-    p.add_argument("--speed-points", type=int, default=23, metavar="N", help="default 23")
-    p.add_argument("--torque-points", type=int, default=5, metavar="N", help="default 5")
+    grid_options(p)
     p.add_argument("--samples", type=int, default=256, help="samples N, a power of 2 (256)")
     p.add_argument("--seed", type=int, default=0, help="seed of the Sobol samples (0)")
     p.add_argument("--sensitivity", action="store_true", help="also Sobol indices (SALib)")

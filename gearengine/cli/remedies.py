@@ -33,8 +33,10 @@ def remedies_request(args: argparse.Namespace) -> RemediesRequest:
     doc = read_document(args.file)
     if not isinstance(doc, dict) or "design" not in doc:
         raise InvalidInputError([f'{args.file}: remedies need {{"design": {{...}}}}'])
-    envelope: dict[str, object] = {"speed": args.speed, "speed_points": args.speed_points,
-                                   "torque_points": args.torque_points}  # fmt: skip
+    envelope: dict[str, object] = {"speed": args.speed}
+    for name in ("speed_points", "torque_points"):
+        if getattr(args, name) is not None:
+            envelope[name] = getattr(args, name)
     if args.refine is not None:
         envelope["refine"] = args.refine
     if args.torque:

@@ -38,6 +38,9 @@ chaos between a refined point near the limit and its grid neighbours (the z = 23
 5 N*m, 3,557 rpm, 19 % of starts; a chaotic 8.44 N*m level at 4,636 rpm, 38 %): depth 2 finds
 them at 1.6x the CPU of depth 1 on its 1,000-6,000 rpm x 5-60 N*m envelope (benchmarks)."""
 MAX_REFINE_DEPTH = 4
+GRID_POINTS = {"speed": 23, "torque": 5}
+"""The gate's grid (speeds, torque levels) unless ``--speed-points`` / ``--torque-points`` (the
+remedies' envelope's ``speed_points`` / ``torque_points``) say otherwise."""
 STOP_BATCH = 4
 """Points of the first batch of each level of a refinement that stops at its first failure
 (``refine``'s ``stop``), each next batch twice the last: a failure early in a level leaves the

@@ -10,6 +10,7 @@ from pydantic import (
     ConfigDict,
     Field,
     ValidationError,
+    ValidationInfo,
     field_validator,
     model_validator,
 )
@@ -22,9 +23,10 @@ from gearengine.gate.envelope import (
     envelope_sweep,
     gate_settings,
 )
-from gearengine.gate.resolution import MAX_REFINE_DEPTH, REFINE_DEPTH
+from gearengine.gate.resolution import GRID_POINTS, MAX_REFINE_DEPTH, REFINE_DEPTH
 from gearengine.gate.rules import Rules
 from gearengine.jsonio import message
+from gearengine.model import params
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.errors import Problems
 from gearengine.model.params import request_config
@@ -59,14 +61,19 @@ class Envelope(BaseModel):
     """The operating envelope: driver speeds x mean torques, as ``gearengine check`` takes it."""
 
     model_config = request_config()
+    model_config["json_schema_extra"] = {"if": params.given("torque_points"),
+                                         "then": params.given("torque")}  # fmt: skip
 
     speed: str = Field(description="Driver speeds LOW:HIGH (rpm unless a unit is given).",
                        examples=["500:6000"])  # fmt: skip
     torque: str | None = Field(None, description="Mean driver torques LOW:HIGH (N*m unless a "
                                "unit is given); absent: the design's torque.",
                                examples=["2:40"])  # fmt: skip
-    speed_points: int = Field(23, ge=1, le=200, description="Grid speeds (as the gate).")
-    torque_points: int = Field(5, ge=1, le=50, description="Grid torques (as the gate).")
+    speed_points: int = Field(GRID_POINTS["speed"], ge=1, le=200,
+                              description="Grid speeds (as the gate).")  # fmt: skip
+    torque_points: int = Field(GRID_POINTS["torque"], ge=1, le=50,
+                               description="Grid torques (as the gate); only with "
+                               "torque.")  # fmt: skip
     refine: int = Field(
         REFINE_DEPTH, ge=0, le=MAX_REFINE_DEPTH,
         description="Halvings of the grid spacing where neighbours differ (verdict or attractor "
@@ -74,6 +81,17 @@ class Envelope(BaseModel):
         "on a 2x finer grid, refined one halving more (as finely as a check of a grid 2x finer "
         "again).",
     )  # fmt: skip
+
+    @field_validator("torque_points")
+    @classmethod
+    def _over_torques(cls, num: int, info: ValidationInfo) -> int:
+        """A torque grid needs its range: without ``torque`` the design's one torque is
+        checked, and the count was ignored unsaid."""
+        if info.data.get("torque") is None:
+            raise ValueError(
+                "counts the points of a torque range, and none is given (torque LOW:HIGH)"
+            )
+        return num
 
 
 class LeverRange(BaseModel):
