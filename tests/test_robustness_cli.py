@@ -139,7 +139,16 @@ def test_the_answers_say_how_many_starts_decided_each_sample(
     assert ONE_START not in text and ONE_START not in report["notes"]
     args = [str(design_file), "--speed", "5000:5000", "--speed-points", "1", "--samples", "8"]
     assert main(["robustness", *args]) == 0
-    assert "(8 samples, 1 start a sample)" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "(8 samples, 1 start a sample)" in text
+    # the dynamic factor's event is shown with its limit, which nothing printed (leftover d)
+    assert ", dynamic factor > 1.5 " in text
+    gate = [*base[:-2], "--max-probability", "dynamic_factor_above_limit=0.9"]
+    assert main([*gate, "--json", str(out)]) in (0, 1)
+    report, text = json.loads(out.read_text()), capsys.readouterr().out
+    said = "the largest dynamic mesh force above 1.5 times the static force"
+    assert report["result"]["dynamic_factor_limit"] == 1.5
+    assert any(said in n for n in report["notes"]) and said in text
 
 
 def test_the_result_names_the_units_of_its_points_values(design_file: Path, tmp_path: Path) -> None:

@@ -139,11 +139,17 @@ def junit(report: ProbabilityReport, name: str) -> str:
 def cmd_robustness(args: argparse.Namespace) -> int:
     """Run the study; print one line per point; --json and --plot write the outputs."""
     request, result = study(args, read_document(args.file))
+    shown = {
+        "chaotic": "chaotic",
+        "separation": "separation",
+        "back_flank": "back_flank",
+        "dynamic_factor_above_limit": f"dynamic factor > {result.dynamic_factor_limit:g}",
+    }
     for p in result.points:
         pr = p.probabilities
         words = ", ".join(
-            f"{k} {pr[k].value:.3f} [{pr[k].interval[0]:.3f}, {pr[k].interval[1]:.3f}]"
-            for k in ("chaotic", "separation", "back_flank")
+            f"{label} {pr[k].value:.3f} [{pr[k].interval[0]:.3f}, {pr[k].interval[1]:.3f}]"
+            for k, label in shown.items()
         )
         if pr["diverged"].count:  # no class or contact known for them: never hidden
             words += f", diverged {pr['diverged'].count} of {p.samples}"
@@ -232,6 +238,14 @@ ONE_START = (
 """The probability gate's words for one start a sample (its default, chosen for its cost)."""
 
 
+def dynamic_factor_event(result: RobustnessResult) -> str:
+    """What the event dynamic_factor_above_limit counts, with the study's limit (the name alone
+    never said 1.5)."""
+    return (f"dynamic_factor_above_limit: the largest dynamic mesh force above "
+            f"{result.dynamic_factor_limit:g} times the static force (the study's "
+            "dynamic_factor_limit)")  # fmt: skip
+
+
 def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     """``check --max-probability`` of the design document ``doc``: exit 1 where a point is over
     a limit or undecided (its interval holds the limit); a sample count that cannot prove a
@@ -247,14 +261,15 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
         print(note, file=sys.stderr)
     else:
         _, result = study(args, doc)
-    if result.starts_per_sample == 1:
-        notes.append(ONE_START)
-    report = probability_report(result, limits, confidence, notes, own_point(doc))
+    told = [ONE_START] if result.starts_per_sample == 1 else []
+    if "dynamic_factor_above_limit" in limits:
+        told.append(dynamic_factor_event(result))
+    report = probability_report(result, limits, confidence, notes + told, own_point(doc))
     counts = sorted({p.samples for p in result.points})
     sampled = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
     print(f"probabilities from {sampled} samples a point, {result.starts_text()}")
-    if result.starts_per_sample == 1:
-        print(ONE_START)
+    for note in told:
+        print(note)
     for p, v in zip(result.points, report.verdicts, strict=True):
         shown = {"pass": "PASS", "fail": "FAIL", "undecided": "UNDECIDED"}[v.verdict]
         said = v.reasons or proofs(p, v)  # a pass names the bounds that prove it

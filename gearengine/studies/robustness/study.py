@@ -326,6 +326,10 @@ class RobustnessResult(BaseModel):
         examples=[{"speed": "rpm", "torque": "N*m"}],
     )  # fmt: skip
     settings: SimulationSettings | None = Field(None, description="The settings every run used.")
+    dynamic_factor_limit: float = Field(
+        1.5, description="The event dynamic_factor_above_limit: the largest dynamic mesh force "
+        "above this many times the static force (the request's)."
+    )  # fmt: skip
     starts_per_sample: int = Field(
         1, description="Initial states each sample ran: settings.basins' starts (the sample "
         "counts as its worst attractor above basins.min_fraction), else the settings' own "
@@ -419,6 +423,7 @@ def assemble(request: RobustnessRequest, chunks: list[str]) -> RobustnessResult:
         partial=not complete,
         model=ASSUMPTIONS + ([] if basins is None else [basin_assumption(basins)]),
         settings=request.settings,
+        dynamic_factor_limit=request.dynamic_factor_limit,
         starts_per_sample=len(request.settings.starts()) if basins is None else basins.starts,
         values_units={a.parameter: axis_unit(a.parameter) for a in request.axes},
         shown_units={a.parameter: display_unit(a.parameter)[0] for a in request.axes},
