@@ -41,6 +41,7 @@ from gearengine.studies.robustness.sequential import (
     sequential,
 )
 from gearengine.studies.robustness.study import (
+    SALTELLI_SAMPLES,
     RobustnessRequest,
     RobustnessResult,
     checked,
@@ -158,6 +159,8 @@ def cmd_robustness(args: argparse.Namespace) -> int:
             print(f"  {line}")
     if result.settings is not None:
         print(f"settings: {result.settings.run_text()}")
+    if request.sensitivity:
+        print(f"note: {SALTELLI_SAMPLES}")
     if args.json:
         Path(args.json).write_text(result.model_dump_json())
     if args.plot:

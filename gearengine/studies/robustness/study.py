@@ -354,6 +354,15 @@ ASSUMPTIONS = [
 ]
 
 
+SALTELLI_SAMPLES = (
+    "with sensitivity the probabilities are counted on the N base rows of SALib's Saltelli "
+    "design (its own scrambled Sobol points), not on the N points of the study without "
+    "sensitivity: the two give different samples, so their probabilities differ, within their "
+    "intervals"
+)
+"""The model line of a study with ``sensitivity``: where its probabilities come from."""
+
+
 def basin_assumption(basins: Any) -> str:
     """The model line of a study with ``settings.basins``: how a sample is decided."""
     return (f"with settings.basins a sample counts as its worst attractor whose basin fraction "
@@ -421,7 +430,9 @@ def assemble(request: RobustnessRequest, chunks: list[str]) -> RobustnessResult:
         seed=request.seed,
         variables=[RobustnessVariable(path=v.path, distribution=v.words) for v in variables_],
         partial=not complete,
-        model=ASSUMPTIONS + ([] if basins is None else [basin_assumption(basins)]),
+        model=ASSUMPTIONS
+        + ([] if basins is None else [basin_assumption(basins)])
+        + ([SALTELLI_SAMPLES] if request.sensitivity else []),
         settings=request.settings,
         dynamic_factor_limit=request.dynamic_factor_limit,
         starts_per_sample=len(request.settings.starts()) if basins is None else basins.starts,
