@@ -46,6 +46,15 @@ def test_not_applicable_says_why_t_crit_depends_on_the_load_backlash_and_stiffne
         assert words in note
 
 
+def test_not_applicable_says_the_teeth_are_in_contact_at_rest_only() -> None:
+    """The reason read "the teeth stay in contact" above the paragraph saying "impacts on both
+    flanks" (basins at 5,750 rpm / 2 N*m; stop-39 leftover): the static load keeps them in
+    contact at rest, and the numerical verdict says whether they separate in motion."""
+    summary = answer(EXAMPLE_DESIGN).engineering.summary
+    assert "stay in contact" not in summary
+    assert "at rest the teeth are in contact (in motion they may separate" in summary
+
+
 @pytest.mark.parametrize("factor", [1 - 1e-6, 1 + 1e-6])
 def test_applicability_switches_at_the_critical_torque(factor: float) -> None:
     t_crit = answer(LIGHT).engineering.critical_torque_nm

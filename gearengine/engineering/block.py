@@ -85,8 +85,9 @@ def load_words(conv: DesignConversion, f_crit: float, t_crit: float) -> str:
     torque = to_physical("mesh_force", abs(fm), conv.scales) * r_a  # at the design's own k_m
     return (
         f"under {torque:,.3g} N*m the mesh deflects {abs(fm) * b_um:.3g} µm statically (half "
-        f"backlash {b_um:.3g} µm) and the teeth stay in contact, beyond the reach of the "
-        f"backlash nonlinearity's saddle, which exists only below the critical torque "
+        f"backlash {b_um:.3g} µm) and at rest the teeth are in contact (in motion they may "
+        "separate: the numerical verdict says), beyond the reach of the backlash nonlinearity's "
+        "saddle, which exists only below the critical torque "
         f"{t_crit:,.3g} N*m; the homoclinic mechanism of chaos does not exist at this load; the "
         "numerical verdict still applies"
     )

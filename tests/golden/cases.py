@@ -45,8 +45,6 @@ CASES: dict[str, list[str]] = {
         "1",
         "--speed-points",
         "7",
-        "--torque-points",
-        "2",
         "--json",
         "{out}",
     ],
