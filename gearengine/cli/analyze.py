@@ -20,7 +20,7 @@ from gearengine.cli.documents import (
     read_request,
     validated_input,
 )
-from gearengine.cli.envelope import cmd_envelope, physical_limits, rules_of
+from gearengine.cli.envelope import cmd_envelope, physical_limits, rules_of, settings_text
 from gearengine.cli.melnikov import fmt_value, render_engineering, render_melnikov
 from gearengine.gate.rules import Rules, verdict_failures
 from gearengine.jsonio import dumps
@@ -130,6 +130,14 @@ def envelope_only(args: argparse.Namespace) -> list[str]:
     return [option for name, option in ENVELOPE_ONLY.items() if getattr(args, name) is not None]
 
 
+ONE_DESIGN_SETTINGS = (
+    "as analyze runs the file; an envelope check runs the light settings where the file sets "
+    "none, so its DTE and forces at this point can differ in their last digits"
+)
+"""Why a one-design check and an envelope check may give one point two DTEs (5.02 and
+5.0096 µm: 500 + 500 periods at 200 steps against 60 + 60 at 128, a new-user review)."""
+
+
 def cmd_check(args: argparse.Namespace) -> int:
     """CI gate: exit 0 pass, 1 fail, 2 invalid input; one summary line. With --speed or
     --torque, the gate over the operating envelope (``cli.envelope``); with --max-probability,
@@ -181,6 +189,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     print(f"{verdict}: {result.summary()}{why}")
     for note in design_readings(request):  # stdout keeps its one summary line
         print(f"note: {note}", file=sys.stderr)
+    print(f"{settings_text(request.settings)} ({ONE_DESIGN_SETTINGS})", file=sys.stderr)
     return EXIT_FAIL if reasons else EXIT_OK
 
 

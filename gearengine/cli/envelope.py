@@ -254,8 +254,7 @@ def settings_text(settings: SimulationSettings) -> str:
     """The integration settings that matter for cost and verdict, in one line."""
     rand = settings.random_initial_states
     starts = "" if rand is None else f", {rand.count} random starts (seed {rand.seed})"
-    return (f"settings: {settings.lengths_text()}, "
-            f"{settings.steps_per_period} steps per period{starts}")  # fmt: skip
+    return f"settings: {settings.run_text()}{starts}"
 
 
 def refined_levels(report: EnvelopeReport) -> dict[str, str]:
