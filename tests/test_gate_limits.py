@@ -280,6 +280,23 @@ def test_a_one_design_check_refuses_the_envelope_options_it_would_ignore(
     assert f"{option[0]} checks an envelope" in capsys.readouterr().err
 
 
+def test_one_point_over_a_range_is_refused(capsys: pytest.CaptureFixture) -> None:
+    """``check --speed 1000:6000 --torque 5:60 --speed-points 1 --torque-points 1`` printed
+    "PASS: 0 of 1 operating points" having checked 1,000 rpm / 5 N*m alone, 6,000 rpm and
+    60 N*m unsaid (third new-user review): one point over a range is its start alone, so it is
+    refused in the gate, the study and the sweep (``SweepAxis.count_problem``)."""
+    from gearengine.cli.main import main
+
+    design = str(ROOT / "examples" / "design-geometry.json")
+    said = "1 point over 1000 rpm:6000 rpm is its start alone: give at least 2 points"
+    assert main(["check", design, "--speed", "1000:6000", "--speed-points", "1"]) == 2
+    assert f"--speed-points: {said}" in capsys.readouterr().err
+    assert main(["robustness", design, "--speed", "1000:6000", "--speed-points", "1"]) == 2
+    assert f"--speed-points: {said}" in capsys.readouterr().err
+    assert main(["check", design, "--speed", "1000:1000", "--speed-points", "3"]) == 2
+    assert "stop must differ from start when num > 1" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("axis", ["speed", "torque"])
 def test_a_grid_without_its_range_is_refused(axis: str, capsys: pytest.CaptureFixture) -> None:
     """``check FILE --torque 5:20 --speed-points 5`` checked the torque levels at the design's

@@ -191,7 +191,7 @@ def test_cli_refuses_bad_input_before_compute() -> None:
     assert "envelope.speed" not in run.stderr and "levers[0]" not in run.stderr
 
 
-SMALL = ["--speed", "4500:5000", "--speed-points", "2", "--torque", "2:11.5", "--torque-points",
+SMALL = ["--speed", "4500:5000", "--speed-points", "2", "--torque", "2:2", "--torque-points",
          "1", "--starts", "1",
          "--lever", "transmission_error.harmonics.0.amplitude=0um:10um"]  # fmt: skip
 
@@ -200,7 +200,7 @@ def small_body() -> dict:
     doc = json.loads(EXAMPLE.read_text())
     return {"design": doc["design"], "settings": doc["settings"], "fail_on": ["chaotic"],
             "starts": 1,
-            "envelope": {"speed": "4500:5000", "speed_points": 2, "torque": "2:11.5",
+            "envelope": {"speed": "4500:5000", "speed_points": 2, "torque": "2:2",
                          "torque_points": 1},
             "levers": [{"lever": "transmission_error.harmonics.0.amplitude",
                         "bounds": ["0um", "10um"]}]}  # fmt: skip

@@ -96,6 +96,8 @@ def test_unknown_job_is_404(client: TestClient) -> None:
         ({"direction": "both"}, "direction"),
         ({"settings": {"steps_per_period": 2}}, "settings.steps_per_period"),
         ({"axes": [{"parameter": "F_e1", "start": 0, "stop": 0.3, "num": 50_000}]}, "axes"),
+        # one point over a range is its start alone (a new-user review: a gate passed on it)
+        ({"axes": [{"parameter": "F_e1", "start": 0, "stop": 0.3, "num": 1}]}, "axes[0].num"),
     ],
 )
 def test_invalid_sweeps_are_422_naming_the_field(
@@ -301,6 +303,7 @@ def test_a_basins_sweep_csv_from_the_service_has_each_attractors_columns(
     doc = json.loads((Path(__file__).parents[1] / "examples" / "envelope-map.json").read_text())
     doc["settings"] = {**SHORT, "basins": {"starts": 4}}
     doc["axes"][0]["num"], doc["axes"][1]["num"] = 2, 1
+    doc["axes"][1]["stop"] = doc["axes"][1]["start"]  # one torque
     job = wait(working, working.post("/v1/sweeps", json=doc).json()["id"])
     assert job["status"] == "succeeded"
     text = working.get(f"/v1/sweeps/{job['id']}/result", params={"format": "csv"}).text

@@ -20,7 +20,10 @@ DESIGN = (
 )
 SYNC_BUDGET = "the analysis fits the synchronous compute budget (max_sync_steps)"
 JOB_BUDGET = "the job fits the compute budget of one job (max_job_steps)"
-AXES = "an axis' stop differs from its start and every corner of the grid is a valid design"
+AXES = (
+    "an axis' stop differs from its start (and equals it for one point) and every corner of the "
+    "grid is a valid design"
+)
 RECORD = "the record holds enough revolutions at the given speed for an order reading"
 DERIVED = "the dimensionless parameters derived from the physical data stay within their bounds"
 UPLOAD = (

@@ -164,6 +164,9 @@ def request_errors(request: RobustnessRequest) -> list[InitErrorDetails]:
         if is_dimensionless(axis.parameter):
             problems.add(("axes", i, "parameter"), "a physical field of the design", 0)
             continue
+        if (count := axis.count_problem()) is not None:
+            problems.add(("axes", i, count[0]), count[1], getattr(axis, count[0]))
+            continue
         problem = axis_problem(pair.params, request.design, axis.parameter, axis.start,
                                axis.stop, {})  # fmt: skip
         if problem is not None:

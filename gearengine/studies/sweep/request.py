@@ -102,6 +102,17 @@ class SweepAxis(BaseModel):
         examples=[301],
     )
 
+    def count_problem(self) -> tuple[str, str] | None:
+        """(field, why) when the points do not span the range: stop equal to start with
+        ``num`` > 1, or one point over a range, which is its start alone (``check --speed
+        1000:6000 --speed-points 1`` passed on 1,000 rpm, 6,000 unsaid); else None."""
+        if self.num > 1 and self.stop == self.start:
+            return "stop", "stop must differ from start when num > 1"
+        if self.num == 1 and self.stop != self.start:
+            return "num", (f"1 point over {self.start}:{self.stop} is its start alone: give at "
+                           "least 2 points, or stop equal to start for one point")  # fmt: skip
+        return None
+
     def values(self, design: Design | None = None) -> list[float]:
         """The ``num`` values, start to stop (``numpy.linspace``), in SI units for a physical
         field of ``design``. A physical axis whose ends are written in one unit is spaced in
@@ -222,7 +233,8 @@ class SweepRequest(ParamsOrDesign):
 def request_errors(request: SweepRequest, max_points: int | None = None) -> list[InitErrorDetails]:
     """Checks across fields that pydantic cannot express, as pydantic error details.
 
-    Distinct axis parameters, stop != start when num > 1, direction only with continuation,
+    Distinct axis parameters, points that span their range (``SweepAxis.count_problem``),
+    direction only with continuation,
     the point count under ``max_points``, and every corner of the grid a valid design (the
     admissible set of each alias is an interval, so the corners decide).
     """
@@ -230,8 +242,8 @@ def request_errors(request: SweepRequest, max_points: int | None = None) -> list
     add, errors = problems.add, problems.details
 
     for i, axis in enumerate(request.axes):
-        if axis.num > 1 and axis.stop == axis.start:
-            add(("axes", i, "stop"), "stop must differ from start when num > 1", axis.stop)
+        if (problem := axis.count_problem()) is not None:
+            add(("axes", i, problem[0]), problem[1], getattr(axis, problem[0]))
         if i and axis.parameter in [a.parameter for a in request.axes[:i]]:
             add(("axes", i, "parameter"), f"{axis.parameter} is already swept", axis.parameter)
     if request.direction != "forward" and not request.continuation:
