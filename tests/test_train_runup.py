@@ -17,7 +17,7 @@ from fastapi.testclient import TestClient
 from gearengine.model.design import Design
 from gearengine.model.train import EXAMPLE_TRAIN
 from gearengine.studies.runup import run_local
-from gearengine.studies.runup.profile import ramp_forcing, validated
+from gearengine.studies.runup.profile import ramp_forcing, validated_runup
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.systems.gear_train.model import equivalent_design, train_of
 from gearengine.systems.gear_train.system import train_system
@@ -47,9 +47,9 @@ def test_stiff_train_runs_up_as_its_equivalent_pair(monkeypatch: pytest.MonkeyPa
     design accepts, hence set on its model) gives each bin's contact regime, its FTLE within 3
     standard errors, and its DTE and dynamic factor within 1 %, of the equivalent pair's
     run-up (the pair's kernel splits its steps at the backlash edges, the train's does not)."""
-    pair = validated({"design": json.loads(equivalent_design(Design.model_validate(
+    pair = validated_runup({"design": json.loads(equivalent_design(Design.model_validate(
         TRAIN_DESIGN)).model_dump_json()), **PROFILE})  # fmt: skip
-    train = validated({"design": TRAIN_DESIGN, **PROFILE})
+    train = validated_runup({"design": TRAIN_DESIGN, **PROFILE})
     own = RunupRequest.model
 
     def stiffened(request: RunupRequest):

@@ -203,7 +203,7 @@ class RunupRequest(ParamsOrDesign):
 def request_errors(request: RunupRequest) -> list[InitErrorDetails]:
     """Checks across fields, as pydantic error details naming each field: a design with the
     piecewise law, one profile (points, or from/to with rate or duration), ordered speeds and
-    times (the work budget is ``profile.checked``'s), all before any compute."""
+    times (the work budget is ``profile.checked_runup``'s), all before any compute."""
     problems = Problems("runup")
     add, errors = problems.add, problems.details
 
