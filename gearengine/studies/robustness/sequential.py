@@ -145,14 +145,15 @@ def sequential(
                 f"after {done} samples ({n} would take {spent + cost} steps in all)"
             )
             break  # fmt: skip
-        texts = {k: point_request(request, points[k], n).model_dump_json() for k in todo}
+        asked = {k: point_request(request, points[k], n) for k in todo}  # once a round
+        texts = {k: asked[k].model_dump_json() for k in todo}
         tasks = [(k, texts[k], i) for k in todo
                  for i in range(done // DEFAULT_CHUNK_ROWS, n // DEFAULT_CHUNK_ROWS)]  # fmt: skip
         with ThreadPoolExecutor(max(1, workers)) as pool:
             for (k, _, _), text in zip(tasks, pool.map(_chunk, tasks), strict=True):
                 chunks[k].append(text)
         for k in todo:
-            (answers[k],) = assemble(point_request(request, points[k], n), chunks[k]).points
+            (answers[k],) = assemble(asked[k], chunks[k]).points
             verdicts[k] = verdict(answers[k], limits, confidence)  # type: ignore[arg-type]
         spent, done = spent + cost, n
         rounds.append(n)
