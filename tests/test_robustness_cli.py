@@ -481,4 +481,4 @@ def test_the_gate_reads_the_design_once_through_its_request(
     argv = ["check", str(design_file), "--samples", "8", "--max-probability", "back_flank=0.5"]
     assert main(argv) == 0
     assert "PASS: speed 4000 rpm, torque 5 N*m (8 samples)" in capsys.readouterr().out
-    assert DESIGN not in calls  # each sample's design is its own tree (sweep.axes.design_with)
+    assert DESIGN not in calls  # each sample's design is its own tree (model.fields.design_with)
