@@ -112,3 +112,23 @@ def test_a_train_ramp_without_acceleration_is_its_stationary_run() -> None:
     assert np.allclose(table[:, 0], steps.min(axis=1), rtol=0, atol=1e-9)
     assert np.allclose(table[:, 1], steps.max(axis=1), rtol=0, atol=1e-9)
     assert table[:, 3].max() == pytest.approx(run.fmax, rel=1e-9)
+
+
+def test_a_train_run_up_builds_its_system_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The train's ``TrainSystem`` is built when its request is validated and carried: the
+    budget check and every plan read that one (each ``runup_plan`` built it again before)."""
+    import gearengine.studies.runup.request as runup_request
+    from gearengine.studies.runup.profile import runup_plan
+
+    built: list[object] = []
+    build = runup_request.design_model
+
+    def counted(design: Design) -> tuple:
+        built.append(design)
+        return build(design)
+
+    monkeypatch.setattr(runup_request, "design_model", counted)
+    request = validated_runup({"design": TRAIN_DESIGN, **PROFILE})  # the budget: one plan
+    first, again = runup_plan(request), runup_plan(request)
+    assert first.system is again.system
+    assert len(built) == 1
