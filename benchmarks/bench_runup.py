@@ -24,7 +24,7 @@ from gearengine.model.units import RPM
 from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.studies.runup import run_local
 from gearengine.studies.runup.compute import compute_chunk
-from gearengine.studies.runup.profile import runup_plan, validated
+from gearengine.studies.runup.profile import runup_plan, validated_runup
 from gearengine.studies.sweep.axes import point_params
 from gearengine.systems.spur_pair.forcing import packed_forcing
 from gearengine.systems.spur_pair.kernels import run_kink
@@ -33,7 +33,7 @@ REPEATS = 3
 
 
 def main() -> None:
-    request = validated({"design": EXAMPLE_DESIGN, "from_speed": "500 rpm",
+    request = validated_runup({"design": EXAMPLE_DESIGN, "from_speed": "500 rpm",
                          "to_speed": "6000 rpm", "rate": "1000 rpm/s"})  # fmt: skip
     plan = runup_plan(request)
     members = request.ensemble.size

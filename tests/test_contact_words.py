@@ -146,11 +146,11 @@ def test_runup_bins_give_the_contact_force_beside_the_models() -> None:
     import json
 
     from gearengine.studies.runup import run_local
-    from gearengine.studies.runup.profile import validated
+    from gearengine.studies.runup.profile import validated_runup
     from tests.conftest import ROOT
 
     design = json.loads((ROOT / "examples" / "ci" / "design.json").read_text())["design"]
-    r = validated({"design": design, "from_speed": "4300 rpm", "to_speed": "4500 rpm",
+    r = validated_runup({"design": design, "from_speed": "4300 rpm", "to_speed": "4500 rpm",
                    "rate": "4000 rpm/s", "direction": "up", "settle_periods": 0,
                    "ensemble": {"size": 1}})  # fmt: skip
     bins = run_local(r).up.bins  # type: ignore[union-attr]

@@ -470,3 +470,24 @@ def test_a_gate_on_one_design_names_its_speed_and_torque(
     }
     case = ElementTree.parse(tmp_path / "j.xml").getroot().find("testsuite/testcase")
     assert case is not None and case.get("name") == "speed 4000 rpm, torque 5 N*m"
+
+
+def test_the_gate_reads_the_design_once_through_its_request(
+    design_file: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The point a study without axes is named by (``own_point``) is the request's design, not
+    the document's design validated a second time after the study."""
+    from gearengine.model.design import Design
+
+    calls: list[object] = []
+    validate = Design.model_validate
+
+    def counted(data: object, *args: object, **kwargs: object) -> Design:
+        calls.append(data)
+        return validate(data, *args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(Design, "model_validate", counted)
+    argv = ["check", str(design_file), "--samples", "8", "--max-probability", "back_flank=0.5"]
+    assert main(argv) == 0
+    assert "PASS: speed 4000 rpm, torque 5 N*m (8 samples)" in capsys.readouterr().out
+    assert DESIGN not in calls  # each sample's design is its own tree (model.fields.design_with)

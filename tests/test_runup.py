@@ -25,7 +25,7 @@ from gearengine.jsonio import dumps, error_lines
 from gearengine.model.units import RPM
 from gearengine.studies.runup import run_local
 from gearengine.studies.runup.compute import compute_chunk
-from gearengine.studies.runup.profile import ramp_forcing, validated
+from gearengine.studies.runup.profile import ramp_forcing, validated_runup
 from gearengine.studies.runup.reading import jumps
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.systems.spur_pair.forcing import packed_forcing
@@ -43,7 +43,7 @@ def _request(**fields: object) -> dict:
 
 def test_ramp_forcing_without_acceleration_is_the_stationary_forcing() -> None:
     """beta = 0: the phase record reproduces Eq. (9)'s forcing at absolute time exactly."""
-    r = validated(_request(from_speed="1500 rpm", to_speed="2000 rpm", rate="1000 rpm/s"))
+    r = validated_runup(_request(from_speed="1500 rpm", to_speed="2000 rpm", rate="1000 rpm/s"))
     conv = r.conversion
     assert conv is not None and r.params is not None
     wn = 1.0 / conv.time_scale_s
@@ -131,7 +131,7 @@ def _dop853_eq7(request: RunupRequest, t_end: float, samples_per_mesh: int = 200
 def test_runup_follows_an_independent_integration_of_eq7() -> None:
     """DTE envelope and contact status of every bin of a fast up-and-down ramp through the
     separating branch (4300-4500 rpm at 4000 rpm/s) against DOP853 of the SI model."""
-    r = validated(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s",
+    r = validated_runup(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s",
                            direction="up_down", settle_periods=0,
                            ensemble={"size": 1}))  # fmt: skip
     result = run_local(r)
@@ -161,7 +161,7 @@ def _region_at(events: list[tuple[float, int]], t: float) -> int:
 def test_slow_runup_reproduces_the_quasi_static_jumps() -> None:
     """examples/ci/design.json at 40 N m: at 100 rpm/s the jump up and the jump down agree
     with the continuation sweep (the hysteresis loop) within its grid step."""
-    r = validated(_request(from_speed="3700 rpm", to_speed="4400 rpm", rate="100 rpm/s",
+    r = validated_runup(_request(from_speed="3700 rpm", to_speed="4400 rpm", rate="100 rpm/s",
                            direction="up_down", ensemble={"size": 1}))  # fmt: skip
     result = run_local(r, workers=2)
     step = result.quasi_static.grid_step_rpm
@@ -180,7 +180,7 @@ def test_a_fast_ramp_lags_the_quasi_static_jump() -> None:
     jump comes later (lower speed) than the quasi-static one, by more than at 1000 rpm/s."""
     lags = {}
     for rate in ("1000 rpm/s", "20000 rpm/s"):
-        r = validated(_request(from_speed="3500 rpm", to_speed="4500 rpm", rate=rate,
+        r = validated_runup(_request(from_speed="3500 rpm", to_speed="4500 rpm", rate=rate,
                                direction="up_down", ensemble={"size": 1}))  # fmt: skip
         result = run_local(r, workers=2)
         (jump,) = [j for j in result.down.jumps if j.to_um < j.from_um]  # type: ignore[union-attr]
@@ -205,13 +205,13 @@ def test_bad_ramps_are_refused_naming_the_field(fields: dict, path: str, words: 
     ramp = _request(from_speed="500 rpm", to_speed="6000 rpm", rate="1000 rpm/s")
     body = {k: v for k, v in {**ramp, **fields}.items() if v is not None}
     with pytest.raises(ValidationError) as exc:
-        validated(body)
+        validated_runup(body)
     lines = error_lines(exc.value)
     assert any(line.startswith(f"{path}:") and words in line for line in lines), lines
 
 
 def test_a_chunk_is_the_same_bytes_twice() -> None:
-    r = validated(_request(from_speed="4000 rpm", to_speed="4100 rpm", rate="5000 rpm/s",
+    r = validated_runup(_request(from_speed="4000 rpm", to_speed="4100 rpm", rate="5000 rpm/s",
                            ensemble={"size": 2}))  # fmt: skip
     assert compute_chunk(r, 1) == compute_chunk(r, 1)
     assert compute_chunk(r, 0) != compute_chunk(r, 1)  # the perturbed start differs
@@ -247,7 +247,7 @@ def test_the_service_job_is_the_cli_document(tmp_path: Path) -> None:
             assert plot.status_code == 200 and plot.content[:4] == b"\x89PNG"
     finally:
         server.stop()
-    assert dumps(run_local(validated(body))) == out.read_text()
+    assert dumps(run_local(validated_runup(body))) == out.read_text()
 
 
 def test_the_gate_runs_up_and_down_and_names_the_speeds(tmp_path: Path) -> None:
@@ -266,7 +266,7 @@ def test_the_gate_runs_up_and_down_and_names_the_speeds(tmp_path: Path) -> None:
 
 def test_chaos_fails_the_gate_only_when_it_lasts(tmp_path: Path) -> None:
     """A run of chaotic bins fails after CHAOS_SECONDS, not before (the rule over time)."""
-    r = validated(_request(from_speed="4000 rpm", to_speed="4400 rpm", rate="4000 rpm/s",
+    r = validated_runup(_request(from_speed="4000 rpm", to_speed="4400 rpm", rate="4000 rpm/s",
                            ensemble={"size": 2}))  # fmt: skip
     result = run_local(r)
     bins = result.up.bins  # type: ignore[union-attr]
@@ -332,7 +332,7 @@ def test_the_assembly_reads_the_design_converted_with_the_plan(
     from gearengine.studies.runup.compute import RUNUP_JOB, chunk_counts
     from gearengine.studies.runup.profile import runup_plan
 
-    r = validated(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s",
+    r = validated_runup(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s",
                            settle_periods=0, ensemble={"size": 1}))  # fmt: skip
     assert runup_plan(r).conversion == r.model()[1]
     chunks = [compute_chunk(r, i) for i in range(len(chunk_counts(r, 1)))]
@@ -350,7 +350,7 @@ def test_a_pair_run_up_converts_its_design_once(monkeypatch: pytest.MonkeyPatch)
     import gearengine.systems.designs as designs
     from gearengine.studies.runup.profile import runup_plan
 
-    r = validated(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s"))
+    r = validated_runup(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s"))
     conversions = []
     convert = designs.convert_design
     monkeypatch.setattr(designs, "convert_design", lambda d: conversions.append(d) or convert(d))

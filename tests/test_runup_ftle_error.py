@@ -5,12 +5,12 @@ rates of every member's blocks in the bin."""
 from __future__ import annotations
 
 from gearengine.studies.runup import run_local
-from gearengine.studies.runup.profile import validated
+from gearengine.studies.runup.profile import validated_runup
 from tests.test_runup import _request
 
 
 def test_ftle_standard_error_is_positive_where_the_members_agree() -> None:
-    r = validated(_request(from_speed="1000 rpm", to_speed="1200 rpm", rate="4000 rpm/s",
+    r = validated_runup(_request(from_speed="1000 rpm", to_speed="1200 rpm", rate="4000 rpm/s",
                            direction="up", ensemble={"size": 2}))  # fmt: skip
     bins = run_local(r).up.bins  # type: ignore[union-attr]
     assert bins and all(b.lle is not None and b.lle < 0 for b in bins)  # a periodic response
@@ -23,7 +23,7 @@ def test_ftle_is_read_from_500_rpm_on() -> None:
     underflowed to 0 and every bin's FTLE was null; it is the damping's contraction, ~ -mu."""
     from tests.test_robustness import DESIGN
 
-    r = validated({"design": DESIGN, "from_speed": "500 rpm", "to_speed": "700 rpm",
+    r = validated_runup({"design": DESIGN, "from_speed": "500 rpm", "to_speed": "700 rpm",
                    "rate": "4000 rpm/s", "direction": "up", "ensemble": {"size": 2}})  # fmt: skip
     bins = run_local(r).up.bins  # type: ignore[union-attr]
     assert bins and all(b.lle is not None for b in bins)

@@ -30,10 +30,10 @@ def test_impact_counts_of_both_flanks_are_in_the_table() -> None:
 def test_a_bin_that_separates_at_times_is_labelled_separation() -> None:
     """Not 'no_contact' (which read as never touching) for teeth apart 1 % of the time."""
     from gearengine.studies.runup import run_local
-    from gearengine.studies.runup.profile import validated
+    from gearengine.studies.runup.profile import validated_runup
     from tests.test_runup import _request
 
-    r = validated(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s",
+    r = validated_runup(_request(from_speed="4300 rpm", to_speed="4500 rpm", rate="4000 rpm/s",
                            direction="up", ensemble={"size": 1}))  # fmt: skip
     bins = run_local(r).up.bins  # type: ignore[union-attr]
     apart = [b for b in bins if b.separation_fraction and b.back_flank_fraction == 0]

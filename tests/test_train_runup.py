@@ -17,7 +17,7 @@ from fastapi.testclient import TestClient
 from gearengine.model.design import Design
 from gearengine.model.train import EXAMPLE_TRAIN
 from gearengine.studies.runup import run_local
-from gearengine.studies.runup.profile import ramp_forcing, validated
+from gearengine.studies.runup.profile import ramp_forcing, validated_runup
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.systems.gear_train.model import equivalent_design, train_of
 from gearengine.systems.gear_train.system import train_system
@@ -47,9 +47,9 @@ def test_stiff_train_runs_up_as_its_equivalent_pair(monkeypatch: pytest.MonkeyPa
     design accepts, hence set on its model) gives each bin's contact regime, its FTLE within 3
     standard errors, and its DTE and dynamic factor within 1 %, of the equivalent pair's
     run-up (the pair's kernel splits its steps at the backlash edges, the train's does not)."""
-    pair = validated({"design": json.loads(equivalent_design(Design.model_validate(
+    pair = validated_runup({"design": json.loads(equivalent_design(Design.model_validate(
         TRAIN_DESIGN)).model_dump_json()), **PROFILE})  # fmt: skip
-    train = validated({"design": TRAIN_DESIGN, **PROFILE})
+    train = validated_runup({"design": TRAIN_DESIGN, **PROFILE})
     own = RunupRequest.model
 
     def stiffened(request: RunupRequest):
@@ -112,3 +112,23 @@ def test_a_train_ramp_without_acceleration_is_its_stationary_run() -> None:
     assert np.allclose(table[:, 0], steps.min(axis=1), rtol=0, atol=1e-9)
     assert np.allclose(table[:, 1], steps.max(axis=1), rtol=0, atol=1e-9)
     assert table[:, 3].max() == pytest.approx(run.fmax, rel=1e-9)
+
+
+def test_a_train_run_up_builds_its_system_once(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The train's ``TrainSystem`` is built when its request is validated and carried: the
+    budget check and every plan read that one (each ``runup_plan`` built it again before)."""
+    import gearengine.studies.runup.request as runup_request
+    from gearengine.studies.runup.profile import runup_plan
+
+    built: list[object] = []
+    build = runup_request.design_model
+
+    def counted(design: Design) -> tuple:
+        built.append(design)
+        return build(design)
+
+    monkeypatch.setattr(runup_request, "design_model", counted)
+    request = validated_runup({"design": TRAIN_DESIGN, **PROFILE})  # the budget: one plan
+    first, again = runup_plan(request), runup_plan(request)
+    assert first.system is again.system
+    assert len(built) == 1

@@ -15,9 +15,9 @@ from pydantic import ValidationError
 
 from gearengine.cli.main import main
 from gearengine.model.design import EXAMPLE_DESIGN, Design
+from gearengine.model.fields import design_with
 from gearengine.model.reduction import convert_design
 from gearengine.studies.runup.request import RunupRequest
-from gearengine.studies.sweep.axes import design_with
 
 
 def _design(**changes: object) -> dict:

@@ -96,8 +96,13 @@ PROBABILITY_WAYS = (
 
 def study(args: argparse.Namespace, doc: object) -> tuple[RobustnessRequest, RobustnessResult]:
     request = robustness_request(args, doc)
+    return request, run_study(request)
+
+
+def run_study(request: RobustnessRequest) -> RobustnessResult:
+    """The study of ``request`` here, its progress on standard error."""
     tick = progress(time.monotonic(), "robustness", "runs")  # a sample at a point: one run
-    return request, run_local(request, tick, workers=os.cpu_count() or 1)
+    return run_local(request, tick, workers=os.cpu_count() or 1)
 
 
 def point_name(values: dict[str, float]) -> str:
@@ -200,14 +205,12 @@ def _power_of_two(n: int) -> int:
     return 1 << max(0, (int(n) - 1).bit_length())
 
 
-def auto_study(args: argparse.Namespace, doc: object, limits: dict[str, float]
+def auto_study(request: RobustnessRequest, limits: dict[str, float]
                ) -> tuple[SequentialResult, str]:  # fmt: skip
-    """``--samples auto`` on the design document ``doc`` (read once: standard input too): each
-    point sampled until it is decided, within the job budget
-    (``studies.robustness.sequential``); refused before computing when even the first round
-    (``FIRST_SAMPLES`` at every point) is over the budget. With how it stopped, in words."""
-    args.samples, args.auto = FIRST_SAMPLES, True
-    request = robustness_request(args, doc)  # the first round's budget, in the user's terms
+    """``--samples auto`` from ``request``, the study of its first round (``FIRST_SAMPLES`` at
+    every point, refused over the job budget when it was built): each point sampled until it
+    is decided, within the job budget (``studies.robustness.sequential``). With how it
+    stopped, in words."""
     budget = jobs.job_step_budget()
     tick = progress(time.monotonic(), "robustness", "points decided")
     out = sequential(request, limits, budget, workers=os.cpu_count() or 1, progress=tick)
@@ -218,10 +221,9 @@ def auto_study(args: argparse.Namespace, doc: object, limits: dict[str, float]
     return out, note
 
 
-def own_point(doc: dict) -> dict[str, PhysicalValue]:
+def own_point(design: Design) -> dict[str, PhysicalValue]:
     """The design's own speed and torque in gear units: the point a study without axes
     samples (the gate named it 'operating point', its report's point {})."""
-    design = Design.model_validate(doc["design"])
     out = {}
     for name in ("speed", "torque"):
         unit, factor = display_unit(name)
@@ -257,17 +259,22 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     args.samples = GATE_SAMPLES if args.samples is None else args.samples
     args.seed = 0 if args.seed is None else args.seed
     samples_needed(limits, args.samples)
+    auto = args.samples == "auto"
+    if auto:  # the first round's request: its budget refused in the user's terms
+        args.samples, args.auto = FIRST_SAMPLES, True
+    request = robustness_request(args, doc)  # the document read into a request once, here
+    own = own_point(request.design)
     confidence, notes = ONE_LOOK, []
-    if args.samples == "auto":
-        auto, note = auto_study(args, doc, limits)
-        result, confidence, notes = auto.result, auto.confidence, [note]
+    if auto:
+        decided, note = auto_study(request, limits)
+        result, confidence, notes = decided.result, decided.confidence, [note]
         print(note, file=sys.stderr)
     else:
-        _, result = study(args, doc)
+        result = run_study(request)
     told = [ONE_START] if result.starts_per_sample == 1 else []
     if "dynamic_factor_above_limit" in limits:
         told.append(dynamic_factor_event(result))
-    report = probability_report(result, limits, confidence, notes + told, own_point(doc))
+    report = probability_report(result, limits, confidence, notes + told, own)
     counts = sorted({p.samples for p in result.points})
     sampled = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
     print(f"probabilities from {sampled} samples a point, {result.starts_text()}")

@@ -18,7 +18,7 @@ from gearengine.cli.documents import EXIT_OK, InvalidInputError, read_document, 
 from gearengine.cli.sweep import progress_bar
 from gearengine.jsonio import dumps
 from gearengine.studies.runup.compute import run_local
-from gearengine.studies.runup.profile import validated
+from gearengine.studies.runup.profile import validated_runup
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.studies.runup.results import RunupBranch, RunupResult
 
@@ -52,7 +52,7 @@ def runup_request(args: argparse.Namespace) -> RunupRequest:
         body["bin_rpm"] = args.bin
     if args.ensemble is not None:
         body["ensemble"] = {**body.get("ensemble", {}), "size": args.ensemble}
-    return validated_input(validated, body, args.file)
+    return validated_input(validated_runup, body, args.file)
 
 
 def _number(value: float | None, fmt: str) -> str:

@@ -248,6 +248,8 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
     for p in [*result.points, *refined]:
         if p.branch != "down":
             rows.setdefault(_level_key(p), []).append(p)
+    checked = [p for row in rows.values() for p in row]
+    notes = unjudged_chaos(checked, rules)  # how the rules read, before what they fail
     failures: list[FailingWindow] = []
     failing = 0
     for _, row in sorted(rows.items()):
@@ -266,14 +268,12 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
                 failures.append(FailingWindow(level=level, rule=rule, speeds_rpm=span,
                                               attractors=named))  # fmt: skip
     return EnvelopeReport(
-        notes=unjudged_chaos([p for r in rows.values() for p in r], rules),
+        notes=notes,
         passed=not failures,
         rules=rules,
-        points=sum(len(r) for r in rows.values()),
+        points=len(checked),
         failing_points=failing,
-        melnikov_not_judged=sum(
-            1 for r in rows.values() for p in r if p.melnikov_chaos_possible is None
-        ),
+        melnikov_not_judged=sum(1 for p in checked if p.melnikov_chaos_possible is None),
         failures=failures,
         windows=speed_windows(result, [*result.points, *refined]) or [],
         resolution=resolution,

@@ -10,7 +10,13 @@ from __future__ import annotations
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.model.units import display_unit
-from gearengine.studies.robustness.sequential import ERROR, Verdict, decision_interval, verdict
+from gearengine.studies.robustness.sequential import (
+    ERROR,
+    Verdict,
+    combined,
+    decision_interval,
+    verdict,
+)
 from gearengine.studies.robustness.study import Probability, RobustnessPoint, RobustnessResult
 from gearengine.studies.robustness.tolerances import probability
 from gearengine.studies.sweep.points import PhysicalValue
@@ -142,27 +148,27 @@ def verdict_reasons(point: RobustnessPoint, limits: dict[str, float],
 def point_verdict(point: RobustnessPoint, limits: dict[str, float], confidence: float,
                   starts: int, units: dict[str, str] | None,
                   own: dict[str, PhysicalValue] | None = None) -> PointVerdict:  # fmt: skip
-    """One point's verdict under ``limits`` at ``confidence`` (``sequential.verdict``), a pass
-    undecided where diverged samples could break it (``unfollowed``), its values in ``units``
+    """One point's verdict under ``limits`` at ``confidence``: each limit's
+    (``sequential.verdict``), a pass undecided where diverged samples could break it
+    (``unfollowed``), combined once (``sequential.combined``), its values in ``units``
     (the result's ``shown_units``, else ``display_unit``); a study without axes named by
     ``own`` (the design's speed and torque) instead of an empty point."""
+    reasons = verdict_reasons(point, limits, confidence)
     read = {}
     for name, limit in limits.items():
         prob = point.probabilities[name]
-        said = verdict(point, {name: limit}, confidence)
-        if unfollowed(point, name, limit, confidence) is not None:
-            said = "undecided"
+        followed = unfollowed(point, name, limit, confidence) is None
+        said = verdict(point, {name: limit}, confidence) if followed else "undecided"
         read[name] = LimitVerdict(
             limit=limit, verdict=said, count=prob.count, samples=prob.samples,
             interval=decision_interval(prob, confidence), confidence=confidence,
         )  # fmt: skip
     shown = {k: PhysicalValue(value=v, unit=(units or {}).get(k) or display_unit(k)[0])
              for k, v in point.shown.items()} or dict(own or {})  # fmt: skip
-    overall = verdict(point, limits, confidence)
-    if overall == "pass" and any(r.verdict == "undecided" for r in read.values()):
-        overall = "undecided"  # proved on the followed samples, not on the diverged ones
-    return PointVerdict(point=shown, verdict=overall,
-                        reasons=verdict_reasons(point, limits, confidence), limits=read,
+    # from the limits' verdicts as read: a pass proved on the followed samples alone, not on
+    # the diverged ones, is undecided
+    overall = combined(r.verdict for r in read.values())
+    return PointVerdict(point=shown, verdict=overall, reasons=reasons, limits=read,
                         samples=point.samples, starts_per_sample=starts)  # fmt: skip
 
 

@@ -17,7 +17,7 @@ from gearengine.gate.envelope import EnvelopeReport, FailingWindow
 from gearengine.gate.rules import Rules
 from gearengine.model.units import RPM
 from gearengine.studies.runup.compute import run_local
-from gearengine.studies.runup.profile import validated
+from gearengine.studies.runup.profile import validated_runup
 from gearengine.studies.runup.reading import transient_chaos
 from gearengine.studies.runup.results import RunupBin, RunupResult
 from gearengine.studies.sweep.points import PhysicalValue
@@ -124,7 +124,7 @@ def gate_envelope(
     for k, level in enumerate(levels):
         at_level = design if "torque" not in level else (
             design.model_copy(update={"torque": level["torque"].value}))  # fmt: skip
-        request = validated({"design": at_level, **ramp})
+        request = validated_runup({"design": at_level, **ramp})
         failures += runup_failures(run_local(request, workers=workers), report.rules, level)
         if progress is not None:
             progress(k + 1, len(levels))

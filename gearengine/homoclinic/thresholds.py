@@ -44,7 +44,7 @@ from gearengine.homoclinic.schemas import (
     ThresholdsRequest,
 )
 from gearengine.homoclinic.terms import packed_terms
-from gearengine.model.aliases import get_alias, with_alias, with_aliases
+from gearengine.model.aliases import get_alias, with_alias
 from gearengine.model.errors import InputError
 from gearengine.model.params import CubicBacklash, GearParams, PiecewiseBacklash
 from gearengine.systems.spur_pair.laws import melnikov_cubic
@@ -100,20 +100,15 @@ def _cubic(backlash: CubicBacklash | PiecewiseBacklash) -> tuple[float, float]:
     return a, c
 
 
-def strength_at(
-    params: GearParams,
-    values: dict[str, float] | None = None,
-    mean_load: MeanLoad = "unperturbed",
-) -> float:
-    """``sign_change_strength`` of ``params`` with aliases set to ``values``; NaN without a
-    saddle loop (the criterion does not apply there: no saddle, or |F_m| >= F_crit with the
-    mean load in the unperturbed system)."""
-    design = with_aliases(params, values) if values else params
-    a, c = _cubic(design.backlash)
-    fm = loop_load(design, mean_load)
+def strength_at(params: GearParams, mean_load: MeanLoad = "unperturbed") -> float:
+    """``sign_change_strength`` of ``params``; NaN without a saddle loop (the criterion does not
+    apply there: no saddle, or |F_m| >= F_crit with the mean load in the unperturbed system).
+    A path's point is made by the path (``boundary.Path``), not here."""
+    a, c = _cubic(params.backlash)
+    fm = loop_load(params, mean_load)
     if not saddle_loop(a, c, fm):
         return math.nan
-    return sign_change_strength(design, a, c, fm=fm)
+    return sign_change_strength(params, a, c, fm=fm)
 
 
 def chaos_possible(params: GearParams, mean_load: MeanLoad = "unperturbed") -> bool | None:

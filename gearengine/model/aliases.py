@@ -96,6 +96,13 @@ def _alias(name: str) -> tuple[str, str]:
         raise ValueError(f"unknown parameter {name!r}; expected one of {sorted(ALIASES)}") from None
 
 
+def fastest_frequency(params: GearParams) -> float | None:
+    """The largest fundamental frequency among the given excitations: the value of a sweep's
+    ``Omega`` axis, whose points ``with_speed_factor`` makes."""
+    freqs = [exc.frequency for _, exc in params.excitations()]
+    return max(freqs) if freqs else None
+
+
 def with_speed_factor(params: GearParams, factor: float) -> GearParams:
     """A copy of ``params`` with every excitation frequency times ``factor`` (> 0): a change of
     running speed, which moves the mesh, transmission-error and torque frequencies together and

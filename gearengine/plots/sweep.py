@@ -20,11 +20,12 @@ from matplotlib.figure import Figure
 from gearengine.homoclinic.boundary import chaos_intervals_from, flips, strength_at
 from gearengine.homoclinic.grid import strength_grid
 from gearengine.model.aliases import ALIASES, get_alias
+from gearengine.model.fields import is_integer_field
 from gearengine.model.params import GearParams
 from gearengine.model.units import display_unit
 from gearengine.plots.envelope import axis_label, envelope_map
 from gearengine.plots.style import LLE_LABEL, SYMBOLS, ImageFormat, figure_bytes
-from gearengine.studies.sweep.axes import is_dimensionless, is_integer_field
+from gearengine.studies.sweep.axes import is_dimensionless
 from gearengine.studies.sweep.export import agreement_table
 from gearengine.studies.sweep.points import SweepBifurcation, SweepPoint
 from gearengine.studies.sweep.request import SweepRequest

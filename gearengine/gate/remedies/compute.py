@@ -31,9 +31,9 @@ from gearengine.gate.remedies.search import (
     shared_check,
     verify_depth,
 )
+from gearengine.model.fields import design_with
 from gearengine.numerics.batch import threads_may_share_kernels
 from gearengine.studies import jobs
-from gearengine.studies.sweep.axes import design_with
 from gearengine.studies.sweep.plan import sweep_work
 from gearengine.studies.sweep.request import SweepRequest
 

@@ -29,10 +29,10 @@ from gearengine.jsonio import message
 from gearengine.model import params
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.errors import Problems
+from gearengine.model.fields import field_value, si_value
 from gearengine.model.params import request_config
 from gearengine.model.units import display_unit, in_display_unit
 from gearengine.numerics.settings import SimulationSettings, over_light
-from gearengine.studies.sweep.axes import field_value, si_value
 from gearengine.studies.sweep.request import SweepRequest, validated
 
 SAMPLES = 5
@@ -189,7 +189,7 @@ class Lever(BaseModel):
         return self.start + t * (self.end - self.start)
 
     def shown(self, si: float) -> float:
-        """``si`` in the lever's display unit (``studies.sweep.axes.display_unit``)."""
+        """``si`` in the lever's display unit (``model.units.display_unit``)."""
         return in_display_unit(self.path, si)
 
     @property

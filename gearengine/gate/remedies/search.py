@@ -51,7 +51,7 @@ from gearengine.gate.rules import attractor_failures
 from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.homoclinic.train_reduction import melnikov_point
 from gearengine.model.design import Design
-from gearengine.studies.sweep.axes import design_with, si_value
+from gearengine.model.fields import design_with, si_value
 from gearengine.studies.sweep.compute import points_at
 from gearengine.studies.sweep.points import SweepPoint
 from gearengine.studies.sweep.request import SweepRequest

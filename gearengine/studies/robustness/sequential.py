@@ -19,7 +19,7 @@ not 368. A gate at a fixed sample count looks once and decides at 95 %.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Literal
 
@@ -73,13 +73,23 @@ def verdict(point: RobustnessPoint, limits: dict[str, float], confidence: float 
     """``fail`` when a lower bound is above its limit, ``pass`` when every upper bound is at or
     below its limit, else ``undecided`` (an interval holds its limit, or no samples); the
     intervals at ``confidence`` (``decision_interval``)."""
-    intervals = [(decision_interval(point.probabilities[name], confidence), limit)
-                 for name, limit in limits.items()]  # fmt: skip
-    if any(ci is not None and ci[0] > limit for ci, limit in intervals):
+    return combined(_limit_verdict(decision_interval(point.probabilities[name], confidence),
+                                   limit) for name, limit in limits.items())  # fmt: skip
+
+
+def _limit_verdict(ci: list[float] | None, limit: float) -> Verdict:
+    if ci is not None and ci[0] > limit:
         return "fail"
-    if all(ci is not None and ci[1] <= limit for ci, limit in intervals):
-        return "pass"
-    return "undecided"
+    return "pass" if ci is not None and ci[1] <= limit else "undecided"
+
+
+def combined(verdicts: Iterable[Verdict]) -> Verdict:
+    """A point's verdict from its limits' own: ``fail`` when one fails, ``pass`` when every one
+    passes, else ``undecided``."""
+    said = list(verdicts)
+    if "fail" in said:
+        return "fail"
+    return "pass" if all(v == "pass" for v in said) else "undecided"
 
 
 class SequentialResult(BaseModel):
@@ -135,14 +145,15 @@ def sequential(
                 f"after {done} samples ({n} would take {spent + cost} steps in all)"
             )
             break  # fmt: skip
-        texts = {k: point_request(request, points[k], n).model_dump_json() for k in todo}
+        asked = {k: point_request(request, points[k], n) for k in todo}  # once a round
+        texts = {k: asked[k].model_dump_json() for k in todo}
         tasks = [(k, texts[k], i) for k in todo
                  for i in range(done // DEFAULT_CHUNK_ROWS, n // DEFAULT_CHUNK_ROWS)]  # fmt: skip
         with ThreadPoolExecutor(max(1, workers)) as pool:
             for (k, _, _), text in zip(tasks, pool.map(_chunk, tasks), strict=True):
                 chunks[k].append(text)
         for k in todo:
-            (answers[k],) = assemble(point_request(request, points[k], n), chunks[k]).points
+            (answers[k],) = assemble(asked[k], chunks[k]).points
             verdicts[k] = verdict(answers[k], limits, confidence)  # type: ignore[arg-type]
         spent, done = spent + cost, n
         rounds.append(n)

@@ -36,6 +36,7 @@ from gearengine.homoclinic.thresholds import chaos_possible
 from gearengine.homoclinic.train_reduction import melnikov_point
 from gearengine.model.design import Design
 from gearengine.model.errors import InputError, Problems
+from gearengine.model.fields import design_with
 from gearengine.model.params import request_config
 from gearengine.model.reduction import convert_design
 from gearengine.model.units import Scales, display_unit, in_display_unit, response_values
@@ -59,7 +60,6 @@ from gearengine.studies.robustness.tolerances import (
 from gearengine.studies.sweep.axes import (
     axis_problem,
     axis_unit,
-    design_with,
     is_dimensionless,
 )
 from gearengine.studies.sweep.request import SweepAxis

@@ -7,7 +7,7 @@ field's physical bounds, ``triang``). Samples are points of a scrambled Sobol se
 (scipy.stats.qmc, seeded: the same seed gives the same samples), or with sensitivity the
 Saltelli design of SALib built on it (``studies.robustness.sensitivity``), mapped through the
 inverse CDFs. Every sample is a full design, re-validated and converted as a single analysis of it
-would be (``studies.sweep.axes.design_with``), at every operating point of the request.
+would be (``model.fields.design_with``), at every operating point of the request.
 
 A probability is k of n samples with the Clopper-Pearson 95 % interval
 (``scipy.stats.binomtest(...).proportion_ci(method="exact")``): exact for independent samples and
@@ -28,10 +28,10 @@ from scipy.stats import qmc
 
 from gearengine.model.design import ACCURACY_FIELD, BACKLASH_FIELD, Design, TransmissionError
 from gearengine.model.errors import InputError
+from gearengine.model.fields import design_with, si_value
 from gearengine.model.reduction import half_backlash_band
 from gearengine.model.standards import iso1328
 from gearengine.model.tolerances import Distribution, Normal, Triangular, Uniform
-from gearengine.studies.sweep.axes import design_with, si_value
 
 BOUNDS: dict[str, tuple[float, float]] = {
     "damping_ratio": (0.0, 1.0),

@@ -239,7 +239,7 @@ def budget_errors(request: RunupRequest) -> list[InitErrorDetails]:
     return errors
 
 
-def checked(request: RunupRequest) -> RunupRequest:
+def checked_runup(request: RunupRequest) -> RunupRequest:
     """``request`` if ``request_errors`` and ``budget_errors`` find nothing; else
     ``ValidationError`` naming each field (the checks the API and the CLI share)."""
     errors = request_errors(request) or budget_errors(request)
@@ -248,6 +248,6 @@ def checked(request: RunupRequest) -> RunupRequest:
     return request
 
 
-def validated(data: object) -> RunupRequest:
+def validated_runup(data: object) -> RunupRequest:
     """Parse and check a run-up request document; raises ``ValidationError`` naming each field."""
-    return checked(RunupRequest.model_validate(data))
+    return checked_runup(RunupRequest.model_validate(data))

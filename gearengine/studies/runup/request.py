@@ -22,7 +22,7 @@ import itertools
 import math
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, BeforeValidator, Field, WithJsonSchema
+from pydantic import BaseModel, BeforeValidator, Field, PrivateAttr, WithJsonSchema, model_validator
 from pydantic_core import InitErrorDetails
 
 from gearengine.model.design import EXAMPLE_DESIGN
@@ -157,18 +157,31 @@ class RunupRequest(ParamsOrDesign):
 
     TRAINS = True  # a train design runs as its System (model)
 
+    _model: tuple[System, DesignConversion] | None = PrivateAttr(None)
+
+    @model_validator(mode="after")
+    def _carry_model(self) -> RunupRequest:
+        """Build what the members integrate once, when the request is validated (as
+        ``analysis.AnalysisRequest`` carries its system): the budget check, the plan of every
+        chunk and the reading all read it from here (``model``)."""
+        if self.design is None:
+            return self
+        if self.design.train is None:
+            assert self.conversion is not None
+            self._model = SpurPair(self.conversion.params), self.conversion
+            return self
+        model, conversion = design_model(self.design)
+        assert isinstance(model, System)
+        self._model = model, conversion
+        return self
+
     def model(self) -> tuple[System, DesignConversion]:
         """(the system the members integrate, the conversion whose scales read them): the
         pair of Eq. (9) and the design's conversion, or a train's ``TrainSystem`` and its
-        equivalent pair's (I_a = I_m + I_p, I_b = I_g + I_l). The pair's conversion is the
-        one validation made (``ParamsOrDesign.conversion``), not made again."""
-        assert self.design is not None
-        if self.design.train is None:
-            assert self.conversion is not None
-            return SpurPair(self.conversion.params), self.conversion
-        model, conversion = design_model(self.design)
-        assert isinstance(model, System)
-        return model, conversion
+        equivalent pair's (I_a = I_m + I_p, I_b = I_g + I_l), built once when the request
+        was validated (the pair's conversion the one ``ParamsOrDesign.conversion`` made)."""
+        assert self.design is not None and self._model is not None
+        return self._model
 
     def leg_seconds(self) -> float:
         """Duration of one leg of a linear ramp [s]."""
@@ -203,7 +216,7 @@ class RunupRequest(ParamsOrDesign):
 def request_errors(request: RunupRequest) -> list[InitErrorDetails]:
     """Checks across fields, as pydantic error details naming each field: a design with the
     piecewise law, one profile (points, or from/to with rate or duration), ordered speeds and
-    times (the work budget is ``profile.checked``'s), all before any compute."""
+    times (the work budget is ``profile.checked_runup``'s), all before any compute."""
     problems = Problems("runup")
     add, errors = problems.add, problems.details
 

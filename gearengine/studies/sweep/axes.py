@@ -15,14 +15,13 @@ An axis names one of:
 
 from __future__ import annotations
 
-from typing import Any
-
 from pydantic import ValidationError
 
-from gearengine.model.aliases import ALIASES, with_aliases, with_speed_factor
+from gearengine.model.aliases import ALIASES, fastest_frequency, with_aliases, with_speed_factor
 from gearengine.model.design import Design
+from gearengine.model.fields import design_with, si_value
 from gearengine.model.params import GearParams
-from gearengine.model.units import Scales, field_unit, si_numbers
+from gearengine.model.units import Scales, field_unit
 from gearengine.systems.base import System
 from gearengine.systems.designs import design_model, params_of
 from gearengine.systems.spur_pair.forcing import packed_forcing
@@ -56,72 +55,6 @@ def bare_reading(parameter: str, where: str, value: object) -> str | None:
         text += (f" = {shown:,.6g} {unit.display}; write '{value:g} {unit.display}' if "
                  f"{unit.display} was meant")  # fmt: skip
     return text
-
-
-def _set(tree: dict[str, Any], path: str, value: object) -> None:
-    """Set the field at ``path``; a whole float on an integer field (a grid value 19.0 of
-    ``driver.teeth``) is set as that integer, since the design refuses floats there."""
-    *head, last = path.split(".")
-    node: Any = tree
-    for key in head:
-        node = node[int(key)] if key.isdigit() else node[key]
-    key: int | str = int(last) if last.isdigit() else last
-    if not last.isdigit() and not (isinstance(node, dict) and last in node):
-        raise KeyError(last)
-    if _is_int(node[key]) and isinstance(value, float) and value.is_integer():
-        value = int(value)
-    node[key] = value
-
-
-def _is_int(value: object) -> bool:
-    return isinstance(value, int) and not isinstance(value, bool)
-
-
-def is_integer_field(design: Design, path: str) -> bool:
-    """True when the design's field at ``path`` holds an integer (``driver.teeth``): its axis
-    values must be whole numbers."""
-    try:
-        return _is_int(_get(design.model_dump(), path))
-    except (KeyError, IndexError, TypeError):
-        return False
-
-
-def _get(tree: Any, path: str) -> Any:
-    for key in path.split("."):
-        tree = tree[int(key)] if key.isdigit() else tree[key]
-    return tree
-
-
-def field_value(design: Design, path: str) -> Any:
-    """The design's field at ``path`` (SI units); KeyError or IndexError for a missing one."""
-    return _get(design.model_dump(), path)
-
-
-def design_with(design: Design, values: dict[str, object]) -> Design:
-    """``design`` with physical fields set (unit strings or SI numbers), re-validated.
-
-    Raises KeyError for a path the design does not have, ValidationError for a bad value.
-    """
-    tree = design.model_dump()
-    for path, value in values.items():
-        _set(tree, path, value)
-    for k, share in design.ripple_shares.items():  # a ripple in % follows the mean torque
-        path = f"torque_fluctuation.harmonics.{k}.amplitude"
-        if path not in values:
-            _set(tree, path, f"{share!r} %")
-    with si_numbers():  # the dump's numbers are SI: no note on them
-        return Design.model_validate(tree)
-
-
-def si_value(design: Design, path: str, value: object) -> float:
-    """The SI number of ``value`` (a unit string or a number) for the field at ``path``."""
-    return float(_get(design_with(design, {path: value}).model_dump(), path))
-
-
-def fastest_frequency(params: GearParams) -> float | None:
-    """The largest fundamental frequency among the given excitations (the ``Omega`` axis)."""
-    freqs = [exc.frequency for _, exc in params.excitations()]
-    return max(freqs) if freqs else None
 
 
 def point_params(params: GearParams, design: Design | None, values: dict[str, float]) -> GearParams:

@@ -26,6 +26,7 @@ from pydantic_core import InitErrorDetails
 from gearengine.model.design import Design
 from gearengine.model.errors import Problems
 from gearengine.model.examples import PAPER_SECTION_41
+from gearengine.model.fields import is_integer_field, si_value
 from gearengine.model.params import GearParams, WholeNumber, request_config
 from gearengine.model.reduction import ParamsOrDesign
 from gearengine.model.units import Scales
@@ -35,10 +36,8 @@ from gearengine.studies.sweep.axes import (
     axis_problem,
     changes_nothing,
     is_dimensionless,
-    is_integer_field,
     point_model,
     scaled_point,
-    si_value,
 )
 from gearengine.systems.base import System
 

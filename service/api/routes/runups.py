@@ -12,7 +12,7 @@ from __future__ import annotations
 from fastapi import Request
 
 from gearengine.plots import runup_figure
-from gearengine.studies.runup.profile import checked
+from gearengine.studies.runup.profile import checked_runup
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.studies.runup.results import RunupResult
 from service.api.routes.jobs import JobRoutes
@@ -20,7 +20,7 @@ from service.core.config import Settings
 
 
 def _check(body: RunupRequest, request: Request, settings: Settings) -> None:
-    checked(body)
+    checked_runup(body)
 
 
 RUNUPS = JobRoutes(
