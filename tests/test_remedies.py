@@ -73,6 +73,16 @@ def test_remedies_list_damping_and_transmission_error(answer: RemediesResult) ->
         assert r.unit == {"mesh.damping_ratio": "1"}.get(r.lever, r.unit)
         assert r.samples[0].value == r.from_ and not r.samples[0].passed
         assert r.summary.startswith(("raise", "lower"))
+        # a sample's failing points are of the points its check looked at: the design's own
+        # value refined as check refines it, the others' grids only (a review read "1 failing
+        # point" as a count where check finds 6 of 220, not said to be a grid's alone)
+        if r.bound == "numerical":
+            assert r.samples[0].failing_points == answer.check.failing_points
+            assert r.samples[0].points == answer.check.points
+            res = answer.check.resolution
+            grid = res.speed_points * res.torque_points
+            assert all(s.points == grid for s in r.samples[1:] if not s.passed), grid
+        assert all(0 <= s.failing_points <= s.points for s in r.samples)
     assert answer.answer.count("numerically") == len(numerical)
     for u in answer.unreachable:
         assert len(u.searched) == 2 and u.why and not any(s.passed for s in u.samples)

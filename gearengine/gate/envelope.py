@@ -210,7 +210,7 @@ class EnvelopeReport(BaseModel):
 
     passed: bool
     rules: Rules
-    points: int = Field(description="Grid points checked.")
+    points: int = Field(description="Points checked: the grid's and the refined ones between.")
     failing_points: int
     melnikov_not_judged: int = Field(
         0,

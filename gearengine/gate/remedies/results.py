@@ -23,8 +23,15 @@ class Sample(BaseModel):
 
     value: float = Field(description="In the remedy's unit.")
     passed: bool
-    failing_points: int = Field(description="Points failing (numerical) or where the criterion "
-                                "allows chaos (Melnikov).")  # fmt: skip
+    failing_points: int = Field(
+        description="Numerical: the failing points of the check at this value, of ``points``. "
+        "The design's own value is checked in full (refined, as gearengine check); any other "
+        "failing value's grid is not refined (the search needs pass or fail only), so a full "
+        "check there finds at least as many. Melnikov: the grid points where the criterion "
+        "allows chaos."
+    )  # fmt: skip
+    points: int = Field(description="The points that check looked at (the grid's, with the "
+                        "refined ones where it refined).")  # fmt: skip
 
 
 class Remedy(BaseModel):

@@ -80,21 +80,21 @@ def melnikov_failures(design: Design, points: list[dict[str, float]],
     return sum(v is True for v in verdicts), sum(v is None for v in verdicts)
 
 
-def _search(test: Callable[[float], tuple[bool, int]], lever: Lever, samples: int,
+def _search(test: Callable[[float], tuple[bool, int, int]], lever: Lever, samples: int,
             width: Callable[[float, float], bool], max_steps: int,
             passes_at: Callable[[float], bool] | None = None,
             verify: Callable[[float], bool] | None = None,
             ) -> tuple[list[Sample], bool, tuple[float, float] | None]:  # fmt: skip
     """Bracket samples of v(t), monotone on them?, and [last failing, first passing] value (SI)
     after bisection (None when no sample passes, or none passes ``verify``).
-    ``test(v) -> (passed, failing points)`` runs the samples; ``passes_at(v)`` (default: the
+    ``test(v) -> (passed, failing points, points)`` runs the samples; ``passes_at(v)`` (default: the
     test's pass) each bisection step, where only pass or fail is needed. With ``verify`` the
     value found must pass it too (a finer grid): if not, the search goes on from it toward the
     far end with ``verify`` as its test, and the bracket returned is ``verify``'s."""
     ts = [k / (samples - 1) for k in range(samples)]
     results = [test(lever.at(t)) for t in ts]
-    shown = [Sample(value=lever.shown(lever.at(t)), passed=r[0], failing_points=r[1])
-             for t, r in zip(ts, results, strict=True)]  # fmt: skip
+    shown = [Sample(value=lever.shown(lever.at(t)), passed=r[0], failing_points=r[1],
+                    points=r[2]) for t, r in zip(ts, results, strict=True)]  # fmt: skip
     passes = [r[0] for r in results]
     if not any(passes):
         return shown, False, None
@@ -243,9 +243,9 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
                 failed[finer] = [p for p in report.sweep.points if attractor_failures(p, rules)]
         return reports[(value, finer)]
 
-    def numerical(value: float) -> tuple[bool, int]:
+    def numerical(value: float) -> tuple[bool, int, int]:
         report = run(value)
-        return report.passed, report.failing_points
+        return report.passed, report.failing_points, report.points
 
     def passes_at(value: float, finer: bool = False) -> bool:
         """Pass or fail at ``value``: the grid points that failed last run first (``HINTS``),
@@ -288,9 +288,9 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
 
     points = envelope_points(request)
 
-    def melnikov(value: float) -> tuple[bool, int]:
+    def melnikov(value: float) -> tuple[bool, int, int]:
         possible, _ = melnikov_failures(request.design, points, {lever.path: value})
-        return possible == 0, possible
+        return possible == 0, possible, len(points)
 
     searched = [f"{lever.shown(v):g}{lever.suffix}" for v in (lever.start, lever.end)]
     remedies: list[Remedy] = []
