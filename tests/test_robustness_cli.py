@@ -307,8 +307,10 @@ def test_the_gates_json_is_its_report_at_the_confidence_it_decided_at(
     assert read["interval"] == pytest.approx(clopper_pearson(0, 128, 1 - 0.05 / 7))
     kept = report["result"]["points"][0]["probabilities"]["separation"]
     assert kept["interval"][1] < read["interval"][1]  # the result's own 95 % interval, kept
-    assert "every point decided" not in report["notes"][0]
-    assert report["notes"][0].startswith("--samples auto: the budget of 3500000 RK4 steps")
+    # said before computing: the budget cannot hold the round that proves 1 % without events
+    assert report["notes"][0].startswith("--samples auto: a point with no events needs 561 ")
+    assert "every point decided" not in report["notes"][1]
+    assert report["notes"][1].startswith("--samples auto: the budget of 3500000 RK4 steps")
     assert main([*base, "--samples", "8", "--max-probability", "back_flank=0.5",
                  "--json", str(out)]) == 0  # fmt: skip
     assert "PASS: 0 of 2 points over a probability limit (P(back_flank) <= 0.5), 0 undecided" in (
@@ -491,3 +493,24 @@ def test_the_gate_reads_the_design_once_through_its_request(
     assert main(argv) == 0
     assert "PASS: speed 4000 rpm, torque 5 N*m (8 samples)" in capsys.readouterr().out
     assert DESIGN not in calls  # each sample's design is its own tree (model.fields.design_with)
+
+
+def test_samples_auto_says_before_computing_that_the_budget_cannot_prove_a_limit() -> None:
+    """``--samples auto`` on the worked envelope (115 points, P(chaotic) <= 1 %) ran 98 s and
+    ended with 104 points undecided, the budget spent: a point with no events needs 561 samples
+    at 99.3 %, the round of 1,024, which the budget could not hold at every point, and nothing
+    said so before (third new-user review). ``unreachable`` says it from the work alone."""
+    from gearengine.studies.robustness.sequential import unreachable
+    from gearengine.studies.robustness.study import checked, robustness_work
+
+    axes = [{"parameter": "speed", "start": "2000 rpm", "stop": "5000 rpm", "num": 3}]
+    request = checked(RobustnessRequest.model_validate({"design": DESIGN, "axes": axes,
+                                                        "samples": 64}))  # fmt: skip
+    per_sample = robustness_work(request.model_copy(update={"samples": 1}))
+    said = unreachable(request, {"chaotic": 0.01}, 600 * per_sample)
+    assert said is not None
+    assert said.startswith("a point with no events needs 561 samples to prove P(chaotic) <= 0.01 "
+                           "at 99.3 % (the round of 1024 samples)")  # fmt: skip
+    assert "holds 600 samples at each of the 3 points" in said
+    assert unreachable(request, {"chaotic": 0.01}, 1024 * per_sample) is None
+    assert unreachable(request, {"chaotic": 0.05}, 600 * per_sample) is None  # 110: round 128

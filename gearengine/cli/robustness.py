@@ -39,6 +39,7 @@ from gearengine.studies.robustness.sequential import (
     SequentialResult,
     looks,
     sequential,
+    unreachable,
 )
 from gearengine.studies.robustness.study import (
     SALTELLI_SAMPLES,
@@ -81,15 +82,16 @@ def robustness_request(args: argparse.Namespace, doc: object) -> RobustnessReque
     return request
 
 
-STUDY_WAYS = (
-    "use fewer points (--speed-points, --torque-points, or a narrower --speed/--torque range at "
-    "the same spacing), starts (--starts) or --samples; or allow it here with "
-    f"{jobs.BUDGET_ENV[0]}=STEPS in the environment"
-)
+FEWER_POINTS = ("use fewer points (--speed-points, --torque-points, or a narrower --speed/--torque "
+                "range at the same spacing)")  # fmt: skip
+ALLOW = f"or allow it here with {jobs.BUDGET_ENV[0]}=STEPS in the environment"
+STUDY_WAYS = f"{FEWER_POINTS}, starts (--starts) or --samples; {ALLOW}"
 """The ways out of a robustness study over the job budget, in the CLI's options."""
 PROBABILITY_WAYS = (
-    f"{STUDY_WAYS}; or --samples auto: each point sampled only until it is decided, within the "
-    "budget (points the budget leaves undecided are reported undecided and fail the gate)"
+    f"{FEWER_POINTS}, starts (--starts) or samples (--samples, not below the count that can "
+    f"prove the limits); {ALLOW}; or --samples auto: each point sampled only until it is decided, "
+    "within the budget (a point with no events still needs those samples: points the budget "
+    "leaves undecided are reported undecided and fail the gate)"
 )
 """The ways out of a probability gate over the job budget."""
 
@@ -266,8 +268,13 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     own = own_point(request.design)
     confidence, notes = ONE_LOOK, []
     if auto:
+        short = unreachable(request, limits, jobs.job_step_budget())
+        if short is not None:  # said before computing, as a fixed count's refusal is
+            notes.append(f"--samples auto: {short}")
+            print(notes[-1], file=sys.stderr)
         decided, note = auto_study(request, limits)
-        result, confidence, notes = decided.result, decided.confidence, [note]
+        result, confidence = decided.result, decided.confidence
+        notes.append(note)
         print(note, file=sys.stderr)
     else:
         result = run_study(request)
