@@ -102,3 +102,19 @@ def test_a_one_design_check_reads_the_designs_bare_speed_in_its_si_unit(tmp_path
           "--json", str(out)])  # fmt: skip
     point = json.loads(out.read_text())["sweep"]["points"][0]
     assert point["physical"]["speed"] == {"value": pytest.approx(4000.0), "unit": "rpm"}
+
+
+def test_the_summary_gives_the_encoders_te_beside_the_dte() -> None:
+    """ "dynamic transmission error 0.856 µm peak to peak" at 1,000 rpm where the JSON's
+    te_with_static_peak_to_peak_um was 23.04 µm (third new-user review): the DTE is the mesh
+    deflection's, the static TE excluded, which the summary now says, with the encoders'
+    number beside it."""
+    from gearengine.analysis import AnalysisRequest, analyze
+
+    result = analyze(AnalysisRequest.model_validate(DOC))
+    resp = result.engineering.response
+    assert resp.te_with_static_peak_to_peak_um > 1.5 * resp.dte_peak_to_peak_um
+    said = (f"dynamic transmission error {resp.dte_peak_to_peak_um:.3g} µm peak to peak (the "
+            f"static transmission error excluded; with it {resp.te_with_static_peak_to_peak_um:.3g}"
+            " µm, what shaft encoders read)")  # fmt: skip
+    assert said in result.engineering.summary
