@@ -174,10 +174,10 @@ def test_gate_option_max_dynamic_factor(tmp_path: Path) -> None:
     good.write_text(json.dumps({"design": EXAMPLE_DESIGN, "settings": LIGHT}))
     run = [sys.executable, "-m", "gearengine.cli", "check", str(good), "--speed", "500:6000",
            "--speed-points", "3"]  # fmt: skip
-    out = subprocess.run([*run, "--max-dynamic-factor", "1"], cwd=ROOT, capture_output=True,
+    out = subprocess.run([*run, "--max-dynamic-factor", "1.001"], cwd=ROOT, capture_output=True,
                          text=True, timeout=600)  # fmt: skip
-    assert out.returncode == 1 and "dynamic factor > 1" in out.stdout, out.stdout + out.stderr
-    assert "--max-dynamic-factor 1" in out.stdout
+    assert out.returncode == 1 and "dynamic factor > 1.001" in out.stdout, out.stdout + out.stderr
+    assert "--max-dynamic-factor 1.001" in out.stdout
     out = subprocess.run([*run, "--max-dynamic-factor", "1e6"], cwd=ROOT, capture_output=True,
                          text=True, timeout=600)  # fmt: skip
     assert out.returncode == 0 and out.stdout.startswith("PASS"), out.stdout + out.stderr

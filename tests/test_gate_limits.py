@@ -315,7 +315,16 @@ def test_a_grid_without_its_range_is_refused(axis: str, capsys: pytest.CaptureFi
         assert f"--{axis}-points: counts the points of a {axis} range, and none is given" in err
 
 
-@pytest.mark.parametrize("option", ["--max-dte=-1um", "--max-dte=0", "--max-dynamic-factor=0"])
+@pytest.mark.parametrize(
+    "option",
+    [
+        "--max-dte=-1um",
+        "--max-dte=0",
+        "--max-dynamic-factor=0",
+        "--max-dynamic-factor=0.5",
+        "--max-dynamic-factor=1",
+    ],
+)
 def test_a_limit_no_point_can_meet_is_refused_naming_the_option(
     option: str, capsys: pytest.CaptureFixture
 ) -> None:
@@ -326,4 +335,6 @@ def test_a_limit_no_point_can_meet_is_refused_naming_the_option(
     from gearengine.cli.main import main
 
     assert main(["check", str(ROOT / "examples" / "design-geometry.json"), option]) == 2
-    assert f"{option.split('=')[0]}: Input should be greater than 0" in capsys.readouterr().err
+    floor = "1" if option.startswith("--max-dynamic-factor") else "0"
+    assert f"{option.split('=')[0]}: Input should be greater than {floor}" in (
+        capsys.readouterr().err)  # fmt: skip

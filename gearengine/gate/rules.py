@@ -55,8 +55,10 @@ class Rules(BaseModel):
         "a limit at or under 0 would fail every point).",
     )  # fmt: skip
     max_dynamic_factor: float | None = Field(
-        None, gt=0.0, allow_inf_nan=False,
-        description="Largest dynamic factor allowed: max mesh force / static force, above 0.",
+        None, gt=1.0, allow_inf_nan=False,
+        description="Largest dynamic factor allowed: max mesh force / static force, above 1 (the "
+        "largest force is at least the mean, the static force: a limit at or under 1 would fail "
+        "every point).",
     )  # fmt: skip
     min_basin: float | None = Field(
         None,
