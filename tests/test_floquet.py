@@ -35,7 +35,7 @@ from service.core.config import Settings
 from service.main import create_app
 from tests._gear_cases import paper
 from tests._polling import poll
-from tests.conftest import PAPER_PARAMS, started
+from tests.conftest import PAPER_PARAMS, ROOT, started
 
 MU, FM, WE, A, C = 0.07, 0.01, 0.5, 0.1667, 0.1667
 CUBIC, PIECEWISE = 0, 1  # kernel codes of systems.spur_pair.laws.LAWS
@@ -462,3 +462,15 @@ def test_check_gate_on_the_stability_margin(tmp_path, capsys) -> None:
     assert main(argv) == 0  # the margin applies to periodic responses only
     assert main(["analyze", str(periodic)]) == 0
     assert "stability margin 0.476" in capsys.readouterr().out
+
+
+def test_the_text_says_why_a_complex_pair_cannot_bifurcate(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``analyze`` printed "stability margin 1 (nearest bifurcation: neimark_sacker)" for
+    multipliers of modulus 4e-10 (third new-user review): the JSON's note says a complex pair
+    of this planar system cannot reach the unit circle, and now the text says it too."""
+    assert main(["analyze", str(ROOT / "examples" / "design-geometry.json")]) == 0
+    line = next(s for s in capsys.readouterr().out.splitlines() if "Floquet" in s)
+    assert "(nearest bifurcation: neimark_sacker); " in line
+    assert "so the pair cannot reach the unit circle" in line
