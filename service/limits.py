@@ -71,8 +71,9 @@ class Limits:
         if steps > cap:
             raise over_limit(
                 field,
-                f"this analysis needs {steps} RK4 steps, over the synchronous compute budget of "
-                f"{cap} steps ({self.speed.describe()}); {hint}",
+                f"this analysis needs up to {steps} RK4 steps (its full transient and record; "
+                "a run that settles ends sooner, which is not known before it runs), over the "
+                f"synchronous compute budget of {cap} steps ({self.speed.describe()}); {hint}",
                 kind="over-budget",
             )
 
