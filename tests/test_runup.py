@@ -418,3 +418,46 @@ def test_a_quasi_static_jump_is_lagged_by_one_ramp_jump() -> None:
     first, second = with_lags(ramp, quasi, "up")
     assert (first.quasi_static_speed_rpm, first.lag_rpm) == (4050.0, 50.0)
     assert second.quasi_static_speed_rpm is None and second.lag_rpm is None
+
+
+@pytest.mark.parametrize("direction", ["up_down", "down"])
+def test_the_quasi_static_loop_joins_and_starts_where_the_ramp_does(direction: str) -> None:
+    """examples/ci/design.json from 3600 to 4000 rpm ends inside its hysteresis loop: two
+    responses coexist in the top bin (19 µm and 57 µm). The quasi-static down line started from
+    the sweep's default start in the backlash gap and took the 57 µm one, so the loop did not
+    join (18.7 µm up, 57.4 µm down in the top bin) and printed a down jump the ramp's run-down
+    never made (new-user review of issue 30, the z = 23/67 example over 1000-6000 rpm): the
+    down line continues from where the up line ended and, run down alone, starts from the
+    members' start (static contact), as the ramp does."""
+    r = validated(_request(from_speed="3600 rpm", to_speed="4000 rpm", rate="2000 rpm/s",
+                           direction=direction, ensemble={"size": 1}))  # fmt: skip
+    result = run_local(r)
+    up, down = result.quasi_static.up.points, result.quasi_static.down.points
+    assert down[0].speed_rpm == up[-1].speed_rpm == 3975.0
+    assert result.down is not None
+    first = result.down.bins[0].dte_peak_to_peak_um
+    assert first is not None and down[0].dte_peak_to_peak_um is not None
+    assert abs(down[0].dte_peak_to_peak_um - first) < 0.1 * first  # the ramp's response
+    if direction == "up_down":
+        assert down[0].dte_peak_to_peak_um == pytest.approx(up[-1].dte_peak_to_peak_um, rel=0.01)
+    assert result.quasi_static.down.jumps == [] == result.down.jumps
+    assert not any("start on different responses" in n for n in result.notes)
+
+
+def test_a_ramp_and_a_continuation_starting_apart_are_said_to() -> None:
+    """Where the ramp's first bin and the continuation at its centre differ as a jump does,
+    the notes say they start on different responses (not two silently different answers)."""
+    from gearengine.studies.runup.reading import start_note
+    from gearengine.studies.runup.results import RunupResult
+
+    golden = RunupResult.model_validate_json((ROOT / "tests/golden/runup-ci.json").read_text())
+    assert golden.down is not None
+    b_um = 50.0
+    assert start_note("down", golden.down, golden.quasi_static.down, b_um) is None
+    first = golden.down.bins[0].model_copy(update={"dte_peak_to_peak_um": 19.4})
+    apart = golden.down.model_copy(update={"bins": [first, *golden.down.bins[1:]]})
+    note = start_note("down", apart, golden.quasi_static.down, b_um)
+    assert note is not None and note.startswith(
+        "run-down and the quasi-static down start on different responses: 19.4 µm in the "
+        "ramp's first bin (4450-4500 rpm)"
+    )
