@@ -264,6 +264,29 @@ def test_the_gate_runs_up_and_down_and_names_the_speeds(tmp_path: Path) -> None:
     assert down[0] < up[0] <= 4200 and up[1] == down[1] == 4400
 
 
+def test_a_passing_gate_says_which_run_ups_it_ran(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """``check --speed --torque --runup 2000`` that passed said nothing of its run-ups (no
+    rate, levels or result in the text or the JSON), though they took most of its time
+    (new-user review of issue 30): a pass says what it ran, in the text and the report."""
+    report = tmp_path / "report.json"
+    code = main(["check", str(ROOT / "examples" / "ci" / "design.json"), "--speed", "3500:3700",
+                 "--speed-points", "5", "--torque", "30:40", "--torque-points", "2",
+                 "--runup", "2000", "--json", str(report)])  # fmt: skip
+    assert code == 0
+    out = capsys.readouterr().out
+    assert (
+        "  run-ups: run-up and run-down at 2000 rpm/s through 3500-3700 rpm (50 rpm bins, 4 "
+        "starts) at each of the 2 levels, torque 30 N*m to torque 40 N*m: no failing window\n"
+    ) in out
+    ran = json.loads(report.read_text())["runup"]
+    assert (ran["rate_rpm_s"], ran["speeds_rpm"], ran["directions"]) == (
+        2000.0, [3500.0, 3700.0], ["up", "down"])  # fmt: skip
+    assert [lv["torque"]["value"] for lv in ran["levels"]] == [30.0, 40.0]
+    assert ran["failing_windows"] == 0
+
+
 def test_chaos_fails_the_gate_only_when_it_lasts(tmp_path: Path) -> None:
     """A run of chaotic bins fails after CHAOS_SECONDS, not before (the rule over time)."""
     r = validated(_request(from_speed="4000 rpm", to_speed="4400 rpm", rate="4000 rpm/s",
@@ -299,6 +322,7 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
     import gearengine.gate.runup as gate
     from gearengine.gate.envelope import EnvelopeReport
     from gearengine.studies.runup.results import RunupResult
+    from gearengine.studies.sweep.points import PhysicalValue
     from gearengine.studies.sweep.request import validated as sweep_request
 
     seen: list[RunupRequest] = []
@@ -312,7 +336,7 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
     sweep = sweep_request({"design": doc.get("design", doc), "axes": [
         {"parameter": "speed", "start": "3500 rpm", "stop": "4500 rpm", "num": 5},
         {"parameter": "torque", "start": "10 N*m", "stop": "40 N*m", "num": 2}]})  # fmt: skip
-    levels = [{"torque": SimpleNamespace(value=t)} for t in (10.0, 40.0)]
+    levels = [{"torque": PhysicalValue(value=t, unit="N*m")} for t in (10.0, 40.0)]
     windows = [SimpleNamespace(level=lv) for lv in levels]
     sweep_result = SimpleNamespace(windows=windows)
     report = EnvelopeReport.model_construct(failures=[], rules=Rules(), sweep=sweep_result)

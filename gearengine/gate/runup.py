@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from gearengine.gate.envelope import EnvelopeReport, FailingWindow
+from gearengine.gate.envelope import EnvelopeReport, FailingWindow, RunupCheck
 from gearengine.gate.rules import Rules
 from gearengine.model.units import RPM
 from gearengine.studies.runup.compute import run_local
@@ -102,7 +102,7 @@ def gate_envelope(
 ) -> EnvelopeReport:  # fmt: skip
     """``report`` with the failing windows of a run-up and run-down at ``rate_rpm_s`` [rpm/s]
     through the envelope sweep's speed range (its grid step as the bins) at each of its torque
-    levels. Raises ``ValidationError`` naming the field of a bad ramp.
+    levels, and what ran (``runup``). Raises ``ValidationError`` naming the field of a bad ramp.
 
     The sweep's design is validated already (every corner of its grid, ``request_errors``):
     each level's run-up carries it, at the level's torque, as the validated ``Design`` it is,
@@ -120,12 +120,16 @@ def gate_envelope(
         "bin_rpm": (hi - lo) / (axis.num - 1), "ensemble": {"size": GATE_ENSEMBLE},
     }  # fmt: skip
     levels = [w.level for w in report.sweep.windows or []] or [{}]
-    failures = list(report.failures)
+    found: list[FailingWindow] = []
     for k, level in enumerate(levels):
         at_level = design if "torque" not in level else (
             design.model_copy(update={"torque": level["torque"].value}))  # fmt: skip
         request = validated({"design": at_level, **ramp})
-        failures += runup_failures(run_local(request, workers=workers), report.rules, level)
+        found += runup_failures(run_local(request, workers=workers), report.rules, level)
         if progress is not None:
             progress(k + 1, len(levels))
-    return report.model_copy(update={"failures": failures, "passed": not failures})
+    ran = RunupCheck(rate_rpm_s=rate_rpm_s, speeds_rpm=[lo, hi], directions=["up", "down"],
+                     bin_rpm=ramp["bin_rpm"], ensemble=GATE_ENSEMBLE, levels=levels,
+                     failing_windows=len(found))  # fmt: skip
+    failures = [*report.failures, *found]
+    return report.model_copy(update={"failures": failures, "passed": not failures, "runup": ran})
