@@ -210,6 +210,40 @@ def test_bad_ramps_are_refused_naming_the_field(fields: dict, path: str, words: 
     assert any(line.startswith(f"{path}:") and words in line for line in lines), lines
 
 
+def test_a_bin_wider_than_a_quarter_of_the_range_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """``runup --bin 10000`` over 1000-6000 rpm ran one bin over the whole range, its FTLE
+    averaged over it, and the chaotic bins 50 rpm bins find vanished unsaid (new-user review of
+    issue 30): a bin wider than a quarter of the range is refused, naming the field (and the
+    option) in the library, the API and the CLI; the default 50 rpm stays allowed on a narrow
+    profile (4000-4100 rpm: two bins)."""
+    from fastapi.testclient import TestClient
+
+    from service.core.config import Settings
+    from service.main import create_app
+
+    ramp = _request(from_speed="1000 rpm", to_speed="6000 rpm", rate="2000 rpm/s")
+    with pytest.raises(ValidationError) as exc:
+        validated({**ramp, "bin_rpm": 1250.5})
+    (line,) = error_lines(exc.value)
+    assert line.startswith(
+        "bin_rpm: a bin of 1250.5 rpm is wider than a quarter of the profile's 1000-6000 rpm range"
+    )
+    assert "give at most 1250 rpm" in line
+    assert validated({**ramp, "bin_rpm": 1250}).bin_rpm == 1250
+    assert validated(_request(from_speed="4000 rpm", to_speed="4100 rpm", rate="5000 rpm/s"))
+    with TestClient(create_app(Settings(data_dir=tmp_path, workers=0))) as client:
+        r = client.post("/v1/runups", json={**ramp, "bin_rpm": 10000})
+    assert r.status_code == 422 and "bin_rpm" in r.text and "quarter" in r.text, r.text
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": CI_DESIGN}))
+    code = main(["runup", str(path), "--from", "1000", "--to", "6000", "--rate", "2000",
+                 "--bin", "10000"])  # fmt: skip
+    assert code == 2
+    assert "(the CLI's --bin)" in capsys.readouterr().err
+
+
 def test_a_chunk_is_the_same_bytes_twice() -> None:
     r = validated(_request(from_speed="4000 rpm", to_speed="4100 rpm", rate="5000 rpm/s",
                            ensemble={"size": 2}))  # fmt: skip
@@ -346,6 +380,13 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
         assert r.design.readings == sweep.design.readings
         assert r.design.model_copy(update={"torque": sweep.design.torque}) == sweep.design
         assert (r.from_speed, r.to_speed) == (seen[0].from_speed, seen[0].to_speed)
+    assert seen[0].bin_rpm == 250.0  # the grid step
+    # three grid speeds: a 500 rpm step is over a quarter of the range, the bins a quarter
+    coarse = sweep_request({"design": doc.get("design", doc), "axes": [
+        {"parameter": "speed", "start": "3500 rpm", "stop": "4500 rpm", "num": 3},
+        {"parameter": "torque", "start": "10 N*m", "stop": "40 N*m", "num": 2}]})  # fmt: skip
+    assert gate.gate_envelope(report, coarse, 1000.0).runup.bin_rpm == 250.0  # type: ignore[union-attr]
+    assert seen[-1].bin_rpm == 250.0
 
 
 def test_the_assembly_reads_the_design_converted_with_the_plan(
