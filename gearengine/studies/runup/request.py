@@ -161,7 +161,9 @@ class RunupRequest(ParamsOrDesign):
     ensemble: Ensemble = Field(default_factory=Ensemble)
     quasi_static: SimulationSettings = Field(
         default_factory=lambda: SimulationSettings(**QUASI_STATIC_SETTINGS),  # type: ignore[arg-type]
-        description="Settings of each point of the quasi-static continuation sweep (bin centres).",
+        description="Settings of each point of the quasi-static continuation sweep (bin "
+        "centres); its starts are the loop's own (the members' start, then where the first line "
+        "ended), not initial_state or other starts given here.",
     )
     label: str | None = Field(None, max_length=200, description="The client's name for it.")
 
