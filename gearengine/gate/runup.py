@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 from gearengine.gate.envelope import EnvelopeReport, FailingWindow, RunupCheck
 from gearengine.gate.rules import Rules
-from gearengine.model.units import RPM
+from gearengine.model.units import RPM, shown
 from gearengine.studies.runup.compute import run_local
 from gearengine.studies.runup.profile import validated
 from gearengine.studies.runup.reading import transient_chaos
@@ -131,8 +131,9 @@ def gate_envelope(
         found += runup_failures(run_local(request, workers=workers), report.rules, level)
         if progress is not None:
             progress(k + 1, len(levels))
-    ran = RunupCheck(rate_rpm_s=rate_rpm_s, speeds_rpm=[lo, hi], directions=["up", "down"],
-                     bin_rpm=ramp["bin_rpm"], ensemble=GATE_ENSEMBLE, levels=levels,
+    ran = RunupCheck(rate_rpm_s=rate_rpm_s, speeds_rpm=[shown(lo), shown(hi)],
+                     directions=["up", "down"], bin_rpm=shown(ramp["bin_rpm"]),
+                     ensemble=GATE_ENSEMBLE, levels=levels,
                      failing_windows=len(found))  # fmt: skip
     failures = [*report.failures, *found]
     return report.model_copy(update={"failures": failures, "passed": not failures, "runup": ran})
