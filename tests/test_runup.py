@@ -210,6 +210,40 @@ def test_bad_ramps_are_refused_naming_the_field(fields: dict, path: str, words: 
     assert any(line.startswith(f"{path}:") and words in line for line in lines), lines
 
 
+def test_a_bin_wider_than_a_quarter_of_the_range_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """``runup --bin 10000`` over 1000-6000 rpm ran one bin over the whole range, its FTLE
+    averaged over it, and the chaotic bins 50 rpm bins find vanished unsaid (new-user review of
+    issue 30): a bin wider than a quarter of the range is refused, naming the field (and the
+    option) in the library, the API and the CLI; the default 50 rpm stays allowed on a narrow
+    profile (4000-4100 rpm: two bins)."""
+    from fastapi.testclient import TestClient
+
+    from service.core.config import Settings
+    from service.main import create_app
+
+    ramp = _request(from_speed="1000 rpm", to_speed="6000 rpm", rate="2000 rpm/s")
+    with pytest.raises(ValidationError) as exc:
+        validated({**ramp, "bin_rpm": 1250.5})
+    (line,) = error_lines(exc.value)
+    assert line.startswith(
+        "bin_rpm: a bin of 1250.5 rpm is wider than a quarter of the profile's 1000-6000 rpm range"
+    )
+    assert "give at most 1250 rpm" in line
+    assert validated({**ramp, "bin_rpm": 1250}).bin_rpm == 1250
+    assert validated(_request(from_speed="4000 rpm", to_speed="4100 rpm", rate="5000 rpm/s"))
+    with TestClient(create_app(Settings(data_dir=tmp_path, workers=0))) as client:
+        r = client.post("/v1/runups", json={**ramp, "bin_rpm": 10000})
+    assert r.status_code == 422 and "bin_rpm" in r.text and "quarter" in r.text, r.text
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": CI_DESIGN}))
+    code = main(["runup", str(path), "--from", "1000", "--to", "6000", "--rate", "2000",
+                 "--bin", "10000"])  # fmt: skip
+    assert code == 2
+    assert "(the CLI's --bin)" in capsys.readouterr().err
+
+
 def test_a_chunk_is_the_same_bytes_twice() -> None:
     r = validated_runup(_request(from_speed="4000 rpm", to_speed="4100 rpm", rate="5000 rpm/s",
                            ensemble={"size": 2}))  # fmt: skip
@@ -264,6 +298,29 @@ def test_the_gate_runs_up_and_down_and_names_the_speeds(tmp_path: Path) -> None:
     assert down[0] < up[0] <= 4200 and up[1] == down[1] == 4400
 
 
+def test_a_passing_gate_says_which_run_ups_it_ran(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """``check --speed --torque --runup 2000`` that passed said nothing of its run-ups (no
+    rate, levels or result in the text or the JSON), though they took most of its time
+    (new-user review of issue 30): a pass says what it ran, in the text and the report."""
+    report = tmp_path / "report.json"
+    code = main(["check", str(ROOT / "examples" / "ci" / "design.json"), "--speed", "3500:3700",
+                 "--speed-points", "5", "--torque", "30:40", "--torque-points", "2",
+                 "--runup", "2000", "--json", str(report)])  # fmt: skip
+    assert code == 0
+    out = capsys.readouterr().out
+    assert (
+        "  run-ups: run-up and run-down at 2000 rpm/s through 3500-3700 rpm (50 rpm bins, 4 "
+        "starts) at each of the 2 levels, torque 30 N*m to torque 40 N*m: no failing window\n"
+    ) in out
+    ran = json.loads(report.read_text())["runup"]
+    assert (ran["rate_rpm_s"], ran["speeds_rpm"], ran["directions"]) == (
+        2000.0, [3500.0, 3700.0], ["up", "down"])  # fmt: skip
+    assert [lv["torque"]["value"] for lv in ran["levels"]] == [30.0, 40.0]
+    assert ran["failing_windows"] == 0
+
+
 def test_chaos_fails_the_gate_only_when_it_lasts(tmp_path: Path) -> None:
     """A run of chaotic bins fails after CHAOS_SECONDS, not before (the rule over time)."""
     r = validated_runup(_request(from_speed="4000 rpm", to_speed="4400 rpm", rate="4000 rpm/s",
@@ -299,6 +356,7 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
     import gearengine.gate.runup as gate
     from gearengine.gate.envelope import EnvelopeReport
     from gearengine.studies.runup.results import RunupResult
+    from gearengine.studies.sweep.points import PhysicalValue
     from gearengine.studies.sweep.request import validated as sweep_request
 
     seen: list[RunupRequest] = []
@@ -312,7 +370,7 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
     sweep = sweep_request({"design": doc.get("design", doc), "axes": [
         {"parameter": "speed", "start": "3500 rpm", "stop": "4500 rpm", "num": 5},
         {"parameter": "torque", "start": "10 N*m", "stop": "40 N*m", "num": 2}]})  # fmt: skip
-    levels = [{"torque": SimpleNamespace(value=t)} for t in (10.0, 40.0)]
+    levels = [{"torque": PhysicalValue(value=t, unit="N*m")} for t in (10.0, 40.0)]
     windows = [SimpleNamespace(level=lv) for lv in levels]
     sweep_result = SimpleNamespace(windows=windows)
     report = EnvelopeReport.model_construct(failures=[], rules=Rules(), sweep=sweep_result)
@@ -322,6 +380,13 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
         assert r.design.readings == sweep.design.readings
         assert r.design.model_copy(update={"torque": sweep.design.torque}) == sweep.design
         assert (r.from_speed, r.to_speed) == (seen[0].from_speed, seen[0].to_speed)
+    assert seen[0].bin_rpm == 250.0  # the grid step
+    # three grid speeds: a 500 rpm step is over a quarter of the range, the bins a quarter
+    coarse = sweep_request({"design": doc.get("design", doc), "axes": [
+        {"parameter": "speed", "start": "3500 rpm", "stop": "4500 rpm", "num": 3},
+        {"parameter": "torque", "start": "10 N*m", "stop": "40 N*m", "num": 2}]})  # fmt: skip
+    assert gate.gate_envelope(report, coarse, 1000.0).runup.bin_rpm == 250.0  # type: ignore[union-attr]
+    assert seen[-1].bin_rpm == 250.0
 
 
 def test_the_assembly_reads_the_design_converted_with_the_plan(
@@ -418,3 +483,46 @@ def test_a_quasi_static_jump_is_lagged_by_one_ramp_jump() -> None:
     first, second = with_lags(ramp, quasi, "up")
     assert (first.quasi_static_speed_rpm, first.lag_rpm) == (4050.0, 50.0)
     assert second.quasi_static_speed_rpm is None and second.lag_rpm is None
+
+
+@pytest.mark.parametrize("direction", ["up_down", "down"])
+def test_the_quasi_static_loop_joins_and_starts_where_the_ramp_does(direction: str) -> None:
+    """examples/ci/design.json from 3600 to 4000 rpm ends inside its hysteresis loop: two
+    responses coexist in the top bin (19 µm and 57 µm). The quasi-static down line started from
+    the sweep's default start in the backlash gap and took the 57 µm one, so the loop did not
+    join (18.7 µm up, 57.4 µm down in the top bin) and printed a down jump the ramp's run-down
+    never made (new-user review of issue 30, the z = 23/67 example over 1000-6000 rpm): the
+    down line continues from where the up line ended and, run down alone, starts from the
+    members' start (static contact), as the ramp does."""
+    r = validated(_request(from_speed="3600 rpm", to_speed="4000 rpm", rate="2000 rpm/s",
+                           direction=direction, ensemble={"size": 1}))  # fmt: skip
+    result = run_local(r)
+    up, down = result.quasi_static.up.points, result.quasi_static.down.points
+    assert down[0].speed_rpm == up[-1].speed_rpm == 3975.0
+    assert result.down is not None
+    first = result.down.bins[0].dte_peak_to_peak_um
+    assert first is not None and down[0].dte_peak_to_peak_um is not None
+    assert abs(down[0].dte_peak_to_peak_um - first) < 0.1 * first  # the ramp's response
+    if direction == "up_down":
+        assert down[0].dte_peak_to_peak_um == pytest.approx(up[-1].dte_peak_to_peak_um, rel=0.01)
+    assert result.quasi_static.down.jumps == [] == result.down.jumps
+    assert not any("start on different responses" in n for n in result.notes)
+
+
+def test_a_ramp_and_a_continuation_starting_apart_are_said_to() -> None:
+    """Where the ramp's first bin and the continuation at its centre differ as a jump does,
+    the notes say they start on different responses (not two silently different answers)."""
+    from gearengine.studies.runup.reading import start_note
+    from gearengine.studies.runup.results import RunupResult
+
+    golden = RunupResult.model_validate_json((ROOT / "tests/golden/runup-ci.json").read_text())
+    assert golden.down is not None
+    b_um = 50.0
+    assert start_note("down", golden.down, golden.quasi_static.down, b_um) is None
+    first = golden.down.bins[0].model_copy(update={"dte_peak_to_peak_um": 19.4})
+    apart = golden.down.model_copy(update={"bins": [first, *golden.down.bins[1:]]})
+    note = start_note("down", apart, golden.quasi_static.down, b_um)
+    assert note is not None and note.startswith(
+        "run-down and the quasi-static down start on different responses: 19.4 µm in the "
+        "ramp's first bin (4450-4500 rpm)"
+    )

@@ -244,6 +244,8 @@ def print_report(report: EnvelopeReport, design: Design | None = None) -> None:
         print(f"  note: {note}")
     if report.resolution is not None:
         print(f"  resolution: {report.resolution.text()}")
+    if report.runup is not None:
+        print(f"  run-ups: {report.runup.text()}")
     for w in report.failures:
         print(f"  {window_text(w)}")
     for line in windows_summary(report.windows, short, refined_levels(report)):

@@ -203,6 +203,38 @@ class FailingWindow(BaseModel):
     )
 
 
+class RunupCheck(BaseModel):
+    """What ``check --runup`` ran (``gate.runup.gate_envelope``): a run-up and run-down at one
+    rate through the envelope's speed range at each of its levels, and what they found."""
+
+    model_config = ConfigDict(frozen=True)
+
+    rate_rpm_s: float = Field(description="Ramp rate [rpm/s].")
+    speeds_rpm: list[float] = Field(description="[lowest, highest] speed [rpm] of each ramp.")
+    directions: list[str] = Field(description="The legs run at each level, in order.")
+    bin_rpm: float = Field(description="Width of a speed bin [rpm] (the grid's speed step).")
+    ensemble: int = Field(description="Perturbed starts of each bin's FTLE.")
+    levels: list[dict[str, PhysicalValue]] = Field(
+        description="The levels of the other axis run (one empty level: the design's torque)."
+    )
+    failing_windows: int = Field(description="Failing windows the run-ups found (in failures).")
+
+    def text(self) -> str:
+        """ "run-up and run-down at 2000 rpm/s through 1000-6000 rpm (50 rpm bins, 4 starts) at
+        each of the 5 levels, torque 5 N*m to torque 60 N*m: no failing window"."""
+        lo, hi = self.speeds_rpm
+        legs = " and ".join(f"run-{d}" for d in self.directions)
+        n = len(self.levels)
+        where = "at the design's torque" if n == 1 and not self.levels[0] else (
+            f"at the level {level_text(self.levels[0])}" if n == 1 else
+            f"at each of the {n} levels, {level_text(self.levels[0])} to "
+            f"{level_text(self.levels[-1])}")  # fmt: skip
+        k = self.failing_windows
+        found = "no failing window" if k == 0 else f"{k} failing window{'s' if k != 1 else ''}"
+        ramp = f"{legs} at {self.rate_rpm_s:g} rpm/s through {lo:g}-{hi:g} rpm"
+        return f"{ramp} ({self.bin_rpm:.4g} rpm bins, {self.ensemble} starts) {where}: {found}"
+
+
 class EnvelopeReport(BaseModel):
     """The verdict of the gate over an envelope (``gearengine check --speed --torque``)."""
 
@@ -233,6 +265,9 @@ class EnvelopeReport(BaseModel):
         "checked by the same rules; their failures are in failures.",
     )  # fmt: skip
     notes: list[str] = Field([], description="How the rules were read, where it needs saying.")
+    runup: RunupCheck | None = Field(
+        None, description="What check --runup ran and found (null: no run-ups ran)."
+    )
 
 
 def _level_key(p: SweepPoint) -> tuple:

@@ -13,12 +13,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from gearengine.gate.envelope import EnvelopeReport, FailingWindow
+from gearengine.gate.envelope import EnvelopeReport, FailingWindow, RunupCheck
 from gearengine.gate.rules import Rules
-from gearengine.model.units import RPM
+from gearengine.model.units import RPM, shown
 from gearengine.studies.runup.compute import run_local
 from gearengine.studies.runup.profile import validated_runup
 from gearengine.studies.runup.reading import transient_chaos
+from gearengine.studies.runup.request import widest_bin_rpm
 from gearengine.studies.runup.results import RunupBin, RunupResult
 from gearengine.studies.sweep.points import PhysicalValue
 from gearengine.studies.sweep.request import SweepRequest
@@ -101,8 +102,9 @@ def gate_envelope(
     progress: Callable[[int, int], None] | None = None, workers: int = 1,
 ) -> EnvelopeReport:  # fmt: skip
     """``report`` with the failing windows of a run-up and run-down at ``rate_rpm_s`` [rpm/s]
-    through the envelope sweep's speed range (its grid step as the bins) at each of its torque
-    levels. Raises ``ValidationError`` naming the field of a bad ramp.
+    through the envelope sweep's speed range (its grid step as the bins, at most a quarter of
+    the range: ``widest_bin_rpm``) at each of its torque levels, and what ran (``runup``).
+    Raises ``ValidationError`` naming the field of a bad ramp.
 
     The sweep's design is validated already (every corner of its grid, ``request_errors``):
     each level's run-up carries it, at the level's torque, as the validated ``Design`` it is,
@@ -117,15 +119,21 @@ def gate_envelope(
     ramp = {
         "from_speed": f"{lo!r} rpm", "to_speed": f"{hi!r} rpm",
         "rate": f"{rate_rpm_s!r} rpm/s", "direction": "up_down",
-        "bin_rpm": (hi - lo) / (axis.num - 1), "ensemble": {"size": GATE_ENSEMBLE},
+        "bin_rpm": min((hi - lo) / (axis.num - 1), widest_bin_rpm(lo, hi)),
+        "ensemble": {"size": GATE_ENSEMBLE},
     }  # fmt: skip
     levels = [w.level for w in report.sweep.windows or []] or [{}]
-    failures = list(report.failures)
+    found: list[FailingWindow] = []
     for k, level in enumerate(levels):
         at_level = design if "torque" not in level else (
             design.model_copy(update={"torque": level["torque"].value}))  # fmt: skip
         request = validated_runup({"design": at_level, **ramp})
-        failures += runup_failures(run_local(request, workers=workers), report.rules, level)
+        found += runup_failures(run_local(request, workers=workers), report.rules, level)
         if progress is not None:
             progress(k + 1, len(levels))
-    return report.model_copy(update={"failures": failures, "passed": not failures})
+    ran = RunupCheck(rate_rpm_s=rate_rpm_s, speeds_rpm=[shown(lo), shown(hi)],
+                     directions=["up", "down"], bin_rpm=shown(ramp["bin_rpm"]),
+                     ensemble=GATE_ENSEMBLE, levels=levels,
+                     failing_windows=len(found))  # fmt: skip
+    failures = [*report.failures, *found]
+    return report.model_copy(update={"failures": failures, "passed": not failures, "runup": ran})

@@ -1,8 +1,16 @@
 """Computing a run-up as a job: one chunk per ensemble member (the whole profile on the
 integrated driver angle through the system's ``run_ramp``: the pair's kink-accurate RK4,
 ``systems.spur_pair.kernels.ramp``, or a train's, ``systems.gear_train.ramp``), and the two
-lines of the quasi-static continuation sweep (up and down, ``studies.sweep.compute``, on the bin
-centres); the assembly reads them into bins, jumps and lags (``studies.runup.reading``).
+quasi-static continuation loop in one more (``studies.sweep.compute``, on the bin centres); the
+assembly reads them into bins, jumps and lags (``studies.runup.reading``).
+
+The loop is traced as the profile first travels (up then down, or down then up for a profile
+that starts by falling): its first line from the state the members settle from (the static
+contact x = 1 + F~_m, v = 0), the second continuing from the state the first ended in, as the
+ramp's run-down continues from where its run-up ended; one chunk, as its lines depend on each
+other. (Two independent lines, the down one from the sweep's default start in the backlash gap,
+gave the z = 23/67 example a loop that did not join: 7.9 µm up and 18.3 µm down in the top bin,
+and a down jump the ramp's run-down in the same output never made.)
 
 Member m starts from the state of the settling (``settle_periods`` mesh periods at the start
 speed from the static contact x = 1 + F~_m, v = 0; a train's shafts and bearings at their static
@@ -13,6 +21,7 @@ on (request, index), so a resumed job gives the same bytes.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from collections.abc import Callable
@@ -21,15 +30,22 @@ import numpy as np
 
 from gearengine.model.units import RPM
 from gearengine.studies import jobs
-from gearengine.studies.runup.profile import RunupPlan, mid_speeds_rpm, runup_plan, segment_angle
+from gearengine.studies.runup.profile import (
+    Branch,
+    RunupPlan,
+    mid_speeds_rpm,
+    runup_plan,
+    segment_angle,
+)
 from gearengine.studies.runup.reading import read_runup
 from gearengine.studies.runup.request import RunupRequest, n_bins
 from gearengine.studies.runup.results import RunupResult
+from gearengine.studies.sweep.compute import continuation_line, starting_from
 from gearengine.studies.sweep.plan import sweep_work
 from gearengine.studies.sweep.request import SweepRequest
 
-QUASI_STATIC_CHUNKS = 2
-"""Chunks after the members: the up and the down line of the continuation sweep."""
+QUASI_STATIC_CHUNKS = 1
+"""Chunks after the members: the quasi-static loop (its second line continues the first)."""
 
 
 def member_blocks(request: RunupRequest, plan: RunupPlan, member: int) -> list[list[float | None]]:
@@ -63,8 +79,12 @@ def member_blocks(request: RunupRequest, plan: RunupPlan, member: int) -> list[l
     return rows
 
 
-def quasi_static_request(request: RunupRequest) -> SweepRequest:
-    """The continuation sweep, up and down, on the centres of the run-up's speed bins.
+def quasi_static_request(
+    request: RunupRequest, direction: str = "both", start: list[float] | None = None
+) -> SweepRequest:
+    """The continuation sweep on the centres of the run-up's speed bins: ``direction``
+    "both" (the loop's document, its cost) or one line ("forward" up, "backward" down) from
+    ``start`` [x, v] (None: the request's ``quasi_static`` starts).
 
     The design's torque is a second axis of one value: a one-axis line would also locate its
     bifurcation points by Newton shooting, which the run-up does not read (and which costs
@@ -75,10 +95,11 @@ def quasi_static_request(request: RunupRequest) -> SweepRequest:
     lo, hi = (w / RPM for w in request.speed_range())
     n = n_bins(lo, hi, request.bin_rpm)
     first, last = lo + 0.5 * request.bin_rpm, lo + (n - 0.5) * request.bin_rpm
+    settings = request.quasi_static
     return SweepRequest.model_validate(
         {
             "design": request.design,
-            "settings": request.quasi_static,
+            "settings": settings if start is None else starting_from(settings, start),
             "axes": [
                 {
                     "parameter": "speed",
@@ -89,7 +110,7 @@ def quasi_static_request(request: RunupRequest) -> SweepRequest:
                 {"parameter": "torque", "start": torque, "stop": torque, "num": 1},
             ],
             "continuation": True,
-            "direction": "both",
+            "direction": direction,
             "outputs": [
                 "classification",
                 "lle",
@@ -102,8 +123,34 @@ def quasi_static_request(request: RunupRequest) -> SweepRequest:
     )
 
 
+def loop_order(request: RunupRequest) -> tuple[Branch, Branch]:
+    """The quasi-static loop's lines in the order the profile first travels: ("down", "up")
+    for a profile whose first change of speed is a fall, else ("up", "down")."""
+    speeds = [w for _, w in request.knots()]
+    falls = next((b < a for a, b in itertools.pairwise(speeds) if b != a), False)
+    return ("down", "up") if falls else ("up", "down")
+
+
+def quasi_static_loop(request: RunupRequest, plan: RunupPlan) -> dict[str, list[str]]:
+    """The quasi-static loop's chunk: ``{"quasi_static": [up line, down line]}`` (each the
+    sweep's chunk output), computed in ``loop_order``: the first line from the members' start
+    (x = 1 + F~_m, v = 0), the second from the state the first ended in (the start again if it
+    diverged)."""
+    start = [1.0 + plan.mean_force[0], 0.0]
+    texts: dict[str, str] = {}
+    for branch in loop_order(request):
+        line = quasi_static_request(request, SWEEP_DIRECTION[branch], start)
+        texts[branch], end = continuation_line(line, 0)
+        start = start if end is None else end
+    return {"quasi_static": [texts["up"], texts["down"]]}
+
+
+SWEEP_DIRECTION = {"up": "forward", "down": "backward"}
+"""A run-up branch's direction of the continuation sweep."""
+
+
 def chunk_counts(request: RunupRequest, size: int) -> list[int]:
-    """One unit of work per chunk: the members, then the two quasi-static lines."""
+    """One unit of work per chunk: the members, then the quasi-static loop."""
     return [1] * (request.ensemble.size + QUASI_STATIC_CHUNKS)
 
 
@@ -115,32 +162,34 @@ def work(request: RunupRequest) -> int:
 
 
 def compute_chunk(request: RunupRequest, index: int, chunk_points: int = 1) -> str:
-    """Chunk ``index`` as JSON text: a member's block table, or a quasi-static line."""
+    """Chunk ``index`` as JSON text: a member's block table, or the quasi-static loop."""
     members = request.ensemble.size
+    plan = runup_plan(request)
     if index < members:
-        return json.dumps({"member": index, "blocks": member_blocks(request, runup_plan(request),
-                                                                    index)})  # fmt: skip
-    sweep = jobs.kind("sweep")
-    return sweep.compute_chunk(quasi_static_request(request), index - members, 1)
+        return json.dumps({"member": index, "blocks": member_blocks(request, plan, index)})
+    if index - members >= QUASI_STATIC_CHUNKS:
+        raise IndexError(f"chunk {index} out of range 0..{members + QUASI_STATIC_CHUNKS - 1}")
+    return json.dumps(quasi_static_loop(request, plan))
 
 
 def assemble(request: RunupRequest, chunks: list[str]) -> RunupResult:
     """The run-up's document from its chunks in index order.
 
-    Chunks say what they hold (a member's ``{"member": m, "blocks": ...}`` or a quasi-static
-    line), so the finished chunks of an unfinished job (``?partial=true``) assemble too: the
-    lowest member present is read as the nominal one, a missing line leaves its branch empty.
+    Chunks say what they hold (a member's ``{"member": m, "blocks": ...}`` or the quasi-static
+    loop's ``{"quasi_static": [up, down]}``), so the finished chunks of an unfinished job
+    (``?partial=true``) assemble too: the lowest member present is read as the nominal one, a
+    missing loop leaves its branches empty.
     """
     members: list[list] = []
     lines: list[str] = []
     for text in chunks:
         doc = json.loads(text)
-        if isinstance(doc, dict) and "member" in doc:
+        if "member" in doc:
             members.append(doc["blocks"])
         else:
-            lines.append(text)
+            lines += doc["quasi_static"]
     quasi = jobs.kind("sweep").assemble(quasi_static_request(request), lines)
-    return read_runup(request, runup_plan(request), members, quasi)
+    return read_runup(request, runup_plan(request), members, quasi, loop_order(request))
 
 
 def run_local(

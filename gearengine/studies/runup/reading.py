@@ -60,6 +60,13 @@ CMIN, CMAX = 15, 16
 before they were added: the bin's contact force is then null)."""
 
 
+def differ(a: float, c: float, b_um: float) -> bool:
+    """True if two DTEs [µm] differ as much as a jump: by ``JUMP_RATIO`` times and by
+    ``JUMP_MIN_B`` half backlashes (``b_um`` µm each) or more."""
+    lo, hi = min(a, c), max(a, c)
+    return hi - lo >= JUMP_MIN_B * b_um and hi >= JUMP_RATIO * max(lo, 1e-12)
+
+
 def jumps(speeds: Sequence[float], dte: Sequence[float | None], b_um: float) -> list[RunupJump]:
     """Jumps along a sequence in the order travelled: ``speeds`` are the edges between entries
     i and i+1 (len(dte) - 1 of them), ``dte`` [µm] the amplitudes. A jump spread over
@@ -68,10 +75,7 @@ def jumps(speeds: Sequence[float], dte: Sequence[float | None], b_um: float) -> 
     steps: list[tuple[int, float, float]] = []
     for i in range(len(speeds)):
         a, c = dte[i], dte[i + 1]
-        if a is None or c is None:
-            continue
-        lo, hi = min(a, c), max(a, c)
-        if hi - lo >= JUMP_MIN_B * b_um and hi >= JUMP_RATIO * max(lo, 1e-12):
+        if a is not None and c is not None and differ(a, c, b_um):
             steps.append((i, a, c))
     groups: list[list[tuple[int, float, float]]] = []
     for step in steps:
@@ -232,11 +236,34 @@ def transient_note(name: str, spans: list[list[float]]) -> str:
             "check, with its basin starts, may find chaos there too)")  # fmt: skip
 
 
+def start_note(name: str, branch: RunupBranch, quasi: QuasiStaticBranch, b_um: float) -> str | None:
+    """A note when the ramp's branch ``name`` and the quasi-static one of the same direction
+    start on different responses: the DTE of the ramp's first bin and of the continuation at
+    its centre differ as a jump does (``differ``); None when they agree (or cannot be read)."""
+    first = branch.bins[0]
+    lo, hi = first.speed_rpm
+    centre = round(0.5 * (lo + hi), 6)
+    point = next((p for p in quasi.points if round(p.speed_rpm, 6) == centre), None)
+    a = first.dte_peak_to_peak_um
+    c = None if point is None else point.dte_peak_to_peak_um
+    if a is None or c is None or not differ(a, c, b_um):
+        return None
+    return (f"run-{name} and the quasi-static {name} start on different responses: "
+            f"{a:.3g} µm in the ramp's first bin ({lo:.0f}-{hi:.0f} rpm), {c:.3g} µm on the "
+            f"continuation at {centre:.0f} rpm (coexisting attractors, or the ramp's lag behind "
+            "a jump near its start)")  # fmt: skip
+
+
 def read_runup(
-    request: RunupRequest, plan: RunupPlan, tables: list[list], quasi: SweepResult
+    request: RunupRequest,
+    plan: RunupPlan,
+    tables: list[list],
+    quasi: SweepResult,
+    loop: tuple[Branch, Branch],
 ) -> RunupResult:
-    """The run-up's document from the members' block tables and the quasi-static sweep, read
-    with the system and conversion of ``plan`` (the design converted once)."""
+    """The run-up's document from the members' block tables and the quasi-static sweep (its
+    lines computed in the order ``loop``), read with the system and conversion of ``plan``
+    (the design converted once)."""
     design, system, conv = request.design, plan.system, plan.conversion
     assert design is not None
     arrays = [np.array(t, dtype=float).reshape(-1, len(t[0]) if t else CMAX + 1)
@@ -264,13 +291,18 @@ def read_runup(
         f"settled for {request.settle_periods} mesh periods at {request.knots()[0][1] / RPM:g} "
         "rpm before the profile starts",
         "the quasi-static loop is the continuation sweep at the design's torque "
-        f"({design.torque:g} N m), on the bin centres, up and down",
+        f"({design.torque:g} N m), on the bin centres, {' then '.join(loop)}: the {loop[0]} "
+        f"line from the members' start, the {loop[1]} line from where the {loop[0]} line ended",
     ]
     if request.to_torque is not None:
         notes.append(f"the torque ramps linearly in time to {request.to_torque:g} N m")
     for name, branch in branches.items():
-        spans = [] if branch is None else transient_chaos(branch, getattr(qs, name))
+        if branch is None:
+            continue
+        spans = transient_chaos(branch, getattr(qs, name))
         notes += [transient_note(name, spans)] if spans else []
+        apart = start_note(name, branch, getattr(qs, name), b_um)
+        notes += [apart] if apart is not None else []
     judged = melnikov_point(system)  # a train's mesh-mode reduction, when it holds
     windows = [] if judged is None else speed_windows(judged, conv.speed_rpm, lo, hi)
     if system.n > 2:

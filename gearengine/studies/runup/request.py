@@ -10,7 +10,9 @@ linearly in time from the design's torque to ``to_torque`` over the whole profil
 Refused before any compute (422 naming the field): a rate that is zero or negative, speeds
 outside the plausible range of a shaft (``model.units``), a profile whose integration is over
 the work budget (``MAX_RUNUP_STEPS``), a params-only request (a run-up needs the design's time
-scale), the cubic-fit law (the run-up kernel is the kink-accurate piecewise one).
+scale), the cubic-fit law (the run-up kernel is the kink-accurate piecewise one), a bin wider
+than a quarter of the speed range (``widest_bin_rpm``: one 5000 rpm bin averaged away the chaotic
+bins 50 rpm bins found).
 
 A design with a ``train`` runs as its ``System`` (``systems.designs.design_model``) on the
 scales of its equivalent pair: ``RunupRequest.model`` is the one door of the run-up room.
@@ -31,6 +33,7 @@ from gearengine.model.params import request_config
 from gearengine.model.reduction import DesignConversion, ParamsOrDesign
 from gearengine.model.units import (
     QUANTITIES,
+    RPM,
     Duration,
     Speed,
     Time,
@@ -100,6 +103,11 @@ class Ensemble(BaseModel):
     seed: int = Field(0, ge=0, description="Seed of numpy.random.default_rng.")
 
 
+DEFAULT_BIN_RPM = 50.0
+"""Width of a speed bin unless the request gives one [rpm]."""
+MIN_BINS = 4
+"""Fewest bins a profile's speed range is read in (unless they are no wider than the default)."""
+
 QUASI_STATIC_SETTINGS = {"transient_periods": 60, "record_periods": 40, "steps_per_period": 128}
 """Settings of each point of the quasi-static continuation sweep unless the request gives them."""
 
@@ -139,7 +147,9 @@ class RunupRequest(ParamsOrDesign):
         None, description="Torque at the end of the profile (linear in time from the design's)."
     )
     bin_rpm: float = Field(
-        50.0, gt=0.0, le=10_000.0, allow_inf_nan=False, description="Width of a speed bin [rpm]."
+        DEFAULT_BIN_RPM, gt=0.0, le=10_000.0, allow_inf_nan=False, description="Width of a "
+        f"speed bin [rpm]; at most a quarter of the profile's speed range ({MIN_BINS} bins), or "
+        f"{DEFAULT_BIN_RPM:g} rpm where that is wider."
     )  # fmt: skip
     steps_per_period: int = Field(
         64, ge=16, le=1000, description="RK4 steps per period of the fastest of the natural "
@@ -151,7 +161,9 @@ class RunupRequest(ParamsOrDesign):
     ensemble: Ensemble = Field(default_factory=Ensemble)
     quasi_static: SimulationSettings = Field(
         default_factory=lambda: SimulationSettings(**QUASI_STATIC_SETTINGS),  # type: ignore[arg-type]
-        description="Settings of each point of the quasi-static continuation sweep (bin centres).",
+        description="Settings of each point of the quasi-static continuation sweep (bin "
+        "centres); its starts are the loop's own (the members' start, then where the first line "
+        "ended), not initial_state or other starts given here.",
     )
     label: str | None = Field(None, max_length=200, description="The client's name for it.")
 
@@ -246,7 +258,21 @@ def request_errors(request: RunupRequest) -> list[InitErrorDetails]:
             add(("to_speed",), "must be above from_speed (direction down runs down)", hi)
         if (request.rate is None) == (request.duration is None):
             add(("rate",), "give rate or duration (one of them)", request.rate)
+    if not errors:  # a profile to read the speed range of
+        lo, hi = (w / RPM for w in request.speed_range())
+        widest = widest_bin_rpm(lo, hi)
+        if request.bin_rpm > widest:
+            add(("bin_rpm",), f"a bin of {request.bin_rpm:g} rpm is wider than a quarter of the "
+                f"profile's {lo:g}-{hi:g} rpm range ({MIN_BINS} bins at least): a bin's FTLE and "
+                "extremes are over its whole width, so chaos in part of it vanishes; give at "
+                f"most {widest:g} rpm (the CLI's --bin)", request.bin_rpm)  # fmt: skip
     return errors
+
+
+def widest_bin_rpm(lo_rpm: float, hi_rpm: float) -> float:
+    """The widest bin [rpm] a run-up over ``lo_rpm``..``hi_rpm`` [rpm] accepts: ``MIN_BINS``
+    bins over the range, or the default bin where that is wider (a narrow profile)."""
+    return max(DEFAULT_BIN_RPM, (hi_rpm - lo_rpm) / MIN_BINS)
 
 
 def n_bins(lo_rpm: float, hi_rpm: float, width: float) -> int:

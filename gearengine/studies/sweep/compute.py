@@ -130,11 +130,21 @@ def compute_chunk(
     return _compute(request, chunk_index, chunk_points)[0]
 
 
+def continuation_line(request: SweepRequest, chunk_index: int) -> tuple[str, list[float] | None]:
+    """Line ``chunk_index`` of a continuation sweep: its chunk output (as ``compute_chunk_json``
+    gives it) and the state [x, v] its last point ends in (None: it diverged), from which
+    another line may continue (a run-up's quasi-static loop: down from where up ended)."""
+    assert request.continuation, "only a continuation line ends in a state to carry on from"
+    points, bifurcations, end = _compute(request, chunk_index, DEFAULT_CHUNK_POINTS)
+    return chunk_json(points, bifurcations, request.outputs), end
+
+
 def _compute(
     request: SweepRequest, chunk_index: int, chunk_points: int
-) -> tuple[list[SweepPoint], list[SweepBifurcation] | None]:
-    """A chunk's points and, for a line of a one-axis continuation sweep, the bifurcation
-    points located on it (``numerics.bifurcations``; None for other chunks)."""
+) -> tuple[list[SweepPoint], list[SweepBifurcation] | None, list[float] | None]:
+    """A chunk's points, for a line of a one-axis continuation sweep the bifurcation points
+    located on it (``numerics.bifurcations``; None for other chunks), and for a continuation
+    line the state its last point ends in (None otherwise, or if it diverged)."""
     chunk = SweepPlan(request, chunk_points).chunk(chunk_index)
     axes = request.axes
     grids = request.grids()
@@ -142,7 +152,7 @@ def _compute(
     scaled = [request.scaled_point(v) for v in values]
     designs = [params for params, _ in scaled]
     if not request.continuation:
-        return _points(request, values, chunk.branch, scaled), None
+        return _points(request, values, chunk.branch, scaled), None, None
     verdicts = []
     settings = request.settings
     for design in designs:
@@ -150,10 +160,12 @@ def _compute(
         verdicts.append(bp)
         settings = _carried(request.settings, bp)
     points = _points(request, values, chunk.branch, scaled, verdicts)
+    last = verdicts[-1].final_state if verdicts else None
+    end = None if last is None else [float(c) for c in last]
     if len(axes) != 1 or len(values) < 2:
-        return points, None
+        return points, None, end
     line = [v[axes[0].parameter] for v in values]
-    return points, _line_bifurcations(request, line, designs, verdicts)
+    return points, _line_bifurcations(request, line, designs, verdicts), end
 
 
 def points_at(request: SweepRequest, values: list[dict[str, float]]) -> list[SweepPoint]:
@@ -286,17 +298,19 @@ def _carried(settings: SimulationSettings, bp: BatchPoint) -> SimulationSettings
     """Settings starting from the final state of ``bp`` (the original starts if it diverged)."""
     if bp.final_state is None:
         return settings
+    return starting_from(settings, list(bp.final_state))
+
+
+def starting_from(settings: SimulationSettings, state: list[float]) -> SimulationSettings:
+    """``settings`` with one start, ``state`` [x, v] (its other starts dropped)."""
     return settings.model_copy(
-        update={
-            "initial_state": list(bp.final_state),
-            "initial_states": None,
-            "random_initial_states": None,
-        }
+        update={"initial_state": state, "initial_states": None, "random_initial_states": None}
     )
 
 
 def _chunk_text(request: SweepRequest, chunk_index: int, chunk_points: int) -> str:
-    return chunk_json(*_compute(request, chunk_index, chunk_points), request.outputs)
+    points, bifurcations, _ = _compute(request, chunk_index, chunk_points)
+    return chunk_json(points, bifurcations, request.outputs)
 
 
 def compute_chunk_json(request_json: str, chunk_index: int, chunk_points: int) -> str:
