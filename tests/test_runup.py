@@ -225,14 +225,14 @@ def test_a_bin_wider_than_a_quarter_of_the_range_is_refused(
 
     ramp = _request(from_speed="1000 rpm", to_speed="6000 rpm", rate="2000 rpm/s")
     with pytest.raises(ValidationError) as exc:
-        validated({**ramp, "bin_rpm": 1250.5})
+        validated_runup({**ramp, "bin_rpm": 1250.5})
     (line,) = error_lines(exc.value)
     assert line.startswith(
         "bin_rpm: a bin of 1250.5 rpm is wider than a quarter of the profile's 1000-6000 rpm range"
     )
     assert "give at most 1250 rpm" in line
-    assert validated({**ramp, "bin_rpm": 1250}).bin_rpm == 1250
-    assert validated(_request(from_speed="4000 rpm", to_speed="4100 rpm", rate="5000 rpm/s"))
+    assert validated_runup({**ramp, "bin_rpm": 1250}).bin_rpm == 1250
+    assert validated_runup(_request(from_speed="4000 rpm", to_speed="4100 rpm", rate="5000 rpm/s"))
     with TestClient(create_app(Settings(data_dir=tmp_path, workers=0))) as client:
         r = client.post("/v1/runups", json={**ramp, "bin_rpm": 10000})
     assert r.status_code == 422 and "bin_rpm" in r.text and "quarter" in r.text, r.text
@@ -494,7 +494,7 @@ def test_the_quasi_static_loop_joins_and_starts_where_the_ramp_does(direction: s
     never made (new-user review of issue 30, the z = 23/67 example over 1000-6000 rpm): the
     down line continues from where the up line ended and, run down alone, starts from the
     members' start (static contact), as the ramp does."""
-    r = validated(_request(from_speed="3600 rpm", to_speed="4000 rpm", rate="2000 rpm/s",
+    r = validated_runup(_request(from_speed="3600 rpm", to_speed="4000 rpm", rate="2000 rpm/s",
                            direction=direction, ensemble={"size": 1}))  # fmt: skip
     result = run_local(r)
     up, down = result.quasi_static.up.points, result.quasi_static.down.points
