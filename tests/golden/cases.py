@@ -87,7 +87,7 @@ CASES: dict[str, list[str]] = {
         "--speed",
         "5000:6000",
         "--torque",
-        "5:10",
+        "5:5",
         "--speed-points",
         "2",
         "--torque-points",
