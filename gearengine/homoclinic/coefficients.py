@@ -304,8 +304,8 @@ def melnikov_coefficients(
             omega = r * exc.frequency
             unit = how.term(name, omega, a, c, branch, fm)
             phase = 0.0 if h is None else h.phase
-            terms.append(
-                Term.model_construct(
+            terms.append(  # validated: pydantic-core does it in half model_construct's time
+                Term(
                     excitation=name,
                     r=r,
                     frequency=omega,
@@ -314,7 +314,7 @@ def melnikov_coefficients(
                     per_unit=unit,
                 )
             )
-    return BranchCoefficients.model_construct(
+    return BranchCoefficients(
         damping=per_unit_damping * params.damping, damping_per_unit=per_unit_damping, terms=terms
     )
 
@@ -331,7 +331,7 @@ def active_only(coef: BranchCoefficients, params: GearParams) -> BranchCoefficie
     ]
     if all(amp != 0.0 for amp in amplitudes):
         return coef  # no inactive harmonic to drop
-    return BranchCoefficients.model_construct(
+    return BranchCoefficients(
         damping=coef.damping,
         damping_per_unit=coef.damping_per_unit,
         terms=[t for t, amp in zip(coef.terms, amplitudes, strict=True) if amp != 0.0],
