@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
 
 import pytest
@@ -216,6 +217,27 @@ def test_health_ready_metrics(client: TestClient) -> None:
     text = client.get("/metrics").text
     assert 'gearchaos_requests_total{method="POST",route="/v1/melnikov",status="200"}' in text
     assert "gearchaos_request_duration_seconds_bucket" in text
+
+
+def test_access_log_line_and_counts(client: TestClient, caplog: pytest.LogCaptureFixture) -> None:
+    """Each request logs one JSON line (with its key id under auth) and counts once per route,
+    method and status: the middleware keeps the metrics' children, so a second status of the
+    same route has its own count."""
+    with caplog.at_level(logging.INFO, logger="gearchaos.access"):
+        for _ in range(2):
+            client.post("/v1/melnikov", json={"params": PAPER_PARAMS})
+        client.post("/v1/melnikov", json={"params": {"damping": -1}})
+    lines = [json.loads(r.getMessage()) for r in caplog.records if r.name == "gearchaos.access"]
+    assert [(x["route"], x["method"], x["status"]) for x in lines] == [
+        ("/v1/melnikov", "POST", 200),
+        ("/v1/melnikov", "POST", 200),
+        ("/v1/melnikov", "POST", 422),
+    ]
+    assert all(x["event"] == "request" and x["duration_ms"] >= 0.0 for x in lines)
+    assert all(x["key_id"] is None for x in lines)
+    text = client.get("/metrics").text
+    assert 'gearchaos_requests_total{method="POST",route="/v1/melnikov",status="200"} 2.0' in text
+    assert 'gearchaos_requests_total{method="POST",route="/v1/melnikov",status="422"} 1.0' in text
 
 
 def test_committed_openapi_matches_the_app() -> None:
