@@ -95,10 +95,17 @@ class BodyLimit:
 
 
 class AccessLog:
-    """One structured JSON log line and the metrics of every request."""
+    """One structured JSON log line and the metrics of every request.
+
+    The metrics' children are kept per (route, method, status), looked up once each (a
+    ``labels()`` call validates and locks); the log record is made without ``findCaller``'s walk
+    of the stack (its caller is always this middleware, and the line is the JSON alone). Both
+    cost a tenth of a health request's CPU otherwise.
+    """
 
     def __init__(self, app: ASGIApp, metrics: Metrics) -> None:
         self.app, self.metrics = app, metrics
+        self._children: dict[tuple[str, str, int], tuple[Any, Any]] = {}
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] != "http":
@@ -118,10 +125,11 @@ class AccessLog:
         finally:
             elapsed = time.perf_counter() - start
             route = _route_of(scope)
-            self.metrics.requests.labels(route, scope["method"], str(status)).inc()
-            self.metrics.latency.labels(route).observe(elapsed)
-            access_log.info(
-                json.dumps(
+            count, latency = self._metrics_of(route, scope["method"], status)
+            count.inc()
+            latency.observe(elapsed)
+            if access_log.isEnabledFor(logging.INFO):
+                line = json.dumps(
                     {
                         "event": "request",
                         "method": scope["method"],
@@ -131,7 +139,21 @@ class AccessLog:
                         "key_id": scope.get("state", {}).get("key_id"),
                     }
                 )
+                record = access_log.makeRecord(
+                    access_log.name, logging.INFO, __file__, 0, line, (), None
+                )
+                access_log.handle(record)
+
+    def _metrics_of(self, route: str, method: str, status: int) -> tuple[Any, Any]:
+        """(request counter, latency histogram) children of a route, method and status (as many
+        as the metrics' own label sets)."""
+        children = self._children.get((route, method, status))
+        if children is None:
+            children = self._children[(route, method, status)] = (
+                self.metrics.requests.labels(route, method, str(status)),
+                self.metrics.latency.labels(route),
             )
+        return children
 
 
 def _route_of(scope: dict[str, Any]) -> str:

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
+import logging
 from pathlib import Path
 
 import pytest
@@ -216,6 +218,63 @@ def test_health_ready_metrics(client: TestClient) -> None:
     text = client.get("/metrics").text
     assert 'gearchaos_requests_total{method="POST",route="/v1/melnikov",status="200"}' in text
     assert "gearchaos_request_duration_seconds_bucket" in text
+
+
+def test_access_log_line_and_counts(client: TestClient, caplog: pytest.LogCaptureFixture) -> None:
+    """Each request logs one JSON line (with its key id under auth) and counts once per route,
+    method and status: the middleware keeps the metrics' children, so a second status of the
+    same route has its own count."""
+    with caplog.at_level(logging.INFO, logger="gearchaos.access"):
+        for _ in range(2):
+            client.post("/v1/melnikov", json={"params": PAPER_PARAMS})
+        client.post("/v1/melnikov", json={"params": {"damping": -1}})
+    lines = [json.loads(r.getMessage()) for r in caplog.records if r.name == "gearchaos.access"]
+    assert [(x["route"], x["method"], x["status"]) for x in lines] == [
+        ("/v1/melnikov", "POST", 200),
+        ("/v1/melnikov", "POST", 200),
+        ("/v1/melnikov", "POST", 422),
+    ]
+    assert all(x["event"] == "request" and x["duration_ms"] >= 0.0 for x in lines)
+    assert all(x["key_id"] is None for x in lines)
+    text = client.get("/metrics").text
+    assert 'gearchaos_requests_total{method="POST",route="/v1/melnikov",status="200"} 2.0' in text
+    assert 'gearchaos_requests_total{method="POST",route="/v1/melnikov",status="422"} 1.0' in text
+
+
+ONE = (
+    '{"damping": 0.05, "transmission_error": {"frequency": 0.5, "harmonics": [{"amplitude": 0.2}]}}'
+)
+VERDICT_BODIES = [
+    '{"params": ' + ONE + "}",
+    '{"params": ' + ONE + ', "params": {"damping": 0.07}}',  # a duplicate key
+    '{"params": {"damping": 1, "torque": {"frequency": 1, "harmonics": [{"amplitude": -0}]}}}',
+    '{"params": ' + ONE + ', "method": "quadrature"}',
+    '{"params": ' + ONE + ', "extra": 1}',
+    '{"params": {"damping": 1e400}}',
+    '{"params": {"damping": NaN}}',
+    '{"params": {"damping": "0.05"}}',
+    "[]",
+    "",
+    '{"params": {"damping": 0.05}, "design": {}}',
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("body", VERDICT_BODIES)
+@pytest.mark.parametrize("key", [None, "team-a-secret", "wrong"])
+def test_verdict_route_answers_as_fastapi(tmp_path: Path, body: str, key: str | None) -> None:
+    """POST /v1/melnikov takes a short path for an application/json body that validates
+    (``VerdictRoute``); every body answers as FastAPI's own handler does (here under a +json
+    media type, which only FastAPI's handler reads): status, problem and verdict bytes, with
+    and without a valid API key."""
+    (tmp_path / "api_keys.sha256").write_text(hashlib.sha256(b"team-a-secret").hexdigest())
+    keys = {"x-api-key": key} if key else {}
+    with TestClient(create_app(Settings(data_dir=tmp_path, workers=0))) as c:
+        answers = [
+            c.post("/v1/melnikov", content=body.encode(), headers={"content-type": media, **keys})
+            for media in ("application/json", "application/vnd.gearchaos+json")
+        ]
+    short, fastapi = ((r.status_code, r.content) for r in answers)
+    assert short == fastapi
 
 
 def test_committed_openapi_matches_the_app() -> None:

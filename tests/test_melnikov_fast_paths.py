@@ -21,7 +21,13 @@ from gearengine.homoclinic import loops
 from gearengine.homoclinic.extrema import extrema
 from gearengine.homoclinic.perturbations import SAMPLES, loop_extremes
 from gearengine.homoclinic.terms import packed_terms
-from gearengine.homoclinic.thresholds import OMEGA_SCAN, _scan_compiled, _scan_python
+from gearengine.homoclinic.thresholds import (
+    CONTROL_PARAMETERS,
+    OMEGA_SCAN,
+    _family,
+    _scan_compiled,
+    _scan_python,
+)
 from gearengine.model.params import GearParams
 
 LAWS = [(0.1667, 0.1667), (1.0, 0.7), (0.3, 2.0), (2.0, 0.05), (0.01, 5.0)]
@@ -165,3 +171,39 @@ def test_compiled_scan_equals_the_documents(excitations: tuple[str, ...]) -> Non
             python = _scan_python(p, 0.1667, 0.1667, OMEGA_SCAN, value, "closed_form", fm)
             assert found[0] == pytest.approx(python[0], rel=1e-9)
             assert np.array(found[1]) == pytest.approx(np.array(python[1]), rel=1e-9)
+
+
+@pytest.mark.parametrize("load", [-0.6, 0.0, 0.8])
+def test_one_sinusoid_floats_equal_the_arrays(load: float) -> None:
+    """A branch of one sinusoid is read as floats, without arrays (``BranchCoefficients.extrema``
+    and ``thresholds._family`` with no trig sum): the extrema bit for bit those of its
+    ``TrigSum``, and each control parameter's family (its harmonic present, inactive with a zero
+    amplitude, or absent) the same m0 and g as the family split from the arrays, for every
+    excitation, amplitude sign and phase."""
+    a, c, omega = 0.1667, 0.1667, 0.7
+    fm = load * mk.critical_mean_force(a, c)
+    taus = np.linspace(0.0, 2.0 * math.pi / omega, 7)
+    for name in EXCITATIONS:
+        for amplitude, phase in ((0.2, 0.0), (-0.15, 1.3), (0.0, 0.4)):
+            harmonic = {"amplitude": amplitude, "phase": phase}
+            p = GearParams.model_validate(
+                {
+                    "damping": 0.05,
+                    "mean_force": fm,
+                    name: {"frequency": omega, "harmonics": [harmonic]},
+                }
+            )
+            for br in mk.BRANCH_SIGN:
+                units = mk.melnikov_coefficients(p, a, c, br, include_inactive=True, fm=fm)
+                active = mk.active_only(units, p)
+                assert active.extrema(2.0 * math.pi / omega) == extrema(active.trig_sum())
+                for parameter in CONTROL_PARAMETERS:
+                    floats = _family(units, None, parameter)
+                    arrays = _family(units, units.trig_sum(), parameter)
+                    if arrays is None:
+                        assert floats is None
+                        continue
+                    off0, offg, a0, ag = floats
+                    sine = np.sin(omega * taus + units.terms[0].phase)
+                    assert arrays[0](taus).tolist() == (off0 + a0 * sine).tolist()
+                    assert arrays[1](taus).tolist() == (offg + ag * sine).tolist()

@@ -2,8 +2,15 @@
 
 from __future__ import annotations
 
+import io
+import logging
 import subprocess
 import sys
+import time
+
+import pytest
+
+from service.server import flush_log, log_to_stderr
 
 PROGRAM = """
 import logging, signal
@@ -28,3 +35,35 @@ def test_queued_lines_are_written_before_the_signal_ends_the_process() -> None:
     """20,000 lines queued at once (a loaded server stopping) all reach stderr: the servers'
     shutdown calls ``flush_log``, as here; atexit does not run once the signal is re-raised."""
     assert lines_written("flush_log()") == 20000
+
+
+class CountingStream(io.StringIO):
+    """stderr that counts its writes."""
+
+    writes = 0
+
+    def write(self, text: str) -> int:
+        self.writes += 1
+        return super().write(text)
+
+
+def test_lines_are_written_in_batches(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Lines logged one at a time, as requests come, are written whole and in order, many to a
+    write: a wake-up of the log thread and a write a line took the GIL from the event loop
+    once a request."""
+    stream = CountingStream()
+    monkeypatch.setattr(sys, "stderr", stream)
+    root = logging.getLogger()
+    handlers, level = root.handlers[:], root.level
+    try:
+        log_to_stderr()
+        for i in range(50):
+            logging.getLogger("gearchaos.access").info('{"event": "request", "n": %d}', i)
+            time.sleep(0.001)
+        flush_log()
+    finally:
+        root.handlers[:], root.level = handlers, level
+    assert stream.getvalue().splitlines() == [
+        f'{{"event": "request", "n": {i}}}' for i in range(50)
+    ]
+    assert stream.writes <= 5

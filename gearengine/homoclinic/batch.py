@@ -34,7 +34,7 @@ from gearengine.homoclinic.coefficients import (
     loop_load,
     saddle_loop,
 )
-from gearengine.homoclinic.extrema import NEGLIGIBLE, extrema
+from gearengine.homoclinic.extrema import NEGLIGIBLE
 from gearengine.homoclinic.kernels import (
     AMPLITUDE,
     FUNDAMENTAL,
@@ -187,7 +187,7 @@ def design_verdict(p: GearParams, mean_load: MeanLoad = "unperturbed") -> BatchV
         }
     chaos, period = False, poincare_period(p)
     for br in BRANCH_SIGN:
-        ext = extrema(active_only(units[br], p).trig_sum(), period)
+        ext = active_only(units[br], p).extrema(period)
         chaos = chaos or ext.minimum.value < 0.0 < ext.maximum.value
     margins: dict[str, Margin] = {}
     for q in CONTROL_PARAMETERS:

@@ -43,7 +43,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.homoclinic import kernels, loops
-from gearengine.homoclinic.extrema import TrigSum
+from gearengine.homoclinic.extrema import Extrema, TrigSum, extrema, single_extrema
 from gearengine.homoclinic.terms import system_array
 from gearengine.model.params import GearParams
 
@@ -129,6 +129,14 @@ class BranchCoefficients(BaseModel):
             np.array([t.frequency for t in self.terms]),
             np.array([t.phase for t in self.terms]),
         )
+
+    def extrema(self, period: float | None = None) -> Extrema:
+        """``extrema.extrema`` of ``trig_sum()`` (``period``: a common period known beforehand);
+        one sinusoid on the floats of its term (``single_extrema``), without arrays."""
+        if len(self.terms) == 1 and self.terms[0].coefficient != 0.0:
+            term = self.terms[0]
+            return single_extrema(self.damping, term.coefficient, term.frequency, term.phase)
+        return extrema(self.trig_sum(), period)
 
     def __call__(self, tau0: np.ndarray | float) -> np.ndarray | float:
         """Evaluate M at tau0 (array or scalar, dimensionless time)."""
@@ -296,8 +304,8 @@ def melnikov_coefficients(
             omega = r * exc.frequency
             unit = how.term(name, omega, a, c, branch, fm)
             phase = 0.0 if h is None else h.phase
-            terms.append(
-                Term.model_construct(
+            terms.append(  # validated: pydantic-core does it in half model_construct's time
+                Term(
                     excitation=name,
                     r=r,
                     frequency=omega,
@@ -306,7 +314,7 @@ def melnikov_coefficients(
                     per_unit=unit,
                 )
             )
-    return BranchCoefficients.model_construct(
+    return BranchCoefficients(
         damping=per_unit_damping * params.damping, damping_per_unit=per_unit_damping, terms=terms
     )
 
@@ -323,7 +331,7 @@ def active_only(coef: BranchCoefficients, params: GearParams) -> BranchCoefficie
     ]
     if all(amp != 0.0 for amp in amplitudes):
         return coef  # no inactive harmonic to drop
-    return BranchCoefficients.model_construct(
+    return BranchCoefficients(
         damping=coef.damping,
         damping_per_unit=coef.damping_per_unit,
         terms=[t for t, amp in zip(coef.terms, amplitudes, strict=True) if amp != 0.0],

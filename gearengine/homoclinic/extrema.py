@@ -16,7 +16,7 @@ import functools
 import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, NamedTuple
 
 import numpy as np
 
@@ -116,7 +116,8 @@ def extrema(m: TrigSum, period: float | None = None) -> Extrema:
         return Extrema(const, const, "constant")
     m = TrigSum(m.offset, m.amplitudes[active], m.frequencies[active], m.phases[active])
     if m.amplitudes.size == 1:
-        return _single(m)
+        b, om, ph = float(m.amplitudes[0]), float(m.frequencies[0]), float(m.phases[0])
+        return single_extrema(m.offset, b, om, ph)
     period = _period(tuple(m.frequencies.tolist())) if period is None else period
     if period is None:
         spread = float(np.abs(m.amplitudes).sum())
@@ -130,21 +131,21 @@ def extrema(m: TrigSum, period: float | None = None) -> Extrema:
     return Extrema(Extremum(-bottom.value, bottom.tau0), top, "exact")
 
 
-def _single(m: TrigSum) -> Extrema:
-    """A + B sin(Omega tau0 + phi): extrema A -/+ |B| where the sine is -/+ sign(B)."""
-    b, om, ph = float(m.amplitudes[0]), float(m.frequencies[0]), float(m.phases[0])
+def single_extrema(offset: float, b: float, om: float, ph: float) -> Extrema:
+    """A + B sin(Omega tau0 + phi) with A = ``offset``, B = ``b`` != 0, Omega = ``om`` > 0 and
+    phi = ``ph`` [rad], on floats: extrema A -/+ |B| where the sine is -/+ sign(B)."""
     period = 2.0 * math.pi / om
     up = ((math.copysign(0.5 * math.pi, b) - ph) / om) % period
     down = (up + 0.5 * period) % period
-    return Extrema(Extremum(m.offset - abs(b), down), Extremum(m.offset + abs(b), up), "exact")
+    return Extrema(Extremum(offset - abs(b), down), Extremum(offset + abs(b), up), "exact")
 
 
 # --- Sets of a control parameter ----------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class Interval:
-    """Closed interval [lo, hi]; None marks an unbounded end."""
+class Interval(NamedTuple):
+    """Closed interval [lo, hi]; None marks an unbounded end (a tuple: a verdict builds a few
+    dozen, and a frozen dataclass costs three times as much to build)."""
 
     lo: float | None
     hi: float | None
@@ -256,11 +257,11 @@ def one_sinusoid_interval(off0: float, offg: float, a: float, b: float) -> Inter
     if b == 0.0:
         return _affine_nonpositive(off0 + abs(a) if a != 0.0 else off0, offg)
     base = off0 + 0.0
-    kinks = (-math.inf, -a / b, math.inf)
+    kink = -a / b
     sign = 1.0 if b > 0.0 else -1.0
-    return _union_of_pieces(  # piece j lies between kinks j-1 and j
-        (base + s * a, offg + s * b, kinks[j], kinks[j + 1]) for j, s in ((0, -sign), (1, sign))
-    )
+    left = (base - sign * a, offg - sign * b, -math.inf, kink)  # the pieces either side
+    right = (base + sign * a, offg + sign * b, kink, math.inf)  # of the kink
+    return _union_of_pieces((left, right))
 
 
 def _union_of_pieces(pieces: Iterable[tuple[float, float, float, float]]) -> Interval | None:

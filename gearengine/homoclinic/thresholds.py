@@ -54,8 +54,9 @@ CONTROL_PARAMETERS = ("F_e1", "mu", "k_p1", "F_p1")
 
 _TERM_OF = {"F_e1": "transmission_error", "k_p1": "stiffness", "F_p1": "torque"}
 
+UNBOUNDED = Interval(None, None)
 DOMAIN = {"mu": Interval(0.0, None)}
-"""Admissible range of a control parameter (damping is non-negative); others are unbounded."""
+"""Admissible range of a control parameter (damping is non-negative); others are ``UNBOUNDED``."""
 
 OMEGA_SCAN = (0.05, 3.0, 60)
 """Default Omega_e scan for critical frequencies: start, stop, number of points."""
@@ -126,9 +127,10 @@ Family = tuple[TrigSum, TrigSum] | tuple[float, float, float, float]
 at most one sinusoid the floats (m0.offset, g.offset, a, b) of ``extrema.one_sinusoid``."""
 
 
-def _family(coef: BranchCoefficients, m: TrigSum, parameter: str) -> Family | None:
+def _family(coef: BranchCoefficients, m: TrigSum | None, parameter: str) -> Family | None:
     """Split M = m0 + p g for the control parameter p (None if p's excitation is absent);
-    ``m`` is ``coef.trig_sum()``, read once for every parameter."""
+    ``m`` is ``coef.trig_sum()``, read once for every parameter (``trig_sums``: None for at most
+    one term, read from ``coef`` itself)."""
     if coef.damping_per_unit is None:
         raise ValueError("coefficients read back from JSON carry no per-unit values (they are "
                          "not serialised): compute them again from the parameters")  # fmt: skip
@@ -138,11 +140,11 @@ def _family(coef: BranchCoefficients, m: TrigSum, parameter: str) -> Family | No
         j = next((i for i, t in enumerate(coef.terms) if t.excitation == name and t.r == 1), None)
         if j is None:
             return None
-    if m.amplitudes.size <= 1:  # the floats of one_sinusoid, without arrays
-        only = float(m.amplitudes[0]) if m.amplitudes.size else 0.0
+    if m is None:  # the floats of one_sinusoid, without arrays
+        only = float(coef.terms[0].coefficient) if coef.terms else 0.0
         if j is None:
             return 0.0, float(coef.damping_per_unit), only, 0.0
-        return float(m.offset), 0.0, 0.0, float(coef.terms[j].per_unit)
+        return float(coef.damping), 0.0, 0.0, float(coef.terms[j].per_unit)
     zeros = np.zeros_like(m.amplitudes)
     if j is None:
         return (
@@ -196,8 +198,14 @@ def parameter_threshold(
     ``method`` and ``mean_load``).
     """
     coefs = unit_coefficients(params, a, c, method, mean_load) if coefs is None else coefs
-    sums = {br: coefs[br].trig_sum() for br in BRANCH_SIGN}
+    sums = trig_sums(coefs)
     return ParameterThreshold(**_threshold(parameter, get_alias(params, parameter), coefs, sums))
+
+
+def trig_sums(coefs: Coefficients) -> dict[HomoclinicBranch, TrigSum | None]:
+    """Each branch's ``trig_sum`` for ``_family``, read once for every control parameter; None
+    for a branch of at most one term (its family is read from the coefficients as floats)."""
+    return {br: coefs[br].trig_sum() if len(coefs[br].terms) > 1 else None for br in BRANCH_SIGN}
 
 
 def parameter_thresholds(
@@ -212,7 +220,7 @@ def parameter_thresholds(
     the design's values of the parameters (``get_alias``); with the margin in the force scale
     ``f_crit``, ``forces`` being the largest force along the loops per unit of each parameter
     (``perturbations.force_per_unit``; None: no such force)."""
-    sums = {br: coefs[br].trig_sum() for br in BRANCH_SIGN}
+    sums = trig_sums(coefs)
     return {p: _threshold(p, values[p], coefs, sums, forces[p], f_crit) for p in CONTROL_PARAMETERS}
 
 
@@ -220,14 +228,14 @@ def _threshold(
     parameter: str,
     value: float | None,
     coefs: Coefficients,
-    sums: dict[HomoclinicBranch, TrigSum],
+    sums: dict[HomoclinicBranch, TrigSum | None],
     force: float | None = None,
     f_crit: float = 1.0,
 ) -> dict:
     """The fields of ``parameter_threshold`` of a design whose ``parameter`` is ``value``, from
-    the branches' ``unit_coefficients`` and their trig sums; with ``force`` (the largest force
+    the branches' ``unit_coefficients`` and their ``trig_sums``; with ``force`` (the largest force
     along the loops per unit of the parameter) the margin also in the force scale ``f_crit``."""
-    domain = DOMAIN.get(parameter, Interval(None, None))
+    domain = DOMAIN.get(parameter, UNBOUNDED)
     branches: dict[HomoclinicBranch, dict] = {}
     sets: dict[HomoclinicBranch, list[Interval]] = {}
     for br in BRANCH_SIGN:

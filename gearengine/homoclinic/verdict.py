@@ -19,7 +19,7 @@ from gearengine.homoclinic.coefficients import (
     melnikov_coefficients,
     saddle_loop,
 )
-from gearengine.homoclinic.extrema import Extrema, extrema
+from gearengine.homoclinic.extrema import Extrema
 from gearengine.homoclinic.loops import saddle
 from gearengine.homoclinic.perturbations import (
     caveat,
@@ -138,7 +138,7 @@ def melnikov(
         return not_applicable(a, c, method, notes, mean_load)
     fm, f_crit = loop_load(params, mean_load), critical_mean_force(a, c)
     coefs = {br: active_only(units[br], params) for br in BRANCH_SIGN}
-    branches = {br: branch_verdict(extrema(coefs[br].trig_sum(), period)) for br in BRANCH_SIGN}
+    branches = {br: branch_verdict(coefs[br].extrema(period)) for br in BRANCH_SIGN}
     if any(b["extrema"] == "supremum" for b in branches.values()):
         notes.append(
             "the active frequencies are incommensurate (no ratio p/q with q <= 64): min and max "

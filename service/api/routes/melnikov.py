@@ -3,7 +3,11 @@ margins of many."""
 
 from __future__ import annotations
 
+from collections.abc import Awaitable, Callable
+
 from fastapi import APIRouter, Depends, Request, Response
+from fastapi.routing import APIRoute
+from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 
 from gearengine.analysis import MelnikovAnswer, answer_melnikov
@@ -20,12 +24,35 @@ from service.api.responses import CACHED, JSON, PROBLEMS
 router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 
 
-@router.post(
-    "/melnikov",
-    response_model=MelnikovAnswer,
-    responses=CACHED,
-    summary="Melnikov verdict, thresholds and margins of one design",
-)
+class VerdictRoute(APIRoute):
+    """POST /v1/melnikov with a well-formed JSON body without FastAPI's request machinery.
+
+    A body sent as ``application/json`` that validates (``model_validate_json``) goes straight
+    to ``post_melnikov`` after the key check (``require_key``, the router's dependency):
+    FastAPI's dependency solving, body reading and parsing around it cost as much CPU as the
+    one-harmonic verdict (0.08 of 0.17 ms a request in process with a constant verdict).
+    Everything else (another media type, a body that does not parse or validate) takes
+    FastAPI's own handler, which reads the same body and gives every error as before.
+    """
+
+    def get_route_handler(self) -> Callable[[Request], Awaitable[Response]]:
+        fastapi_handler = super().get_route_handler()
+
+        async def handler(request: Request) -> Response:
+            media = request.headers.get("content-type", "").partition(";")[0].strip().lower()
+            if media == JSON:
+                try:
+                    body = MelnikovRequest.model_validate_json(await request.body())
+                except ValidationError:
+                    pass  # FastAPI's handler answers, with its own errors
+                else:
+                    await require_key(request)
+                    return await post_melnikov(body, request)
+            return await fastapi_handler(request)
+
+        return handler
+
+
 async def post_melnikov(body: MelnikovRequest, request: Request) -> Response:
     """Can the stable and unstable manifolds of the saddle intersect transversally?
 
@@ -41,6 +68,17 @@ async def post_melnikov(body: MelnikovRequest, request: Request) -> Response:
         lambda: (dumps(answer_melnikov(body)).encode(), JSON),
         inline=one_sinusoid(body),
     )
+
+
+router.add_api_route(
+    "/melnikov",
+    post_melnikov,
+    methods=["POST"],
+    response_model=MelnikovAnswer,
+    responses=CACHED,
+    summary="Melnikov verdict, thresholds and margins of one design",
+    route_class_override=VerdictRoute,
+)
 
 
 def one_sinusoid(body: MelnikovRequest) -> bool:
