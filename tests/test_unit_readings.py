@@ -14,10 +14,12 @@ import pytest
 from pydantic import ValidationError
 
 from gearengine.cli.main import main
+from gearengine.gate.envelope import envelope_axis, envelope_sweep
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.reduction import convert_design
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.studies.sweep.axes import design_with
+from gearengine.studies.sweep.request import validated
 
 
 def _design(**changes: object) -> dict:
@@ -170,3 +172,42 @@ def test_the_text_says_how_a_bare_design_speed_was_read(tmp_path, capsys) -> Non
     assert f"note: {said}" in capsys.readouterr().out
     main(["check", str(path)])
     assert f"note: {said}" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("command", "options", "refused"),
+    [
+        ("check", ["--speed", "1000:6000", "--torque", "5%:60%"], "--torque (its low end): '5%'"),
+        ("check", ["--speed", "1000:6000", "--torque=5:60%"], "--torque (its high end): '60%'"),
+        ("check", ["--speed=50%:100%"], "--speed (its low end): '50%'"),
+        ("robustness", ["--speed", "1000:6000", "--torque", "5:60%"], "--torque (its high end)"),
+        ("remedies", ["--speed", "1000:6000", "--torque", "5%:60"], "--torque: '5%'"),
+        ("runup", ["--from", "1000", "--to", "2000", "--rate", "5%"], "--rate: '5%'"),
+        ("runup", ["--from", "10%", "--to", "2000", "--rate", "500"], "--from: '10%'"),
+    ],
+)
+def test_a_share_is_refused_in_every_cli_quantity_option(
+    client, tmp_path, capsys, command: str, options: list[str], refused: str
+) -> None:
+    """``--torque 5%:60%`` ran the envelope at 0.05 and 0.6 N*m without a word, and
+    ``--torque=5:60%`` from 5 to 0.6 N*m ("5%" got the option's unit appended: "5% N*m",
+    which pint reads as 0.05 N*m), where the API refuses "5 %" on a torque axis: a share is
+    refused in every dimensional option, naming the option, as in the API and the library."""
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": _design()}))
+    assert main([command, str(path), *options]) == 2
+    err = capsys.readouterr().err
+    assert refused in err and "is a share, not a" in err
+    axis = {"parameter": "torque", "start": "5 %", "stop": "60 N*m", "num": 2}
+    answer = client.post("/v1/sweeps", json={"design": _design(), "axes": [axis]})
+    assert answer.status_code == 422 and "is a share" in answer.text
+    with pytest.raises(ValidationError, match="is a share, not a torque"):
+        validated(envelope_sweep(_design(), None, [envelope_axis("torque", "5:60%", "N*m", 2)],
+                                 "x"))  # fmt: skip
+
+
+def test_a_bare_number_in_exponent_form_is_in_the_option_s_unit() -> None:
+    """A bare "1e3" holds a letter, so it kept no unit and was read in SI units (1000 rad/s = 9549
+    rpm) where "1000" is 1000 rpm."""
+    assert envelope_axis("speed", "1e3:6e3", "rpm", 2)["start"] == "1e3 rpm"
+    assert envelope_axis("speed", "52 rad/s:6e3", "rpm", 2)["start"] == "52 rad/s"

@@ -54,6 +54,7 @@ from gearengine.model.units.quantities import (
     readings,
     registry,
     si_numbers,
+    with_unit,
 )
 
 __all__ = [
@@ -103,4 +104,5 @@ __all__ = [
     "shown",
     "si_numbers",
     "to_physical",
+    "with_unit",
 ]

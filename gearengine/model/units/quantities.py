@@ -405,6 +405,19 @@ def plain_number(name: str) -> Any:
     return BeforeValidator(refuse_share)
 
 
+def with_unit(text: str, unit: str) -> str:
+    """A command-line quantity: a bare number ("500", "1e3") in the option's ``unit`` ("500
+    rpm"); any other text ("52 rad/s", "5%") as written, for ``parse_quantity`` to read or
+    refuse. A share is no bare number: "5%" stays a share, refused in a dimensional field,
+    where "5%" with the unit appended read as "5% N*m" = 0.05 N*m, and "1e3" (a letter)
+    kept no unit and was read in SI units."""
+    try:
+        float(text)
+    except ValueError:
+        return text.strip()
+    return f"{text.strip()} {unit}"
+
+
 Length = quantity_type("length")
 Module = quantity_type("module")
 Bore = quantity_type("length", allow_zero=True)
