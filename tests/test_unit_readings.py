@@ -17,6 +17,8 @@ from gearengine.cli.main import main
 from gearengine.gate.envelope import envelope_axis, envelope_sweep
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.reduction import convert_design
+from gearengine.studies import jobs
+from gearengine.studies.jobs import validated_json
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.studies.sweep.axes import design_with
 from gearengine.studies.sweep.request import validated
@@ -211,3 +213,37 @@ def test_a_bare_number_in_exponent_form_is_in_the_option_s_unit() -> None:
     rpm) where "1000" is 1000 rpm."""
     assert envelope_axis("speed", "1e3:6e3", "rpm", 2)["start"] == "1e3 rpm"
     assert envelope_axis("speed", "52 rad/s:6e3", "rpm", 2)["start"] == "52 rad/s"
+
+
+@pytest.mark.parametrize(
+    ("fields", "path"),
+    [
+        ({"rate": 2000}, "rate"),
+        ({"rate": "2000"}, "rate"),
+        ({"from_speed": 500, "rate": "1000 rpm/s"}, "from_speed"),
+        ({"to_speed": "6000", "rate": "1000 rpm/s"}, "to_speed"),
+    ],
+)
+def test_a_run_up_s_bare_rate_or_speed_is_refused_with_its_unit(
+    client, tmp_path, capsys, fields: dict, path: str
+) -> None:
+    """A bare ``"rate": 2000`` was read as 2000 rad/s^2 (a 0.26 s ramp from 1000 to 6000 rpm)
+    with no note, where the CLI's ``--rate 2000`` is rpm/s (2.5 s), and the run-up's answer
+    has no notes of the request's readings: a bare number in a run-up's rate and speeds is
+    refused naming the field and both units, in the API, the library and a file given to the
+    CLI; a stored request's SI numbers are read back (``jobs.validated_json``)."""
+    body = {"design": _design(), "from_speed": "1000 rpm", "to_speed": "6000 rpm", **fields}
+    answer = client.post("/v1/runups", json=body)
+    assert answer.status_code == 422
+    (error,) = answer.json()["errors"]
+    assert error["path"] == path and "has no unit" in error["message"]
+    with pytest.raises(ValidationError, match="has no unit: a"):
+        RunupRequest.model_validate(body)
+    file = tmp_path / "runup.json"
+    file.write_text(json.dumps(body))
+    assert main(["runup", str(file)]) == 2
+    assert f"{path}: the bare number" in capsys.readouterr().err
+    good = RunupRequest.model_validate({**body, "rate": "2000 rpm/s", "from_speed": "1000 rpm",
+                                        "to_speed": "6000 rpm"})  # fmt: skip
+    again = validated_json(jobs.kind("runup"), good.model_dump_json())
+    assert again.rate == pytest.approx(good.rate) and again.leg_seconds() == pytest.approx(2.5)

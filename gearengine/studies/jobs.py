@@ -26,6 +26,7 @@ from typing import Any
 from pydantic import BaseModel
 
 from gearengine.jsonio import dumps
+from gearengine.model.units import si_numbers
 
 
 @dataclass(frozen=True)
@@ -199,12 +200,20 @@ def cyclic_gc_paused() -> Iterator[None]:
                 gc.enable()
 
 
+def validated_json(job: JobKind, request_json: str) -> Any:
+    """The request of a job read back from its JSON text (stored, or handed to a worker): its
+    numbers are the engine's own SI values (``si_numbers``), read with no note, and read even
+    where a user's bare number is refused (a run-up's speeds and rate)."""
+    with si_numbers():
+        return job.request.model_validate_json(request_json)
+
+
 def compute_chunk_json(name: str, request_json: str, index: int, chunk_points: int) -> str:
     """Chunk ``index`` of a job of kind ``name`` from its request's JSON text (what workers run),
     with the cyclic collector paused (``cyclic_gc_paused``)."""
     job = kind(name)
     with cyclic_gc_paused():
-        return job.compute_chunk(job.request.model_validate_json(request_json), index, chunk_points)
+        return job.compute_chunk(validated_json(job, request_json), index, chunk_points)
 
 
 def run_local(

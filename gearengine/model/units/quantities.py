@@ -186,13 +186,18 @@ POSITIVE_KINDS = frozenset(
 
 
 def parse_quantity(
-    value: object, kind: QuantityKind, allow_zero: bool = False, field: str | None = None
+    value: object,
+    kind: QuantityKind,
+    allow_zero: bool = False,
+    field: str | None = None,
+    unit_required: bool = False,
 ) -> float:
     """``value`` (a string with a unit, or a number in SI units) in the kind's SI unit.
 
     Raises ValueError naming the unit given and the dimension expected, or the plausible range
     with a guess at the intended unit. A bare number is read in SI units with a note naming
-    ``field`` (``_bare``).
+    ``field`` (``_bare``), or, ``unit_required``, refused naming the units meant (a field whose
+    answer has no place for the note), except inside ``si_numbers``.
     """
     ureg = registry()
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
@@ -219,9 +224,8 @@ def parse_quantity(
                 "torque)"
             )
         if not isinstance(quantity, ureg.Quantity) or str(quantity.units) == "dimensionless":
-            return _bare(
-                float(getattr(quantity, "magnitude", quantity)), value, kind, allow_zero, field
-            )
+            magnitude = float(getattr(quantity, "magnitude", quantity))
+            return _bare(magnitude, value, kind, allow_zero, field, unit_required)
         if quantity.dimensionless and kind.unit not in ("rad",):
             quantity = ureg.Quantity(quantity.magnitude, kind.unit)
         if quantity.dimensionality != kind.dimensionality:
@@ -233,7 +237,7 @@ def parse_quantity(
         _angle_given(quantity, value, kind)
         si = float(quantity.to(kind.unit).magnitude)
     else:
-        return _bare(float(value), value, kind, allow_zero, field)
+        return _bare(float(value), value, kind, allow_zero, field, unit_required)
     return _plausible(si, value, kind, allow_zero)
 
 
@@ -265,16 +269,28 @@ SHARES = frozenset({"percent", "permille", "ppm"})
 
 
 def _bare(
-    si: float, given: object, kind: QuantityKind, allow_zero: bool, field: str | None
+    si: float,
+    given: object,
+    kind: QuantityKind,
+    allow_zero: bool,
+    field: str | None,
+    unit_required: bool = False,
 ) -> float:
     """A bare number (no unit) read in the kind's SI unit, noted in the current ``readings``
     with the value in the example's unit ("shaft speed: the bare number 6000 read as 6000
     rad/s = 57,295.8 rpm; write '6000 rpm' if rpm was meant"), the same reading as every other
-    door (API, library; the CLI's options name their unit)."""
+    door (API, library; the CLI's options name their unit); ``unit_required``, refused saying
+    both readings (outside ``si_numbers``: the engine's own SI values read back pass)."""
+    shown = kind.example.split(maxsplit=1)[-1]
+    if unit_required and not _SI_NUMBERS.get():
+        raise ValueError(
+            f"the bare number {si:g} has no unit: a {kind.name} needs one, e.g. "
+            f"'{si:g} {shown}' or '{si:g} {kind.unit}' (no note can say how a bare number "
+            "was read here)"
+        )
     si = _plausible(si, given, kind, allow_zero)
     found = _READINGS.get()
     if found is not None and si != 0.0 and not _SI_NUMBERS.get():
-        shown = kind.example.split(maxsplit=1)[-1]
         text = f"{field or kind.name}: the bare number {si:g} read as {kind.describe(si)}"
         if shown != kind.unit:
             other = float(registry().Quantity(si, kind.unit).to(shown).magnitude)
@@ -347,39 +363,46 @@ class QuantitySchema:
     """The JSON schema of a quantity field, made when a schema is asked for (the OpenAPI
     document), not at import: the pattern's unit factors need pint (``registry``)."""
 
-    def __init__(self, kind: QuantityKind, allow_zero: bool, keyword: str | None) -> None:
+    def __init__(
+        self, kind: QuantityKind, allow_zero: bool, keyword: str | None, unit_required: bool
+    ) -> None:
         self.kind, self.allow_zero, self.keyword = kind, allow_zero, keyword
+        self.unit_required = unit_required
 
     def __get_pydantic_json_schema__(self, core: Any, handler: Any) -> dict[str, Any]:
         kind = self.kind
         low = -kind.high if kind.low == 0.0 else kind.low  # the plausible range (_plausible)
         words = [] if self.keyword is None else [{"const": self.keyword}]
         zero = [{"const": 0}] if self.allow_zero and kind.low > 0.0 else []
+        number = {"type": "number", "description": f"in {kind.unit}", "minimum": low,
+                  "maximum": kind.high}  # fmt: skip
+        text = {"type": "string", "pattern": quantity_pattern(kind), "examples": [kind.example]}
+        if self.unit_required:
+            return {**text, "description": f"{kind.name}: a string with a unit (e.g. "
+                    f"{kind.example!r}); plausible range {kind.span()}"}  # fmt: skip
         return {
-            "anyOf": [
-                *words,
-                {"type": "string", "pattern": quantity_pattern(kind), "examples": [kind.example]},
-                {"type": "number", "description": f"in {kind.unit}", "minimum": low,
-                 "maximum": kind.high},
-                *zero,
-            ],
+            "anyOf": [*words, text, number, *zero],
             "description": f"{kind.name}: a string with a unit (e.g. {kind.example!r}) or a "
             f"number in {kind.unit} (read with a note); plausible range {kind.span()}",
-        }  # fmt: skip
+        }
 
 
-def quantity_type(key: str, allow_zero: bool = False, keyword: str | None = None) -> Any:
-    """A pydantic field type: a string with a unit or an SI number, stored in SI units; a
-    ``keyword`` (such as "iso6336": derive it) passes through as the string itself."""
+def quantity_type(
+    key: str, allow_zero: bool = False, keyword: str | None = None, unit_required: bool = False
+) -> Any:
+    """A pydantic field type: a string with a unit or an SI number (``unit_required``: a
+    string with a unit only), stored in SI units; a ``keyword`` (such as "iso6336": derive it)
+    passes through as the string itself."""
     kind = QUANTITIES[key]
 
     def parse(value: object, info: ValidationInfo) -> float | str:
         if keyword is not None and value == keyword:
             return keyword
-        return parse_quantity(value, kind, allow_zero, info.field_name)
+        return parse_quantity(value, kind, allow_zero, info.field_name, unit_required)
 
     stored = float if keyword is None else float | str
-    return Annotated[stored, BeforeValidator(parse), QuantitySchema(kind, allow_zero, keyword)]
+    schema = QuantitySchema(kind, allow_zero, keyword, unit_required)
+    return Annotated[stored, BeforeValidator(parse), schema]
 
 
 SHARE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*%\s*")
