@@ -247,3 +247,30 @@ def test_a_run_up_s_bare_rate_or_speed_is_refused_with_its_unit(
                                         "to_speed": "6000 rpm"})  # fmt: skip
     again = validated_json(jobs.kind("runup"), good.model_dump_json())
     assert again.rate == pytest.approx(good.rate) and again.leg_seconds() == pytest.approx(2.5)
+
+
+def test_a_negative_mean_torque_is_refused_saying_the_response_mirrors(
+    client, tmp_path, capsys
+) -> None:
+    """A design torque of "-20 N*m" was read (convert exit 0, the API 200) and its Melnikov
+    answer was +20 N*m's, unsaid, where the documented range is 0 .. 1e6 N*m: a negative mean
+    torque is refused naming the field and why (the backlash is symmetric: a reversed torque
+    mirrors the response), in the API, the library, the CLI and a sweep's torque axis."""
+    said = "-20 N*m is negative; a mean torque is a magnitude"
+    answer = client.post("/v1/conversions/design", json={"design": _design(torque="-20 N*m")})
+    assert answer.status_code == 422
+    (error,) = answer.json()["errors"]
+    assert error["path"] == "design.torque" and said in error["message"]
+    assert "mirrors the response" in error["message"] and "'20 N*m'" in error["message"]
+    for field in ("torque", "braking_torque"):
+        with pytest.raises(ValidationError, match="is negative; a mean torque") as err:
+            Design.model_validate(_design(**{field: -20}))
+        assert err.value.errors()[0]["loc"] == (field,)
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": _design(torque="-20 N*m")}))
+    assert main(["convert", str(path)]) == 2
+    assert f"design.torque: {said}" in capsys.readouterr().err
+    path.write_text(json.dumps({"design": _design()}))
+    assert main(["check", str(path), "--speed", "1000:2000", "--torque=-5:60"]) == 2
+    assert "--torque (its low end): -5 N*m is negative" in capsys.readouterr().err
+    assert Design.model_validate(_design(torque=0)).torque == 0.0

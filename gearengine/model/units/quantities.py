@@ -54,6 +54,14 @@ class QuantityKind:
     spellings: dict[str, str] = field(default_factory=dict)
     """Units as engineers type them that pint reads otherwise (``Nm``: pint's N is Avogadro's
     number), and the unit meant; the whole unit text must match."""
+    negative: str | None = None
+    """Why a negative value is refused, for a kind whose range starts at 0 (which otherwise
+    takes either sign: a displacement, a harmonic's amplitude)."""
+
+    @property
+    def signed(self) -> bool:
+        """Negative values are read (their magnitude checked against the range)."""
+        return self.low == 0.0 and self.negative is None
 
     @property
     def dimensionality(self) -> Any:
@@ -143,6 +151,17 @@ QUANTITIES: dict[str, QuantityKind] = {
         "shaft speed", "rad/s", 2 * math.pi / 60, 1e5 * 2 * math.pi / 60, ("rpm",), "1500 rpm"
     ),  # 1 to 100,000 rpm: a bare 20000 (rad/s, 191,000 rpm) is refused, not read silently
     "torque": QuantityKind("torque", "N*m", 0.0, 1e6, (), "40 N*m", TORQUE_SPELLINGS),
+    "mean_torque": QuantityKind(
+        "torque",
+        "N*m",
+        0.0,
+        1e6,
+        (),
+        "40 N*m",
+        TORQUE_SPELLINGS,
+        "a mean torque is a magnitude, 0 to 1e6 N*m: the model's backlash is symmetric, so a "
+        "reversed torque mirrors the response (x -> -x); give its magnitude",
+    ),  # "-20 N*m" was read and answered as +20 N*m's mirror, unsaid
     "stiffness": QuantityKind("mesh stiffness", "N/m", 1e6, 1e11, ("N/um", "N/mm"), "1e8 N/m"),
     "stiffness_variation": QuantityKind(
         "stiffness variation", "N/m", 0.0, 1e11, ("N/um", "N/mm"), "1e7 N/m"
@@ -305,10 +324,12 @@ def _plausible(si: float, given: object, kind: QuantityKind, allow_zero: bool) -
         raise ValueError(f"{given!r} is not a finite {kind.name}")
     if si == 0.0 and allow_zero:
         return si
+    shown = given if isinstance(given, str) else kind.describe(si)
+    if si < 0.0 and kind.negative is not None:
+        raise ValueError(f"{shown} is negative; {kind.negative}, e.g. '{-si:.6g} {kind.unit}'")
     if kind.low <= abs(si) <= kind.high and (si > 0.0 or kind.low == 0.0):
         return si
     ureg = registry()
-    shown = given if isinstance(given, str) else kind.describe(si)
     if si < 0.0 and kind.low > 0.0:  # no slip of the unit makes it positive
         raise ValueError(f"{shown} is negative; a {kind.name} is a positive magnitude, e.g. "
                          f"{kind.example!r}")  # fmt: skip
@@ -339,7 +360,7 @@ def quantity_pattern(kind: QuantityKind) -> str:
     right dimension, "0.5 mm"): the pattern states the common case, and the example, so that
     requests generated from the schema (schemathesis) are mostly valid."""
     ureg = registry()
-    sign = "-?" if kind.low == 0.0 else ""
+    sign = "-?" if kind.signed else ""
     alternatives = [re.escape(kind.example)]
     for unit in dict.fromkeys([kind.unit, kind.example.split(maxsplit=1)[-1], *kind.slips]):
         per_si = float(ureg.Quantity(1.0, unit).to(kind.unit).magnitude)
@@ -371,7 +392,7 @@ class QuantitySchema:
 
     def __get_pydantic_json_schema__(self, core: Any, handler: Any) -> dict[str, Any]:
         kind = self.kind
-        low = -kind.high if kind.low == 0.0 else kind.low  # the plausible range (_plausible)
+        low = -kind.high if kind.signed else kind.low  # the plausible range (_plausible)
         words = [] if self.keyword is None else [{"const": self.keyword}]
         zero = [{"const": 0}] if self.allow_zero and kind.low > 0.0 else []
         number = {"type": "number", "description": f"in {kind.unit}", "minimum": low,
@@ -450,6 +471,8 @@ Backlash = quantity_type("backlash")
 ErrorAmplitude = quantity_type("error", allow_zero=True)
 Speed = quantity_type("speed")
 Torque = quantity_type("torque", allow_zero=True)
+MeanTorque = quantity_type("mean_torque", allow_zero=True)
+"""A mean (driving or braking) torque: a magnitude, a negative one refused."""
 Stiffness = quantity_type("stiffness")
 MeshStiffness = quantity_type("stiffness", keyword="iso6336")
 StiffnessVariation = quantity_type("stiffness_variation", allow_zero=True)

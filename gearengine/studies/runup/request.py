@@ -35,8 +35,8 @@ from gearengine.model.reduction import DesignConversion, ParamsOrDesign
 from gearengine.model.units import (
     QUANTITIES,
     Duration,
+    MeanTorque,
     Time,
-    Torque,
     parse_quantity,
     quantity_type,
     registry,
@@ -142,7 +142,7 @@ class RunupRequest(ParamsOrDesign):
         "linear in between; rising stretches are read as up, falling ones as down.",
         examples=[[["0 s", "500 rpm"], ["3 s", "6000 rpm"], ["5 s", "2000 rpm"]]],
     )
-    to_torque: Torque | None = Field(
+    to_torque: MeanTorque | None = Field(
         None, description="Torque at the end of the profile (linear in time from the design's)."
     )
     bin_rpm: float = Field(
