@@ -51,6 +51,7 @@ from gearengine.gate.resolution import GRID_POINTS
 from gearengine.gate.rules import Rules
 from gearengine.jsonio import dumps
 from gearengine.model.units import POINT_OUTPUTS
+from gearengine.numerics.attractors import IMPACT_TEXT
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies import jobs
 from gearengine.studies.sweep.axes import axis_unit
@@ -303,8 +304,8 @@ def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit",
 
 
 CONTACT_LABELS = {
-    "separation": "tooth separation",
-    "back_flank": "back-flank impacts",
+    "separation": IMPACT_TEXT["single_sided"],
+    "back_flank": IMPACT_TEXT["double_sided"],
 }
 """The contact of a speed window (``SpeedWindows.contact``) in the gate's words."""
 
