@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
+    STARTS_FIELD,
     InvalidInputError,
     Options,
     axis_options,
@@ -109,7 +110,10 @@ def envelope_request(args: argparse.Namespace, doc: object) -> SweepRequest:
     )
     counted_points(axes, "envelope check")  # before the sweep's checks build its grids
     given = [i for i, name in enumerate(["speed", "torque"]) if getattr(args, name)]
-    request = validated_input(validated, sweep, args.file, axis_options(axes, given))
+    options = axis_options(axes, given)
+    if args.starts is not None:
+        options[STARTS_FIELD] = "--starts"
+    request = validated_input(validated, sweep, args.file, options)
     why = budget_refusal("sweep", request, "envelope check", ENVELOPE_WAYS)
     if why is not None:
         raise InvalidInputError([why])

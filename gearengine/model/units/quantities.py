@@ -59,6 +59,11 @@ class QuantityKind:
     takes either sign: a displacement, a harmonic's amplitude)."""
 
     @property
+    def a_name(self) -> str:
+        """The name with its article: "a shaft speed", "an angle" (it read "a angle")."""
+        return f"{'an' if self.name[0] in 'aeiou' else 'a'} {self.name}"
+
+    @property
     def signed(self) -> bool:
         """Negative values are read (their magnitude checked against the range)."""
         return self.low == 0.0 and self.negative is None
@@ -237,7 +242,7 @@ def parse_quantity(
                              f"{kind.example!r}") from None  # fmt: skip
         if isinstance(quantity, ureg.Quantity) and str(quantity.units) in SHARES:
             raise ValueError(
-                f"{value!r} is a share, not a {kind.name}: give a unit of dimension "
+                f"{value!r} is a share, not {kind.a_name}: give a unit of dimension "
                 f"{kind.dimensionality}, e.g. {kind.example!r} (a share of a nominal value is "
                 "read only where one is meant: a torque fluctuation amplitude in % of the mean "
                 "torque)"
@@ -250,7 +255,7 @@ def parse_quantity(
         if quantity.dimensionality != kind.dimensionality:
             raise ValueError(
                 f"{value!r} has the unit {quantity.units:~} ({quantity.dimensionality}); "
-                f"a {kind.name} needs a unit of dimension {kind.dimensionality}, e.g. "
+                f"{kind.a_name} needs a unit of dimension {kind.dimensionality}, e.g. "
                 f"{kind.example!r}"
             )
         _angle_given(quantity, value, kind)
@@ -275,7 +280,7 @@ def _angle_given(quantity: Any, value: str, kind: QuantityKind) -> None:
     radians = (quantity * ureg.radian).to(kind.unit).magnitude
     per = kind.unit.removeprefix("rad")
     raise ValueError(
-        f"{value!r} has no angle (pint would read Hz and 1/s as rad/s): a {kind.name} needs "
+        f"{value!r} has no angle (pint would read Hz and 1/s as rad/s): {kind.a_name} needs "
         f"one; write "
         f"'{turns:.6g} {shown}' or '{quantity.to('1' + per).magnitude:.6g} rev{per}' for "
         f"revolutions, '{radians:.6g} {kind.unit}' for radians"
@@ -303,7 +308,7 @@ def _bare(
     shown = kind.example.split(maxsplit=1)[-1]
     if unit_required and not _SI_NUMBERS.get():
         raise ValueError(
-            f"the bare number {si:g} has no unit: a {kind.name} needs one, e.g. "
+            f"the bare number {si:g} has no unit: {kind.a_name} needs one, e.g. "
             f"'{si:g} {shown}' or '{si:g} {kind.unit}' (no note can say how a bare number "
             "was read here)"
         )
@@ -331,9 +336,9 @@ def _plausible(si: float, given: object, kind: QuantityKind, allow_zero: bool) -
         return si
     ureg = registry()
     if si < 0.0 and kind.low > 0.0:  # no slip of the unit makes it positive
-        raise ValueError(f"{shown} is negative; a {kind.name} is a positive magnitude, e.g. "
+        raise ValueError(f"{shown} is negative; {kind.a_name} is a positive magnitude, e.g. "
                          f"{kind.example!r}")  # fmt: skip
-    message = f"{shown} is outside the plausible range of a {kind.name}, {kind.span()}"
+    message = f"{shown} is outside the plausible range of {kind.a_name}, {kind.span()}"
     magnitude = ureg.Quantity(given.strip()).magnitude if isinstance(given, str) else si
     for slip in kind.slips:
         meant = float(ureg.Quantity(abs(float(magnitude)), slip).to(kind.unit).magnitude)
