@@ -56,7 +56,7 @@ Z23 = {
     "backlash_law": "piecewise",
 }  # fmt: skip
 """The issue's z = 23/67 design (module 2.5 mm, face 20 mm, ISO 6336 stiffness, half backlash
-47 um, TE 11.3 um, ripple 0.15 N m at order 1) at 4,000 rpm and 5 N m (single-sided impacts):
+47 um, TE 11.3 um, ripple 0.15 N m at order 1) at 4,000 rpm and 5 N m (tooth separation):
 T0 is one driver revolution, 23 mesh periods."""
 DESIGNS = {
     "README CI design (z = 18, 40 N m)": lambda: json.loads(

@@ -132,7 +132,7 @@ def test_headline_is_the_worst_attractor_and_the_summary_names_the_others() -> N
     worst = num.attractors[0]
     assert worst.classification == "chaotic" and worst.lle is not None and worst.lle > 0
     assert result.verdict.chaotic and result.verdict.decided_by is not None
-    assert result.verdict.decided_by.startswith("chaotic, double-sided impacts from")
+    assert result.verdict.decided_by.startswith("chaotic, back-flank impacts from")
     assert "of 64 starts" in result.verdict.summary and "periodic 1T" in result.verdict.summary
     assert sum(a.count for a in num.attractors) + num.basins.unsettled == 64
     assert all(a.dte_um is not None and a.dynamic_factor is not None for a in num.attractors)

@@ -5,11 +5,14 @@ while apart) beside the model's force, each defined where it is reported."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from gearengine.gate.rules import Rules, point_failures
 from gearengine.model.params import GearParams, PiecewiseBacklash
+from gearengine.numerics.attractors import IMPACT_TEXT, describe
 from gearengine.studies.robustness.study import RobustnessRequest, run_local
 from gearengine.studies.sweep.points import SweepPoint
 from gearengine.systems.spur_pair.forcing import contact_force_of, static_error
@@ -159,3 +162,21 @@ def test_runup_bins_give_the_contact_force_beside_the_models() -> None:
         assert b.force_min_n < 0.0
         assert b.contact_force_min_n == 0.0
         assert 0.0 < b.contact_force_max_n <= b.force_max_n
+
+
+def test_attractor_labels_say_the_contact_in_the_text_words() -> None:
+    """Gate lines said "3920 rpm: periodic 1T, single-sided impacts from 56 % of starts"
+    beside windows saying "tooth separation", where docs/units.md's one vocabulary has the
+    text words "teeth always in contact", "tooth separation" and "back-flank impacts": an
+    attractor's label (JSON, gate and sweep text) uses them, as the gate's rules do."""
+    assert describe("periodic", 1, "single_sided") == "periodic 1T, tooth separation"
+    assert describe("chaotic", None, "double_sided") == "chaotic, back-flank impacts"
+    assert describe("periodic", 2, "no_impact") == "periodic 2T, teeth always in contact"
+    table = (Path(__file__).resolve().parents[1] / "docs" / "units.md").read_text()
+    for words in IMPACT_TEXT.values():
+        assert f"| {words} |" in table
+    rules = Rules(fail_on=["back_flank", "separation"])
+    assert point_failures(_point("double_sided"), rules) == [
+        IMPACT_TEXT["double_sided"],
+        IMPACT_TEXT["single_sided"],
+    ]

@@ -530,7 +530,7 @@ def test_the_map_shows_impacts_and_the_dynamic_factor(page: Page) -> None:
         lambda d: d.find_elements(By.CSS_SELECTOR, "#envelope-map .scatterlayer path.point")
     )
     legend = page.text("#envelope-map .legend")
-    assert "teeth always in contact" in legend and "back-flank contact" in legend
+    assert "teeth always in contact" in legend and "back-flank impacts" in legend
     ActionChains(page.driver).move_to_element(points[0]).perform()
     hover = page.wait(lambda d: page.text("#envelope-map .hoverlayer"))
     assert "dynamic factor" in hover and "DTE" in hover and "µm" in hover

@@ -70,3 +70,29 @@ def test_the_api_names_a_lever_s_bound_by_its_own_path(client) -> None:
     assert error["path"] == "levers[0].bounds[1]"
     assert error["pointer"] == "/levers/0/bounds/1"
     assert error["message"].startswith("1 m is outside the plausible range of a half backlash")
+
+
+def test_wording_of_refusals_new_user_review(
+    design_file: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Four refusals a new user met (issue 30 review): "plausible range of a angle"; --starts 0
+    named settings.basins.starts; --torque -5:60 got argparse's "expected one argument" (the
+    range taken for an option), where its end is refused with its reason; --max-lle 1/s was
+    "not a number" beside a help saying check prints the LLE in 1/s too."""
+    from gearengine.model.design import EXAMPLE_DESIGN, Design
+
+    driver = {**EXAMPLE_DESIGN["driver"], "pressure_angle": "50 deg"}
+    with pytest.raises(ValueError, match="plausible range of an angle"):
+        Design.model_validate({**EXAMPLE_DESIGN, "driver": driver})
+    for command in (
+        ["check", str(design_file), "--speed", "1000:2000"],
+        ["basins", str(design_file)],
+    ):
+        assert main([*command, "--starts", "0"]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("--starts: ") and "settings.basins" not in err
+    assert main(["check", str(design_file), "--speed", "1000:2000", "--torque", "-5:60"]) == 2
+    assert "--torque (its low end): -5 N*m is negative; a mean torque" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["check", str(design_file), "--max-lle", "1/s"])
+    assert "per unit tau (tau = omega_n t), a plain number" in capsys.readouterr().err

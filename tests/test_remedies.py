@@ -447,3 +447,26 @@ def test_two_levers_together_when_neither_alone_clears_the_envelope(tmp_path: Pa
     for design, code in [(both, 0), *alone]:
         path.write_text(json.dumps(design))
         assert gearengine("check", str(path), *ENVELOPE).returncode == code
+
+
+def test_a_request_without_torque_is_read_back_from_its_json() -> None:
+    """A remedies request without a torque range dumped the default torque_points 5, which
+    its own check refused when a worker (or the service's store) read the JSON back:
+    "envelope.torque_points: counts the points of a torque range, and none is given" (the
+    train's remedies test failed so). The default is null, filled in by ``sweep``."""
+    from gearengine.model.design import EXAMPLE_DESIGN
+    from gearengine.studies import jobs
+
+    request = RemediesRequest.model_validate(
+        {"design": EXAMPLE_DESIGN, "envelope": {"speed": "900:1000", "speed_points": 2}}
+    )
+    again = jobs.validated_json(jobs.kind("remedies"), request.model_dump_json())
+    assert again == request and len(again.sweep().axes) == 1
+    with_torque = RemediesRequest.model_validate(
+        {"design": EXAMPLE_DESIGN, "envelope": {"speed": "900:1000", "torque": "5:10"}}
+    )
+    assert with_torque.sweep().axes[1].num == 5  # GRID_POINTS' default
+    with pytest.raises(ValidationError, match="counts the points of a torque range"):
+        RemediesRequest.model_validate(
+            {"design": EXAMPLE_DESIGN, "envelope": {"speed": "900:1000", "torque_points": 3}}
+        )

@@ -162,10 +162,12 @@ def test_basins_of_a_train() -> None:
     result = gearengine.analyze(AnalysisRequest(design=TRAIN, settings=settings))
     found, counts = result.numerics.attractors, result.numerics.basins
     assert counts.starts == 4 and counts.diverged == counts.unsettled == 0
-    assert [a.label for a in found] == ["periodic 1T, no impacts"] and found[0].count == 4
+    assert [a.label for a in found] == ["periodic 1T, teeth always in contact"] and found[
+        0
+    ].count == 4
     train = simulate_train(Design.model_validate(TRAIN), SimulationSettings(**settings))
     assert found[0].dte_um == pytest.approx(train.dte_um, rel=1e-3)
-    assert result.verdict.decided_by == "periodic 1T, no impacts from 100 % of starts"
+    assert result.verdict.decided_by == "periodic 1T, teeth always in contact from 100 % of starts"
     # issue 30: the summary names the deciding attractor, though this train has no reduction
     assert not result.melnikov.applicable
     assert f"({result.verdict.decided_by})" in result.engineering.summary
@@ -189,7 +191,7 @@ def test_robustness_of_a_train_is_the_trains() -> None:
 
 
 def test_remedies_of_a_train_pass_the_trains_gate() -> None:
-    """A train failing --max-dte 30 µm at 900-1000 rpm (single-sided impacts, DTE ~50 µm):
+    """A train failing --max-dte 30 µm at 900-1000 rpm (tooth separation, DTE ~50 µm):
     the remedy found on the mesh damping ratio passes the train's own gate (simulated on its
     own at the grid's speeds), and the last failing value tried fails the gate at a point the
     train, simulated on its own, confirms over 30 µm (a refined speed between the grid's: the

@@ -14,10 +14,14 @@ import pytest
 from pydantic import ValidationError
 
 from gearengine.cli.main import main
+from gearengine.gate.envelope import envelope_axis, envelope_sweep
 from gearengine.model.design import EXAMPLE_DESIGN, Design
 from gearengine.model.fields import design_with
 from gearengine.model.reduction import convert_design
+from gearengine.studies import jobs
+from gearengine.studies.jobs import validated_json
 from gearengine.studies.runup.request import RunupRequest
+from gearengine.studies.sweep.request import validated
 
 
 def _design(**changes: object) -> dict:
@@ -170,3 +174,103 @@ def test_the_text_says_how_a_bare_design_speed_was_read(tmp_path, capsys) -> Non
     assert f"note: {said}" in capsys.readouterr().out
     main(["check", str(path)])
     assert f"note: {said}" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("command", "options", "refused"),
+    [
+        ("check", ["--speed", "1000:6000", "--torque", "5%:60%"], "--torque (its low end): '5%'"),
+        ("check", ["--speed", "1000:6000", "--torque=5:60%"], "--torque (its high end): '60%'"),
+        ("check", ["--speed=50%:100%"], "--speed (its low end): '50%'"),
+        ("robustness", ["--speed", "1000:6000", "--torque", "5:60%"], "--torque (its high end)"),
+        ("remedies", ["--speed", "1000:6000", "--torque", "5%:60"], "--torque: '5%'"),
+        ("runup", ["--from", "1000", "--to", "2000", "--rate", "5%"], "--rate: '5%'"),
+        ("runup", ["--from", "10%", "--to", "2000", "--rate", "500"], "--from: '10%'"),
+    ],
+)
+def test_a_share_is_refused_in_every_cli_quantity_option(
+    client, tmp_path, capsys, command: str, options: list[str], refused: str
+) -> None:
+    """``--torque 5%:60%`` ran the envelope at 0.05 and 0.6 N*m without a word, and
+    ``--torque=5:60%`` from 5 to 0.6 N*m ("5%" got the option's unit appended: "5% N*m",
+    which pint reads as 0.05 N*m), where the API refuses "5 %" on a torque axis: a share is
+    refused in every dimensional option, naming the option, as in the API and the library."""
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": _design()}))
+    assert main([command, str(path), *options]) == 2
+    err = capsys.readouterr().err
+    assert refused in err and "is a share, not a" in err
+    axis = {"parameter": "torque", "start": "5 %", "stop": "60 N*m", "num": 2}
+    answer = client.post("/v1/sweeps", json={"design": _design(), "axes": [axis]})
+    assert answer.status_code == 422 and "is a share" in answer.text
+    with pytest.raises(ValidationError, match="is a share, not a torque"):
+        validated(envelope_sweep(_design(), None, [envelope_axis("torque", "5:60%", "N*m", 2)],
+                                 "x"))  # fmt: skip
+
+
+def test_a_bare_number_in_exponent_form_is_in_the_option_s_unit() -> None:
+    """A bare "1e3" holds a letter, so it kept no unit and was read in SI units (1000 rad/s = 9549
+    rpm) where "1000" is 1000 rpm."""
+    assert envelope_axis("speed", "1e3:6e3", "rpm", 2)["start"] == "1e3 rpm"
+    assert envelope_axis("speed", "52 rad/s:6e3", "rpm", 2)["start"] == "52 rad/s"
+
+
+@pytest.mark.parametrize(
+    ("fields", "path"),
+    [
+        ({"rate": 2000}, "rate"),
+        ({"rate": "2000"}, "rate"),
+        ({"from_speed": 500, "rate": "1000 rpm/s"}, "from_speed"),
+        ({"to_speed": "6000", "rate": "1000 rpm/s"}, "to_speed"),
+    ],
+)
+def test_a_run_up_s_bare_rate_or_speed_is_refused_with_its_unit(
+    client, tmp_path, capsys, fields: dict, path: str
+) -> None:
+    """A bare ``"rate": 2000`` was read as 2000 rad/s^2 (a 0.26 s ramp from 1000 to 6000 rpm)
+    with no note, where the CLI's ``--rate 2000`` is rpm/s (2.5 s), and the run-up's answer
+    has no notes of the request's readings: a bare number in a run-up's rate and speeds is
+    refused naming the field and both units, in the API, the library and a file given to the
+    CLI; a stored request's SI numbers are read back (``jobs.validated_json``)."""
+    body = {"design": _design(), "from_speed": "1000 rpm", "to_speed": "6000 rpm", **fields}
+    answer = client.post("/v1/runups", json=body)
+    assert answer.status_code == 422
+    (error,) = answer.json()["errors"]
+    assert error["path"] == path and "has no unit" in error["message"]
+    with pytest.raises(ValidationError, match="has no unit: a"):
+        RunupRequest.model_validate(body)
+    file = tmp_path / "runup.json"
+    file.write_text(json.dumps(body))
+    assert main(["runup", str(file)]) == 2
+    assert f"{path}: the bare number" in capsys.readouterr().err
+    good = RunupRequest.model_validate({**body, "rate": "2000 rpm/s", "from_speed": "1000 rpm",
+                                        "to_speed": "6000 rpm"})  # fmt: skip
+    again = validated_json(jobs.kind("runup"), good.model_dump_json())
+    assert again.rate == pytest.approx(good.rate) and again.leg_seconds() == pytest.approx(2.5)
+
+
+def test_a_negative_mean_torque_is_refused_saying_the_response_mirrors(
+    client, tmp_path, capsys
+) -> None:
+    """A design torque of "-20 N*m" was read (convert exit 0, the API 200) and its Melnikov
+    answer was +20 N*m's, unsaid, where the documented range is 0 .. 1e6 N*m: a negative mean
+    torque is refused naming the field and why (the backlash is symmetric: a reversed torque
+    mirrors the response), in the API, the library, the CLI and a sweep's torque axis."""
+    said = "-20 N*m is negative; a mean torque is a magnitude"
+    answer = client.post("/v1/conversions/design", json={"design": _design(torque="-20 N*m")})
+    assert answer.status_code == 422
+    (error,) = answer.json()["errors"]
+    assert error["path"] == "design.torque" and said in error["message"]
+    assert "mirrors the response" in error["message"] and "'20 N*m'" in error["message"]
+    for field in ("torque", "braking_torque"):
+        with pytest.raises(ValidationError, match="is negative; a mean torque") as err:
+            Design.model_validate(_design(**{field: -20}))
+        assert err.value.errors()[0]["loc"] == (field,)
+    path = tmp_path / "design.json"
+    path.write_text(json.dumps({"design": _design(torque="-20 N*m")}))
+    assert main(["convert", str(path)]) == 2
+    assert f"design.torque: {said}" in capsys.readouterr().err
+    path.write_text(json.dumps({"design": _design()}))
+    assert main(["check", str(path), "--speed", "1000:2000", "--torque=-5:60"]) == 2
+    assert "--torque (its low end): -5 N*m is negative" in capsys.readouterr().err
+    assert Design.model_validate(_design(torque=0)).torque == 0.0

@@ -48,7 +48,7 @@ def test_the_recorded_run_and_the_worst_attractor_differ(analysis):
 
 def test_summaries_name_the_worst_attractor(analysis):
     summary = analysis.engineering.summary
-    assert "The simulated response is chaotic (chaotic, double-sided impacts from 56 %" in summary
+    assert "The simulated response is chaotic (chaotic, back-flank impacts from 56 %" in summary
     assert "the recorded run from the settings' start is periodic (1T)" in summary
     # each LLE beside the response it belongs to: the chaotic attractor's in its parenthesis,
     # the recorded periodic run's with that run's contact, DTE and dynamic factor
@@ -57,7 +57,7 @@ def test_summaries_name_the_worst_attractor(analysis):
     head, tail = summary.split("the recorded run from the settings' start")
     assert f"({worst:+.3g} per unit tau)" in head and f"({run:+.3g} per unit tau)" in tail
     line = analysis.summary()
-    assert line.startswith("chaotic (chaotic, double-sided impacts from 56 % of starts)")
+    assert line.startswith("chaotic (chaotic, back-flank impacts from 56 % of starts)")
 
 
 def _largest(found, field):
@@ -78,7 +78,7 @@ def test_the_one_line_summary_gives_the_largest_dte_and_dynamic_factor_named(ana
     line = analysis.summary()
     named = f"{owner.label} from {100 * owner.fraction:.0f} % of starts"
     assert f"; DTE {dte:.3g} µm, dynamic factor {factor:.3g} ({named})" in line
-    assert line.startswith("chaotic (chaotic, double-sided impacts from 56 % of starts)")
+    assert line.startswith("chaotic (chaotic, back-flank impacts from 56 % of starts)")
     worst = analysis.engineering.most_adverse
     assert worst["dte"].value == dte and worst["dte"].label == owner.label
     assert worst["dte"].attractor == found.index(owner) and worst["dte"].fraction == 0.25
@@ -205,7 +205,7 @@ def test_the_z23_67_point_gives_one_dte_in_headline_check_json_and_gate():
     doc = envelope_sweep(design, gate_settings({}, 16), axes, "z = 23/67")
     report = check_envelope(SweepRequest.model_validate(doc), Rules(max_dte_um=30.0), refine=0)
     (p,) = report.sweep.points
-    assert (p.classification, p.decided_by) == ("chaotic", "chaotic, single-sided impacts from "
+    assert (p.classification, p.decided_by) == ("chaotic", "chaotic, tooth separation from "
                                                 "31 % of starts")  # fmt: skip
     periodic = next(a for a in p.attractors if a.classification == "periodic")
     assert periodic.fraction == 11 / 16 and round(periodic.dte_um) == 62
@@ -213,8 +213,8 @@ def test_the_z23_67_point_gives_one_dte_in_headline_check_json_and_gate():
     assert p.physical["force_max"].value == max(a.force_max_n for a in p.attractors)
     assert p.magnitudes_from["dte"].label == periodic.label
     assert [(w.rule, w.attractors) for w in report.failures] == [
-        ("chaotic", ["5000 rpm: chaotic, single-sided impacts from 31 % of starts"]),
-        ("DTE > 30 µm", ["5000 rpm: periodic 1T, single-sided impacts from 69 % of starts"]),
+        ("chaotic", ["5000 rpm: chaotic, tooth separation from 31 % of starts"]),
+        ("DTE > 30 µm", ["5000 rpm: periodic 1T, tooth separation from 69 % of starts"]),
     ]
 
 

@@ -13,7 +13,7 @@ import argparse
 from pathlib import Path
 
 from gearengine.analysis import AnalysisRequest, AnalysisResult, analyze
-from gearengine.cli.documents import EXIT_OK, read_document, validated_input
+from gearengine.cli.documents import EXIT_OK, STARTS_FIELD, read_document, validated_input
 from gearengine.jsonio import dumps
 from gearengine.numerics.headline import percent
 
@@ -27,7 +27,8 @@ def basins_request(args: argparse.Namespace) -> AnalysisRequest:
         if args.starts is not None:
             basins["starts"] = args.starts
         doc = {**doc, "settings": {**settings, "basins": basins}}
-    return validated_input(AnalysisRequest.model_validate, doc, args.file)
+    options = {STARTS_FIELD: "--starts"} if args.starts is not None else {}
+    return validated_input(AnalysisRequest.model_validate, doc, args.file, options)
 
 
 def table(result: AnalysisResult) -> list[str]:

@@ -65,6 +65,10 @@ def validated_input(
         raise InvalidInputError([f"{path}: {exc}"]) from None
 
 
+STARTS_FIELD = "settings.basins.starts"
+"""The field ``--starts`` sets: a refusal of it is named by the option ("--starts 0" was
+"settings.basins.starts: Input should be greater than or equal to 1")."""
+
 Options = dict[str, str]
 """The option that gave each field of a request the CLI built: {"axes[0].stop": "--speed (its
 high end)", "samples": "--samples"}; a field inside one (``levers[0].bounds[1]``) is named by

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
+    STARTS_FIELD,
     InvalidInputError,
     Options,
     axis_options,
@@ -51,6 +52,7 @@ from gearengine.gate.resolution import GRID_POINTS
 from gearengine.gate.rules import Rules
 from gearengine.jsonio import dumps
 from gearengine.model.units import POINT_OUTPUTS
+from gearengine.numerics.attractors import IMPACT_TEXT
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies import jobs
 from gearengine.studies.sweep.axes import axis_unit
@@ -108,7 +110,10 @@ def envelope_request(args: argparse.Namespace, doc: object) -> SweepRequest:
     )
     counted_points(axes, "envelope check")  # before the sweep's checks build its grids
     given = [i for i, name in enumerate(["speed", "torque"]) if getattr(args, name)]
-    request = validated_input(validated, sweep, args.file, axis_options(axes, given))
+    options = axis_options(axes, given)
+    if args.starts is not None:
+        options[STARTS_FIELD] = "--starts"
+    request = validated_input(validated, sweep, args.file, options)
     why = budget_refusal("sweep", request, "envelope check", ENVELOPE_WAYS)
     if why is not None:
         raise InvalidInputError([why])
@@ -305,8 +310,8 @@ def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit",
 
 
 CONTACT_LABELS = {
-    "separation": "tooth separation",
-    "back_flank": "back-flank impacts",
+    "separation": IMPACT_TEXT["single_sided"],
+    "back_flank": IMPACT_TEXT["double_sided"],
 }
 """The contact of a speed window (``SpeedWindows.contact``) in the gate's words."""
 

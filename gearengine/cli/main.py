@@ -34,6 +34,7 @@ import importlib
 import logging
 import math
 import os
+import re
 import sys
 import traceback
 from collections.abc import Callable, Sequence
@@ -92,6 +93,19 @@ def finite(text: str) -> float:
         return _finite(float(text), text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+
+
+def per_tau(text: str) -> float:
+    """``--max-lle``: a plain number per unit tau (``finite``); a value with a unit ("1/s") is
+    refused saying so, where it read "'1/s' is not a number" beside a help saying check prints
+    the LLE in 1/s too."""
+    try:
+        return finite(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: the LLE limit is per unit tau (tau = omega_n t), a plain number; check "
+            "prints the 1/s equivalent beside it"
+        ) from None
 
 
 def micrometres(text: str) -> float:
@@ -165,7 +179,7 @@ def envelope_options(p: argparse.ArgumentParser, speed_required: bool = False) -
                    "force")  # fmt: skip
     p.add_argument(
         "--max-lle",
-        type=finite,
+        type=per_tau,
         default=None,
         help="fail when the LLE exceeds V per unit tau (tau = omega_n t; "
         "check prints it in 1/s too)",
@@ -348,9 +362,28 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+RANGE_OPTIONS = ("--speed", "--torque")
+"""Options taking LOW:HIGH, whose low end may begin with a minus sign."""
+
+
+def joined_ranges(argv: Sequence[str]) -> list[str]:
+    """``--torque -5:60`` as ``--torque=-5:60``: argparse takes a value beginning with "-"
+    for an option ("expected one argument"); joined, the range is read and a negative end
+    refused with its reason (a mean torque is a magnitude; a speed is positive)."""
+    out: list[str] = []
+    it = iter(argv)
+    for arg in it:
+        value = next(it, None) if arg in RANGE_OPTIONS else None
+        if value is not None and re.match(r"-[\d.]", value):
+            out.append(f"{arg}={value}")
+        else:
+            out += [arg] if value is None else [arg, value]
+    return out
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit code."""
-    args = build_parser().parse_args(argv)
+    args = build_parser().parse_args(joined_ranges(sys.argv[1:] if argv is None else argv))
     func: Command = args.func
     try:
         code = func(args)

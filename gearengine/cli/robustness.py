@@ -18,6 +18,7 @@ from gearengine.cli.documents import (
     EXIT_FAIL,
     EXIT_OK,
     GATED,
+    STARTS_FIELD,
     InvalidInputError,
     axis_options,
     counted_points,
@@ -71,6 +72,8 @@ def robustness_request(args: argparse.Namespace, doc: object) -> RobustnessReque
     counted_points(body["axes"], "robustness study")
     options = {"samples": "--samples", "seed": "--seed",
                **axis_options(axes, list(range(len(axes))))}  # fmt: skip
+    if getattr(args, "starts", None) is not None:
+        options[STARTS_FIELD] = "--starts"
     request = validated_input(
         lambda d: checked(RobustnessRequest.model_validate(d)), body, args.file, options
     )

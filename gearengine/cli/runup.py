@@ -17,23 +17,19 @@ from pathlib import Path
 from gearengine.cli.documents import EXIT_OK, InvalidInputError, read_document, validated_input
 from gearengine.cli.sweep import progress_bar
 from gearengine.jsonio import dumps
+from gearengine.model.units import with_unit
 from gearengine.studies.runup.compute import run_local
 from gearengine.studies.runup.profile import validated_runup
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.studies.runup.results import RunupBranch, RunupResult
 
-OPTIONS = {  # option -> (request field, unit of a bare number)
-    "from_speed": ("from_speed", "rpm"),
-    "to_speed": ("to_speed", "rpm"),
-    "rate": ("rate", "rpm/s"),
-    "duration": ("duration", "s"),
-    "to_torque": ("to_torque", "N*m"),
+OPTIONS = {  # attribute -> (request field, unit of a bare number, option)
+    "from_speed": ("from_speed", "rpm", "--from"),
+    "to_speed": ("to_speed", "rpm", "--to"),
+    "rate": ("rate", "rpm/s", "--rate"),
+    "duration": ("duration", "s", "--duration"),
+    "to_torque": ("to_torque", "N*m", "--to-torque"),
 }
-
-
-def with_unit(text: str, unit: str) -> str:
-    """ "500" -> "500 rpm"; "52 rad/s" stays as it is."""
-    return text if any(c.isalpha() for c in text) else f"{text} {unit}"
 
 
 def runup_request(args: argparse.Namespace) -> RunupRequest:
@@ -41,18 +37,18 @@ def runup_request(args: argparse.Namespace) -> RunupRequest:
     doc = read_document(args.file)
     if not isinstance(doc, dict) or "design" not in doc:
         raise InvalidInputError([f'{args.file}: a run-up needs {{"design": {{...}}}}'])
-    body = dict(doc)
-    for option, (field, unit) in OPTIONS.items():
-        value = getattr(args, option, None)
+    body, options = dict(doc), {}
+    for attribute, (field, unit, option) in OPTIONS.items():
+        value = getattr(args, attribute, None)
         if value is not None:
-            body[field] = with_unit(value, unit)
+            body[field], options[field] = with_unit(value, unit), option
     if args.direction is not None:
         body["direction"] = args.direction
     if args.bin is not None:
-        body["bin_rpm"] = args.bin
+        body["bin_rpm"], options["bin_rpm"] = args.bin, "--bin"
     if args.ensemble is not None:
         body["ensemble"] = {**body.get("ensemble", {}), "size": args.ensemble}
-    return validated_input(validated_runup, body, args.file)
+    return validated_input(validated_runup, body, args.file, options)
 
 
 def _number(value: float | None, fmt: str) -> str:

@@ -17,9 +17,9 @@ from pathlib import Path
 from typing import Any
 
 from gearengine.cli.documents import EXIT_OK, InvalidInputError, validated_input
-from gearengine.cli.runup import with_unit
 from gearengine.jsonio import dumps, load_document
 from gearengine.model.errors import InputError
+from gearengine.model.units import with_unit
 from gearengine.rig import read_signal
 from gearengine.signals.schema import SignalResult
 from gearengine.signals.series import SignalRequest, read_table

@@ -15,7 +15,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from gearengine.gate.resolution import REFINE_DEPTH, Resolution, resolution
 from gearengine.gate.resolution import refine as refine_points
 from gearengine.gate.rules import Rules, attractor_failures, attractor_set, near_limit
-from gearengine.model.units import POINT_OUTPUTS
+from gearengine.model.units import POINT_OUTPUTS, with_unit
 from gearengine.numerics.settings import ENVELOPE_SETTINGS
 from gearengine.studies import jobs
 from gearengine.studies.sweep.compute import points_at, run_local
@@ -58,7 +58,7 @@ def envelope_axis(name: str, text: str, unit: str, num: int) -> dict[str, object
     ends = text.split(":")
     if len(ends) != 2 or not all(e.strip() for e in ends):
         raise ValueError("give a range as LOW:HIGH (two values and a colon, e.g. 500:6000)")
-    lo, hi = (e.strip() if any(c.isalpha() for c in e) else f"{e.strip()} {unit}" for e in ends)
+    lo, hi = (with_unit(e, unit) for e in ends)
     return {"parameter": name, "start": lo, "stop": hi, "num": num}
 
 

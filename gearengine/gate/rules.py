@@ -25,6 +25,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from gearengine.model.errors import InputError
 from gearengine.model.units import IMPACTS_REFUSED, OUTPUTS
+from gearengine.numerics.attractors import IMPACT_TEXT
 from gearengine.numerics.results import Attractor
 from gearengine.signals.classify import SEVERITY
 from gearengine.studies.sweep.points import PhysicalValue, SweepPoint
@@ -117,9 +118,9 @@ def verdict_failures(
     if "melnikov" in rules.fail_on and melnikov_chaos_possible:
         out.append("Melnikov: chaos possible")
     if "back_flank" in rules.fail_on and impact_regime == "double_sided":
-        out.append("back-flank impacts")
+        out.append(IMPACT_TEXT["double_sided"])
     if "separation" in rules.fail_on and impact_regime in SEPARATING:
-        out.append("tooth separation")
+        out.append(IMPACT_TEXT["single_sided"])
     if rules.max_lle is not None and (lle is None or lle > rules.max_lle):
         out.append(f"LLE > {rules.max_lle:g} per unit tau")
     if rules.max_dte_um is not None and (dte_um is None or dte_um > rules.max_dte_um):
@@ -133,7 +134,7 @@ def verdict_failures(
 
 def attractor_failures(p: SweepPoint, rules: Rules) -> list[tuple[str, str]]:
     """(rule, who) of each rule a point breaks: with basins each attractor above
-    ``rules.min_basin`` is checked as if it were the point ("chaotic, double-sided impacts
+    ``rules.min_basin`` is checked as if it were the point ("chaotic, back-flank impacts
     from 41 % of starts" is who broke it), and the point's own verdict too where no attractor
     decides it (``judged_alone``: it diverged, or no start reached an attractor), named by its
     ``decided_by``; without basins, the point itself (who is empty)."""

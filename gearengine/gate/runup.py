@@ -16,6 +16,7 @@ from collections.abc import Callable
 from gearengine.gate.envelope import EnvelopeReport, FailingWindow, RunupCheck
 from gearengine.gate.rules import Rules
 from gearengine.model.units import RPM, shown
+from gearengine.numerics.attractors import IMPACT_TEXT
 from gearengine.studies.runup.compute import run_local
 from gearengine.studies.runup.profile import validated_runup
 from gearengine.studies.runup.reading import transient_chaos
@@ -37,9 +38,9 @@ def bin_failures(b: RunupBin, rules: Rules) -> list[str]:
     says: the gate cannot vouch for a response the model could not follow."""
     out = ["diverged"] if b.lle is None or b.contact is None else []
     if "back_flank" in rules.fail_on and (b.back_flank_impacts or 0) > 0:
-        out.append("back-flank impacts")
+        out.append(IMPACT_TEXT["double_sided"])
     if "separation" in rules.fail_on and (b.separation_fraction or 0) > 0:
-        out.append("tooth separation")
+        out.append(IMPACT_TEXT["single_sided"])
     if rules.max_dte_um is not None and (
         b.dte_peak_to_peak_um is None or b.dte_peak_to_peak_um > rules.max_dte_um
     ):

@@ -51,6 +51,7 @@ from gearengine.model.units import (
     HalfBacklash,
     Inertia,
     Length,
+    MeanTorque,
     MeshStiffness,
     Module,
     Speed,
@@ -279,8 +280,8 @@ class Design(StrictModel):
     driver: Gear = Field(description="The driving gear a.")
     driven: Gear = Field(description="The driven gear b.")
     speed: Speed = Field(description="Driver shaft speed, e.g. '1500 rpm'.")
-    torque: Torque = Field(description="Mean driver torque, e.g. '40 N*m'.")
-    braking_torque: Torque | None = Field(
+    torque: MeanTorque = Field(description="Mean driver torque, e.g. '40 N*m'.")
+    braking_torque: MeanTorque | None = Field(
         None, description="Mean braking torque on the driven gear (default: balancing)."
     )
     mesh: Mesh
@@ -425,7 +426,7 @@ def ripple_of_mean_torque(data: Any, notes: list[str]) -> tuple[Any, dict[int, f
         return data, {}
     try:
         with readings():  # the torque's own reading is noted by its field
-            mean = parse_quantity(data.get("torque"), QUANTITIES["torque"], allow_zero=True)
+            mean = parse_quantity(data.get("torque"), QUANTITIES["mean_torque"], allow_zero=True)
     except ValueError:
         return data, {}
     written = [dict(h) if isinstance(h, dict) else h for h in harmonics]

@@ -52,8 +52,11 @@ CONFIDENCE = 0.95
 DIVERGED, UNSETTLED = -1, -2
 """Labels of starts that reached no attractor."""
 IMPACT_ORDER = {None: -1, "no_impact": 0, "single_sided": 1, "double_sided": 2}
-IMPACT_TEXT = {"no_impact": "no impacts", "single_sided": "single-sided impacts",
-               "double_sided": "double-sided impacts"}  # fmt: skip
+IMPACT_TEXT = {"no_impact": "teeth always in contact", "single_sided": "tooth separation",
+               "double_sided": "back-flank impacts"}  # fmt: skip
+"""An attractor's contact in the text words of docs/units.md's one contact vocabulary (the
+impact regimes no_impact, single_sided and double_sided, in words; "single-sided impacts"
+stood in gate lines beside windows that said "tooth separation")."""
 
 
 def scale_pair(scales: Scales | None) -> tuple[float, float]:
@@ -158,7 +161,7 @@ def _wilson(count: int, n: int) -> tuple[float, float]:
 
 
 def describe(classification: str, period: int | None, impact: str | None) -> str:
-    """'periodic 1T, no impacts', 'chaotic, double-sided impacts'."""
+    """'periodic 1T, teeth always in contact', 'chaotic, back-flank impacts'."""
     kind = f"periodic {period}T" if period else classification.replace("_", "-")
     return f"{kind}, {IMPACT_TEXT[impact]}" if impact in IMPACT_TEXT else kind
 
@@ -345,7 +348,8 @@ def _group(
 
 
 def _distinct_labels(found: list[Attractor]) -> list[Attractor]:
-    """Number the attractors that would share a label: 'periodic 1T, no impacts (2)'."""
+    """Number the attractors that would share a label: 'periodic 1T, back-flank impacts
+    (2)'."""
     seen: dict[str, int] = {}
     out = []
     for a in found:

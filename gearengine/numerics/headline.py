@@ -17,7 +17,7 @@ class Headline:
     classification: str
     period: int | None
     decided_by: str
-    """Which member decided it: 'chaotic, double-sided impacts from 41 % of starts'."""
+    """Which member decided it: 'chaotic, back-flank impacts from 41 % of starts'."""
     fraction: float
     """Its basin fraction (of diverged starts for 'diverged')."""
     attractor: Attractor | None = None
@@ -55,8 +55,8 @@ def of_starts(label: str, fraction: float) -> str:
 
 
 def coexistence(found: list[Attractor], counts: BasinCounts) -> str:
-    """'periodic 1T, no impacts from 83 % of starts; chaotic from 17 %' (largest basin first),
-    with the diverged and unsettled starts."""
+    """'periodic 1T, teeth always in contact from 83 % of starts; chaotic from 17 %' (largest
+    basin first), with the diverged and unsettled starts."""
     parts = [(a.fraction, a.label) for a in sorted(found, key=lambda a: -a.count)]
     for n, what in ((counts.diverged, "diverged"), (counts.unsettled, "unsettled")):
         if n:

@@ -81,9 +81,9 @@ class Attractor(FiniteAnswer):
     """One attractor found from the basin starts (``numerics.attractors``, docs/basins.md)."""
 
     label: str = Field(
-        description="How the gate and the summary name it: 'periodic 1T, no impacts', "
-        "'chaotic, double-sided impacts'.",
-        examples=["chaotic, double-sided impacts"],
+        description="How the gate and the summary name it: 'periodic 1T, teeth always in contact', "
+        "'chaotic, back-flank impacts'.",
+        examples=["chaotic, back-flank impacts"],
     )
     classification: str = Field(description="periodic | chaotic | quasi_periodic.")
     period: int | None = Field(description="Period in units of T0, null if not periodic.")

@@ -26,6 +26,7 @@ from typing import Any
 from pydantic import BaseModel
 
 from gearengine.jsonio import dumps
+from gearengine.model.units import si_numbers
 
 
 @dataclass(frozen=True)
@@ -91,8 +92,9 @@ def one_chunk_kind(
 MAX_JOB_POINTS = 40_000
 """Most operating points of one job (the service's default ``max_job_points``, every door)."""
 MAX_JOB_STEPS = 20_000_000_000
-"""Compute budget of one job in RK4 steps (the service's default ``max_job_steps``): about a
-minute on two cores."""
+"""Compute budget of one job in RK4 steps (the service's default ``max_job_steps``). No time is
+said for it: the steps a second depend on the machine and its load (a 1.08e10-step check took
+98 s on two shared cores, where 2.07e10 steps were said to take "about 1 min")."""
 
 
 BUDGET_ENV = ("GEARCHAOS_MAX_JOB_STEPS", "GEARCHAOS_MAX_SWEEP_STEPS")
@@ -101,11 +103,15 @@ its old name), read by the CLI as by the service."""
 
 
 def starts_words(lanes: int, basin_starts: int) -> str:
-    """ "17 starts (1 + 16 basin starts)", "1 start": the runs of one point in words."""
+    """ "17 starts (16 basin starts and the settings' own start)", "1 start": the runs of one
+    point in words, the basin starts named first as every report counts them ("16 starts a
+    point"; the refusal said "17 starts (1 + 16 basin starts)")."""
     plural = "s" if lanes != 1 else ""
     if not basin_starts:
         return f"{lanes} start{plural}"
-    return f"{lanes} start{plural} ({lanes - basin_starts} + {basin_starts} basin starts)"
+    own = lanes - basin_starts
+    own_words = "the settings' own start" if own == 1 else f"the settings' own {own} starts"
+    return f"{lanes} start{plural} ({basin_starts} basin starts and {own_words})"
 
 
 def job_step_budget() -> int:
@@ -125,18 +131,16 @@ def job_step_budget() -> int:
 
 def budget_refusal(name: str, request: BaseModel, noun: str, cap: int, ways: str) -> str | None:
     """Why a job of kind ``name`` is over the budget of ``cap`` RK4 steps, else None: its steps,
-    its cost in the kind's own terms (``JobKind.terms``: samples x starts x points, what fits),
-    the minutes that would take, and ``ways`` out (in the asker's words: options or fields); the
-    one rule of the CLI and the API (``service.limits``)."""
+    its cost in the kind's own terms (``JobKind.terms``: samples x starts x points, what fits)
+    and ``ways`` out (in the asker's words: options or fields); the one rule of the CLI and the
+    API (``service.limits``)."""
     job = kind(name)
     steps = job.work(request)
     if steps <= cap:
         return None
     terms = "" if job.terms is None else f" ({job.terms(request, cap)})"
-    minutes = steps / MAX_JOB_STEPS  # MAX_JOB_STEPS: about a minute on two cores
-    return (f"this {noun} needs {steps} RK4 steps{terms}, over the budget of {cap} RK4 steps "
-            f"per job (max_job_steps, environment {BUDGET_ENV[0]}); it would take about "
-            f"{minutes:.2g} min on two cores; {ways}")  # fmt: skip
+    return (f"this {noun} needs {steps} RK4 steps{terms}, over the budget of {cap} RK4 "
+            f"steps per job (max_job_steps, environment {BUDGET_ENV[0]}); {ways}")  # fmt: skip
 
 
 def too_many_points(points: int, noun: str) -> str | None:
@@ -199,12 +203,20 @@ def cyclic_gc_paused() -> Iterator[None]:
                 gc.enable()
 
 
+def validated_json(job: JobKind, request_json: str) -> Any:
+    """The request of a job read back from its JSON text (stored, or handed to a worker): its
+    numbers are the engine's own SI values (``si_numbers``), read with no note, and read even
+    where a user's bare number is refused (a run-up's speeds and rate)."""
+    with si_numbers():
+        return job.request.model_validate_json(request_json)
+
+
 def compute_chunk_json(name: str, request_json: str, index: int, chunk_points: int) -> str:
     """Chunk ``index`` of a job of kind ``name`` from its request's JSON text (what workers run),
     with the cyclic collector paused (``cyclic_gc_paused``)."""
     job = kind(name)
     with cyclic_gc_paused():
-        return job.compute_chunk(job.request.model_validate_json(request_json), index, chunk_points)
+        return job.compute_chunk(validated_json(job, request_json), index, chunk_points)
 
 
 def run_local(

@@ -111,7 +111,7 @@ class Settings(BaseSettings):
         ge=1000,
         validation_alias=_job_alias("steps"),
         description="Compute budget of one job in RK4 steps (points x periods x steps x "
-        "starts); the default is about a minute on two cores. Environment: "
+        "starts); how long that takes depends on the machine. Environment: "
         "GEARCHAOS_MAX_JOB_STEPS, or its old name GEARCHAOS_MAX_SWEEP_STEPS (an alias).",
     )
     max_queued_jobs: int = Field(

@@ -263,8 +263,8 @@ function fmt(x, digits = 4) {
 const rpm = (x) => Math.round(x).toLocaleString("en-US");
 const CONTACT = {
   no_impact: "teeth always in contact",
-  single_sided: "single-sided impacts: the teeth separate",
-  double_sided: "double-sided impacts: back-flank contact",
+  single_sided: "tooth separation: the teeth apart at some time",
+  double_sided: "back-flank impacts: the separation reaches the back flank",
 };
 
 // the LLE in the page's units: per s with a design (as its figure), per unit τ otherwise

@@ -71,9 +71,9 @@ class Envelope(BaseModel):
                                examples=["2:40"])  # fmt: skip
     speed_points: int = Field(GRID_POINTS["speed"], ge=1, le=200,
                               description="Grid speeds (as the gate).")  # fmt: skip
-    torque_points: int = Field(GRID_POINTS["torque"], ge=1, le=50,
-                               description="Grid torques (as the gate); only with "
-                               "torque.")  # fmt: skip
+    torque_points: int | None = Field(None, ge=1, le=50,
+                                      description="Grid torques (as the gate, default "
+                                      f"{GRID_POINTS['torque']}); only with torque.")  # fmt: skip
     refine: int = Field(
         REFINE_DEPTH, ge=0, le=MAX_REFINE_DEPTH,
         description="Halvings of the grid spacing where neighbours differ (verdict or attractor "
@@ -84,10 +84,12 @@ class Envelope(BaseModel):
 
     @field_validator("torque_points")
     @classmethod
-    def _over_torques(cls, num: int, info: ValidationInfo) -> int:
+    def _over_torques(cls, num: int | None, info: ValidationInfo) -> int | None:
         """A torque grid needs its range: without ``torque`` the design's one torque is
-        checked, and the count was ignored unsaid."""
-        if info.data.get("torque") is None:
+        checked, and the count was ignored unsaid. None (the default, filled in by ``sweep``)
+        is dumped as null, so that a request read back from its JSON (a worker's, the
+        service's store) passes: the count 5 of the default was refused there."""
+        if num is not None and info.data.get("torque") is None:
             raise ValueError(
                 "counts the points of a torque range, and none is given (torque LOW:HIGH)"
             )
@@ -168,7 +170,8 @@ class RemediesRequest(Rules):
 
         axes = [envelope_axis("speed", env.speed, "rpm", num(env.speed_points))]
         if env.torque is not None:
-            axes.append(envelope_axis("torque", env.torque, "N*m", num(env.torque_points)))
+            torques = GRID_POINTS["torque"] if env.torque_points is None else env.torque_points
+            axes.append(envelope_axis("torque", env.torque, "N*m", num(torques)))
         settings = gate_settings(self.settings.model_dump(exclude_none=True), self.starts,
                                  self.min_basin)  # fmt: skip
         doc = envelope_sweep((design or self.design).model_dump(), settings, axes, "remedies")

@@ -39,6 +39,7 @@ from gearengine.model.units.quantities import (
     Inertia,
     Length,
     Mass,
+    MeanTorque,
     MeshStiffness,
     Module,
     SampleRate,
@@ -51,9 +52,11 @@ from gearengine.model.units.quantities import (
     note,
     parse_quantity,
     plain_number,
+    quantity_type,
     readings,
     registry,
     si_numbers,
+    with_unit,
 )
 
 __all__ = [
@@ -78,6 +81,7 @@ __all__ = [
     "Inertia",
     "Length",
     "Mass",
+    "MeanTorque",
     "MeshStiffness",
     "Module",
     "SampleRate",
@@ -97,10 +101,12 @@ __all__ = [
     "note",
     "parse_quantity",
     "plain_number",
+    "quantity_type",
     "readings",
     "registry",
     "response_values",
     "shown",
     "si_numbers",
     "to_physical",
+    "with_unit",
 ]

@@ -54,6 +54,19 @@ class QuantityKind:
     spellings: dict[str, str] = field(default_factory=dict)
     """Units as engineers type them that pint reads otherwise (``Nm``: pint's N is Avogadro's
     number), and the unit meant; the whole unit text must match."""
+    negative: str | None = None
+    """Why a negative value is refused, for a kind whose range starts at 0 (which otherwise
+    takes either sign: a displacement, a harmonic's amplitude)."""
+
+    @property
+    def a_name(self) -> str:
+        """The name with its article: "a shaft speed", "an angle" (it read "a angle")."""
+        return f"{'an' if self.name[0] in 'aeiou' else 'a'} {self.name}"
+
+    @property
+    def signed(self) -> bool:
+        """Negative values are read (their magnitude checked against the range)."""
+        return self.low == 0.0 and self.negative is None
 
     @property
     def dimensionality(self) -> Any:
@@ -143,6 +156,17 @@ QUANTITIES: dict[str, QuantityKind] = {
         "shaft speed", "rad/s", 2 * math.pi / 60, 1e5 * 2 * math.pi / 60, ("rpm",), "1500 rpm"
     ),  # 1 to 100,000 rpm: a bare 20000 (rad/s, 191,000 rpm) is refused, not read silently
     "torque": QuantityKind("torque", "N*m", 0.0, 1e6, (), "40 N*m", TORQUE_SPELLINGS),
+    "mean_torque": QuantityKind(
+        "torque",
+        "N*m",
+        0.0,
+        1e6,
+        (),
+        "40 N*m",
+        TORQUE_SPELLINGS,
+        "a mean torque is a magnitude, 0 to 1e6 N*m: the model's backlash is symmetric, so a "
+        "reversed torque mirrors the response (x -> -x); give its magnitude",
+    ),  # "-20 N*m" was read and answered as +20 N*m's mirror, unsaid
     "stiffness": QuantityKind("mesh stiffness", "N/m", 1e6, 1e11, ("N/um", "N/mm"), "1e8 N/m"),
     "stiffness_variation": QuantityKind(
         "stiffness variation", "N/m", 0.0, 1e11, ("N/um", "N/mm"), "1e7 N/m"
@@ -186,13 +210,18 @@ POSITIVE_KINDS = frozenset(
 
 
 def parse_quantity(
-    value: object, kind: QuantityKind, allow_zero: bool = False, field: str | None = None
+    value: object,
+    kind: QuantityKind,
+    allow_zero: bool = False,
+    field: str | None = None,
+    unit_required: bool = False,
 ) -> float:
     """``value`` (a string with a unit, or a number in SI units) in the kind's SI unit.
 
     Raises ValueError naming the unit given and the dimension expected, or the plausible range
     with a guess at the intended unit. A bare number is read in SI units with a note naming
-    ``field`` (``_bare``).
+    ``field`` (``_bare``), or, ``unit_required``, refused naming the units meant (a field whose
+    answer has no place for the note), except inside ``si_numbers``.
     """
     ureg = registry()
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
@@ -213,27 +242,26 @@ def parse_quantity(
                              f"{kind.example!r}") from None  # fmt: skip
         if isinstance(quantity, ureg.Quantity) and str(quantity.units) in SHARES:
             raise ValueError(
-                f"{value!r} is a share, not a {kind.name}: give a unit of dimension "
+                f"{value!r} is a share, not {kind.a_name}: give a unit of dimension "
                 f"{kind.dimensionality}, e.g. {kind.example!r} (a share of a nominal value is "
                 "read only where one is meant: a torque fluctuation amplitude in % of the mean "
                 "torque)"
             )
         if not isinstance(quantity, ureg.Quantity) or str(quantity.units) == "dimensionless":
-            return _bare(
-                float(getattr(quantity, "magnitude", quantity)), value, kind, allow_zero, field
-            )
+            magnitude = float(getattr(quantity, "magnitude", quantity))
+            return _bare(magnitude, value, kind, allow_zero, field, unit_required)
         if quantity.dimensionless and kind.unit not in ("rad",):
             quantity = ureg.Quantity(quantity.magnitude, kind.unit)
         if quantity.dimensionality != kind.dimensionality:
             raise ValueError(
                 f"{value!r} has the unit {quantity.units:~} ({quantity.dimensionality}); "
-                f"a {kind.name} needs a unit of dimension {kind.dimensionality}, e.g. "
+                f"{kind.a_name} needs a unit of dimension {kind.dimensionality}, e.g. "
                 f"{kind.example!r}"
             )
         _angle_given(quantity, value, kind)
         si = float(quantity.to(kind.unit).magnitude)
     else:
-        return _bare(float(value), value, kind, allow_zero, field)
+        return _bare(float(value), value, kind, allow_zero, field, unit_required)
     return _plausible(si, value, kind, allow_zero)
 
 
@@ -252,7 +280,7 @@ def _angle_given(quantity: Any, value: str, kind: QuantityKind) -> None:
     radians = (quantity * ureg.radian).to(kind.unit).magnitude
     per = kind.unit.removeprefix("rad")
     raise ValueError(
-        f"{value!r} has no angle (pint would read Hz and 1/s as rad/s): a {kind.name} needs "
+        f"{value!r} has no angle (pint would read Hz and 1/s as rad/s): {kind.a_name} needs "
         f"one; write "
         f"'{turns:.6g} {shown}' or '{quantity.to('1' + per).magnitude:.6g} rev{per}' for "
         f"revolutions, '{radians:.6g} {kind.unit}' for radians"
@@ -265,16 +293,28 @@ SHARES = frozenset({"percent", "permille", "ppm"})
 
 
 def _bare(
-    si: float, given: object, kind: QuantityKind, allow_zero: bool, field: str | None
+    si: float,
+    given: object,
+    kind: QuantityKind,
+    allow_zero: bool,
+    field: str | None,
+    unit_required: bool = False,
 ) -> float:
     """A bare number (no unit) read in the kind's SI unit, noted in the current ``readings``
     with the value in the example's unit ("shaft speed: the bare number 6000 read as 6000
     rad/s = 57,295.8 rpm; write '6000 rpm' if rpm was meant"), the same reading as every other
-    door (API, library; the CLI's options name their unit)."""
+    door (API, library; the CLI's options name their unit); ``unit_required``, refused saying
+    both readings (outside ``si_numbers``: the engine's own SI values read back pass)."""
+    shown = kind.example.split(maxsplit=1)[-1]
+    if unit_required and not _SI_NUMBERS.get():
+        raise ValueError(
+            f"the bare number {si:g} has no unit: {kind.a_name} needs one, e.g. "
+            f"'{si:g} {shown}' or '{si:g} {kind.unit}' (no note can say how a bare number "
+            "was read here)"
+        )
     si = _plausible(si, given, kind, allow_zero)
     found = _READINGS.get()
     if found is not None and si != 0.0 and not _SI_NUMBERS.get():
-        shown = kind.example.split(maxsplit=1)[-1]
         text = f"{field or kind.name}: the bare number {si:g} read as {kind.describe(si)}"
         if shown != kind.unit:
             other = float(registry().Quantity(si, kind.unit).to(shown).magnitude)
@@ -289,14 +329,16 @@ def _plausible(si: float, given: object, kind: QuantityKind, allow_zero: bool) -
         raise ValueError(f"{given!r} is not a finite {kind.name}")
     if si == 0.0 and allow_zero:
         return si
+    shown = given if isinstance(given, str) else kind.describe(si)
+    if si < 0.0 and kind.negative is not None:
+        raise ValueError(f"{shown} is negative; {kind.negative}, e.g. '{-si:.6g} {kind.unit}'")
     if kind.low <= abs(si) <= kind.high and (si > 0.0 or kind.low == 0.0):
         return si
     ureg = registry()
-    shown = given if isinstance(given, str) else kind.describe(si)
     if si < 0.0 and kind.low > 0.0:  # no slip of the unit makes it positive
-        raise ValueError(f"{shown} is negative; a {kind.name} is a positive magnitude, e.g. "
+        raise ValueError(f"{shown} is negative; {kind.a_name} is a positive magnitude, e.g. "
                          f"{kind.example!r}")  # fmt: skip
-    message = f"{shown} is outside the plausible range of a {kind.name}, {kind.span()}"
+    message = f"{shown} is outside the plausible range of {kind.a_name}, {kind.span()}"
     magnitude = ureg.Quantity(given.strip()).magnitude if isinstance(given, str) else si
     for slip in kind.slips:
         meant = float(ureg.Quantity(abs(float(magnitude)), slip).to(kind.unit).magnitude)
@@ -323,7 +365,7 @@ def quantity_pattern(kind: QuantityKind) -> str:
     right dimension, "0.5 mm"): the pattern states the common case, and the example, so that
     requests generated from the schema (schemathesis) are mostly valid."""
     ureg = registry()
-    sign = "-?" if kind.low == 0.0 else ""
+    sign = "-?" if kind.signed else ""
     alternatives = [re.escape(kind.example)]
     for unit in dict.fromkeys([kind.unit, kind.example.split(maxsplit=1)[-1], *kind.slips]):
         per_si = float(ureg.Quantity(1.0, unit).to(kind.unit).magnitude)
@@ -347,39 +389,46 @@ class QuantitySchema:
     """The JSON schema of a quantity field, made when a schema is asked for (the OpenAPI
     document), not at import: the pattern's unit factors need pint (``registry``)."""
 
-    def __init__(self, kind: QuantityKind, allow_zero: bool, keyword: str | None) -> None:
+    def __init__(
+        self, kind: QuantityKind, allow_zero: bool, keyword: str | None, unit_required: bool
+    ) -> None:
         self.kind, self.allow_zero, self.keyword = kind, allow_zero, keyword
+        self.unit_required = unit_required
 
     def __get_pydantic_json_schema__(self, core: Any, handler: Any) -> dict[str, Any]:
         kind = self.kind
-        low = -kind.high if kind.low == 0.0 else kind.low  # the plausible range (_plausible)
+        low = -kind.high if kind.signed else kind.low  # the plausible range (_plausible)
         words = [] if self.keyword is None else [{"const": self.keyword}]
         zero = [{"const": 0}] if self.allow_zero and kind.low > 0.0 else []
+        number = {"type": "number", "description": f"in {kind.unit}", "minimum": low,
+                  "maximum": kind.high}  # fmt: skip
+        text = {"type": "string", "pattern": quantity_pattern(kind), "examples": [kind.example]}
+        if self.unit_required:
+            return {**text, "description": f"{kind.name}: a string with a unit (e.g. "
+                    f"{kind.example!r}); plausible range {kind.span()}"}  # fmt: skip
         return {
-            "anyOf": [
-                *words,
-                {"type": "string", "pattern": quantity_pattern(kind), "examples": [kind.example]},
-                {"type": "number", "description": f"in {kind.unit}", "minimum": low,
-                 "maximum": kind.high},
-                *zero,
-            ],
+            "anyOf": [*words, text, number, *zero],
             "description": f"{kind.name}: a string with a unit (e.g. {kind.example!r}) or a "
             f"number in {kind.unit} (read with a note); plausible range {kind.span()}",
-        }  # fmt: skip
+        }
 
 
-def quantity_type(key: str, allow_zero: bool = False, keyword: str | None = None) -> Any:
-    """A pydantic field type: a string with a unit or an SI number, stored in SI units; a
-    ``keyword`` (such as "iso6336": derive it) passes through as the string itself."""
+def quantity_type(
+    key: str, allow_zero: bool = False, keyword: str | None = None, unit_required: bool = False
+) -> Any:
+    """A pydantic field type: a string with a unit or an SI number (``unit_required``: a
+    string with a unit only), stored in SI units; a ``keyword`` (such as "iso6336": derive it)
+    passes through as the string itself."""
     kind = QUANTITIES[key]
 
     def parse(value: object, info: ValidationInfo) -> float | str:
         if keyword is not None and value == keyword:
             return keyword
-        return parse_quantity(value, kind, allow_zero, info.field_name)
+        return parse_quantity(value, kind, allow_zero, info.field_name, unit_required)
 
     stored = float if keyword is None else float | str
-    return Annotated[stored, BeforeValidator(parse), QuantitySchema(kind, allow_zero, keyword)]
+    schema = QuantitySchema(kind, allow_zero, keyword, unit_required)
+    return Annotated[stored, BeforeValidator(parse), schema]
 
 
 SHARE = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*%\s*")
@@ -405,6 +454,19 @@ def plain_number(name: str) -> Any:
     return BeforeValidator(refuse_share)
 
 
+def with_unit(text: str, unit: str) -> str:
+    """A command-line quantity: a bare number ("500", "1e3") in the option's ``unit`` ("500
+    rpm"); any other text ("52 rad/s", "5%") as written, for ``parse_quantity`` to read or
+    refuse. A share is no bare number: "5%" stays a share, refused in a dimensional field,
+    where "5%" with the unit appended read as "5% N*m" = 0.05 N*m, and "1e3" (a letter)
+    kept no unit and was read in SI units."""
+    try:
+        float(text)
+    except ValueError:
+        return text.strip()
+    return f"{text.strip()} {unit}"
+
+
 Length = quantity_type("length")
 Module = quantity_type("module")
 Bore = quantity_type("length", allow_zero=True)
@@ -414,6 +476,8 @@ Backlash = quantity_type("backlash")
 ErrorAmplitude = quantity_type("error", allow_zero=True)
 Speed = quantity_type("speed")
 Torque = quantity_type("torque", allow_zero=True)
+MeanTorque = quantity_type("mean_torque", allow_zero=True)
+"""A mean (driving or braking) torque: a magnitude, a negative one refused."""
 Stiffness = quantity_type("stiffness")
 MeshStiffness = quantity_type("stiffness", keyword="iso6336")
 StiffnessVariation = quantity_type("stiffness_variation", allow_zero=True)

@@ -3,9 +3,12 @@
 The profile is a linear ramp between ``from_speed`` and ``to_speed`` (``from_speed`` below
 ``to_speed``) at a ``rate`` or over a ``duration`` (each leg), run ``up`` (from -> to), ``down``
 (to -> from) or ``up_down`` (up, then down from where the up leg ended); or a list of
-``points`` [time, speed], linear between them. Speeds are strings with units ("500 rpm") or
-numbers in rad/s, rates "1000 rpm/s" or rad/s^2, times "5 s" or seconds. The torque may ramp
-linearly in time from the design's torque to ``to_torque`` over the whole profile.
+``points`` [time, speed], linear between them. Speeds are strings with units ("500 rpm",
+"52 rad/s") and rates too ("1000 rpm/s", "100 rad/s^2"): a bare number is refused there, since
+the answer has no place for a note saying how it was read (a bare rate 2000 was 2000 rad/s^2,
+a 0.26 s ramp where the CLI's --rate 2000, rpm/s, takes 2.5 s); times are "5 s" or seconds.
+The torque may ramp linearly in time from the design's torque to ``to_torque`` over the whole
+profile.
 
 Refused before any compute (422 naming the field): a rate that is zero or negative, speeds
 outside the plausible range of a shaft (``model.units``), a profile whose integration is over
@@ -35,10 +38,10 @@ from gearengine.model.units import (
     QUANTITIES,
     RPM,
     Duration,
-    Speed,
+    MeanTorque,
     Time,
-    Torque,
     parse_quantity,
+    quantity_type,
     registry,
 )
 from gearengine.numerics.settings import SimulationSettings
@@ -55,10 +58,11 @@ MAX_ENSEMBLE = 64
 
 
 def _positive_rate(value: object) -> float:
-    """A rate of change of speed: > 0 (the direction says up or down), then plausible."""
+    """A rate of change of speed with its unit: > 0 (the direction says up or down), then
+    plausible."""
     kind = QUANTITIES["speed_rate"]
     try:
-        return parse_quantity(value, kind)
+        return parse_quantity(value, kind, field="rate", unit_required=True)
     except ValueError:
         magnitude = value
         if isinstance(value, str):
@@ -80,12 +84,15 @@ SpeedRate = Annotated[
     BeforeValidator(_positive_rate),
     WithJsonSchema(
         {
-            "anyOf": [{"type": "string", "examples": ["1000 rpm/s"]}, {"type": "number"}],
+            "type": "string",
+            "examples": ["1000 rpm/s"],
             "description": "rate of change of the driver speed: a string with a unit (e.g. "
-            "'1000 rpm/s') or a number in rad/s^2; positive (direction says up or down)",
+            "'1000 rpm/s', '100 rad/s^2'); positive (direction says up or down)",
         }
     ),
 ]
+RunupSpeed = quantity_type("speed", unit_required=True)
+"""A run-up's speed: a string with a unit ("500 rpm"), a bare number refused."""
 
 RunupDirection = Literal["up", "down", "up_down"]
 
@@ -126,14 +133,14 @@ class RunupRequest(ParamsOrDesign):
         }
     )
 
-    from_speed: Speed | None = Field(None, description="Lower speed of a linear ramp.")
-    to_speed: Speed | None = Field(None, description="Upper speed of a linear ramp.")
+    from_speed: RunupSpeed | None = Field(None, description="Lower speed of a linear ramp.")
+    to_speed: RunupSpeed | None = Field(None, description="Upper speed of a linear ramp.")
     rate: SpeedRate | None = Field(None, description="Ramp rate (give rate or duration).")
     duration: Duration | None = Field(None, description="Duration of each leg of the ramp.")
     direction: RunupDirection = Field("up", description="up, down, or up then down.")
     points: (
         Annotated[
-            list[Annotated[tuple[Time, Speed], Field(strict=False)]],
+            list[Annotated[tuple[Time, RunupSpeed], Field(strict=False)]],
             Field(min_length=2, max_length=MAX_PROFILE_POINTS),
         ]
         | None
@@ -143,7 +150,7 @@ class RunupRequest(ParamsOrDesign):
         "linear in between; rising stretches are read as up, falling ones as down.",
         examples=[[["0 s", "500 rpm"], ["3 s", "6000 rpm"], ["5 s", "2000 rpm"]]],
     )
-    to_torque: Torque | None = Field(
+    to_torque: MeanTorque | None = Field(
         None, description="Torque at the end of the profile (linear in time from the design's)."
     )
     bin_rpm: float = Field(

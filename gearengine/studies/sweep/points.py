@@ -127,7 +127,7 @@ class SweepPoint(BaseModel):
     decided_by: str | None = Field(
         None,
         description="With settings.basins: the attractor (or divergence) that decided the "
-        "verdict fields, with its basin fraction: 'chaotic, double-sided impacts from 31 % of "
+        "verdict fields, with its basin fraction: 'chaotic, back-flank impacts from 31 % of "
         "starts'; null without basins (or when no basin is above basins.min_fraction).",
     )
     decided_fraction: float | None = Field(

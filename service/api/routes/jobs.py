@@ -273,7 +273,7 @@ class JobRoutes:
         """The kind's result document of job ``job_id``: its stored request and chunk results
         joined by the kind's ``assemble`` (ValueError from a kind with no partial result)."""
         kind = job_kinds.kind(self.kind)
-        request = kind.request.model_validate_json(jobs.store.request_json(job_id))
+        request = job_kinds.validated_json(kind, jobs.store.request_json(job_id))
         return kind.assemble(request, list(jobs.store.chunk_results(job_id)))
 
     def figure_route(
