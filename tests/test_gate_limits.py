@@ -146,7 +146,7 @@ def test_envelope_settings_merge_over_the_light_defaults(tmp_path: Path) -> None
 @pytest.mark.parametrize(
     ("options", "named"),
     [
-        (["--speed", "4000:nan"], "--speed (its high end): 'nan' is not a finite shaft speed"),
+        (["--speed", "4000:nan"], "--speed (its high end): 'nan rpm' is not a finite shaft speed"),
         (["--speed", "4000:5000", "--speed-points", "0"], "--speed-points: "),
         (["--speed", "4000:5000", "--torque", "5N:10N"], "--torque (its low end): '5N' has"),
     ],

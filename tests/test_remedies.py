@@ -157,17 +157,17 @@ def test_bisection_reports_a_non_monotone_response() -> None:
     lever = Lever(path="mesh.damping_ratio", start=0.0, end=1.0)
     passes = [(0.2, 0.3), (0.55, 1.0)]  # values that pass
 
-    def test(v: float) -> tuple[bool, int]:
+    def test(v: float) -> tuple[bool, int, int]:  # (passed, failing points, points)
         ok = any(lo <= v <= hi for lo, hi in passes)
-        return ok, 0 if ok else 1
+        return ok, 0 if ok else 1, 4
 
     samples, monotone, bracket = _search(test, lever, 5, _narrow(1e-3, lever), 40)
     assert [s.passed for s in samples] == [False, True, False, True, True] and not monotone
     assert bracket is not None and bracket[1] == pytest.approx(0.2, rel=2e-3)
     assert not test(bracket[0])[0] and test(bracket[1])[0]
-    _, monotone, bracket = _search(lambda v: (v >= 0.6, 0), lever, 5, _narrow(1e-3, lever), 40)
+    _, monotone, bracket = _search(lambda v: (v >= 0.6, 0, 4), lever, 5, _narrow(1e-3, lever), 40)
     assert monotone and bracket is not None and bracket[1] == pytest.approx(0.6, rel=2e-3)
-    assert _search(lambda v: (False, 3), lever, 5, _narrow(1e-3, lever), 40)[2] is None
+    assert _search(lambda v: (False, 3, 4), lever, 5, _narrow(1e-3, lever), 40)[2] is None
 
 
 @pytest.mark.parametrize(

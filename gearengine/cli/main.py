@@ -100,12 +100,13 @@ def per_tau(text: str) -> float:
     refused saying so, where it read "'1/s' is not a number" beside a help saying check prints
     the LLE in 1/s too."""
     try:
-        return finite(text)
-    except argparse.ArgumentTypeError:
+        float(text)
+    except ValueError:
         raise argparse.ArgumentTypeError(
             f"{text!r}: the LLE limit is per unit tau (tau = omega_n t), a plain number; check "
             "prints the 1/s equivalent beside it"
         ) from None
+    return finite(text)
 
 
 def micrometres(text: str) -> float:
