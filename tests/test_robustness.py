@@ -16,13 +16,8 @@ from fastapi.testclient import TestClient
 from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.studies.jobs import compute_chunk_json
 from gearengine.studies.robustness import sensitivity
-from gearengine.studies.robustness.study import (
-    SALTELLI_SAMPLES,
-    RobustnessRequest,
-    checked,
-    compute_chunk,
-    run_local,
-)
+from gearengine.studies.robustness.results import SALTELLI_SAMPLES
+from gearengine.studies.robustness.study import RobustnessRequest, checked, compute_chunk, run_local
 from gearengine.studies.robustness.tolerances import (
     base_design,
     probability,

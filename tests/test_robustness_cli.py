@@ -245,8 +245,8 @@ def test_sequential_looks_share_the_error_of_one_decision() -> None:
     95 % would give a point 7 chances to pass by luck (the expert's push on issue 30's auto
     sampling). The 5 % is shared over the looks: 0 events in 368 samples prove P <= 1 % at 95 %
     (one look, --samples N) but not at a look of the sequential study (561 are needed)."""
+    from gearengine.studies.robustness.results import Probability, RobustnessPoint
     from gearengine.studies.robustness.sequential import decision_confidence, looks, verdict
-    from gearengine.studies.robustness.study import Probability, RobustnessPoint
     from gearengine.studies.robustness.tolerances import probability, samples_to_prove
 
     def point(k: int, n: int) -> RobustnessPoint:
@@ -350,7 +350,7 @@ def test_diverged_samples_never_pass_a_limit_they_could_break() -> None:
     outcome (a few of many do not matter), else the point is undecided, saying why; the
     lower bound (a fail) counts the followed events alone."""
     from gearengine.gate.probability import point_verdict
-    from gearengine.studies.robustness.study import Probability, RobustnessPoint
+    from gearengine.studies.robustness.results import Probability, RobustnessPoint
     from gearengine.studies.robustness.tolerances import probability
 
     def point(diverged: int, chaotic: int, n: int = 64) -> RobustnessPoint:

@@ -35,6 +35,7 @@ from gearengine.model.design import Design
 from gearengine.model.units import IMPACTS_REFUSED, display_unit
 from gearengine.model.units import shown as rounded
 from gearengine.studies import jobs
+from gearengine.studies.robustness.results import SALTELLI_SAMPLES, RobustnessResult
 from gearengine.studies.robustness.sequential import (
     FIRST_SAMPLES,
     SequentialResult,
@@ -42,13 +43,7 @@ from gearengine.studies.robustness.sequential import (
     sequential,
     unreachable,
 )
-from gearengine.studies.robustness.study import (
-    SALTELLI_SAMPLES,
-    RobustnessRequest,
-    RobustnessResult,
-    checked,
-    run_local,
-)
+from gearengine.studies.robustness.study import RobustnessRequest, checked, run_local
 from gearengine.studies.robustness.tolerances import samples_to_prove
 from gearengine.studies.sweep.points import PhysicalValue
 

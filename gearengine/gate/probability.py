@@ -10,6 +10,7 @@ from __future__ import annotations
 from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.model.units import display_unit
+from gearengine.studies.robustness.results import Probability, RobustnessPoint, RobustnessResult
 from gearengine.studies.robustness.sequential import (
     ERROR,
     Verdict,
@@ -17,7 +18,6 @@ from gearengine.studies.robustness.sequential import (
     decision_interval,
     verdict,
 )
-from gearengine.studies.robustness.study import Probability, RobustnessPoint, RobustnessResult
 from gearengine.studies.robustness.tolerances import probability
 from gearengine.studies.sweep.points import PhysicalValue
 

@@ -10,7 +10,8 @@ from matplotlib.figure import Figure
 
 from gearengine.model.units import display_unit
 from gearengine.plots.style import ImageFormat, figure_bytes
-from gearengine.studies.robustness.study import RobustnessRequest, RobustnessResult
+from gearengine.studies.robustness.results import RobustnessResult
+from gearengine.studies.robustness.study import RobustnessRequest
 
 PANELS = ("chaotic", "separation", "back_flank", "dynamic_factor_above_limit")
 TITLES = {

@@ -1,10 +1,35 @@
 """Units: the one door between gear data and the engine's numbers.
 
 ``quantities`` reads what engineers type ("1500 rpm", "50 um", "40 N*m") with pint, refusing
-what no spur-gear pair can have; ``outputs`` maps answers back to SI and display units (the one
-output table). Everything else imports units from here.
+what no spur-gear pair can have; ``field_types`` makes the request models' quantity fields of
+it; ``outputs`` maps answers back to SI and display units (the one output table). Everything
+else imports units from here.
 """
 
+from gearengine.model.units.field_types import (
+    Angle,
+    Backlash,
+    BearingStiffness,
+    Bore,
+    Damping,
+    Duration,
+    ErrorAmplitude,
+    HalfBacklash,
+    Inertia,
+    Length,
+    Mass,
+    MeanTorque,
+    MeshStiffness,
+    Module,
+    SampleRate,
+    ShearModulus,
+    Speed,
+    StiffnessVariation,
+    Time,
+    Torque,
+    TorsionalStiffness,
+    quantity_type,
+)
 from gearengine.model.units.outputs import (
     IMPACTS_REFUSED,
     OUTPUTS,
@@ -28,31 +53,9 @@ from gearengine.model.units.outputs import (
 from gearengine.model.units.quantities import (
     QUANTITIES,
     SHARE,
-    Angle,
-    Backlash,
-    BearingStiffness,
-    Bore,
-    Damping,
-    Duration,
-    ErrorAmplitude,
-    HalfBacklash,
-    Inertia,
-    Length,
-    Mass,
-    MeanTorque,
-    MeshStiffness,
-    Module,
-    SampleRate,
-    ShearModulus,
-    Speed,
-    StiffnessVariation,
-    Time,
-    Torque,
-    TorsionalStiffness,
     note,
     parse_quantity,
     plain_number,
-    quantity_type,
     readings,
     registry,
     si_numbers,

@@ -26,13 +26,11 @@ from typing import Literal
 from pydantic import BaseModel, Field
 
 from gearengine.studies import jobs
+from gearengine.studies.robustness.results import Probability, RobustnessPoint, RobustnessResult
 from gearengine.studies.robustness.study import (
     DEFAULT_CHUNK_ROWS,
     MAX_SAMPLES,
-    Probability,
-    RobustnessPoint,
     RobustnessRequest,
-    RobustnessResult,
     assemble,
     robustness_work,
 )

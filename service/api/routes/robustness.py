@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from fastapi import Request
 
-from gearengine.studies.robustness.study import RobustnessRequest, RobustnessResult, checked
+from gearengine.studies.robustness.results import RobustnessResult
+from gearengine.studies.robustness.study import RobustnessRequest, checked
 from service.api.routes.jobs import JobRoutes
 from service.core.config import Settings
 
