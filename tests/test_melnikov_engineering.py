@@ -174,3 +174,19 @@ def test_the_stiffness_at_a_torque_is_the_conversions() -> None:
         whole = convert_design(design.model_copy(update={"torque": torque}))
         assert iso_mesh_stiffness(design, torque) == whole.mesh_stiffness_n_per_m
     assert iso_mesh_stiffness(design, 0.5) < iso_mesh_stiffness(design, 5.0)
+
+
+def test_a_parameter_without_a_critical_value_is_explained(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``convert`` of the z = 23/67 pair showed "-" for the TE's nearest critical value and
+    margin beside "the criterion allows chaos", unexplained (third new-user review): no TE
+    amplitude alone flips the verdict there, since the other excitations keep it."""
+    from gearengine.cli.main import main
+    from tests.conftest import ROOT
+
+    assert main(["convert", str(ROOT / "examples" / "remedies-z23-67.json")]) == 0
+    out = capsys.readouterr().out
+    row = next(s for s in out.splitlines() if "transmission_error_amplitude [um]" in s)
+    assert row.split()[-2:] == ["-", "-"]
+    assert "-: no value of that parameter alone flips the verdict" in out

@@ -78,6 +78,9 @@ def render_engineering(eng: Engineering) -> str:
             f"  {name + ' [' + c.unit + ']':<36} {fmt_value(c.value):>12} "
             f"{fmt_value(c.nearest):>17} {fmt_value(c.margin_to_chaos):>16}"
         )
+    if any(not c.critical_values for c in eng.critical.values()):
+        lines.append("  -: no value of that parameter alone flips the verdict (the other "
+                     "excitations keep it where it is)")  # fmt: skip
     lines.append(f"  {eng.summary}")
     return "\n".join(lines)
 
