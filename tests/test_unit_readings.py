@@ -9,6 +9,7 @@ import contextlib
 import copy
 import json
 import math
+from pathlib import Path
 
 import pytest
 from pydantic import ValidationError
@@ -22,6 +23,7 @@ from gearengine.studies import jobs
 from gearengine.studies.jobs import validated_json
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.studies.sweep.request import validated
+from tests.conftest import ROOT
 
 
 def _design(**changes: object) -> dict:
@@ -274,3 +276,24 @@ def test_a_negative_mean_torque_is_refused_saying_the_response_mirrors(
     assert main(["check", str(path), "--speed", "1000:2000", "--torque=-5:60"]) == 2
     assert "--torque (its low end): -5 N*m is negative" in capsys.readouterr().err
     assert Design.model_validate(_design(torque=0)).torque == 0.0
+
+
+def test_a_design_validated_again_keeps_its_readings_and_the_run_up_says_them(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A run-up of a design with a bare torque printed no note: its request was validated
+    again inside the run, and a Design handed back through its validator had its readings
+    (and its ripple shares in % of the mean torque) reset to those of no text. A Design given
+    again is now itself, and ``gearengine runup`` prints the design's readings."""
+    doc = json.loads((ROOT / "examples" / "ci" / "design.json").read_text())
+    doc["design"]["torque"] = 40
+    design = Design.model_validate(doc["design"])
+    said = "torque: the bare number 40 read as 40 N*m"
+    assert said in design.readings
+    assert Design.model_validate(design).readings == design.readings
+    path = tmp_path / "bare.json"
+    path.write_text(json.dumps(doc))
+    argv = ["runup", str(path), "--from", "3500", "--to", "3600", "--rate", "2000",
+            "--direction", "up"]  # fmt: skip
+    assert main(argv) == 0
+    assert f"note: {said}" in capsys.readouterr().out

@@ -111,7 +111,7 @@ def cmd_runup(args: argparse.Namespace) -> int:
             print("\n".join(branch_table(name, branch, result)))
     for line in quasi_static_lines(result):
         print(line)
-    for note in result.notes:
+    for note in [*result.notes, *request.design.readings]:  # the design's bare numbers too
         print(f"note: {note}")
     if args.json:
         Path(args.json).write_text(dumps(result))

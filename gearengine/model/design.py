@@ -318,7 +318,12 @@ class Design(StrictModel):
     @classmethod
     def _with_readings(cls, data: Any, handler: ModelWrapValidatorHandler[Design]) -> Design:
         """Validate, keeping what was understood from engineers' unit spellings ("40 Nm"),
-        bare numbers and torque fluctuation amplitudes in % of the mean torque."""
+        bare numbers and torque fluctuation amplitudes in % of the mean torque. A Design
+        given again is itself: handing it back through the validator set its readings and
+        ripple shares to those of no text (a run-up's design lost the note on its bare
+        torque once its request was validated again)."""
+        if isinstance(data, Design):
+            return data
         with readings() as found:
             data, shares = ripple_of_mean_torque(data, found)
             design = handler(data)._derived_inputs()
