@@ -374,7 +374,7 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
     windows = [SimpleNamespace(level=lv) for lv in levels]
     sweep_result = SimpleNamespace(windows=windows)
     report = EnvelopeReport.model_construct(failures=[], rules=Rules(), sweep=sweep_result)
-    gate.gate_envelope(report, sweep, 1000.0)
+    gate.gate_envelope(report, sweep, 20000.0)  # fast enough that half CHAOS_SECONDS is 500 rpm
     assert [r.design.torque for r in seen] == [10.0, 40.0]
     for r in seen:
         assert r.design.readings == sweep.design.readings
@@ -385,7 +385,7 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
     coarse = sweep_request({"design": doc.get("design", doc), "axes": [
         {"parameter": "speed", "start": "3500 rpm", "stop": "4500 rpm", "num": 3},
         {"parameter": "torque", "start": "10 N*m", "stop": "40 N*m", "num": 2}]})  # fmt: skip
-    assert gate.gate_envelope(report, coarse, 1000.0).runup.bin_rpm == 250.0  # type: ignore[union-attr]
+    assert gate.gate_envelope(report, coarse, 20000.0).runup.bin_rpm == 250.0  # type: ignore[union-attr]
     assert seen[-1].bin_rpm == 250.0
 
 
@@ -526,3 +526,17 @@ def test_a_ramp_and_a_continuation_starting_apart_are_said_to() -> None:
         "run-down and the quasi-static down start on different responses: 19.4 µm in the "
         "ramp's first bin (4450-4500 rpm)"
     )
+
+
+def test_the_gates_run_up_bins_resolve_its_chaos_rule(tmp_path: Path) -> None:
+    """The gate's run-up bins were the grid step: 227 rpm bins (0.114 s at 2000 rpm/s) on the
+    z = 23/67 envelope, longer than the CHAOS_SECONDS a chaotic run may last, and the verdict
+    changed with --speed-points (fourth new-user review). Each bin now lasts at most half of
+    it: 50 rpm at 2000 rpm/s, as the runup command's own bins."""
+    from gearengine.gate.runup import CHAOS_SECONDS
+
+    report = tmp_path / "report.json"
+    main(["check", str(ROOT / "examples" / "ci" / "design.json"), "--speed", "3500:4500",
+          "--speed-points", "2", "--runup", "2000", "--json", str(report)])  # fmt: skip
+    ran = json.loads(report.read_text())["runup"]
+    assert ran["bin_rpm"] == 2000 * CHAOS_SECONDS / 2 == 50.0
