@@ -41,6 +41,15 @@ def _request(**fields: object) -> dict:
     return {"design": CI_DESIGN, **fields}
 
 
+def test_a_run_up_says_other_responses_can_coexist() -> None:
+    """A run-up showed 7.97 um at 6,000 rpm where basins find 18.2 and 73.2 um too, and said
+    nothing of them (fourth new-user review): its notes say it follows one response."""
+    r = validated_runup(_request(from_speed="3500 rpm", to_speed="3600 rpm", rate="2000 rpm/s",
+                                 direction="up", ensemble={"size": 2}))  # fmt: skip
+    said = "other responses can coexist at a speed (gearengine basins"
+    assert any(said in note for note in run_local(r).notes)
+
+
 def test_ramp_forcing_without_acceleration_is_the_stationary_forcing() -> None:
     """beta = 0: the phase record reproduces Eq. (9)'s forcing at absolute time exactly."""
     r = validated_runup(_request(from_speed="1500 rpm", to_speed="2000 rpm", rate="1000 rpm/s"))

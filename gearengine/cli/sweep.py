@@ -102,6 +102,11 @@ def _sweep(args: argparse.Namespace) -> int:
     result = run_local(request, progress(time.monotonic(), stem), workers=os.cpu_count() or 1)
     for text in result.notes or []:  # a bare number on a physical axis, read in SI
         print(f"note: {text}", file=sys.stderr)
+    if request.settings.basins is None:  # say what one or a few starts cannot see
+        n = len(request.settings.starts())
+        print(f"note: each point from {n} start{'s' if n > 1 else ''} of the settings: other "
+              "attractors are not searched (settings.basins searches them, as the gate "
+              "does)", file=sys.stderr)  # fmt: skip
     csv = to_csv(result, request.outputs, design=request.design is not None)
     if args.out == "-":  # stream one document to standard output, no files
         sys.stdout.write("".join(csv) if args.format == "csv" else dumps(result) + "\n")

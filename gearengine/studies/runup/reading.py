@@ -293,6 +293,8 @@ def read_runup(
         "the quasi-static loop is the continuation sweep at the design's torque "
         f"({design.torque:g} N m), on the bin centres, {' then '.join(loop)}: the {loop[0]} "
         f"line from the members' start, the {loop[1]} line from where the {loop[0]} line ended",
+        "the ramp and the loop follow the response they start on: other responses can "
+        "coexist at a speed (gearengine basins, or check's basin starts, searches them)",
     ]
     if request.to_torque is not None:
         notes.append(f"the torque ramps linearly in time to {request.to_torque:g} N m")
