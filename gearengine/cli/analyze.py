@@ -75,11 +75,11 @@ def floquet_line(r: AnalysisResult) -> str | None:
             else f"no Floquet multipliers: {r.numerics.floquet_note}"
         )
     lams = ", ".join(f"{re:.6g}{im:+.6g}i" if im else f"{re:.6g}" for re, im in fl.multipliers)
-    notes = "".join(f"; {note}" for note in fl.notes)  # as the JSON: why a label cannot occur
-    return (
-        f"Floquet multipliers {lams}; stability margin {fl.stability_margin:.4g} "
-        f"(nearest bifurcation: {fl.nearest_bifurcation}){notes}"
-    )
+    pair = any(note.startswith("complex pair") for note in fl.notes)  # JSON: the generic label
+    near = "no bifurcation while they are a complex pair" if pair else (
+        f"nearest bifurcation: {fl.nearest_bifurcation}")  # fmt: skip
+    notes = "".join(f"; {note}" for note in fl.notes)  # as the JSON says them
+    return f"Floquet multipliers {lams}; stability margin {fl.stability_margin:.4g} ({near}){notes}"
 
 
 def margin_failure(r: AnalysisResult, min_margin: float) -> str | None:

@@ -106,7 +106,9 @@ class SweepAxis(BaseModel):
         ``num`` > 1, or one point over a range, which is its start alone (``check --speed
         1000:6000 --speed-points 1`` passed on 1,000 rpm, 6,000 unsaid); else None."""
         if self.num > 1 and self.stop == self.start:
-            return "stop", "stop must differ from start when num > 1"
+            return "stop", ("stop equals start, which is one value: give 1 point (num 1; "
+                            "--speed-points 1 or --torque-points 1 on the command line), or a "
+                            "stop that differs for several")  # fmt: skip
         if self.num == 1 and self.stop != self.start:
             return "num", (f"1 point over {self.start}:{self.stop} is its start alone: give at "
                            "least 2 points, or stop equal to start for one point")  # fmt: skip
