@@ -258,6 +258,32 @@ def test_rules_that_leave_chaos_out_say_so_when_points_are_chaotic() -> None:
     assert unjudged_chaos([calm], Rules(fail_on=["separation"])) == []
 
 
+def test_a_report_says_when_points_left_basin_starts_unsettled() -> None:
+    """A check passed a point where 8 of 16 basin starts were unsettled (the attractors'
+    fractions summing to 0.5) and its text never said so (fourth new-user review): the report
+    notes the points with unsettled starts and the worst of them."""
+    from gearengine.gate.envelope import unsettled_starts
+    from gearengine.numerics.results import BasinCounts
+
+    half = BasinCounts(
+        starts=16,
+        diverged=0,
+        unsettled=8,
+        labels=[0] * 8 + [-2] * 8,
+        grid=None,
+        box=[[-1.5, 1.5], [-0.5, 0.5]],
+    )
+    at = {"speed": PhysicalValue(value=5659.09, unit="rpm"),
+          "torque": PhysicalValue(value=18.75, unit="N*m")}  # fmt: skip
+    open_ = SweepPoint(values={"speed": 592.6}, branch=None, classification="periodic",
+                       physical=at, basins=half)  # fmt: skip
+    settled = open_.model_copy(update={"basins": half.model_copy(update={"unsettled": 0})})
+    (note,) = unsettled_starts([open_, settled])
+    assert note.startswith("1 of 2 points left basin starts unsettled")
+    assert "up to 8 of 16 at speed 5659.09 rpm, torque 18.75 N*m" in note
+    assert unsettled_starts([settled]) == []
+
+
 @pytest.mark.parametrize(
     "option",
     [

@@ -284,7 +284,7 @@ def envelope_report(result: SweepResult, rules: Rules, refined: Sequence[SweepPo
         if p.branch != "down":
             rows.setdefault(_level_key(p), []).append(p)
     checked = [p for row in rows.values() for p in row]
-    notes = unjudged_chaos(checked, rules)  # how the rules read, before what they fail
+    notes = unjudged_chaos(checked, rules) + unsettled_starts(checked)  # before what fails
     failures: list[FailingWindow] = []
     failing = 0
     for _, row in sorted(rows.items()):
@@ -330,6 +330,25 @@ def unjudged_chaos(points: Sequence[SweepPoint], rules: Rules) -> list[str]:
     return [f"{chaotic} of {len(points)} points are chaotic, which these rules do not judge "
             f"(fail_on: {given}; a class given replaces the default chaotic: add chaotic to "
             "fail on it)"]  # fmt: skip
+
+
+def unsettled_starts(points: Sequence[SweepPoint]) -> list[str]:
+    """A note when points left basin starts unsettled: a point is judged by the starts that
+    reached an attractor, and a pass at 8 of 16 starts unsettled (the fractions summing to
+    0.5) said nothing of the other half (fourth new-user review)."""
+    hit = [p for p in points if p.basins is not None and p.basins.unsettled]
+    if not hit:
+        return []
+    worst = max(hit, key=lambda p: p.basins.unsettled / p.basins.starts)  # type: ignore[union-attr]
+    where = ", ".join(f"{k} {v.value:g} {v.unit}" for k, v in (worst.physical or {}).items()
+                      if k not in POINT_OUTPUTS)  # fmt: skip
+    counts = worst.basins
+    assert counts is not None
+    return [f"{len(hit)} of {len(points)} points left basin starts unsettled (no period up to "
+            "64 and no positive LLE within the run: an unfinished transient or a longer "
+            f"period), up to {counts.unsettled} of {counts.starts} at {where}; such a point is "
+            "judged by the starts that settled, or by the settings' own start when none did "
+            "(more transient_periods in the file's settings decide them)"]  # fmt: skip
 
 
 def level_text(level: dict[str, PhysicalValue]) -> str:
