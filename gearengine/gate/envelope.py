@@ -352,8 +352,9 @@ def unsettled_starts(points: Sequence[SweepPoint]) -> list[str]:
 
 
 def level_text(level: dict[str, PhysicalValue]) -> str:
-    """ "torque 40 N*m", or "all" for a one-axis sweep."""
-    return ", ".join(f"{k} {v.value:g} {v.unit}" for k, v in level.items()) or "all"
+    """ "torque 40 N*m", or "the design's torque" for a sweep over the speed alone (it read
+    "all", which a user did not take for a torque level: fourth new-user review)."""
+    return ", ".join(f"{k} {v.value:g} {v.unit}" for k, v in level.items()) or "the design's torque"
 
 
 def window_text(w: FailingWindow) -> str:
