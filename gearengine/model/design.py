@@ -317,11 +317,8 @@ class Design(StrictModel):
     @model_validator(mode="wrap")
     @classmethod
     def _with_readings(cls, data: Any, handler: ModelWrapValidatorHandler[Design]) -> Design:
-        """Validate, keeping what was understood from engineers' unit spellings ("40 Nm"),
-        bare numbers and torque fluctuation amplitudes in % of the mean torque. A Design
-        given again is itself: handing it back through the validator set its readings and
-        ripple shares to those of no text (a run-up's design lost the note on its bare
-        torque once its request was validated again)."""
+        """Validate, keeping what was understood from unit spellings ("40 Nm"), bare numbers
+        and ripple in % of the mean torque; a Design given again is itself (it lost them)."""
         if isinstance(data, Design):
             return data
         with readings() as found:
