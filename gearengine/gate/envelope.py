@@ -212,7 +212,9 @@ class RunupCheck(BaseModel):
     rate_rpm_s: float = Field(description="Ramp rate [rpm/s].")
     speeds_rpm: list[float] = Field(description="[lowest, highest] speed [rpm] of each ramp.")
     directions: list[str] = Field(description="The legs run at each level, in order.")
-    bin_rpm: float = Field(description="Width of a speed bin [rpm] (the grid's speed step).")
+    bin_rpm: float = Field(description="Width of a speed bin [rpm]: the grid's speed step, "
+                           "at most a quarter of the range and half the time a chaotic run may "
+                           "last (gate.runup.CHAOS_SECONDS).")  # fmt: skip
     ensemble: int = Field(description="Perturbed starts of each bin's FTLE.")
     levels: list[dict[str, PhysicalValue]] = Field(
         description="The levels of the other axis run (one empty level: the design's torque)."
@@ -336,14 +338,12 @@ def unsettled_starts(points: Sequence[SweepPoint]) -> list[str]:
     """A note when points left basin starts unsettled: a point is judged by the starts that
     reached an attractor, and a pass at 8 of 16 starts unsettled (the fractions summing to
     0.5) said nothing of the other half (fourth new-user review)."""
-    hit = [p for p in points if p.basins is not None and p.basins.unsettled]
+    hit = [(p, p.basins) for p in points if p.basins is not None and p.basins.unsettled]
     if not hit:
         return []
-    worst = max(hit, key=lambda p: p.basins.unsettled / p.basins.starts)  # type: ignore[union-attr]
-    where = ", ".join(f"{k} {v.value:g} {v.unit}" for k, v in (worst.physical or {}).items()
-                      if k not in POINT_OUTPUTS)  # fmt: skip
-    counts = worst.basins
-    assert counts is not None
+    worst, counts = max(hit, key=lambda pc: pc[1].unsettled / pc[1].starts)
+    where = level_text({k: v for k, v in (worst.physical or {}).items()
+                        if k not in POINT_OUTPUTS})  # fmt: skip
     return [f"{len(hit)} of {len(points)} points left basin starts unsettled (no period up to "
             "64 and no positive LLE within the run: an unfinished transient or a longer "
             f"period), up to {counts.unsettled} of {counts.starts} at {where}; such a point is "
