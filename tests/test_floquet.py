@@ -22,7 +22,7 @@ from scipy.optimize import brentq, root
 from gearengine.cli import main
 from gearengine.model.params import GearParams
 from gearengine.numerics.bifurcations import feigenbaum_ratios, locate_bifurcations
-from gearengine.numerics.floquet import NEWTON_MAX_STEPS, floquet, floquet_of
+from gearengine.numerics.floquet import NEWTON_MAX_STEPS, floquet, floquet_of, liouville_words
 from gearengine.numerics.runs import as_system
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate
@@ -475,3 +475,15 @@ def test_the_text_says_why_a_complex_pair_cannot_bifurcate(
     # the generic label (the JSON's) is not offered as a bifurcation near (fourth review)
     assert "(no bifurcation while they are a complex pair); " in line and "neimark" not in line
     assert "so the pair cannot reach the unit circle" in line
+
+
+def test_a_missed_liouville_check_is_weighed_against_the_margin() -> None:
+    """The note says how large the multipliers' error is against the stability margin it could
+    move: 2.2e-4 beside a margin of 0.88 (the analyze-geometry golden) is small, not
+    "Phi is inaccurate"; the same error beside a margin of 1e-4 leaves the margin uncertain."""
+    small = liouville_words(2.2e-4, 0.88, 2)
+    assert "exp(-2 mu n T0)" in small and "small against the stability margin 0.88" in small
+    assert "inaccurate" not in small
+    near = liouville_words(2.2e-4, 1e-4, 2)
+    assert "not small against the stability margin" in near and "uncertain" in near
+    assert "exp(tr J n T0)" in liouville_words(2.2e-4, 0.5, 6)

@@ -54,7 +54,7 @@ NEWTON_MAX_STEPS = 8
 NEWTON_TOL = 1e-11
 """Convergence: |G(X)| < NEWTON_TOL * max(1, |X|) with G(X) = phi_{n T0}(X) - X."""
 LIOUVILLE_WARN = 1e-4
-"""liouville_error above which the result carries a note (Phi inaccurate)."""
+"""liouville_error above which the result carries a note (``liouville_words``)."""
 
 
 def multipliers(phi: np.ndarray) -> tuple[complex, ...]:
@@ -98,6 +98,20 @@ def liouville_error(det: float, trace_rate: float, duration: float) -> float:
     if det > 0.0:
         return abs(math.expm1(min(math.log(det) - log_exact, 700.0)))
     return 1.0 + (math.exp(min(math.log(-det) - log_exact, 700.0)) if det < 0.0 else 0.0)
+
+
+def liouville_words(error: float, margin: float, n: int) -> str:
+    """The note on a Liouville check missed by ``error`` (relative, > ``LIOUVILLE_WARN``): the
+    multipliers' moduli carry an error of about error / n (det Phi is the product of the ``n``
+    multipliers), judged against the stability ``margin`` 1 - |lambda_max| it could move."""
+    exact = "exp(-2 mu n T0)" if n == 2 else "exp(tr J n T0)"
+    words = (f"det Phi differs from {exact} by {error:.3g} (relative): the multipliers' moduli "
+             "carry an integration error of about that size (more steps per period reduce it, "
+             "or the smaller multiplier is below its rounding error)")  # fmt: skip
+    if error / n < 0.1 * abs(margin):
+        return f"{words}; small against the stability margin {margin:.3g}"
+    return (f"{words}; not small against the stability margin {margin:.3g}: the margin and "
+            "the nearest bifurcation are uncertain at this resolution")  # fmt: skip
 
 
 def classify_multiplier(lam: complex) -> Bifurcation:
@@ -175,10 +189,7 @@ def refine(
             "belong to an approximate orbit"
         )
     if lv_error > LIOUVILLE_WARN:
-        notes.append(
-            f"det Phi misses exp(-2 mu n T0) by {lv_error:.3g} (relative): Phi is inaccurate "
-            "(too few steps per period, or the smaller multiplier is below its rounding error)"
-        )
+        notes.append(liouville_words(lv_error, 1.0 - abs(lam[0]), len(X)))
     if lam[0].imag != 0.0 and len(X) == 2:
         notes.append(
             f"complex pair of modulus exp(-mu n T0) = {abs(lam[0]):.6g}: with constant "
