@@ -23,9 +23,10 @@ from gearengine.gate.rules import Rules
 from gearengine.gate.runup import runup_failures
 from gearengine.jsonio import dumps, error_lines
 from gearengine.model.units import RPM
+from gearengine.studies import jobs
 from gearengine.studies.runup import run_local
 from gearengine.studies.runup.compute import compute_chunk
-from gearengine.studies.runup.profile import ramp_forcing, validated_runup
+from gearengine.studies.runup.profile import checked_runup, ramp_forcing, validated_runup
 from gearengine.studies.runup.reading import jumps
 from gearengine.studies.runup.request import RunupRequest
 from gearengine.systems.spur_pair.forcing import packed_forcing
@@ -251,6 +252,33 @@ def test_a_bin_wider_than_a_quarter_of_the_range_is_refused(
                  "--bin", "10000"])  # fmt: skip
     assert code == 2
     assert "(the CLI's --bin)" in capsys.readouterr().err
+
+
+def test_a_start_the_quasi_static_loop_would_not_use_is_refused(tmp_path: Path) -> None:
+    """The loop starts its first line where the members start and its second where the first
+    ended, so a ``quasi_static`` start was silently replaced (stop 40's note): it is refused,
+    naming the field, in the library and the API; the default start, which every stored request
+    carries when it is read back, stays accepted."""
+    from fastapi.testclient import TestClient
+
+    from service.core.config import Settings
+    from service.main import create_app
+
+    ramp = _request(from_speed="4000 rpm", to_speed="4100 rpm", rate="5000 rpm/s")
+    box = {"count": 4, "box": [[-1, 1], [-1, 1]]}
+    given = {"initial_state": [0.5, 0.0], "initial_states": [[0.5, 0.0]],
+             "random_initial_states": box}  # fmt: skip
+    for name, value in given.items():
+        with pytest.raises(ValidationError) as exc:
+            validated_runup({**ramp, "quasi_static": {name: value}})
+        (line,) = error_lines(exc.value)
+        assert line.startswith(f"quasi_static.{name}: the quasi-static loop starts where"), line
+    stored = validated_runup(ramp).model_dump_json()  # as the job store keeps it
+    reread = checked_runup(jobs.validated_json(jobs.kind("runup"), stored))
+    assert reread.quasi_static.initial_state == [0.01, 0.01]
+    with TestClient(create_app(Settings(data_dir=tmp_path, workers=0))) as client:
+        r = client.post("/v1/runups", json={**ramp, "quasi_static": {"initial_state": [0.5, 0]}})
+    assert r.status_code == 422 and "quasi_static" in r.text and "initial_state" in r.text, r.text
 
 
 def test_a_chunk_is_the_same_bytes_twice() -> None:

@@ -170,7 +170,7 @@ class RunupRequest(ParamsOrDesign):
         default_factory=lambda: SimulationSettings(**QUASI_STATIC_SETTINGS),  # type: ignore[arg-type]
         description="Settings of each point of the quasi-static continuation sweep (bin "
         "centres); its starts are the loop's own (the members' start, then where the first line "
-        "ended), not initial_state or other starts given here.",
+        "ended): initial_state, initial_states and random_initial_states are refused here.",
     )
     label: str | None = Field(None, max_length=200, description="The client's name for it.")
 
@@ -273,7 +273,22 @@ def request_errors(request: RunupRequest) -> list[InitErrorDetails]:
                 f"profile's {lo:g}-{hi:g} rpm range ({MIN_BINS} bins at least): a bin's FTLE and "
                 "extremes are over its whole width, so chaos in part of it vanishes; give at "
                 f"most {widest:g} rpm (the CLI's --bin)", request.bin_rpm)  # fmt: skip
+    for name, value in ignored_starts(request.quasi_static).items():
+        add(("quasi_static", name), "the quasi-static loop starts where the members start, its "
+            "second line where the first ended: a start given here would not be used; remove "
+            "it", value)  # fmt: skip
     return errors
+
+
+def ignored_starts(settings: SimulationSettings) -> dict[str, object]:
+    """The starts ``settings`` give other than the default ``initial_state``: the quasi-static
+    loop replaces them with its own (``compute.quasi_static_loop``)."""
+    default = SimulationSettings.model_fields["initial_state"].get_default(
+        call_default_factory=True)  # fmt: skip
+    given = {"initial_state": None if settings.initial_state == default else
+             settings.initial_state, "initial_states": settings.initial_states,
+             "random_initial_states": settings.random_initial_states}  # fmt: skip
+    return {name: value for name, value in given.items() if value is not None}
 
 
 def widest_bin_rpm(lo_rpm: float, hi_rpm: float) -> float:
