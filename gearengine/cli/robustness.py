@@ -38,7 +38,6 @@ from gearengine.studies import jobs
 from gearengine.studies.robustness.results import SALTELLI_SAMPLES, RobustnessResult
 from gearengine.studies.robustness.sequential import (
     FIRST_SAMPLES,
-    SequentialResult,
     looks,
     sequential,
     unreachable,
@@ -205,20 +204,31 @@ def _power_of_two(n: int) -> int:
     return 1 << max(0, (int(n) - 1).bit_length())
 
 
-def auto_study(request: RobustnessRequest, limits: dict[str, float]
-               ) -> tuple[SequentialResult, str]:  # fmt: skip
-    """``--samples auto`` from ``request``, the study of its first round (``FIRST_SAMPLES`` at
-    every point, refused over the job budget when it was built): each point sampled until it
-    is decided, within the job budget (``studies.robustness.sequential``). With how it
-    stopped, in words."""
+def gate_study(request: RobustnessRequest, limits: dict[str, float], auto: bool
+               ) -> tuple[RobustnessResult, float, list[str]]:  # fmt: skip
+    """The study the probability gate judges, the confidence its verdicts read at, and what it
+    said on standard error: a fixed count's (``run_study``, one look at 95 %), or with
+    ``--samples auto`` from ``request``, the study of its first round (``FIRST_SAMPLES`` at
+    every point, refused over the job budget when it was built), each point sampled until it
+    is decided within the job budget (``studies.robustness.sequential``): first why points
+    without events may end undecided (``unreachable``, said before computing, as a fixed
+    count's refusal is), then how it stopped."""
+    if not auto:
+        return run_study(request), ONE_LOOK, []
     budget = jobs.job_step_budget()
+    short = unreachable(request, limits, budget)
+    notes = [] if short is None else [f"--samples auto: {short}"]
+    for note in notes:
+        print(note, file=sys.stderr)
     tick = progress(time.monotonic(), "robustness", "points decided")
     out = sequential(request, limits, budget, workers=os.cpu_count() or 1, progress=tick)
     rounds = ", ".join(str(n) for n in out.rounds)
-    note = (f"--samples auto: {out.stopped} (rounds of {rounds} samples, {out.steps} RK4 steps "
-            f"of a budget of {budget}); each look decides at {100 * out.confidence:.3g} %, the "
-            f"5 % error shared over the {looks()} looks a point may take")  # fmt: skip
-    return out, note
+    notes.append(f"--samples auto: {out.stopped} (rounds of {rounds} samples, {out.steps} RK4 "
+                 f"steps of a budget of {budget}); each look decides at "
+                 f"{100 * out.confidence:.3g} %, the 5 % error shared over the {looks()} looks "
+                 "a point may take")  # fmt: skip
+    print(notes[-1], file=sys.stderr)
+    return out.result, out.confidence, notes
 
 
 def own_point(design: Design) -> dict[str, PhysicalValue]:
@@ -264,18 +274,7 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
         args.samples, args.auto = FIRST_SAMPLES, True
     request = robustness_request(args, doc)  # the document read into a request once, here
     own = own_point(request.design)
-    confidence, notes = ONE_LOOK, []
-    if auto:
-        short = unreachable(request, limits, jobs.job_step_budget())
-        if short is not None:  # said before computing, as a fixed count's refusal is
-            notes.append(f"--samples auto: {short}")
-            print(notes[-1], file=sys.stderr)
-        decided, note = auto_study(request, limits)
-        result, confidence = decided.result, decided.confidence
-        notes.append(note)
-        print(note, file=sys.stderr)
-    else:
-        result = run_study(request)
+    result, confidence, notes = gate_study(request, limits, auto)
     told = [ONE_START] if result.starts_per_sample == 1 else []
     if "dynamic_factor_above_limit" in limits:
         told.append(dynamic_factor_event(result))
