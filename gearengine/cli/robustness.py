@@ -26,10 +26,10 @@ from gearengine.cli.documents import (
     validated_input,
 )
 from gearengine.cli.envelope import budget_refusal, option_axes
-from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import gate_settings, level_text
-from gearengine.gate.probability import ONE_LOOK, ProbabilityReport, probability_report, proofs
+from gearengine.gate.junit import probability_junit
+from gearengine.gate.probability import ONE_LOOK, probability_report, proofs
 from gearengine.jsonio import dumps
 from gearengine.model.design import Design
 from gearengine.model.units import IMPACTS_REFUSED, display_unit
@@ -132,13 +132,6 @@ def limits_of(texts: list[str]) -> dict[str, float]:
                                      "name"])  # fmt: skip
         out[name] = limit
     return out
-
-
-def junit(report: ProbabilityReport, name: str) -> str:
-    """JUnit XML: one test case per operating point, failed once with its reasons."""
-    cases = [Case(level_text(v.point), v.reasons, [r.split(")")[0] + ")" for r in v.reasons])
-             for v in report.verdicts]  # fmt: skip
-    return junit_xml("gearchaos robustness", name, "robustness", cases)
 
 
 def cmd_robustness(args: argparse.Namespace) -> int:
@@ -292,7 +285,7 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     if args.json:
         Path(args.json).write_text(dumps(report))
     if args.junit:
-        Path(args.junit).write_text(junit(report, f"robustness of {args.file}"))
+        Path(args.junit).write_text(probability_junit(report, f"robustness of {args.file}"))
     named = ", ".join(f"P({k}) <= {v:g}" for k, v in limits.items())
     print(f"{'PASS' if report.passed else 'FAIL'}: {report.failing_points} of {report.points} "
           f"points over a probability limit ({named}), {report.undecided_points} "

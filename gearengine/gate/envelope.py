@@ -1,7 +1,7 @@
 """The CI gate over an operating envelope: which grid points of a speed x torque sweep break
 which rule (``gate.rules``), refined between grid points where neighbours differ or a point is
-near a limit, gathered into failing speed windows per torque level, and the JUnit XML report
-that GitHub, GitLab and Jenkins show.
+near a limit, gathered into failing speed windows per torque level (in words:
+``gate.envelope_text``; the JUnit XML that GitHub, GitLab and Jenkins show: ``gate.junit``).
 """
 
 from __future__ import annotations
