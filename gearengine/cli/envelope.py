@@ -37,11 +37,11 @@ from gearengine.cli.documents import (
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import (
     REFINE_DEPTH,
-    check_envelope,
     envelope_axis,
     envelope_sweep,
     gate_settings,
     refined_report,
+    sweep_here,
 )
 from gearengine.gate.envelope_text import report_lines
 from gearengine.gate.junit import envelope_junit
@@ -186,12 +186,6 @@ def rules_of(args: argparse.Namespace) -> Rules:
     return validated_input(Rules.model_validate, given, "check", RULE_OPTIONS)
 
 
-def physical_limits(rules: Rules) -> list[str]:
-    """The limits of ``rules`` that need a design in physical units (µm, static force)."""
-    names = {"--max-dte": rules.max_dte_um, "--max-dynamic-factor": rules.max_dynamic_factor}
-    return [name for name, limit in names.items() if limit is not None]
-
-
 def settings_text(settings: SimulationSettings) -> str:
     """The integration settings that matter for cost and verdict, in one line."""
     rand = settings.random_initial_states
@@ -207,9 +201,9 @@ NOMINAL_ONLY = (
 gate failed every point, and said nothing of them)."""
 
 
-def cmd_envelope(args: argparse.Namespace, doc: object) -> int:
-    """The envelope gate of the design document ``doc``; exit 0 pass, 1 fail, 2 invalid
-    input."""
+def cmd_envelope(args: argparse.Namespace, doc: object, rules: Rules) -> int:
+    """The envelope gate of the design document ``doc`` under ``rules`` (``rules_of``); exit 0
+    pass, 1 fail, 2 invalid input."""
     if args.min_stability_margin is not None:
         raise InvalidInputError(
             [
@@ -218,16 +212,15 @@ def cmd_envelope(args: argparse.Namespace, doc: object) -> int:
             ]
         )
     request = envelope_request(args, doc)
-    rules = rules_of(args)
     print(settings_text(request.settings), file=sys.stderr)
     tick = progress(time.monotonic(), "envelope")
-    depth = REFINE_DEPTH if args.refine is None else args.refine
-    if args.server:
-        key = os.environ.get("GEARCHAOS_API_KEY")
-        result = run_on_server(args.server, request, key, tick)  # refined here, as locally
-        report = refined_report(request, result, rules, depth, workers=os.cpu_count() or 1)
+    workers = os.cpu_count() or 1
+    if args.server:  # its result refined here, as a result computed here is
+        result = run_on_server(args.server, request, os.environ.get("GEARCHAOS_API_KEY"), tick)
     else:
-        report = check_envelope(request, rules, tick, workers=os.cpu_count() or 1, refine=depth)
+        result = sweep_here(request, tick, workers)
+    depth = REFINE_DEPTH if args.refine is None else args.refine
+    report = refined_report(request, result, rules, depth, workers=workers)
     if getattr(args, "runup", None) is not None:  # run-ups through the range (gate.runup)
         from gearengine.gate.runup import gate_envelope
 
