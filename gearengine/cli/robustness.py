@@ -29,7 +29,7 @@ from gearengine.cli.envelope import budget_refusal, option_axes
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import gate_settings, level_text
 from gearengine.gate.junit import probability_junit
-from gearengine.gate.probability import ONE_LOOK, probability_report, proofs
+from gearengine.gate.probability import ONE_LOOK, probability_report, proofs, sampling_notes
 from gearengine.jsonio import dumps
 from gearengine.model.design import Design
 from gearengine.model.units import IMPACTS_REFUSED, display_unit
@@ -238,22 +238,6 @@ GATE_SAMPLES = 64
 """``check --max-probability``'s samples a point when ``--samples`` is not given."""
 
 
-ONE_START = (
-    "each sample is judged from the settings' own start, not as the worst attractor of the 16 "
-    "starts the envelope check runs a point: another attractor of a sample may be chaotic; "
-    "--starts 16 judges each sample by its worst of 16 starts, at 17x the work"
-)
-"""The probability gate's words for one start a sample (its default, chosen for its cost)."""
-
-
-def dynamic_factor_event(result: RobustnessResult) -> str:
-    """What the event dynamic_factor_above_limit counts, with the study's limit (the name alone
-    never said 1.5)."""
-    return (f"dynamic_factor_above_limit: the largest dynamic mesh force above "
-            f"{result.dynamic_factor_limit:g} times the static force (the study's "
-            "dynamic_factor_limit)")  # fmt: skip
-
-
 def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     """``check --max-probability`` of the design document ``doc``: exit 1 where a point is over
     a limit or undecided (its interval holds the limit); a sample count that cannot prove a
@@ -268,9 +252,7 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     request = robustness_request(args, doc)  # the document read into a request once, here
     own = own_point(request.design)
     result, confidence, notes = gate_study(request, limits, auto)
-    told = [ONE_START] if result.starts_per_sample == 1 else []
-    if "dynamic_factor_above_limit" in limits:
-        told.append(dynamic_factor_event(result))
+    told = sampling_notes(result, limits)
     report = probability_report(result, limits, confidence, notes + told, own)
     counts = sorted({p.samples for p in result.points})
     sampled = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
