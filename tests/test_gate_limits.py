@@ -10,8 +10,9 @@ from pathlib import Path
 import pytest
 
 from gearengine.cli.documents import InvalidInputError, read_document
-from gearengine.cli.envelope import envelope_request, windows_summary
+from gearengine.cli.envelope import envelope_request
 from gearengine.cli.main import build_parser, main
+from gearengine.gate.envelope_text import windows_summary
 from gearengine.gate.rules import Rules, attractor_failures, point_failures, verdict_failures
 from gearengine.gate.runup import bin_failures
 from gearengine.studies.runup.results import RunupBin

@@ -14,8 +14,8 @@ import json
 
 import pytest
 
-from gearengine.cli.junit import envelope_junit
 from gearengine.gate.envelope import envelope_axis, envelope_sweep, gate_settings, refined_report
+from gearengine.gate.junit import envelope_junit
 from gearengine.gate.rules import Rules, near_limit
 from gearengine.studies.sweep import run_local, validated
 from tests.conftest import ROOT
@@ -73,8 +73,8 @@ def test_windows_are_the_failures_points_and_levels_ascend() -> None:
     the grid and the refined points its failures come from, at every torque level, ascending
     (the windows said chaotic 4500-5000 rpm at 2 N*m beside a failure at 4500-5250 rpm, left out
     the refined 6.75 N*m level, and the failures listed 2, 11.5, then 6.75 N*m)."""
-    from gearengine.cli.envelope import windows_summary
     from gearengine.gate.envelope import EnvelopeReport, envelope_report
+    from gearengine.gate.envelope_text import windows_summary
 
     golden = EnvelopeReport.model_validate_json((ROOT / "tests/golden/check-envelope.json")
                                                 .read_text())  # fmt: skip
@@ -147,8 +147,8 @@ def test_refined_levels_say_where_they_were_checked_and_each_is_a_junit_case() -
     the text names the speeds checked there and JUnit has one case per level of the text."""
     from xml.etree import ElementTree
 
-    from gearengine.cli.envelope import refined_levels, windows_summary
     from gearengine.gate.envelope import EnvelopeReport, envelope_report
+    from gearengine.gate.envelope_text import refined_levels, windows_summary
 
     golden = EnvelopeReport.model_validate_json((ROOT / "tests/golden/check-envelope.json")
                                                 .read_text())  # fmt: skip

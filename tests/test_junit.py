@@ -10,7 +10,7 @@ from xml.etree import ElementTree
 
 import xmlschema
 
-from gearengine.cli.junit import Case, junit_xml
+from gearengine.gate.junit import Case, junit_xml
 from tests.conftest import ROOT
 from tests.test_envelope import LIGHT, gearengine, rattling
 

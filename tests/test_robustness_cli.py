@@ -10,9 +10,8 @@ from xml.etree import ElementTree
 import pytest
 
 from gearengine.cli.main import main
-from gearengine.cli.robustness import ONE_START
 from gearengine.gate.envelope import ENVELOPE_SETTINGS
-from gearengine.gate.probability import ONE_LOOK
+from gearengine.gate.probability import ONE_LOOK, ONE_START
 from gearengine.studies.robustness.study import RobustnessRequest, run_local
 from tests.test_robustness import DESIGN
 

@@ -16,8 +16,8 @@ from pydantic import ValidationError
 
 import gearengine
 from gearengine.analysis import AnalysisRequest
-from gearengine.cli.envelope import not_judged_reason, windows_summary
 from gearengine.gate.envelope import check_envelope
+from gearengine.gate.envelope_text import not_judged_reason, windows_summary
 from gearengine.gate.remedies.compute import remedies
 from gearengine.gate.remedies.request import RemediesRequest as RemediesRequest_
 from gearengine.gate.remedies.search import verify_depth

@@ -20,7 +20,7 @@ from gearengine.cli.documents import (
     read_request,
     validated_input,
 )
-from gearengine.cli.envelope import cmd_envelope, physical_limits, rules_of, settings_text
+from gearengine.cli.envelope import cmd_envelope, rules_of, settings_text
 from gearengine.cli.melnikov import fmt_value, render_engineering, render_melnikov
 from gearengine.gate.rules import Rules, verdict_failures
 from gearengine.jsonio import dumps
@@ -143,7 +143,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     """CI gate: exit 0 pass, 1 fail, 2 invalid input; one summary line. With --speed or
     --torque, the gate over the operating envelope (``cli.envelope``); with --max-probability,
     over the design's tolerances (``cli.robustness``), refused with the envelope's rules and
-    options, which it would ignore (``envelope_only``). The document is read once, here."""
+    options, which it would ignore (``envelope_only``). The document is read once, here, and
+    the rules once for the envelope and the one design."""
     if not args.max_probability and (args.samples is not None or args.seed is not None):
         raise InvalidInputError(["--samples and --seed sample a design's tolerances: give "
                                  "--max-probability NAME=P with them"])  # fmt: skip
@@ -161,8 +162,9 @@ def cmd_check(args: argparse.Namespace) -> int:
         from gearengine.cli.robustness import cmd_probability_gate
 
         return cmd_probability_gate(args, doc)
+    rules = rules_of(args)  # one read of the rules, for the envelope and the one design
     if args.speed or args.torque:
-        return cmd_envelope(args, doc)
+        return cmd_envelope(args, doc, rules)
     given = [option for option, value in (
         ("--starts", args.starts), ("--min-basin", args.min_basin), ("--json", args.json),
         ("--junit", args.junit), ("--server", args.server), ("--refine", args.refine),
@@ -175,11 +177,11 @@ def cmd_check(args: argparse.Namespace) -> int:
                                  f"would ignore {them}): give --speed LOW:HIGH (rpm) and/or "
                                  "--torque LOW:HIGH (N m)"])  # fmt: skip
     request = validated_input(AnalysisRequest.model_validate, doc, args.file)
-    rules = rules_of(args)
-    if request.design is None and physical_limits(rules):
+    limits = physical_limits(rules)
+    if request.design is None and limits:
         raise InvalidInputError(
             [
-                f"{args.file}: {', '.join(physical_limits(rules))} need a design in physical "
+                f"{args.file}: {', '.join(limits)} need a design in physical "
                 'units ({"design": {...}}); dimensionless params have no µm or static force'
             ]
         )
@@ -192,6 +194,12 @@ def cmd_check(args: argparse.Namespace) -> int:
         print(f"note: {note}", file=sys.stderr)
     print(f"{settings_text(request.settings)} ({ONE_DESIGN_SETTINGS})", file=sys.stderr)
     return EXIT_FAIL if reasons else EXIT_OK
+
+
+def physical_limits(rules: Rules) -> list[str]:
+    """The limits of ``rules`` that need a design in physical units (µm, static force)."""
+    names = {"--max-dte": rules.max_dte_um, "--max-dynamic-factor": rules.max_dynamic_factor}
+    return [name for name, limit in names.items() if limit is not None]
 
 
 def design_readings(request: AnalysisRequest) -> list[str]:

@@ -23,7 +23,6 @@ import urllib.error
 import urllib.request
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from gearengine.cli.documents import (
     EXIT_FAIL,
@@ -35,34 +34,25 @@ from gearengine.cli.documents import (
     counted_points,
     validated_input,
 )
-from gearengine.cli.junit import envelope_junit
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import (
     REFINE_DEPTH,
-    EnvelopeReport,
-    check_envelope,
     envelope_axis,
     envelope_sweep,
     gate_settings,
-    level_text,
     refined_report,
-    window_text,
+    sweep_here,
 )
+from gearengine.gate.envelope_text import report_lines
+from gearengine.gate.junit import envelope_junit
 from gearengine.gate.resolution import GRID_POINTS
 from gearengine.gate.rules import Rules
 from gearengine.jsonio import dumps
-from gearengine.model.units import POINT_OUTPUTS
-from gearengine.numerics.attractors import IMPACT_TEXT
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies import jobs
 from gearengine.studies.sweep.axes import axis_unit
-from gearengine.studies.sweep.points import SpeedWindows
 from gearengine.studies.sweep.request import SweepRequest, validated
 from gearengine.studies.sweep.results import SweepResult
-from gearengine.studies.sweep.windows import SPEED
-
-if TYPE_CHECKING:
-    from gearengine.model.design import Design
 
 POLL_SECONDS = 1.0
 
@@ -196,129 +186,11 @@ def rules_of(args: argparse.Namespace) -> Rules:
     return validated_input(Rules.model_validate, given, "check", RULE_OPTIONS)
 
 
-def physical_limits(rules: Rules) -> list[str]:
-    """The limits of ``rules`` that need a design in physical units (µm, static force)."""
-    names = {"--max-dte": rules.max_dte_um, "--max-dynamic-factor": rules.max_dynamic_factor}
-    return [name for name, limit in names.items() if limit is not None]
-
-
-def rules_text(rules: Rules) -> str:
-    """The rules as options: "--fail-on chaotic, --max-dte 20 µm"."""
-    parts = [f"--fail-on {f}" for f in rules.fail_on]
-    if rules.max_lle is not None:
-        parts.append(f"--max-lle {rules.max_lle:g} per unit tau")
-    if rules.max_dte_um is not None:
-        parts.append(f"--max-dte {rules.max_dte_um:g} µm")
-    if rules.max_dynamic_factor is not None:
-        parts.append(f"--max-dynamic-factor {rules.max_dynamic_factor:g}")
-    if rules.min_basin is not None:
-        parts.append(f"--min-basin {rules.min_basin:g}")
-    return ", ".join(parts)
-
-
-def not_judged_reason(design: Design | None) -> tuple[str, str]:
-    """Why the Melnikov criterion judges no point of ``design``'s envelope where it does not,
-    (in a window's words, in the report's): above the critical torque of the pair, or of a
-    train's mesh-mode reduction (``homoclinic.train_reduction``), or, for a train whose mesh no
-    single mode carries, at every point (no one-mode reduction). The gate's axes (speed and
-    torque) leave a train's modes as they are, so the design decides it."""
-    if design is None or design.train is None:
-        return "above T_crit", "the criterion does not apply above the critical torque"
-    from gearengine.homoclinic.train_reduction import SHARE_THRESHOLD, melnikov_point
-    from gearengine.systems.designs import design_model
-
-    if melnikov_point(design_model(design)[0]) is not None:
-        return ("above the mesh-mode reduction's T_crit",
-                "the criterion of the train's mesh-mode reduction does not apply above its "
-                "critical torque")  # fmt: skip
-    share = f"no single mode of the train holds {SHARE_THRESHOLD:.0%} of the mesh strain energy"
-    return share, f"{share}: the one-degree-of-freedom criterion has no reduction to judge"
-
-
-def print_report(report: EnvelopeReport, design: Design | None = None) -> None:
-    """PASS or FAIL, then one line per failing window (rpm and N m); ``design`` says why
-    Melnikov judges no point where it does not (``not_judged_reason``)."""
-    verdict = "PASS" if report.passed else "FAIL"
-    short, reason = not_judged_reason(design)
-    print(f"{verdict}: {report.failing_points} of {report.points} operating points break "
-          f"the rules ({rules_text(report.rules)})")  # fmt: skip
-    if "melnikov" in report.rules.fail_on and report.melnikov_not_judged:
-        print(f"  Melnikov could not judge {report.melnikov_not_judged} of {report.points} points "
-              f"({reason})")  # fmt: skip
-    for note in report.notes:
-        print(f"  note: {note}")
-    if report.resolution is not None:
-        print(f"  resolution: {report.resolution.text()}")
-    if report.runup is not None:
-        print(f"  run-ups: {report.runup.text()}")
-    for w in report.failures:
-        print(f"  {window_text(w)}")
-    for line in windows_summary(report.windows, short, refined_levels(report)):
-        print(f"  {line}")
-
-
 def settings_text(settings: SimulationSettings) -> str:
     """The integration settings that matter for cost and verdict, in one line."""
     rand = settings.random_initial_states
     starts = "" if rand is None else f", {rand.count} random starts (seed {rand.seed})"
     return f"settings: {settings.run_text()}{starts}"
-
-
-def refined_levels(report: EnvelopeReport) -> dict[str, str]:
-    """The speeds checked at each torque level refined between the grid's (by its
-    ``level_text``): "refined level, checked at 3 speeds in 4636-4864 rpm" (the grid's levels
-    are checked over the whole range)."""
-    grid = {level_text(w.level) for w in report.sweep.windows or []}
-    speeds: dict[str, list[float]] = {}
-    for w in report.windows:
-        if level_text(w.level) not in grid:
-            speeds[level_text(w.level)] = []
-    for p in report.refined:
-        level = level_text({k: v for k, v in (p.physical or {}).items()
-                            if k not in (SPEED, *POINT_OUTPUTS)})  # fmt: skip
-        if level in speeds and p.physical is not None:
-            speeds[level].append(p.physical[SPEED].value)
-    return {level: f"refined level, checked at {len(v)} speed{'s' if len(v) != 1 else ''} "
-            f"in {spans_text([[min(v), max(v)]])}" for level, v in speeds.items() if v}  # fmt: skip
-
-
-def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit",
-                    refined: dict[str, str] | None = None) -> list[str]:  # fmt: skip
-    """Per level of the other axis, the impact and Melnikov windows in rpm, pass or fail:
-    "windows at torque 40 N*m: tooth separation 500-1100 rpm; Melnikov:
-    chaos possible nowhere" ("teeth always in contact" only where no point diverged: a
-    diverged point has no contact verdict); ``reason`` says why Melnikov does not apply where
-    it does not (``not_judged_reason``); ``refined`` (``refined_levels``) says over which
-    speeds a level refined between the grid's was checked: "windows at torque 8.44 N*m
-    (refined level, checked at 3 speeds in 4636-4864 rpm): ..."."""
-    out = []
-    for w in windows:
-        parts = [f"{CONTACT_LABELS[k]} {spans_text(v)}" for k, v in w.contact.items()]
-        if "diverged" in w.response:  # no contact verdict there: never "always in contact"
-            parts.append(f"diverged (contact unknown) {spans_text(w.response['diverged'])}")
-        contact = "; ".join(parts)
-        melnikov = f"chaos possible {spans_text(w.melnikov) if w.melnikov else 'nowhere'}"
-        if w.melnikov_not_applicable:
-            na = f"not applicable at {spans_text(w.melnikov_not_applicable)} ({reason})"
-            melnikov = f"{melnikov}, {na}" if w.melnikov else na
-        where = f" at {level_text(w.level)}" if w.level else ""
-        if refined and level_text(w.level) in refined:
-            where += f" ({refined[level_text(w.level)]})"
-        out.append(f"windows{where}: {contact or 'teeth always in contact'}; "
-                   f"Melnikov: {melnikov}")  # fmt: skip
-    return out
-
-
-CONTACT_LABELS = {
-    "separation": IMPACT_TEXT["single_sided"],
-    "back_flank": IMPACT_TEXT["double_sided"],
-}
-"""The contact of a speed window (``SpeedWindows.contact``) in the gate's words."""
-
-
-def spans_text(spans: list[list[float]]) -> str:
-    """ "500-1100, 3000 rpm": speed runs [first, last] in rpm."""
-    return ", ".join(f"{a:g}" if a == b else f"{a:g}-{b:g}" for a, b in spans) + " rpm"
 
 
 NOMINAL_ONLY = (
@@ -329,9 +201,9 @@ NOMINAL_ONLY = (
 gate failed every point, and said nothing of them)."""
 
 
-def cmd_envelope(args: argparse.Namespace, doc: object) -> int:
-    """The envelope gate of the design document ``doc``; exit 0 pass, 1 fail, 2 invalid
-    input."""
+def cmd_envelope(args: argparse.Namespace, doc: object, rules: Rules) -> int:
+    """The envelope gate of the design document ``doc`` under ``rules`` (``rules_of``); exit 0
+    pass, 1 fail, 2 invalid input."""
     if args.min_stability_margin is not None:
         raise InvalidInputError(
             [
@@ -340,23 +212,23 @@ def cmd_envelope(args: argparse.Namespace, doc: object) -> int:
             ]
         )
     request = envelope_request(args, doc)
-    rules = rules_of(args)
     print(settings_text(request.settings), file=sys.stderr)
     tick = progress(time.monotonic(), "envelope")
-    depth = REFINE_DEPTH if args.refine is None else args.refine
-    if args.server:
-        key = os.environ.get("GEARCHAOS_API_KEY")
-        result = run_on_server(args.server, request, key, tick)  # refined here, as locally
-        report = refined_report(request, result, rules, depth, workers=os.cpu_count() or 1)
+    workers = os.cpu_count() or 1
+    if args.server:  # its result refined here, as a result computed here is
+        result = run_on_server(args.server, request, os.environ.get("GEARCHAOS_API_KEY"), tick)
     else:
-        report = check_envelope(request, rules, tick, workers=os.cpu_count() or 1, refine=depth)
+        result = sweep_here(request, tick, workers)
+    depth = REFINE_DEPTH if args.refine is None else args.refine
+    report = refined_report(request, result, rules, depth, workers=workers)
     if getattr(args, "runup", None) is not None:  # run-ups through the range (gate.runup)
         from gearengine.gate.runup import gate_envelope
 
         report = validated_input(lambda r: gate_envelope(report, request, r), args.runup, "--runup")
     if request.design is not None and request.design.tolerances is not None:
         report = report.model_copy(update={"notes": [*report.notes, NOMINAL_ONLY]})
-    print_report(report, request.design)
+    for line in report_lines(report, request.design):
+        print(line)
     if args.json:
         Path(args.json).write_text(dumps(report))
     if args.junit:

@@ -26,10 +26,10 @@ from gearengine.cli.documents import (
     validated_input,
 )
 from gearengine.cli.envelope import budget_refusal, option_axes
-from gearengine.cli.junit import Case, junit_xml
 from gearengine.cli.sweep import progress
 from gearengine.gate.envelope import gate_settings, level_text
-from gearengine.gate.probability import ONE_LOOK, ProbabilityReport, probability_report, proofs
+from gearengine.gate.junit import probability_junit
+from gearengine.gate.probability import ONE_LOOK, probability_report, proofs, sampling_notes
 from gearengine.jsonio import dumps
 from gearengine.model.design import Design
 from gearengine.model.units import IMPACTS_REFUSED, display_unit
@@ -38,7 +38,6 @@ from gearengine.studies import jobs
 from gearengine.studies.robustness.results import SALTELLI_SAMPLES, RobustnessResult
 from gearengine.studies.robustness.sequential import (
     FIRST_SAMPLES,
-    SequentialResult,
     looks,
     sequential,
     unreachable,
@@ -135,13 +134,6 @@ def limits_of(texts: list[str]) -> dict[str, float]:
     return out
 
 
-def junit(report: ProbabilityReport, name: str) -> str:
-    """JUnit XML: one test case per operating point, failed once with its reasons."""
-    cases = [Case(level_text(v.point), v.reasons, [r.split(")")[0] + ")" for r in v.reasons])
-             for v in report.verdicts]  # fmt: skip
-    return junit_xml("gearchaos robustness", name, "robustness", cases)
-
-
 def cmd_robustness(args: argparse.Namespace) -> int:
     """Run the study; print one line per point; --json and --plot write the outputs."""
     request, result = study(args, read_document(args.file))
@@ -205,20 +197,31 @@ def _power_of_two(n: int) -> int:
     return 1 << max(0, (int(n) - 1).bit_length())
 
 
-def auto_study(request: RobustnessRequest, limits: dict[str, float]
-               ) -> tuple[SequentialResult, str]:  # fmt: skip
-    """``--samples auto`` from ``request``, the study of its first round (``FIRST_SAMPLES`` at
-    every point, refused over the job budget when it was built): each point sampled until it
-    is decided, within the job budget (``studies.robustness.sequential``). With how it
-    stopped, in words."""
+def gate_study(request: RobustnessRequest, limits: dict[str, float], auto: bool
+               ) -> tuple[RobustnessResult, float, list[str]]:  # fmt: skip
+    """The study the probability gate judges, the confidence its verdicts read at, and what it
+    said on standard error: a fixed count's (``run_study``, one look at 95 %), or with
+    ``--samples auto`` from ``request``, the study of its first round (``FIRST_SAMPLES`` at
+    every point, refused over the job budget when it was built), each point sampled until it
+    is decided within the job budget (``studies.robustness.sequential``): first why points
+    without events may end undecided (``unreachable``, said before computing, as a fixed
+    count's refusal is), then how it stopped."""
+    if not auto:
+        return run_study(request), ONE_LOOK, []
     budget = jobs.job_step_budget()
+    short = unreachable(request, limits, budget)
+    notes = [] if short is None else [f"--samples auto: {short}"]
+    for note in notes:
+        print(note, file=sys.stderr)
     tick = progress(time.monotonic(), "robustness", "points decided")
     out = sequential(request, limits, budget, workers=os.cpu_count() or 1, progress=tick)
     rounds = ", ".join(str(n) for n in out.rounds)
-    note = (f"--samples auto: {out.stopped} (rounds of {rounds} samples, {out.steps} RK4 steps "
-            f"of a budget of {budget}); each look decides at {100 * out.confidence:.3g} %, the "
-            f"5 % error shared over the {looks()} looks a point may take")  # fmt: skip
-    return out, note
+    notes.append(f"--samples auto: {out.stopped} (rounds of {rounds} samples, {out.steps} RK4 "
+                 f"steps of a budget of {budget}); each look decides at "
+                 f"{100 * out.confidence:.3g} %, the 5 % error shared over the {looks()} looks "
+                 "a point may take")  # fmt: skip
+    print(notes[-1], file=sys.stderr)
+    return out.result, out.confidence, notes
 
 
 def own_point(design: Design) -> dict[str, PhysicalValue]:
@@ -235,22 +238,6 @@ GATE_SAMPLES = 64
 """``check --max-probability``'s samples a point when ``--samples`` is not given."""
 
 
-ONE_START = (
-    "each sample is judged from the settings' own start, not as the worst attractor of the 16 "
-    "starts the envelope check runs a point: another attractor of a sample may be chaotic; "
-    "--starts 16 judges each sample by its worst of 16 starts, at 17x the work"
-)
-"""The probability gate's words for one start a sample (its default, chosen for its cost)."""
-
-
-def dynamic_factor_event(result: RobustnessResult) -> str:
-    """What the event dynamic_factor_above_limit counts, with the study's limit (the name alone
-    never said 1.5)."""
-    return (f"dynamic_factor_above_limit: the largest dynamic mesh force above "
-            f"{result.dynamic_factor_limit:g} times the static force (the study's "
-            "dynamic_factor_limit)")  # fmt: skip
-
-
 def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     """``check --max-probability`` of the design document ``doc``: exit 1 where a point is over
     a limit or undecided (its interval holds the limit); a sample count that cannot prove a
@@ -264,21 +251,8 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
         args.samples, args.auto = FIRST_SAMPLES, True
     request = robustness_request(args, doc)  # the document read into a request once, here
     own = own_point(request.design)
-    confidence, notes = ONE_LOOK, []
-    if auto:
-        short = unreachable(request, limits, jobs.job_step_budget())
-        if short is not None:  # said before computing, as a fixed count's refusal is
-            notes.append(f"--samples auto: {short}")
-            print(notes[-1], file=sys.stderr)
-        decided, note = auto_study(request, limits)
-        result, confidence = decided.result, decided.confidence
-        notes.append(note)
-        print(note, file=sys.stderr)
-    else:
-        result = run_study(request)
-    told = [ONE_START] if result.starts_per_sample == 1 else []
-    if "dynamic_factor_above_limit" in limits:
-        told.append(dynamic_factor_event(result))
+    result, confidence, notes = gate_study(request, limits, auto)
+    told = sampling_notes(result, limits)
     report = probability_report(result, limits, confidence, notes + told, own)
     counts = sorted({p.samples for p in result.points})
     sampled = f"{counts[0]}" if len(counts) == 1 else f"{counts[0]} to {counts[-1]}"
@@ -293,7 +267,7 @@ def cmd_probability_gate(args: argparse.Namespace, doc: object) -> int:
     if args.json:
         Path(args.json).write_text(dumps(report))
     if args.junit:
-        Path(args.junit).write_text(junit(report, f"robustness of {args.file}"))
+        Path(args.junit).write_text(probability_junit(report, f"robustness of {args.file}"))
     named = ", ".join(f"P({k}) <= {v:g}" for k, v in limits.items())
     print(f"{'PASS' if report.passed else 'FAIL'}: {report.failing_points} of {report.points} "
           f"points over a probability limit ({named}), {report.undecided_points} "

@@ -1,7 +1,7 @@
 """The CI gate over an operating envelope: which grid points of a speed x torque sweep break
 which rule (``gate.rules``), refined between grid points where neighbours differ or a point is
-near a limit, gathered into failing speed windows per torque level, and the JUnit XML report
-that GitHub, GitLab and Jenkins show.
+near a limit, gathered into failing speed windows per torque level (in words:
+``gate.envelope_text``; the JUnit XML that GitHub, GitLab and Jenkins show: ``gate.junit``).
 """
 
 from __future__ import annotations
@@ -78,14 +78,20 @@ def check_envelope(
     refine: int = REFINE_DEPTH,
     refine_failing: bool = True,
 ) -> EnvelopeReport:
-    """The gate's report of one envelope sweep, computed in this process (``workers`` threads,
-    ``balanced_chunk_points`` down to one point per chunk, as the CLI gate runs it), refined
-    ``refine`` times between grid points where neighbours differ or a point is near a limit
-    (``gate.resolution.refine``); ``refine_failing`` False skips the refinement when the grid
-    fails already (only pass or fail needed: refining cannot make it pass)."""
-    chunk = balanced_chunk_points(request.n_points(), workers, smallest=1)
-    result = run_local(request, progress_callback, chunk_points=chunk, workers=workers)
+    """The gate's report of one envelope sweep, computed in this process (``sweep_here``),
+    refined ``refine`` times between grid points where neighbours differ or a point is near a
+    limit (``gate.resolution.refine``); ``refine_failing`` False skips the refinement when the
+    grid fails already (only pass or fail needed: refining cannot make it pass)."""
+    result = sweep_here(request, progress_callback, workers)
     return refined_report(request, result, rules, refine, refine_failing, workers)
+
+
+def sweep_here(request: SweepRequest, progress_callback: Callable[[int, int], None] | None = None,
+               workers: int = 1) -> SweepResult:  # fmt: skip
+    """The envelope sweep computed in this process: ``workers`` threads,
+    ``balanced_chunk_points`` down to one point per chunk, as the CLI gate runs it."""
+    chunk = balanced_chunk_points(request.n_points(), workers, smallest=1)
+    return run_local(request, progress_callback, chunk_points=chunk, workers=workers)
 
 
 def check_or_failures(request: SweepRequest, rules: Rules, refine: int = REFINE_DEPTH,
@@ -165,12 +171,14 @@ def refined_report(request: SweepRequest, result: SweepResult, rules: Rules,
                    refine: int = REFINE_DEPTH, refine_failing: bool = True, workers: int = 1
                    ) -> EnvelopeReport:  # fmt: skip
     """The report of an envelope sweep's ``result`` (computed here or on a server), refined
-    between its grid points in this process as ``check_envelope`` says."""
-    report = envelope_report(result, rules, resolution=resolution(request, 0))
-    if refine <= 0 or (not refine_failing and not report.passed):
-        return report
-    added = _refined(request, result, rules, refine, workers)
-    return envelope_report(result, rules, added, resolution(request, refine, len(added)))
+    between its grid points in this process as ``check_envelope`` says, built once: the grid
+    fails when one of its points does (``refine_failing`` False then leaves it unrefined)."""
+    grid_fails = not refine_failing and any(
+        attractor_failures(p, rules) for p in result.points if p.branch != "down"
+    )
+    depth = 0 if grid_fails else max(refine, 0)
+    added = _refined(request, result, rules, depth, workers)
+    return envelope_report(result, rules, added, resolution(request, depth, len(added)))
 
 
 def _refined(request: SweepRequest, result: SweepResult, rules: Rules, depth: int,

@@ -84,6 +84,26 @@ class ProbabilityReport(BaseModel):
     result: RobustnessResult = Field(description="The robustness result (95 % intervals).")
 
 
+ONE_START = (
+    "each sample is judged from the settings' own start, not as the worst attractor of the 16 "
+    "starts the envelope check runs a point: another attractor of a sample may be chaotic; "
+    "--starts 16 judges each sample by its worst of 16 starts, at 17x the work"
+)
+"""The probability gate's words for one start a sample (its default, chosen for its cost)."""
+
+
+def sampling_notes(result: RobustnessResult, limits: dict[str, float]) -> list[str]:
+    """What the gate says of how its samples were judged: from one start each (``ONE_START``),
+    and what the event dynamic_factor_above_limit counts, with the study's limit, where it is
+    limited (the name alone never said 1.5)."""
+    told = [ONE_START] if result.starts_per_sample == 1 else []
+    if "dynamic_factor_above_limit" in limits:
+        told.append(f"dynamic_factor_above_limit: the largest dynamic mesh force above "
+                    f"{result.dynamic_factor_limit:g} times the static force (the study's "
+                    "dynamic_factor_limit)")  # fmt: skip
+    return told
+
+
 def at_confidence(confidence: float) -> str:
     """ " at 95 %", " at 99.3 %": the confidence a bound was read at, in the reasons."""
     return f" at {100 * confidence:.3g} %"

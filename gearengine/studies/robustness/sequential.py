@@ -32,6 +32,7 @@ from gearengine.studies.robustness.study import (
     MAX_SAMPLES,
     RobustnessRequest,
     assemble,
+    point_work,
     robustness_work,
 )
 from gearengine.studies.robustness.tolerances import clopper_pearson, samples_to_prove
@@ -127,11 +128,11 @@ def unreachable(request: RobustnessRequest, limits: dict[str, float], budget: in
         return None
     rounds = [first << k for k in range(looks(first, most))]
     reach = next((r for r in rounds if r >= n), None)
-    per_sample = robustness_work(request.model_copy(update={"samples": 1, "sensitivity": False}))
-    held = budget // max(1, per_sample)
+    unit = point_work(request)
+    held = budget // max(1, sum(unit))
     if reach is not None and held >= reach:
         return None
-    points = max(1, len(request.points()))
+    points = len(unit)
     where = (f"the {most} samples a point it may take" if reach is None else
              f"the round of {reach} samples")  # fmt: skip
     return (f"a point with no events needs {n} samples to prove P({name}) <= {limits[name]:g} "
@@ -155,7 +156,7 @@ def sequential(
     ``budget`` RK4 steps in all and ``most`` samples a point; ``workers`` threads."""
     points = request.points() or [{}]
     confidence = decision_confidence(first, most)
-    unit = [robustness_work(point_request(request, p, 1)) for p in points]
+    unit = point_work(request)
     chunks: list[list[str]] = [[] for _ in points]
     answers: list[RobustnessPoint | None] = [None] * len(points)
     verdicts: list[Verdict] = ["undecided"] * len(points)

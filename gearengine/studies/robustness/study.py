@@ -202,12 +202,15 @@ def chunk_counts(request: RobustnessRequest, rows: int) -> list[int]:
 
 def robustness_work(request: RobustnessRequest) -> int:
     """RK4 steps of every run (nominal design at each point, times the rows)."""
+    return request.n_rows() * sum(point_work(request))
+
+
+def point_work(request: RobustnessRequest) -> list[int]:
+    """RK4 steps of one run of the nominal design at each operating point of ``request`` (one
+    entry, the design's own point, without axes): the cost of a sample there."""
+    points = request.points() or [{}]
     base = base_design(request.design)
-    per_point = [
-        work(design_model(design_with(base, values))[0], request.settings)
-        for values in request.points() or [{}]
-    ]
-    return request.n_rows() * sum(per_point)
+    return [work(design_model(design_with(base, p))[0], request.settings) for p in points]
 
 
 def robustness_terms(request: RobustnessRequest, cap: int) -> str:

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from xml.etree import ElementTree
 
 from gearengine.gate.envelope import EnvelopeReport, level_text, window_text
+from gearengine.gate.probability import ProbabilityReport
 
 
 @dataclass(frozen=True)
@@ -64,3 +65,11 @@ def envelope_junit(report: EnvelopeReport, name: str) -> str:
         cases.append(Case(level_text(level), [window_text(w) for w in mine],
                           [w.rule for w in mine]))  # fmt: skip
     return junit_xml("gearchaos envelope", name, "gearchaos.envelope", cases)
+
+
+def probability_junit(report: ProbabilityReport, name: str) -> str:
+    """The probability gate's JUnit: one test case per operating point, failed once with its
+    reasons."""
+    cases = [Case(level_text(v.point), v.reasons, [r.split(")")[0] + ")" for r in v.reasons])
+             for v in report.verdicts]  # fmt: skip
+    return junit_xml("gearchaos robustness", name, "robustness", cases)
