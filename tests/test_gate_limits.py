@@ -367,3 +367,31 @@ def test_a_limit_no_point_can_meet_is_refused_naming_the_option(
     floor = "1" if option.startswith("--max-dynamic-factor") else "0"
     assert f"{option.split('=')[0]}: Input should be greater than {floor}" in (
         capsys.readouterr().err)  # fmt: skip
+
+
+@pytest.mark.parametrize("rate", ["0", "-500"])
+def test_a_bad_runup_rate_is_refused_before_the_envelope_is_computed(
+    rate: str, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check --speed --torque --runup 0`` computed the whole envelope sweep and its refinement
+    before the run-up request refused its rate as "rate" and "bin_rpm" (noticed in the walk of
+    issue 29): the parser refuses a rate that is not positive, and any other bad ramp is
+    refused before the envelope, naming --runup; no point is computed."""
+    import gearengine.cli.envelope as envelope
+
+    def no_sweep(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the envelope was computed before the ramp was checked")
+
+    monkeypatch.setattr(envelope, "sweep_here", no_sweep)
+    design = str(ROOT / "examples" / "ci" / "design.json")
+    with pytest.raises(SystemExit) as stopped:
+        main(["check", design, "--speed", "3500:4500", "--torque", "20:40", f"--runup={rate}"])
+    assert stopped.value.code == 2
+    err = capsys.readouterr().err
+    assert f"argument --runup: '{rate}': give a positive rate in rpm/s" in err, err
+    # a ramp the run-up refuses for another reason (its work budget) is refused before the
+    # envelope too, naming --runup
+    monkeypatch.setattr("gearengine.studies.runup.profile.MAX_RUNUP_STEPS", 1)
+    assert main(["check", design, "--speed", "3500:4500", "--torque", "20:40", "--runup=500"]) == 2
+    err = capsys.readouterr().err
+    assert "--runup" in err and "over the budget" in err, err

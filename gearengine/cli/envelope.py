@@ -201,6 +201,15 @@ NOMINAL_ONLY = (
 gate failed every point, and said nothing of them)."""
 
 
+RAMP_OPTIONS = {
+    "rate": "--runup",
+    "bin_rpm": "--runup (the bin it sets)",
+    "from_speed": "--speed (its low end)",
+    "to_speed": "--speed (its high end)",
+}
+"""The options that set the fields of ``check --runup``'s run-up (``gate.runup.gate_ramp``)."""
+
+
 def cmd_envelope(args: argparse.Namespace, doc: object, rules: Rules) -> int:
     """The envelope gate of the design document ``doc`` under ``rules`` (``rules_of``); exit 0
     pass, 1 fail, 2 invalid input."""
@@ -212,6 +221,10 @@ def cmd_envelope(args: argparse.Namespace, doc: object, rules: Rules) -> int:
             ]
         )
     request = envelope_request(args, doc)
+    if getattr(args, "runup", None) is not None:  # a bad ramp refused before any compute
+        from gearengine.gate.runup import gate_envelope, gate_ramp
+
+        validated_input(lambda r: gate_ramp(request, r), args.runup, "--runup", RAMP_OPTIONS)
     print(settings_text(request.settings), file=sys.stderr)
     tick = progress(time.monotonic(), "envelope")
     workers = os.cpu_count() or 1
@@ -222,9 +235,7 @@ def cmd_envelope(args: argparse.Namespace, doc: object, rules: Rules) -> int:
     depth = REFINE_DEPTH if args.refine is None else args.refine
     report = refined_report(request, result, rules, depth, workers=workers)
     if getattr(args, "runup", None) is not None:  # run-ups through the range (gate.runup)
-        from gearengine.gate.runup import gate_envelope
-
-        report = validated_input(lambda r: gate_envelope(report, request, r), args.runup, "--runup")
+        report = gate_envelope(report, request, args.runup)
     if request.design is not None and request.design.tolerances is not None:
         report = report.model_copy(update={"notes": [*report.notes, NOMINAL_ONLY]})
     for line in report_lines(report, request.design):

@@ -95,6 +95,18 @@ def finite(text: str) -> float:
         raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
 
 
+def rate(text: str) -> float:
+    """``--runup``: a positive rate [rpm/s] (``finite``); 0 or below is refused naming the
+    option, where the run-up request refused it as "rate" and "bin_rpm", fields the command
+    line never shows."""
+    value = finite(text)
+    if value <= 0.0:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: give a positive rate in rpm/s (the run-down runs at the same rate)"
+        )
+    return value
+
+
 def per_tau(text: str) -> float:
     """``--max-lle``: a plain number per unit tau (``finite``); a value with a unit ("1/s") is
     refused saying so, where it read "'1/s' is not a number" beside a help saying check prints
@@ -244,7 +256,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--junit", metavar="FILE", help="write a JUnit XML report")
     p.add_argument("--server", metavar="URL", help="run the envelope on a running service "
                    "(API key from GEARCHAOS_API_KEY)")  # fmt: skip
-    p.add_argument("--runup", type=finite, default=None, metavar="RATE",
+    p.add_argument("--runup", type=rate, default=None, metavar="RATE",
                    help="envelope checks: also run up and down through --speed at RATE rpm/s "
                    "at each torque level (same rules; chaos fails after 0.05 s)")  # fmt: skip
     p.add_argument(

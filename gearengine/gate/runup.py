@@ -98,35 +98,51 @@ def runup_failures(
     return out
 
 
+def gate_ramp(sweep: SweepRequest, rate_rpm_s: float) -> dict[str, object]:
+    """The run-up and run-down at ``rate_rpm_s`` [rpm/s] through the envelope sweep's speed
+    range, as a run-up request's fields, checked at the design's torque (``validated_runup``)
+    so that a bad ramp is refused before the envelope is computed: ``ValidationError`` naming
+    the field, ``ValueError`` for an envelope without a speed range. Its bins are the grid step,
+    at most a quarter of the range (``widest_bin_rpm``) and at most half ``CHAOS_SECONDS`` of
+    ramp each, so that the chaos rule is resolved: the grid's 227 rpm bins (0.114 s at 2000
+    rpm/s) hid a run-down chaotic over 4900-5650 rpm that 50 rpm bins show, and the verdict
+    changed with --speed-points."""
+    lo, hi, num = speed_range_rpm(sweep)
+    ramp = {
+        "from_speed": f"{lo!r} rpm", "to_speed": f"{hi!r} rpm",
+        "rate": f"{rate_rpm_s!r} rpm/s", "direction": "up_down",
+        "bin_rpm": min((hi - lo) / (num - 1), widest_bin_rpm(lo, hi),
+                       rate_rpm_s * CHAOS_SECONDS / 2),
+        "ensemble": {"size": GATE_ENSEMBLE},
+    }  # fmt: skip
+    validated_runup({"design": sweep.design, **ramp})
+    return ramp
+
+
+def speed_range_rpm(sweep: SweepRequest) -> tuple[float, float, int]:
+    """(lowest, highest speed [rpm], points) of the envelope sweep's speed axis; ``ValueError``
+    when it has no speed range to run up through."""
+    axis = next((a for a in sweep.axes if a.parameter == "speed"), None)
+    grid = [] if axis is None or sweep.design is None else axis.values(sweep.design)
+    if axis is None or axis.num < 2 or not grid[0] < grid[-1]:
+        raise ValueError("--runup: give the envelope a speed range, --speed LOW:HIGH")
+    return grid[0] / RPM, grid[-1] / RPM, axis.num
+
+
 def gate_envelope(
     report: EnvelopeReport, sweep: SweepRequest, rate_rpm_s: float,
     progress: Callable[[int, int], None] | None = None, workers: int = 1,
 ) -> EnvelopeReport:  # fmt: skip
-    """``report`` with the failing windows of a run-up and run-down at ``rate_rpm_s`` [rpm/s]
-    through the envelope sweep's speed range at each of its torque levels, and what ran
-    (``runup``). Its bins are the grid step, at most a quarter of the range
-    (``widest_bin_rpm``) and at most half ``CHAOS_SECONDS`` of ramp each, so that the chaos
-    rule is resolved: the grid's 227 rpm bins (0.114 s at 2000 rpm/s) hid a run-down chaotic
-    over 4900-5650 rpm that 50 rpm bins show, and the verdict changed with --speed-points.
-    Raises ``ValidationError`` naming the field of a bad ramp.
+    """``report`` with the failing windows of the run-up and run-down of ``gate_ramp`` at each
+    torque level of the envelope, and what ran (``runup``).
 
     The sweep's design is validated already (every corner of its grid, ``request_errors``):
     each level's run-up carries it, at the level's torque, as the validated ``Design`` it is,
     not as a document to read again."""
     design = sweep.design
     assert design is not None
-    axis = next(a for a in sweep.axes if a.parameter == "speed")
-    grid = axis.values(design)
-    lo, hi = grid[0] / RPM, grid[-1] / RPM
-    if axis.num < 2 or not lo < hi:
-        raise ValueError("--runup: give the envelope a speed range, --speed LOW:HIGH")
-    ramp = {
-        "from_speed": f"{lo!r} rpm", "to_speed": f"{hi!r} rpm",
-        "rate": f"{rate_rpm_s!r} rpm/s", "direction": "up_down",
-        "bin_rpm": min((hi - lo) / (axis.num - 1), widest_bin_rpm(lo, hi),
-                       rate_rpm_s * CHAOS_SECONDS / 2),
-        "ensemble": {"size": GATE_ENSEMBLE},
-    }  # fmt: skip
+    ramp = gate_ramp(sweep, rate_rpm_s)
+    lo, hi, _ = speed_range_rpm(sweep)
     levels = [w.level for w in report.sweep.windows or []] or [{}]
     found: list[FailingWindow] = []
     for k, level in enumerate(levels):
