@@ -411,7 +411,9 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
     windows = [SimpleNamespace(level=lv) for lv in levels]
     sweep_result = SimpleNamespace(windows=windows)
     report = EnvelopeReport.model_construct(failures=[], rules=Rules(), sweep=sweep_result)
-    gate.gate_envelope(report, sweep, 20000.0)  # fast enough that half CHAOS_SECONDS is 500 rpm
+    runups = gate.gate_runups(sweep, 20000.0)  # fast enough that half CHAOS_SECONDS is 500 rpm
+    assert runups.ran.levels == levels
+    gate.gate_envelope(report, runups)
     assert [r.design.torque for r in seen] == [10.0, 40.0]
     for r in seen:
         assert r.design.readings == sweep.design.readings
@@ -422,8 +424,28 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
     coarse = sweep_request({"design": doc.get("design", doc), "axes": [
         {"parameter": "speed", "start": "3500 rpm", "stop": "4500 rpm", "num": 3},
         {"parameter": "torque", "start": "10 N*m", "stop": "40 N*m", "num": 2}]})  # fmt: skip
-    assert gate.gate_envelope(report, coarse, 20000.0).runup.bin_rpm == 250.0  # type: ignore[union-attr]
+    ran = gate.gate_envelope(report, gate.gate_runups(coarse, 20000.0)).runup
+    assert ran is not None and ran.bin_rpm == 250.0 and ran.failing_windows == 0
     assert seen[-1].bin_rpm == 250.0
+
+
+def test_the_gate_runs_up_at_the_levels_of_the_envelope_windows() -> None:
+    """The run-ups are made (and refused) before the envelope is computed, so their torque
+    levels come from the grid, not from the computed speed windows: they are the windows'
+    levels, to the last bit, on a grid whose levels are not round (5-60 N*m in 7 points)."""
+    from gearengine.gate.runup import gate_runups
+    from gearengine.studies.sweep import run_local as sweep_local
+    from gearengine.studies.sweep.request import validated as sweep_request
+
+    doc = json.loads((ROOT / "examples" / "ci" / "design.json").read_text())
+    sweep = sweep_request({"design": doc.get("design", doc), "axes": [
+        {"parameter": "speed", "start": "3500 rpm", "stop": "4500 rpm", "num": 2},
+        {"parameter": "torque", "start": "5 N*m", "stop": "60 N*m", "num": 7}],
+        "settings": {"transient_periods": 4, "record_periods": 4,
+                     "steps_per_period": 32}})  # fmt: skip
+    windows = sweep_local(sweep).windows
+    assert windows is not None
+    assert gate_runups(sweep, 2000.0).ran.levels == [w.level for w in windows]
 
 
 def test_the_assembly_reads_the_design_converted_with_the_plan(

@@ -207,7 +207,7 @@ RAMP_OPTIONS = {
     "from_speed": "--speed (its low end)",
     "to_speed": "--speed (its high end)",
 }
-"""The options that set the fields of ``check --runup``'s run-up (``gate.runup.gate_ramp``)."""
+"""The options that set the fields of ``check --runup``'s run-ups (``gate.runup.gate_runups``)."""
 
 
 def cmd_envelope(args: argparse.Namespace, doc: object, rules: Rules) -> int:
@@ -222,9 +222,10 @@ def cmd_envelope(args: argparse.Namespace, doc: object, rules: Rules) -> int:
         )
     request = envelope_request(args, doc)
     if getattr(args, "runup", None) is not None:  # a bad ramp refused before any compute
-        from gearengine.gate.runup import gate_envelope, gate_ramp
+        from gearengine.gate.runup import gate_envelope, gate_runups
 
-        validated_input(lambda r: gate_ramp(request, r), args.runup, "--runup", RAMP_OPTIONS)
+        runups = validated_input(lambda r: gate_runups(request, r), args.runup, "--runup",
+                                 RAMP_OPTIONS)  # fmt: skip
     print(settings_text(request.settings), file=sys.stderr)
     tick = progress(time.monotonic(), "envelope")
     workers = os.cpu_count() or 1
@@ -235,7 +236,7 @@ def cmd_envelope(args: argparse.Namespace, doc: object, rules: Rules) -> int:
     depth = REFINE_DEPTH if args.refine is None else args.refine
     report = refined_report(request, result, rules, depth, workers=workers)
     if getattr(args, "runup", None) is not None:  # run-ups through the range (gate.runup)
-        report = gate_envelope(report, request, args.runup)
+        report = gate_envelope(report, runups)
     if request.design is not None and request.design.tolerances is not None:
         report = report.model_copy(update={"notes": [*report.notes, NOMINAL_ONLY]})
     for line in report_lines(report, request.design):

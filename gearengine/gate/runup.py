@@ -12,19 +12,20 @@ Failures name the branch and the speeds.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from gearengine.gate.envelope import EnvelopeReport, FailingWindow, RunupCheck
 from gearengine.gate.rules import Rules
-from gearengine.model.units import RPM, shown
+from gearengine.model.units import RPM, display_unit, in_display_unit, shown
 from gearengine.numerics.attractors import IMPACT_TEXT
 from gearengine.studies.runup.compute import run_local
 from gearengine.studies.runup.profile import validated_runup
 from gearengine.studies.runup.reading import transient_chaos
-from gearengine.studies.runup.request import widest_bin_rpm
+from gearengine.studies.runup.request import RunupRequest, widest_bin_rpm
 from gearengine.studies.runup.results import RunupBin, RunupResult
 from gearengine.studies.sweep.points import PhysicalValue
 from gearengine.studies.sweep.request import SweepRequest
-from gearengine.studies.sweep.windows import runs
+from gearengine.studies.sweep.windows import SPEED, runs
 
 CHAOS_SECONDS = 0.05
 """Longest time a run-up may spend in chaotic bins before the gate fails it [s]."""
@@ -98,63 +99,76 @@ def runup_failures(
     return out
 
 
-def gate_ramp(sweep: SweepRequest, rate_rpm_s: float) -> dict[str, object]:
-    """The run-up and run-down at ``rate_rpm_s`` [rpm/s] through the envelope sweep's speed
-    range, as a run-up request's fields, checked at the design's torque (``validated_runup``)
-    so that a bad ramp is refused before the envelope is computed: ``ValidationError`` naming
-    the field, ``ValueError`` for an envelope without a speed range. Its bins are the grid step,
-    at most a quarter of the range (``widest_bin_rpm``) and at most half ``CHAOS_SECONDS`` of
-    ramp each, so that the chaos rule is resolved: the grid's 227 rpm bins (0.114 s at 2000
-    rpm/s) hid a run-down chaotic over 4900-5650 rpm that 50 rpm bins show, and the verdict
-    changed with --speed-points."""
-    lo, hi, num = speed_range_rpm(sweep)
+@dataclass(frozen=True)
+class GateRunups:
+    """The run-ups of ``check --runup``, validated before the envelope is computed: ``ran``
+    says what they are (its ``failing_windows`` 0 until they run), ``requests`` one run-up and
+    run-down a level of ``ran.levels``."""
+
+    ran: RunupCheck
+    requests: list[RunupRequest]
+
+
+def gate_runups(sweep: SweepRequest, rate_rpm_s: float) -> GateRunups:
+    """A run-up and run-down at ``rate_rpm_s`` [rpm/s] through the envelope sweep's speed range
+    at each torque level of its grid (the levels of the sweep's speed windows), each validated
+    (``validated_runup``) so that a bad ramp is refused before any compute: ``ValidationError``
+    naming the field, ``ValueError`` for an envelope without a speed range.
+
+    Bins are the grid step, at most a quarter of the range (``widest_bin_rpm``) and at most
+    half ``CHAOS_SECONDS`` of ramp each, so that the chaos rule is resolved: the grid's 227 rpm
+    bins (0.114 s at 2000 rpm/s) hid a run-down chaotic over 4900-5650 rpm that 50 rpm bins
+    show, and the verdict changed with --speed-points. The sweep's design is validated already
+    (every corner of its grid, ``request_errors``): each level's run-up carries it, at the
+    level's torque, as the validated ``Design`` it is, not as a document to read again."""
+    design = sweep.design
+    assert design is not None
+    axis = next((a for a in sweep.axes if a.parameter == SPEED), None)
+    grid = [] if axis is None else axis.values(design)
+    if axis is None or axis.num < 2 or not grid[0] < grid[-1]:
+        raise ValueError("--runup: give the envelope a speed range, --speed LOW:HIGH")
+    lo, hi = grid[0] / RPM, grid[-1] / RPM
     ramp = {
         "from_speed": f"{lo!r} rpm", "to_speed": f"{hi!r} rpm",
         "rate": f"{rate_rpm_s!r} rpm/s", "direction": "up_down",
-        "bin_rpm": min((hi - lo) / (num - 1), widest_bin_rpm(lo, hi),
+        "bin_rpm": min((hi - lo) / (axis.num - 1), widest_bin_rpm(lo, hi),
                        rate_rpm_s * CHAOS_SECONDS / 2),
         "ensemble": {"size": GATE_ENSEMBLE},
     }  # fmt: skip
-    validated_runup({"design": sweep.design, **ramp})
-    return ramp
+    levels = torque_levels(sweep)
+    requests = [validated_runup({"design": design if not level else design.model_copy(
+                    update={"torque": level["torque"].value}), **ramp})
+                for level in levels]  # fmt: skip
+    ran = RunupCheck(rate_rpm_s=rate_rpm_s, speeds_rpm=[shown(lo), shown(hi)],
+                     directions=["up", "down"], bin_rpm=shown(ramp["bin_rpm"]),
+                     ensemble=GATE_ENSEMBLE, levels=levels, failing_windows=0)  # fmt: skip
+    return GateRunups(ran=ran, requests=requests)
 
 
-def speed_range_rpm(sweep: SweepRequest) -> tuple[float, float, int]:
-    """(lowest, highest speed [rpm], points) of the envelope sweep's speed axis; ``ValueError``
-    when it has no speed range to run up through."""
-    axis = next((a for a in sweep.axes if a.parameter == "speed"), None)
-    grid = [] if axis is None or sweep.design is None else axis.values(sweep.design)
-    if axis is None or axis.num < 2 or not grid[0] < grid[-1]:
-        raise ValueError("--runup: give the envelope a speed range, --speed LOW:HIGH")
-    return grid[0] / RPM, grid[-1] / RPM, axis.num
+def torque_levels(sweep: SweepRequest) -> list[dict[str, PhysicalValue]]:
+    """The torque levels of the envelope grid, ascending, as its speed windows name them
+    (``studies.sweep.windows``: the torque in its display unit); one empty level when the
+    envelope has no torque axis (the design's torque)."""
+    axis = next((a for a in sweep.axes if a.parameter == "torque"), None)
+    if axis is None or sweep.design is None:
+        return [{}]
+    unit = display_unit("torque")[0]
+    return [{"torque": PhysicalValue(value=in_display_unit("torque", t), unit=unit)}
+            for t in sorted(set(axis.values(sweep.design)))]  # fmt: skip
 
 
 def gate_envelope(
-    report: EnvelopeReport, sweep: SweepRequest, rate_rpm_s: float,
+    report: EnvelopeReport, runups: GateRunups,
     progress: Callable[[int, int], None] | None = None, workers: int = 1,
 ) -> EnvelopeReport:  # fmt: skip
-    """``report`` with the failing windows of the run-up and run-down of ``gate_ramp`` at each
-    torque level of the envelope, and what ran (``runup``).
-
-    The sweep's design is validated already (every corner of its grid, ``request_errors``):
-    each level's run-up carries it, at the level's torque, as the validated ``Design`` it is,
-    not as a document to read again."""
-    design = sweep.design
-    assert design is not None
-    ramp = gate_ramp(sweep, rate_rpm_s)
-    lo, hi, _ = speed_range_rpm(sweep)
-    levels = [w.level for w in report.sweep.windows or []] or [{}]
+    """``report`` with the failing windows of ``runups`` (``gate_runups``), and what ran
+    (``runup``)."""
     found: list[FailingWindow] = []
-    for k, level in enumerate(levels):
-        at_level = design if "torque" not in level else (
-            design.model_copy(update={"torque": level["torque"].value}))  # fmt: skip
-        request = validated_runup({"design": at_level, **ramp})
+    levels = runups.ran.levels
+    for k, (level, request) in enumerate(zip(levels, runups.requests, strict=True)):
         found += runup_failures(run_local(request, workers=workers), report.rules, level)
         if progress is not None:
             progress(k + 1, len(levels))
-    ran = RunupCheck(rate_rpm_s=rate_rpm_s, speeds_rpm=[shown(lo), shown(hi)],
-                     directions=["up", "down"], bin_rpm=shown(ramp["bin_rpm"]),
-                     ensemble=GATE_ENSEMBLE, levels=levels,
-                     failing_windows=len(found))  # fmt: skip
+    ran = runups.ran.model_copy(update={"failing_windows": len(found)})
     failures = [*report.failures, *found]
     return report.model_copy(update={"failures": failures, "passed": not failures, "runup": ran})
