@@ -18,7 +18,7 @@ import importlib
 import os
 import threading
 from collections.abc import Callable, Iterator
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
@@ -228,8 +228,11 @@ def run_local(
 ) -> BaseModel:
     """Every chunk of a job of kind ``name`` in this process, then its result document.
 
-    ``progress_callback(done, total)`` counts the kind's units of work. ``workers`` > 1 runs
-    chunks on that many threads (the kernels release the GIL); the result does not depend on it.
+    ``progress_callback(done, total)`` counts the kind's units of work, each chunk as it
+    completes (chunks completed together in index order: one worker keeps the index order).
+    Awaited in index order, the remedies' six searches were all reported at the end, behind
+    its slowest first chunk. ``workers`` > 1 runs chunks on that many threads (the kernels
+    release the GIL); the result does not depend on it: it is assembled in index order.
     Chunks are computed from the request's JSON text, as a worker would, so the CLI's document
     equals the service's byte for byte.
     """
@@ -240,10 +243,15 @@ def run_local(
     total, done = sum(counts), 0
     results: list[str] = [""] * len(counts)
     with ThreadPoolExecutor(max(1, workers)) as pool:
-        futures = [pool.submit(compute_chunk_json, name, text, i, size) for i in range(len(counts))]
-        for i, future in enumerate(futures):
-            results[i] = future.result()
-            done += counts[i]
-            if progress_callback is not None:
-                progress_callback(done, total)
+        index = {pool.submit(compute_chunk_json, name, text, i, size): i
+                 for i in range(len(counts))}  # fmt: skip
+        pending = set(index)
+        while pending:
+            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for future in sorted(finished, key=index.__getitem__):
+                i = index[future]
+                results[i] = future.result()
+                done += counts[i]
+                if progress_callback is not None:
+                    progress_callback(done, total)
     return job.assemble(request, results)
