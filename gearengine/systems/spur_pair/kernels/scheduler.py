@@ -2,7 +2,7 @@
 
 A lock-step kernel deals its runs to streams run in parallel; a stream of ``LANES`` lanes loads
 its next run into every free lane, advances all lanes by one interval T0 of N RK4 steps, and
-ends the interval of every lane (``intervals.end_interval``: record, divergence, adaptive
+ends the interval of every lane (``intervals.end_intervals``: record, divergence, adaptive
 stopping), until its runs are finished. Only the step differs between the laws (as scipy's
 ``RungeKutta`` writes ``_step_impl`` once and each method is its tableau): a ``LaneLaw`` names
 the law's four compiled pieces, and ``lane_kernel`` makes the kernel of one law
@@ -44,7 +44,7 @@ from numba import njit, prange
 from gearengine.systems.spur_pair.kernels.adaptive import ADAPT_SETTLE
 from gearengine.systems.spur_pair.kernels.intervals import (
     adaptive_window,
-    end_interval,
+    end_intervals,
     new_outputs,
     new_ring,
     reset_lane,
@@ -167,16 +167,14 @@ def _stream(
         if active == 0:
             break
         law_steps(N, Kl, Fl, PT, owner, lane_state, rates, law, coeffs)  # noqa: F821
-        for lane in range(LANES):  # end of an interval T0 for every lane
-            if end_interval(
-                lane, PT[lane], lane_state, counters, TOL2, ring, out, T[max(PT[lane], 0)],
-                n_trans, n_rec, W, settle0, bound, lle_rel, lle_abs,
-            ):  # fmt: skip
-                NEED[lane] = True
-                active -= 1
-                p = PT[lane]
-                dxc[p], dvc[p] = DX[lane], DV[lane]
-                law_keep(lane, p, law, coeffs)  # noqa: F821
+        if end_intervals(PT, lane_state, counters, TOL2, ring, out, T, n_trans, n_rec, W,
+                         settle0, bound, lle_rel, lle_abs, NEED):  # fmt: skip
+            for lane in range(LANES):  # the lanes whose run finished with this interval
+                if NEED[lane]:
+                    active -= 1
+                    p = PT[lane]
+                    dxc[p], dvc[p] = DX[lane], DV[lane]
+                    law_keep(lane, p, law, coeffs)  # noqa: F821
 
 
 def _lanes(
@@ -209,7 +207,7 @@ def _lanes(
     ``kernels.adaptive`` (its last ``ADAPT_WINDOW`` strobes kept in a ring buffer per lane),
     and a chaotic or quasi-periodic one by its LLE rule when ``lle_rel`` or ``lle_abs`` is
     positive; otherwise every run takes ``n_trans + n_rec`` intervals, as ``run_rk4``. The end
-    of an interval is ``kernels.intervals.end_interval``. The mesh force K(t) f_h(x) + 2 mu x'
+    of an interval is ``kernels.intervals.end_intervals``. The mesh force K(t) f_h(x) + 2 mu x'
     is evaluated at every step end and its extremes over the record returned.
 
     Args:
