@@ -9,13 +9,17 @@ import numpy as np
 import pytest
 
 from gearengine.model.params import GearParams
-from gearengine.numerics.batch import run_lanes
+from gearengine.numerics.batch import run_lanes, step_plans
 from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.numerics.simulation import simulate
+from gearengine.signals.classify import DIVERGENCE_BOUND
 from gearengine.signals.lyapunov import BLOCKS
+from gearengine.systems.spur_pair import kernels
+from gearengine.systems.spur_pair.forcing import packed_forcing
 from gearengine.systems.spur_pair.kernels import intervals, kinklanes, lockstep, scheduler
 from gearengine.systems.spur_pair.kernels.adaptive import ADAPT_LLE_MIN_RECORD
+from gearengine.systems.spur_pair.laws import LAWS, fresh_carry, law
 from tests._gear_cases import paper
 
 STARTS = [(0.01, 0.01), (1.5, 0.0), (-1.2, 0.3)]
@@ -154,3 +158,39 @@ def test_one_call_ends_the_interval_of_every_lane_of_a_stream() -> None:
     assert diverged.tolist() == [0, 1, 0] and xf[0] == 0.5
     assert xs[0, 1] == 0.5 and xs[2, 0] == -0.25 and logs[2, 0] == pytest.approx(math.log(5.0))
     assert counters[0].tolist() == [0, 2, 0, 1] and xmin[2] == -1.0
+
+
+def _lanes(point: GearParams, n: int, tangent: bool) -> tuple[tuple, tuple]:
+    """The lock-step kernel of ``point``'s law run n intervals from ``STARTS``, as the
+    physical-time driver calls it (no transient in the call, no early stop): (outputs, carry)."""
+    plan = step_plans([point], 200)[0]
+    kc, fm, fc = packed_forcing(point)
+    table = kernels.forcing_table(plan.period, plan.steps, kc, fm, fc)
+    L = len(STARTS)
+    owner = np.zeros(L, dtype=np.int64)
+    x0, v0 = (np.array([s[i] for s in STARTS]) for i in (0, 1))
+    shared = (np.full(L, plan.period), plan.steps, 0, n, DIVERGENCE_BOUND, False, 1, 0.0, 0.0,
+              tangent)  # fmt: skip
+    carry = fresh_carry(L)
+    lanes = LAWS[point.backlash.model].lanes
+    assert lanes is not None
+    out = lanes([law(point)], owner, [(kc, fm, fc)], np.full(L, point.damping), x0, v0,
+                (table[0][None], table[1][None], owner), shared, carry)  # fmt: skip
+    return out, carry
+
+
+@pytest.mark.parametrize("point", [paper(0.2), paper(0.6, mu=0.1, model="piecewise")],
+                         ids=["cubic", "piecewise"])  # fmt: skip
+def test_a_transient_without_the_tangent_has_the_same_states(point: GearParams) -> None:
+    """``tangent=False`` (the physical-time driver's transient chunks, which read no LLE and no
+    mesh force) skips the tangent's stages and the force's extremes in the lanes' whole steps
+    and gives the same states, strobes, extremes of x and end states, bit for bit (the state
+    never depends on the tangent)."""
+    full, _ = _lanes(point, 60, True)
+    bare, carry = _lanes(point, 60, False)
+    for i in (0, 1, 3, 4, 7, 8, 9, 10, 11):  # xs, vs, xmin, xmax, done, rec, diverged, xf, vf
+        assert np.array_equal(full[i], bare[i])
+    assert np.all(full[2] != 0.0) and np.isfinite(full[5]).all()  # logs, fmin with it
+    if point.backlash.model == "cubic":  # no whole step moved the tangent or saw the force
+        assert np.all(carry[0] == kernels.SQRT1_2) and np.all(bare[2] == 0.0)
+        assert np.all(bare[5] == np.inf)
