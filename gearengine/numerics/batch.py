@@ -253,9 +253,9 @@ def physical_lanes(
 ) -> list[BatchPoint]:  # fmt: skip
     """The ``BatchPoint`` of every lane of one lock-step group, its lengths decided in physical
     time (``numerics.physical``): the transient and the record run in chunks through the same
-    lock-step kernel (no early stopping inside it), a longer record on from the end of the
-    shorter (``extend``: state and ``Carry`` from the kernel, the outputs ``joined``);
-    ``periods_run`` counts both.
+    lock-step kernel (no early stopping inside it; the transient's without the tangent,
+    ``settle``), a longer record on from the end of the shorter (``extend``: state and
+    ``Carry`` from the kernel, the outputs ``joined``); ``periods_run`` counts both.
 
     Args:
         group: (lanes kernel, laws of the points, point of each lane (L,), packed forcing,
