@@ -213,7 +213,7 @@ def _run_lanes(
             continue
         streams = max(1, min(numba.get_num_threads(), -(-len(ks) // kernels.LANES)))
         shared = (per, N, settings.transient_periods, settings.record_periods, DIVERGENCE_BOUND,
-                  settings.adaptive, streams, *lle_tolerances(settings))  # fmt: skip
+                  settings.adaptive, streams, *lle_tolerances(settings), True)  # fmt: skip
         out = lanes_of(laws, inverse, packed, mu, x0, v0, tabled, shared, fresh_carry(len(ks)))
         verdicts = lane_verdicts(out, per)
         strobes = last_strobes(out, list(range(len(ks))), x_only)
@@ -253,9 +253,9 @@ def physical_lanes(
 ) -> list[BatchPoint]:  # fmt: skip
     """The ``BatchPoint`` of every lane of one lock-step group, its lengths decided in physical
     time (``numerics.physical``): the transient and the record run in chunks through the same
-    lock-step kernel (no early stopping inside it), a longer record on from the end of the
-    shorter (``extend``: state and ``Carry`` from the kernel, the outputs ``joined``);
-    ``periods_run`` counts both.
+    lock-step kernel (no early stopping inside it; the transient's without the tangent,
+    ``settle``), a longer record on from the end of the shorter (``extend``: state and
+    ``Carry`` from the kernel, the outputs ``joined``); ``periods_run`` counts both.
 
     Args:
         group: (lanes kernel, laws of the points, point of each lane (L,), packed forcing,
@@ -268,10 +268,11 @@ def physical_lanes(
     """
     lanes_of, laws, inverse, packed, mu, tabled, per, N, r = group
 
-    def call(idx: np.ndarray, xa: np.ndarray, va: np.ndarray, n: int, carry: Carry) -> tuple:
+    def call(idx: np.ndarray, xa: np.ndarray, va: np.ndarray, n: int, carry: Carry,
+             tangent: bool = True) -> tuple:  # fmt: skip
         streams = max(1, min(numba.get_num_threads(), -(-idx.size // kernels.LANES)))
         owner = inverse[idx].astype(np.int64)
-        shared = (per[idx], N, 0, n, DIVERGENCE_BOUND, False, streams, 0.0, 0.0)
+        shared = (per[idx], N, 0, n, DIVERGENCE_BOUND, False, streams, 0.0, 0.0, tangent)
         return lanes_of(laws, owner, packed, mu[idx], xa.copy(), va.copy(),
                         (tabled[0], tabled[1], owner), shared, carry)  # fmt: skip
 
@@ -285,6 +286,10 @@ def physical_lanes(
         carry = fresh_carry(idx.size)
         return chunk(call(idx, xa, va, n, carry), carry, idx)
 
+    def settle(idx: np.ndarray, xa: np.ndarray, va: np.ndarray, n: int) -> physical.Chunk:
+        carry = fresh_carry(idx.size)  # the state alone: 0.65x the CPU of the steps
+        return chunk(call(idx, xa, va, n, carry, False), carry, idx)
+
     def extend(idx: np.ndarray, keeps: list[tuple], n: int) -> physical.Chunk:
         rows = [(out, j) for out, j, _, _ in keeps]
         dx, dv, reg = (np.array([c[i][j] for _, j, _, c in keeps]) for i in range(3))
@@ -292,8 +297,7 @@ def physical_lanes(
         carry = (dx, dv, reg)  # where each record ended: the kernel runs it on from there
         return chunk(joined(rows, call(idx, xf, vf, n, carry)), carry, idx)
 
-    spans = physical.lengths(advance, x0, v0, per, mu, r, settings,
-                             extend)  # fmt: skip
+    spans = physical.lengths(advance, x0, v0, per, mu, r, settings, extend, settle)
     verdicts: dict[int, list[tuple]] = {}
     rows: dict[int, list[int]] = {}
     for s in spans:  # one verdict and one gather of strobes per kernel call

@@ -168,6 +168,7 @@ def lengths(
     mesh_per_T0: float,
     settings: SimulationSettings,
     extend: Extend | None = None,
+    settle: Advance | None = None,
 ) -> list[Lengths]:
     """Run the transient and the record of every lane in physical time (see the module doc).
 
@@ -179,9 +180,13 @@ def lengths(
         mesh_per_T0: r = T0 / T_f, shared by the lanes (same steps per T0).
         settings: caps (transient_periods, record_periods) and the LLE tolerances.
         extend: runs records on (``Extend``); None: a longer record runs again from its start.
+        settle: runs the transient's chunks (an ``Advance`` whose chunks need only the strobes,
+            the extremes of x, the end states and the divergence flags: no tangent, no LLE);
+            None: ``advance``.
     """
     out = [Lengths() for _ in range(x0.size)]
-    x, v = _settle(advance, x0.copy(), v0.copy(), period, mu, mesh_per_T0, settings, out)
+    x, v = _settle(settle or advance, x0.copy(), v0.copy(), period, mu, mesh_per_T0, settings,
+                   out)  # fmt: skip
     _record((advance, extend), x, v, period, mesh_per_T0, settings, out)
     return out
 

@@ -22,7 +22,7 @@ The three run kernels share one output layout (see ``run_rk4``); ``monodromy`` i
 * ``run_kink_batch`` (``kinklanes``): the piecewise law in lock-step lanes, each step split at
   the kinks lane by lane; the numbers of ``run_kink`` with its forcing table. Both lock-step
   kernels are the one lane scheduler (``scheduler``: streams, refill, and the end of every
-  interval, ``intervals.end_interval``: record, adaptive stopping) with their law's steps.
+  interval, ``intervals.end_intervals``: record, adaptive stopping) with their law's steps.
 
 Benettin et al. (Meccanica 15, 1980): the tangent vector starts at (1, 1)/sqrt(2) and is
 renormalised at the end of every interval T0; the log of its norm is recorded over the n_rec

@@ -2,7 +2,7 @@
 
 A lock-step kernel deals its runs to streams run in parallel; a stream of ``LANES`` lanes loads
 its next run into every free lane, advances all lanes by one interval T0 of N RK4 steps, and
-ends the interval of every lane (``intervals.end_interval``: record, divergence, adaptive
+ends the interval of every lane (``intervals.end_intervals``: record, divergence, adaptive
 stopping), until its runs are finished. Only the step differs between the laws (as scipy's
 ``RungeKutta`` writes ``_step_impl`` once and each method is its tableau): a ``LaneLaw`` names
 the law's four compiled pieces, and ``lane_kernel`` makes the kernel of one law
@@ -21,13 +21,16 @@ them; ``law_lanes``: the tuple its ``lanes`` made):
 
 * ``lanes(L)``: the law's per-lane arrays, a tuple;
 * ``load(lane, p, law_lanes, x0, coeffs)``: run p into ``lane``; p < 0 parks an idle lane;
-* ``steps(N, Kl, Fl, PT, owner, lane_state, rates, law_lanes, coeffs)``: the N RK4 steps of
-  one interval T0 of every lane, with the forcing rows ``Kl``, ``Fl`` (2N + 1, LANES), the run
-  of each lane ``PT`` (-1 idle), ``lane_state`` as in ``intervals`` and ``rates`` = (2 mu, h,
-  h / 2, h / 6) per lane. Compiled with ``inline="always"``: numba puts it into the
-  scheduler's body, where the lanes' arrays are the scheduler's own allocations, so LLVM knows
-  they do not overlap and vectorises the lane loop without run-time overlap checks. Called as
-  a function, the piecewise steps were not vectorised (2.3x the CPU time of the lanes);
+* ``steps(N, Kl, Fl, PT, owner, lane_state, rates, law_lanes, coeffs, tangent)``: the N RK4
+  steps of one interval T0 of every lane, with the forcing rows ``Kl``, ``Fl`` (2N + 1, LANES),
+  the run of each lane ``PT`` (-1 idle), ``lane_state`` as in ``intervals`` and ``rates`` =
+  (2 mu, h, h / 2, h / 6) per lane; ``tangent`` False: the state and the extremes of x alone
+  (the tangent vector and the mesh force's extremes are left as they are; the scheduler passes
+  it as a constant, so each value compiles to its own loop). Compiled with
+  ``inline="always"``: numba puts it into the scheduler's body, where the lanes' arrays are the
+  scheduler's own allocations, so LLVM knows they do not overlap and vectorises the lane loop
+  without run-time overlap checks. Called as a function, the piecewise steps were not
+  vectorised (2.3x the CPU time of the lanes);
 * ``keep(lane, p, law_lanes, coeffs)``: what run p carries into a next call beside its tangent
   vector, when it finishes.
 """
@@ -44,7 +47,7 @@ from numba import njit, prange
 from gearengine.systems.spur_pair.kernels.adaptive import ADAPT_SETTLE
 from gearengine.systems.spur_pair.kernels.intervals import (
     adaptive_window,
-    end_interval,
+    end_intervals,
     new_outputs,
     new_ring,
     reset_lane,
@@ -86,6 +89,7 @@ def _stream(
     adaptive,
     lle_rel,
     lle_abs,
+    tangent,
     xs,
     vs,
     logs,
@@ -166,17 +170,18 @@ def _stream(
             law_load(lane, p, law, x0, coeffs)  # noqa: F821
         if active == 0:
             break
-        law_steps(N, Kl, Fl, PT, owner, lane_state, rates, law, coeffs)  # noqa: F821
-        for lane in range(LANES):  # end of an interval T0 for every lane
-            if end_interval(
-                lane, PT[lane], lane_state, counters, TOL2, ring, out, T[max(PT[lane], 0)],
-                n_trans, n_rec, W, settle0, bound, lle_rel, lle_abs,
-            ):  # fmt: skip
-                NEED[lane] = True
-                active -= 1
-                p = PT[lane]
-                dxc[p], dvc[p] = DX[lane], DV[lane]
-                law_keep(lane, p, law, coeffs)  # noqa: F821
+        if tangent:  # a constant in each call of the steps: two loops, no test in them
+            law_steps(N, Kl, Fl, PT, owner, lane_state, rates, law, coeffs, True)  # noqa: F821
+        else:
+            law_steps(N, Kl, Fl, PT, owner, lane_state, rates, law, coeffs, False)  # noqa: F821
+        if end_intervals(PT, lane_state, counters, TOL2, ring, out, T, n_trans, n_rec, W,
+                         settle0, bound, lle_rel, lle_abs, NEED):  # fmt: skip
+            for lane in range(LANES):  # the lanes whose run finished with this interval
+                if NEED[lane]:
+                    active -= 1
+                    p = PT[lane]
+                    dxc[p], dvc[p] = DX[lane], DV[lane]
+                    law_keep(lane, p, law, coeffs)  # noqa: F821
 
 
 def _lanes(
@@ -197,6 +202,7 @@ def _lanes(
     streams,
     lle_rel,
     lle_abs,
+    tangent,
     *coeffs,
 ):  # pragma: no cover - compiled
     """RK4 of Eq. (9) + tangent for P runs advanced together in lanes, by one backlash law.
@@ -209,7 +215,7 @@ def _lanes(
     ``kernels.adaptive`` (its last ``ADAPT_WINDOW`` strobes kept in a ring buffer per lane),
     and a chaotic or quasi-periodic one by its LLE rule when ``lle_rel`` or ``lle_abs`` is
     positive; otherwise every run takes ``n_trans + n_rec`` intervals, as ``run_rk4``. The end
-    of an interval is ``kernels.intervals.end_interval``. The mesh force K(t) f_h(x) + 2 mu x'
+    of an interval is ``kernels.intervals.end_intervals``. The mesh force K(t) f_h(x) + 2 mu x'
     is evaluated at every step end and its extremes over the record returned.
 
     Args:
@@ -226,6 +232,9 @@ def _lanes(
         streams: parallel streams of lanes (at most the number of threads is useful).
         lle_rel, lle_abs: tolerances of the LLE rule (``kernels.adaptive.lle_known``); 0 and 0
             turn it off.
+        tangent: integrate the tangent vector and the mesh force's extremes; False: the state
+            alone, for a transient that reads the strobes and the extremes of x only (``logs``
+            then hold no LLE, ``fmin`` and ``fmax`` no extremes; about 0.65x the CPU).
         coeffs: the law's own per-run inputs (its module says which).
 
     Returns:
@@ -239,7 +248,7 @@ def _lanes(
     for stream in prange(streams):
         law_stream(  # noqa: F821 - a global set by lane_kernel
             stream, streams, mu, x0, v0, dxc, dvc, Ktab, Ftab, owner, T, N, n_trans, n_rec,
-            bound, adaptive, lle_rel, lle_abs,
+            bound, adaptive, lle_rel, lle_abs, tangent,
             xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf, *coeffs,
         )  # fmt: skip
     return xs, vs, logs, xmin, xmax, fmin, fmax, done, rec, diverged, xf, vf
@@ -256,8 +265,8 @@ def _compiled(template: Callable, name: str, scope: dict, doc: str, **options: b
 def lane_kernel(law: LaneLaw) -> Callable:
     """The lock-step kernel of ``law`` (``_lanes``, named ``<law.name>_kernel``; arguments
     ``mu, x0, v0, dxc, dvc, Ktab, Ftab, owner, T, N, n_trans, n_rec, bound, adaptive, streams,
-    lle_rel, lle_abs, *coeffs``), over its scheduler ``<law.name>_stream``; numba caches each
-    under its name."""
+    lle_rel, lle_abs, tangent, *coeffs``), over its scheduler ``<law.name>_stream``; numba
+    caches each under its name."""
     pieces = {
         "law_lanes": law.lanes,
         "law_load": law.load,
