@@ -114,6 +114,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(signals.jobs_router, tags=["signals"])
     app.include_router(signals.router, tags=["signals"])
     app.include_router(explorer.router)
+    app.add_middleware(melnikov.VerdictLane)  # innermost: behind the body limit and the log
     app.add_middleware(
         BodyLimit,
         limit=settings.max_body_bytes,
