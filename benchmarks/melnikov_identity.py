@@ -3,6 +3,7 @@ the CPU time of a request.
 
     PYTHONPATH=$PWD .venv/bin/python benchmarks/melnikov_identity.py --against TREE
     PYTHONPATH=$PWD .venv/bin/python benchmarks/melnikov_identity.py --cpu TREE [--profile]
+    PYTHONPATH=$PWD .venv/bin/python benchmarks/melnikov_identity.py --store FILE --from TREE
 
 ``--against``: about 500 varied requests (one and three excitations, loads of both signs and
 above F_crit, quadrature, perturbation load, not applicable, incommensurate, inactive
@@ -13,10 +14,13 @@ every status, media type, ETag and body must be the same bytes. ``--cpu``: the C
 worker thread (``time.thread_time``) per one-excitation request through the whole ASGI app
 (middlewares, routing, validation, verdict, JSON), each a new design, batches alternating
 between this tree and TREE; ``--profile`` adds cProfile's top functions of this tree.
+``--store``: 60 of those requests with the digests of TREE's answers, the data of
+``tests/test_verdict_lane.py``.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import os
@@ -157,6 +161,10 @@ def three(rng: random.Random, incommensurate: bool = False) -> dict:
     return body
 
 
+ONE_EXCITATION = 430
+"""How many of ``varied()`` come first with one excitation given (or none active)."""
+
+
 def varied(seed: int = 31) -> list[tuple[str, str]]:
     """The (media type, body) of every request of ``--against`` (about 500)."""
     rng = random.Random(seed)
@@ -204,6 +212,7 @@ def varied(seed: int = 31) -> list[tuple[str, str]]:
         body = one(rng)
         body["params"]["transmission_error"]["harmonics"][0]["amplitude"] = amp
         docs.append(body)
+    assert len(docs) == ONE_EXCITATION
     docs += [three(rng) for _ in range(35)]
     docs += [three(rng, incommensurate=True) for _ in range(12)]
     for _ in range(8):  # quadrature
@@ -322,7 +331,34 @@ def bench_one(rng: random.Random) -> dict:
     }
 
 
+def store(tree: Path, path: Path) -> None:
+    """Write a sample of ``varied()`` (every 25th one-excitation request, every second of the
+    rest) with the status, media type, ETag and sha256 of the body that the app of ``tree``
+    answers (``tests/test_verdict_lane.py``)."""
+    requests = varied()
+    requests = requests[:ONE_EXCITATION:25] + requests[ONE_EXCITATION::2]
+    proc = worker(tree)
+    try:
+        got = ask(proc, "responses", requests)
+    finally:
+        proc.stdin.close()
+        proc.wait()
+    rows = [
+        {"media": media, "body": body, "status": status, "content_type": kind, "etag": etag,
+         "sha256": hashlib.sha256(answer.encode()).hexdigest()}
+        for (media, body), (status, kind, etag, answer) in zip(requests, got, strict=True)
+    ]  # fmt: skip
+    path.write_text(json.dumps(rows, indent=1) + "\n")
+    print(f"{len(rows)} responses of {tree} written to {path}")
+
+
 def main() -> None:
+    if "--store" in sys.argv:
+        store(
+            Path(sys.argv[sys.argv.index("--from") + 1]),
+            Path(sys.argv[sys.argv.index("--store") + 1]),
+        )
+        return
     if "--against" in sys.argv:
         sys.exit(1 if against(Path(sys.argv[sys.argv.index("--against") + 1])) else 0)
     cpu(Path(sys.argv[sys.argv.index("--cpu") + 1]), profile="--profile" in sys.argv)
