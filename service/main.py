@@ -83,6 +83,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         version=version("gearchaos"),
         description=DESCRIPTION,
         lifespan=lifespan,
+        telemetry={"tracing": False, "metrics": False, "logs": False},
     )
     app.state.settings = settings
     app.state.cache = ResponseCache(settings.cache_entries)

@@ -13,12 +13,14 @@ from __future__ import annotations
 import asyncio
 import hashlib
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 from fastapi import FastAPI
 from fastapi.routing import APIRoute
 from fastapi.testclient import TestClient
+from opentelemetry import _logs, metrics, trace
 
 from service.core.config import Settings
 from service.main import create_app
@@ -105,3 +107,27 @@ def test_a_body_in_pieces_answers_as_in_one(tmp_path: Path, routed: list[str], d
     assert call(app, [body[:10], body[10:25], body[25:]]) == whole
     assert call(app, [body[:10], body[10:]], length=False) == whole
     assert routed == ["/v1/melnikov"] * (1 if doc is ONE else 3)
+
+
+def test_a_request_does_not_look_up_opentelemetry(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """FastAPI's native OpenTelemetry is off (the service has its own metrics and access log):
+    with it on, every request looked up the global tracer, meter and logger providers, which
+    read the environment each time."""
+    asked: list[str] = []
+
+    def counted(name: str, getter: Callable[[], object]) -> Callable[[], object]:
+        def get() -> object:
+            asked.append(name)
+            return getter()
+
+        return get
+
+    for module, name in ((trace, "tracer"), (metrics, "meter"), (_logs, "logger")):
+        getter = f"get_{name}_provider"
+        monkeypatch.setattr(module, getter, counted(name, getattr(module, getter)))
+    client = TestClient(create_app(Settings(data_dir=tmp_path, workers=0)))
+    assert client.post("/v1/melnikov", json=ONE).status_code == 200
+    assert client.get("/v1/health").status_code == 200
+    assert asked == []
