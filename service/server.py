@@ -101,7 +101,7 @@ class RecordQueue(logging.handlers.QueueHandler):
 
 def log_to_stderr() -> None:
     """The server's log (a JSON line per request and per job transition) on stderr, written by
-    a background thread: a request only puts its record on a queue (``QueueHandler``), and the
+    a background thread: a request only puts its record on a queue (``RecordQueue``), and the
     ``LineWriter`` thread formats and writes the lines in batches. A write and flush per line on
     the event loop cost about 15 % of a Melnikov verdict's throughput (benchmarks/load.py).
     ``flush_log`` ends it; a normal exit (a start-up failure) does too, through ``atexit``."""
