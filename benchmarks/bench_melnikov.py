@@ -55,7 +55,10 @@ WORKER = r"""
 import json, random, sys, time
 from gearengine.homoclinic.thresholds import chaos_possible, parameter_threshold
 from gearengine.homoclinic.verdict import melnikov
-from gearengine.systems.spur_pair.laws import melnikov_cubic
+try:
+    from gearengine.systems.spur_pair.laws import melnikov_cubic
+except ImportError:  # the baseline 2216844 and 8ba34c9: the law was in model.backlash
+    from gearengine.model.backlash import melnikov_cubic
 from gearengine.model.params import GearParams
 
 ONE = GearParams.model_validate({"damping": 0.07, "mean_force": 0.01,

@@ -83,6 +83,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         version=version("gearchaos"),
         description=DESCRIPTION,
         lifespan=lifespan,
+        telemetry={"tracing": False, "metrics": False, "logs": False},
     )
     app.state.settings = settings
     app.state.cache = ResponseCache(settings.cache_entries)
@@ -114,6 +115,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.include_router(signals.jobs_router, tags=["signals"])
     app.include_router(signals.router, tags=["signals"])
     app.include_router(explorer.router)
+    app.add_middleware(melnikov.VerdictLane)  # innermost: behind the body limit and the log
     app.add_middleware(
         BodyLimit,
         limit=settings.max_body_bytes,

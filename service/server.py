@@ -84,9 +84,24 @@ _LISTENER: list[LineWriter] = []
 """The log thread of this process, once ``log_to_stderr`` started it."""
 
 
+class RecordQueue(logging.handlers.QueueHandler):
+    """``QueueHandler`` that queues a plain record (a str message without arguments, exception
+    or stack, such as every access line) as it is: its line is its message, which the writer
+    formats the same later. ``QueueHandler.prepare`` formats and copies every record for a
+    queue that may cross processes; for the log thread of this process that cost 7 us of the
+    CPU of each request (a fifth of a health check's middleware). Other records are prepared
+    as before."""
+
+    def prepare(self, record: logging.LogRecord) -> logging.LogRecord:
+        plain = isinstance(record.msg, str) and not record.args
+        if plain and not record.exc_info and not record.stack_info:
+            return record
+        return super().prepare(record)
+
+
 def log_to_stderr() -> None:
     """The server's log (a JSON line per request and per job transition) on stderr, written by
-    a background thread: a request only puts its record on a queue (``QueueHandler``), and the
+    a background thread: a request only puts its record on a queue (``RecordQueue``), and the
     ``LineWriter`` thread formats and writes the lines in batches. A write and flush per line on
     the event loop cost about 15 % of a Melnikov verdict's throughput (benchmarks/load.py).
     ``flush_log`` ends it; a normal exit (a start-up failure) does too, through ``atexit``."""
@@ -95,7 +110,7 @@ def log_to_stderr() -> None:
     out.setFormatter(logging.Formatter("%(message)s"))
     writer = LineWriter(records, out)
     root = logging.getLogger()
-    root.handlers[:] = [logging.handlers.QueueHandler(records)]
+    root.handlers[:] = [RecordQueue(records)]
     root.setLevel(logging.INFO)
     writer.start()
     _LISTENER.append(writer)

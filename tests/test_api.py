@@ -263,7 +263,7 @@ VERDICT_BODIES = [
 @pytest.mark.parametrize("key", [None, "team-a-secret", "wrong"])
 def test_verdict_route_answers_as_fastapi(tmp_path: Path, body: str, key: str | None) -> None:
     """POST /v1/melnikov takes a short path for an application/json body that validates
-    (``VerdictRoute``); every body answers as FastAPI's own handler does (here under a +json
+    (``VerdictLane``); every body answers as FastAPI's own handler does (here under a +json
     media type, which only FastAPI's handler reads): status, problem and verdict bytes, with
     and without a valid API key."""
     (tmp_path / "api_keys.sha256").write_text(hashlib.sha256(b"team-a-secret").hexdigest())

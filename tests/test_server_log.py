@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import io
 import logging
+import queue
 import subprocess
 import sys
 import time
 
 import pytest
 
-from service.server import flush_log, log_to_stderr
+from service.server import RecordQueue, flush_log, log_to_stderr
 
 PROGRAM = """
 import logging, signal
@@ -67,3 +68,23 @@ def test_lines_are_written_in_batches(monkeypatch: pytest.MonkeyPatch) -> None:
         f'{{"event": "request", "n": {i}}}' for i in range(50)
     ]
     assert stream.writes <= 5
+
+
+def test_a_plain_record_is_queued_as_it_is() -> None:
+    """An access line (a str message, no arguments) goes on the queue without the format and
+    copy of ``QueueHandler.prepare`` (a fifth of a health check's middleware CPU); a record
+    with arguments or an exception is still prepared, its line formatted where it was logged."""
+    handler = RecordQueue(queue.SimpleQueue())
+    plain = logging.LogRecord("gearchaos.access", logging.INFO, __file__, 1, '{"a": 1}', (), None)
+    assert handler.prepare(plain) is plain
+    with_args = logging.LogRecord("gearchaos", logging.INFO, __file__, 1, "job %s", ("x",), None)
+    prepared = handler.prepare(with_args)
+    assert prepared is not with_args and (prepared.msg, prepared.args) == ("job x", None)
+    try:
+        raise ValueError("boom")
+    except ValueError:
+        failed = logging.LogRecord(
+            "gearchaos", logging.ERROR, __file__, 1, "failed", (), sys.exc_info()
+        )
+    prepared = handler.prepare(failed)
+    assert prepared.exc_info is None and "ValueError: boom" in prepared.msg

@@ -7,7 +7,8 @@ Omega_e scan and the threshold root finding run without Python objects in their 
 - ``unit_coefficient`` / ``damping_unit``: B per unit amplitude and A per unit mu, Eq. (19), with
   the same operations in the same order as the scalar functions of ``coefficients`` (libm
   ``exp``, ``sqrt`` and ``pow``), so the numbers are bit for bit the same;
-- ``trig_max`` / ``trig_extrema``: the port of ``extrema.maximum`` / ``extrema.extrema``;
+- ``trig_max`` / ``grid_extrema`` and ``closed_extrema``: the port of ``extrema.maximum`` /
+  ``extrema.extrema``;
 - ``scan_strength`` / ``scan_roots``: the sign-change strength max_s min(max M_s, -min M_s) along
   a running-speed scan (every frequency scaled with Omega_e) and its roots by Brent's method
   (a port of scipy's ``brentq``, Brent 1973, *Algorithms for Minimization without Derivatives*,
@@ -219,22 +220,23 @@ def trig_max(offset: float, amps, freqs, phases, period: float, taus, values, si
 
 
 @jit
-def trig_extrema(offset: float, amps, freqs, phases, period: float, taus, table, values):
-    """(min, max) of M over tau0 (``extrema.extrema``): constant, one sinusoid in closed form,
-    supremum A -/+ sum |B_i| when ``period`` <= 0 (incommensurate), else exact on one period
-    (``taus``, ``table`` from ``grid_sines``; ``values`` is scratch of the grid's size)."""
-    nact, spread, only = 0, 0.0, 0.0
-    for i in range(amps.size):
-        if amps[i] != 0.0:
-            nact += 1
-            spread += abs(amps[i])
-            only = amps[i]
+def closed_extrema(offset: float, nact: int, spread: float, only: float):
+    """(min, max) of M = A + sum_i B_i sin(...) over tau0 without a grid, from its number of
+    active terms ``nact``, sum |B_i| ``spread`` and last active B ``only``: constant (none),
+    A -/+ |B| (one sinusoid), or the infimum and supremum A -/+ sum |B_i| (incommensurate)."""
     if nact == 0:
         return offset, offset
     if nact == 1:
         return offset - abs(only), offset + abs(only)
-    if period <= 0.0:
-        return offset - spread, offset + spread
+    return offset - spread, offset + spread
+
+
+@jit
+def grid_extrema(offset: float, amps, freqs, phases, period: float, taus, table, values):
+    """(min, max) of M over tau0 with at least two active terms of commensurate frequencies,
+    exact on one period (``extrema.extrema``; ``taus``, ``table`` from ``grid_sines``;
+    ``values`` is scratch of the grid's size). Fewer terms, or incommensurate ones:
+    ``closed_extrema``."""
     grid_values(offset, amps, table, values)
     top, _ = trig_max(offset, amps, freqs, phases, period, taus, values, 1.0)
     bottom, _ = trig_max(offset, amps, freqs, phases, period, taus, values, -1.0)
@@ -274,27 +276,32 @@ def _strength(om: float, value: float, terms, system, work) -> float:
     """``scan_strength`` with the ``_workspace`` of its scan."""
     shapes, freqs, amps, taus, table, values = work
     n = terms.shape[1]
-    base, r, phase = terms[FUNDAMENTAL], terms[HARMONIC], terms[PHASE]
     gcd, lcm = system[GCD], system[LCM]
     factor = om / value
     for i in range(n):
-        freqs[i] = r[i] * (base[i] * factor)
+        freqs[i] = terms[HARMONIC, i] * (terms[FUNDAMENTAL, i] * factor)
     exact = n >= 2 and gcd > 0.0
     period = 2.0 * math.pi / (freqs.max() * gcd / lcm) if exact else 0.0
     if exact:
-        taus, table = grid_sines(freqs, phase, period)
+        taus, table = grid_sines(freqs, terms[PHASE], period)
         values = np.empty(taus.size)
     best = -np.inf
     for s, shape, damping_per_mu in shapes:
         damping = damping_per_mu * system[MU]
-        nact = 0
+        nact, spread, only = 0, 0.0, 0.0
         for i in range(n):
             kind = int(terms[KIND_ROW, i])
             amps[i] = unit_on(kind, freqs[i], system, s, shape) * terms[AMPLITUDE, i]
-            nact += amps[i] != 0.0
+            if amps[i] != 0.0:
+                nact += 1
+                spread += abs(amps[i])
+                only = amps[i]
         if 2 <= nact < n:
             return FALLBACK
-        lo, hi = trig_extrema(damping, amps, freqs, phase, period, taus, table, values)
+        if exact and nact >= 2:
+            lo, hi = grid_extrema(damping, amps, freqs, terms[PHASE], period, taus, table, values)
+        else:  # no call with arrays: their reference counts cost more than this branch
+            lo, hi = closed_extrema(damping, nact, spread, only)
         best = max(best, min(hi, -lo))
     return best
 
