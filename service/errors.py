@@ -147,12 +147,25 @@ def allowed_methods(request: Request) -> list[str]:
 HTTP_METHODS = ("get", "put", "post", "delete", "options", "head", "patch", "trace")
 
 
+def engine_error_response(exc: ProblemError | ValidationError | InputError) -> JSONResponse:
+    """The problem+json of an error an endpoint raises: a ``ProblemError`` as it says, the
+    engine's ``ValidationError`` as 422 naming each field, an ``InputError`` (an engine refusal
+    found after validation: a design's radii while costing a job's work, say) as 422 naming its
+    field, never 500. The app's handlers and ``VerdictLane`` answer with it."""
+    if isinstance(exc, ProblemError):
+        return problem_response(exc.problem, exc.headers)
+    if isinstance(exc, ValidationError):
+        errors = field_errors(list(exc.errors(include_url=False)), strip_body=False)
+        return problem_response(validation_problem(errors).problem)
+    return problem_response(engine_refusal(exc).problem)
+
+
 def install(app: FastAPI) -> None:
     """Register the handlers that turn every error into problem+json."""
 
     @app.exception_handler(ProblemError)
     async def _problem(_: Request, exc: ProblemError) -> JSONResponse:
-        return problem_response(exc.problem, exc.headers)
+        return engine_error_response(exc)
 
     @app.exception_handler(RequestValidationError)
     async def _invalid(request: Request, exc: RequestValidationError) -> JSONResponse:
@@ -164,14 +177,11 @@ def install(app: FastAPI) -> None:
 
     @app.exception_handler(ValidationError)
     async def _engine_invalid(_: Request, exc: ValidationError) -> JSONResponse:
-        errors = field_errors(list(exc.errors(include_url=False)), strip_body=False)
-        return problem_response(validation_problem(errors).problem)
+        return engine_error_response(exc)
 
     @app.exception_handler(InputError)
     async def _refused(_: Request, exc: InputError) -> JSONResponse:
-        """An engine refusal found after validation (a design's radii while costing a job's
-        work, say): 422 naming the field, never 500."""
-        return problem_response(engine_refusal(exc).problem)
+        return engine_error_response(exc)
 
     @app.exception_handler(StarletteHTTPException)
     async def _http(request: Request, exc: StarletteHTTPException) -> JSONResponse:

@@ -131,3 +131,34 @@ def test_a_request_does_not_look_up_opentelemetry(
     assert client.post("/v1/melnikov", json=ONE).status_code == 200
     assert client.get("/v1/health").status_code == 200
     assert asked == []
+
+
+def test_a_refused_verdict_is_computed_once_and_answered_as_the_route_would(
+    tmp_path: Path, routed: list[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The lane suppressed every exception of the verdict and let the route compute it again:
+    a refusal found while computing (a ValueError of the engine) ran twice. It runs once and is
+    answered with the app's problem+json (422 naming the field); an unexpected error is the
+    server-error handler's 500, also computed once."""
+    import service.api.routes.melnikov as route
+
+    calls: list[str] = []
+
+    def refused(body: object) -> object:
+        calls.append("verdict")
+        raise ValueError("params.damping: refused by the engine")
+
+    monkeypatch.setattr(route, "answer_melnikov", refused)
+    app = create_app(Settings(data_dir=tmp_path, workers=0))
+    r = TestClient(app).post("/v1/melnikov", json=ONE)
+    assert r.status_code == 422 and r.headers["content-type"] == "application/problem+json"
+    assert "refused by the engine" in r.text and calls == ["verdict"] and routed == []
+
+    def crash(body: object) -> object:
+        calls.append("crash")
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr(route, "answer_melnikov", crash)
+    r = TestClient(app, raise_server_exceptions=False).post("/v1/melnikov", json=ONE)
+    assert r.status_code == 500 and r.json()["title"] == "Internal error"
+    assert calls == ["verdict", "crash"]

@@ -3,9 +3,8 @@ margins of many."""
 
 from __future__ import annotations
 
-import contextlib
-
 from fastapi import APIRouter, Depends, Request, Response
+from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
@@ -17,8 +16,10 @@ from gearengine.homoclinic import (
     melnikov_batch,
 )
 from gearengine.jsonio import dumps
+from gearengine.model.errors import InputError
 from service.api.deps import cached_compute, require_key
 from service.api.responses import CACHED, JSON, PROBLEMS
+from service.errors import ProblemError, engine_error_response
 
 router = APIRouter(prefix="/v1", dependencies=[Depends(require_key)])
 
@@ -31,9 +32,11 @@ class VerdictLane:
     the exception wrapper) and the exception middleware cost about as much CPU as the
     one-harmonic verdict itself. The lane reads the body, validates it, checks the key
     (``require_key``) and answers with ``post_melnikov``, as the route does; anything else
-    (another path or media type, a body that does not parse or validate, a refused key, a
-    refused or failed computation) goes to the app behind it with the body replayed, so every
-    error is FastAPI's own. It sits inside the body limit and the access log, which name the
+    (another path or media type, a body that does not parse or validate, a refused key) goes to
+    the app behind it with the body replayed, so every such error is FastAPI's own. A verdict
+    the engine refuses is answered as the app's handlers answer it (``engine_error_response``),
+    and an unexpected error is raised to the server-error handler, as from the route: neither
+    is computed again. It sits inside the body limit and the access log, which name the
     route as the router would; a body without Content-Length (streamed, whose excess the body
     limit finds while it is read) goes to the route unread.
     """
@@ -53,16 +56,21 @@ class VerdictLane:
         messages: list[Message] = []
         while not messages or _more(messages[-1]):
             messages.append(await receive())
-        response = None
+        body = None
         if messages[-1]["type"] == "http.request":
-            scope["route"] = ROUTE
-            with contextlib.suppress(Exception):  # the app behind answers it, with its errors
+            try:  # a body that does not validate or a refused key: the route's own errors
                 body = MelnikovRequest.model_validate_json(b"".join(_body(m) for m in messages))
                 await require_key(request)
-                response = await post_melnikov(body, request)
-        if response is None:
+            except (ValidationError, ProblemError):
+                body = None
+        if body is None:
             await self.app(scope, _replay(messages, receive), send)
             return
+        scope["route"] = ROUTE
+        try:  # computed once: a refusal answered as the app's handlers answer it, a crash raised
+            response = await post_melnikov(body, request)
+        except (ProblemError, ValidationError, InputError) as exc:
+            response = engine_error_response(exc)
         await response(scope, receive, send)
 
 
