@@ -24,9 +24,11 @@ them; ``law_lanes``: the tuple its ``lanes`` made):
 * ``steps(N, Kl, Fl, PT, owner, lane_state, rates, law_lanes, coeffs, tangent)``: the N RK4
   steps of one interval T0 of every lane, with the forcing rows ``Kl``, ``Fl`` (2N + 1, LANES),
   the run of each lane ``PT`` (-1 idle), ``lane_state`` as in ``intervals`` and ``rates`` =
-  (2 mu, h, h / 2, h / 6) per lane; ``tangent`` False: the state and the extremes of x alone
-  (the tangent vector and the mesh force's extremes are left as they are; the scheduler passes
-  it as a constant, so each value compiles to its own loop). Compiled with
+  (2 mu, h, h / 2, h / 6) per lane; ``tangent`` False is a hint a law may take: the state and
+  the extremes of x alone (the tangent vector and the mesh force's extremes left as they are;
+  the scheduler passes it as a constant, so each value compiles to its own loop). The cubic
+  law takes it; the piecewise law integrates the tangent whatever it says (the same guard in
+  its lane loop made it 2.7x slower). Compiled with
   ``inline="always"``: numba puts it into the scheduler's body, where the lanes' arrays are the
   scheduler's own allocations, so LLVM knows they do not overlap and vectorises the lane loop
   without run-time overlap checks. Called as a function, the piecewise steps were not
@@ -232,9 +234,10 @@ def _lanes(
         streams: parallel streams of lanes (at most the number of threads is useful).
         lle_rel, lle_abs: tolerances of the LLE rule (``kernels.adaptive.lle_known``); 0 and 0
             turn it off.
-        tangent: integrate the tangent vector and the mesh force's extremes; False: the state
-            alone, for a transient that reads the strobes and the extremes of x only (``logs``
-            then hold no LLE, ``fmin`` and ``fmax`` no extremes; about 0.65x the CPU).
+        tangent: integrate the tangent vector and the mesh force's extremes; False, a hint
+            for a transient that reads the strobes and the extremes of x only: a law that takes
+            it (the cubic) runs the state alone (``logs`` then hold no LLE, ``fmin`` and
+            ``fmax`` no extremes; about 0.65x the CPU), the piecewise law ignores it.
         coeffs: the law's own per-run inputs (its module says which).
 
     Returns:
