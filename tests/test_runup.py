@@ -412,7 +412,7 @@ def test_the_gate_hands_each_level_the_validated_design(monkeypatch: pytest.Monk
     sweep_result = SimpleNamespace(windows=windows)
     report = EnvelopeReport.model_construct(failures=[], rules=Rules(), sweep=sweep_result)
     runups = gate.gate_runups(sweep, 20000.0)  # fast enough that half CHAOS_SECONDS is 500 rpm
-    assert runups.ran.levels == levels
+    assert runups.levels == levels
     gate.gate_envelope(report, runups)
     assert [r.design.torque for r in seen] == [10.0, 40.0]
     for r in seen:
@@ -445,7 +445,7 @@ def test_the_gate_runs_up_at_the_levels_of_the_envelope_windows() -> None:
                      "steps_per_period": 32}})  # fmt: skip
     windows = sweep_local(sweep).windows
     assert windows is not None
-    assert gate_runups(sweep, 2000.0).ran.levels == [w.level for w in windows]
+    assert gate_runups(sweep, 2000.0).levels == [w.level for w in windows]
 
 
 def test_the_assembly_reads_the_design_converted_with_the_plan(

@@ -101,11 +101,14 @@ def runup_failures(
 
 @dataclass(frozen=True)
 class GateRunups:
-    """The run-ups of ``check --runup``, validated before the envelope is computed: ``ran``
-    says what they are (its ``failing_windows`` 0 until they run), ``requests`` one run-up and
-    run-down a level of ``ran.levels``."""
+    """The run-ups of ``check --runup``, validated before the envelope is computed: the ramp's
+    rate [rpm/s], [lowest, highest] speed [rpm] and bin width [rpm] as shown, and one run-up and
+    run-down (``requests``) a level of ``levels``."""
 
-    ran: RunupCheck
+    rate_rpm_s: float
+    speeds_rpm: list[float]
+    bin_rpm: float
+    levels: list[dict[str, PhysicalValue]]
     requests: list[RunupRequest]
 
 
@@ -126,7 +129,7 @@ def gate_runups(sweep: SweepRequest, rate_rpm_s: float) -> GateRunups:
     axis = next((a for a in sweep.axes if a.parameter == SPEED), None)
     grid = [] if axis is None else axis.values(design)
     if axis is None or axis.num < 2 or not grid[0] < grid[-1]:
-        raise ValueError("--runup: give the envelope a speed range, --speed LOW:HIGH")
+        raise ValueError("give the envelope a speed range, --speed LOW:HIGH")
     lo, hi = grid[0] / RPM, grid[-1] / RPM
     ramp = {
         "from_speed": f"{lo!r} rpm", "to_speed": f"{hi!r} rpm",
@@ -139,10 +142,9 @@ def gate_runups(sweep: SweepRequest, rate_rpm_s: float) -> GateRunups:
     requests = [validated_runup({"design": design if not level else design.model_copy(
                     update={"torque": level["torque"].value}), **ramp})
                 for level in levels]  # fmt: skip
-    ran = RunupCheck(rate_rpm_s=rate_rpm_s, speeds_rpm=[shown(lo), shown(hi)],
-                     directions=["up", "down"], bin_rpm=shown(ramp["bin_rpm"]),
-                     ensemble=GATE_ENSEMBLE, levels=levels, failing_windows=0)  # fmt: skip
-    return GateRunups(ran=ran, requests=requests)
+    return GateRunups(rate_rpm_s=rate_rpm_s, speeds_rpm=[shown(lo), shown(hi)],
+                      bin_rpm=shown(ramp["bin_rpm"]), levels=levels,
+                      requests=requests)  # fmt: skip
 
 
 def torque_levels(sweep: SweepRequest) -> list[dict[str, PhysicalValue]]:
@@ -164,11 +166,14 @@ def gate_envelope(
     """``report`` with the failing windows of ``runups`` (``gate_runups``), and what ran
     (``runup``)."""
     found: list[FailingWindow] = []
-    levels = runups.ran.levels
+    levels = runups.levels
     for k, (level, request) in enumerate(zip(levels, runups.requests, strict=True)):
         found += runup_failures(run_local(request, workers=workers), report.rules, level)
         if progress is not None:
             progress(k + 1, len(levels))
-    ran = runups.ran.model_copy(update={"failing_windows": len(found)})
+    ran = RunupCheck(rate_rpm_s=runups.rate_rpm_s, speeds_rpm=runups.speeds_rpm,
+                     directions=["up", "down"], bin_rpm=runups.bin_rpm,
+                     ensemble=GATE_ENSEMBLE, levels=levels,
+                     failing_windows=len(found))  # fmt: skip
     failures = [*report.failures, *found]
     return report.model_copy(update={"failures": failures, "passed": not failures, "runup": ran})

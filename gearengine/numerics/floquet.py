@@ -100,15 +100,17 @@ def liouville_error(det: float, trace_rate: float, duration: float) -> float:
     return 1.0 + (math.exp(min(math.log(-det) - log_exact, 700.0)) if det < 0.0 else 0.0)
 
 
-def liouville_words(error: float, margin: float, n: int) -> str:
+def liouville_words(error: float, margin: float, dims: int) -> str:
     """The note on a Liouville check missed by ``error`` (relative, > ``LIOUVILLE_WARN``): the
-    multipliers' moduli carry an error of about error / n (det Phi is the product of the ``n``
-    multipliers), judged against the stability ``margin`` 1 - |lambda_max| it could move."""
-    exact = "exp(-2 mu n T0)" if n == 2 else "exp(tr J n T0)"
+    multipliers' moduli carry an error of about error / dims (det Phi is the product of the
+    ``dims`` multipliers of a state of that dimension), judged against the stability ``margin``
+    1 - |lambda_max| it could move. The state of dimension 2 is the pair's, tr J = -2 mu (as the
+    complex-pair note of ``refine`` reads it)."""
+    exact = "exp(-2 mu n T0)" if dims == 2 else "exp(tr J n T0)"
     words = (f"det Phi differs from {exact} by {error:.3g} (relative): the multipliers' moduli "
              "carry an integration error of about that size (more steps per period reduce it, "
              "or the smaller multiplier is below its rounding error)")  # fmt: skip
-    if error / n < 0.1 * abs(margin):
+    if error / dims < 0.1 * abs(margin):
         return f"{words}; small against the stability margin {margin:.3g}"
     return (f"{words}; not small against the stability margin {margin:.3g}: the margin and "
             "the nearest bifurcation are uncertain at this resolution")  # fmt: skip
@@ -188,8 +190,9 @@ def refine(
             f"Newton shooting stopped after {steps} updates with |G| = {res:.3g}: the multipliers "
             "belong to an approximate orbit"
         )
+    margin = 1.0 - abs(lam[0])
     if lv_error > LIOUVILLE_WARN:
-        notes.append(liouville_words(lv_error, 1.0 - abs(lam[0]), len(X)))
+        notes.append(liouville_words(lv_error, margin, len(X)))
     if lam[0].imag != 0.0 and len(X) == 2:
         notes.append(
             f"complex pair of modulus exp(-mu n T0) = {abs(lam[0]):.6g}: with constant "
@@ -200,7 +203,7 @@ def refine(
         period=n,
         steps_per_period=flow.steps,
         multipliers=[[m.real, m.imag] for m in lam],
-        stability_margin=1.0 - abs(lam[0]),
+        stability_margin=margin,
         nearest_bifurcation=classify_multiplier(lam[0]),
         orbit_state=[float(x) for x in X],
         orbit_residual=res,
