@@ -54,6 +54,7 @@ APP = create_app(
         max_sync_steps=100_000,
         max_curve_points=50,
         max_queued_jobs=100_000,  # no workers: every generated job stays queued (README)
+        max_status_wait_s=0.0,  # so a status request with ?wait answers at once
     )
 )
 CONFIG = SchemathesisConfig.from_path(ROOT / "schemathesis.toml")

@@ -117,6 +117,11 @@ class Settings(BaseSettings):
     max_queued_jobs: int = Field(
         64, ge=1, description="Most unfinished (queued or running) sweep jobs; then 429."
     )
+    max_status_wait_s: float = Field(
+        30.0, ge=0.0, le=30.0, description="Longest hold of a status request's ?wait [s] (the "
+        "API accepts up to 30): lower it behind a proxy that closes idle requests sooner; 0 "
+        "answers every status at once (a fuzzing run, whose jobs never finish)."
+    )  # fmt: skip
     sweep_chunk_points: int | None = Field(
         None,
         ge=1,
