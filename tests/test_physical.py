@@ -15,7 +15,7 @@ from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.gate.envelope import ENVELOPE_SETTINGS
 from gearengine.model.params import GearParams
 from gearengine.numerics import physical
-from gearengine.numerics.batch import simulate_batch
+from gearengine.numerics.batch import _run_lanes, run_lanes, simulate_batch, step_plans
 from gearengine.numerics.physical import DAMPING_TIMES, RECORD_MESH
 from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import SimulationSettings
@@ -194,3 +194,71 @@ def test_x_only_strobes_are_the_strobes_x(settings: SimulationSettings) -> None:
         assert s.poincare_x == [x for x, _ in f.poincare]
         keep = set(type(f).model_fields) - {"poincare", "poincare_x"}
         assert s.model_dump(include=keep) == f.model_dump(include=keep)
+
+
+def test_starts_of_one_point_on_one_cycle_share_one_record() -> None:
+    """The README CI design at 4,000 rpm has two coexisting cycles (tooth separation and full
+    contact). Of six starts, the ones that settle on a cycle another start settled on take its
+    record instead of recording it again (two records, not six), and every start's class,
+    period, contact, DTE and forces are those of six records of their own (to the convergence
+    tolerance); starts in sets of their own never share."""
+    settings = SimulationSettings.model_validate(ENVELOPE_SETTINGS)
+    point = ci_request(4000).params
+    lanes = [(0, (x, v)) for x in (-1.5, 0.0, 1.5) for v in (-0.5, 0.5)]
+    shared = run_lanes([point], lanes, settings)
+    plans = step_plans([point], settings.steps_per_period)
+    own = _run_lanes([point], plans, lanes, settings, range(6), sets=range(6))
+    assert len({b._record for b in shared}) == 2 and len({b._record for b in own}) == 6
+    assert {b.impact_regime for b in shared} == {"single_sided", "no_impact"}
+    for s, o in zip(shared, own, strict=True):
+        assert (s.classification, s.period, s.impact_regime) == (o.classification, o.period,
+                                                                 o.impact_regime)  # fmt: skip
+        for name in ("x_peak_to_peak", "force_max", "force_min"):
+            assert getattr(s, name) == pytest.approx(getattr(o, name), rel=1e-6)
+    for s in shared:  # a start that shares a record has its numbers
+        first = next(b for b in shared if b._record == s._record)
+        assert (s.lle, s.lle_stderr, s.poincare) == (first.lle, first.lle_stderr, first.poincare)
+
+
+def test_a_record_that_misses_its_cycle_leaves_the_starts_joined_to_it_their_own(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A start is joined to the first one that settled on its cycle only if that start's
+    record finds the period back: otherwise (here: every record told to find none at first)
+    the joined starts record their own."""
+    settings = SimulationSettings.model_validate(ENVELOPE_SETTINGS)
+    point = ci_request(3000).params
+    lanes = [(0, (x, 0.0)) for x in (-1.0, 0.0, 1.0)]
+    assert len({b._record for b in run_lanes([point], lanes, settings)}) == 1
+    missed: list[int] = []
+    detect = physical.detect_period
+
+    def once_missing(xs: np.ndarray, vs: np.ndarray, size: float, **kw: object) -> int | None:
+        if kw or missed:  # the transient's test, or a record after the first
+            return detect(xs, vs, size, **kw)  # type: ignore[arg-type]
+        missed.append(1)
+        return None
+
+    monkeypatch.setattr(physical, "detect_period", once_missing)
+    got = run_lanes([point], lanes, settings)
+    assert missed and len({b._record for b in got}) == 3
+    assert {(b.classification, b.period) for b in got[1:]} == {("periodic", 1)}
+
+
+def test_starts_that_share_a_record_are_one_estimate_of_the_attractors_lle() -> None:
+    """Three starts on one cycle share one record: the attractor's LLE is that record's, with
+    its standard error (not the error of a mean of three independent estimates, 1/sqrt 3 of
+    it); starts with records of their own are averaged as before."""
+    from gearengine.numerics.attractors import _attractor
+
+    settings = SimulationSettings.model_validate(ENVELOPE_SETTINGS)
+    point = ci_request(3000).params
+    lanes = [(0, (x, 0.0)) for x in (-1.0, 0.0, 1.0)]
+    shared = run_lanes([point], lanes, settings)
+    a = _attractor([(s, b) for (_, s), b in zip(lanes, shared, strict=True)], 3, None)
+    assert (a.lle, a.lle_stderr, a.count) == (shared[0].lle, shared[0].lle_stderr, 3)
+    plans = step_plans([point], settings.steps_per_period)
+    own = _run_lanes([point], plans, lanes, settings, range(3), sets=range(3))
+    b = _attractor([(s, p) for (_, s), p in zip(lanes, own, strict=True)], 3, None)
+    errs = [p.lle_stderr for p in own]
+    assert b.lle_stderr == pytest.approx(math.sqrt(sum(e * e for e in errs)) / 3)

@@ -172,11 +172,19 @@ def _attractor(
     scales: Scales | None,
 ) -> Attractor:
     """One group of starts as an ``Attractor``: its first start represents it; LLE the mean
-    over members (stderr of the mean of independent estimates), DTE, force and impacts the
-    largest seen."""
+    over its members' records (stderr of the mean of independent estimates: starts that share
+    one record, ``BatchPoint._record``, are one estimate), DTE, force and impacts the largest
+    seen."""
     start, rep = members[0]
-    lles = [bp.lle for _, bp in members if bp.lle is not None]
-    errs = [bp.lle_stderr for _, bp in members if bp.lle_stderr is not None]
+    records: set[int] = set()
+    estimates = []  # one member per record, in start order
+    for _, bp in members:
+        key = id(bp) if bp._record is None else bp._record
+        if key not in records:
+            records.add(key)
+            estimates.append(bp)
+    lles = [bp.lle for bp in estimates if bp.lle is not None]
+    errs = [bp.lle_stderr for bp in estimates if bp.lle_stderr is not None]
     ptp = max((bp.x_peak_to_peak for _, bp in members if bp.x_peak_to_peak is not None),
               default=None)  # fmt: skip
     fmax = max((bp.force_max for _, bp in members if bp.force_max is not None), default=None)

@@ -164,10 +164,14 @@ def _run_lanes(
     settings: SimulationSettings,
     numbers: Sequence[int],
     x_only: bool = False,
+    sets: Sequence[int] | None = None,
 ) -> list[BatchPoint]:
     """``run_lanes`` with each lane's ``start_index`` given (``numbers``, shape (L,)), so no
     verdict is copied to be renumbered (three copies a point cost ~0.05 ms); with ``x_only``
-    the lock-step lanes keep the x of their last strobes alone (``lanes.last_strobes``)."""
+    the lock-step lanes keep the x of their last strobes alone (``lanes.last_strobes``).
+    ``sets``: the set of starts of each lane, shape (L,) (a point's own starts and its basin
+    starts, run together as they would run apart); the lanes of one point and set settling on
+    one cycle share a record (``physical.lengths``' ``kin``). None: one set."""
     results: list[BatchPoint | None] = [None] * len(lanes)
     groups: dict[tuple[str, int, float], list[int]] = {}
     systems: dict[tuple, list[int]] = {}
@@ -207,7 +211,8 @@ def _run_lanes(
         if physical.applies(settings, plans[members[0]], 0.0):
             group = (lanes_of, laws, inverse, packed, mu, tabled, per, N, r)
             mine = [numbers[k] for k in ks]
-            got = physical_lanes(group, x0, v0, settings, mine, x_only)
+            kin = inverse if sets is None else np.array([sets[k] for k in ks]) * len(ks) + inverse
+            got = physical_lanes(group, x0, v0, settings, mine, x_only, kin)
             for k, point in zip(ks, got, strict=True):
                 results[k] = point
             continue
@@ -249,7 +254,7 @@ def system_lanes(
 
 def physical_lanes(
     group: tuple, x0: np.ndarray, v0: np.ndarray, settings: SimulationSettings,
-    numbers: Sequence[int], x_only: bool = False,
+    numbers: Sequence[int], x_only: bool = False, kin: np.ndarray | None = None,
 ) -> list[BatchPoint]:  # fmt: skip
     """The ``BatchPoint`` of every lane of one lock-step group, its lengths decided in physical
     time (``numerics.physical``): the transient and the record run in chunks through the same
@@ -265,6 +270,7 @@ def physical_lanes(
         settings: caps and tolerances.
         numbers: the ``start_index`` of each lane's ``BatchPoint``, shape (L,).
         x_only: keep the x of the last strobes alone (``lanes.last_strobes``).
+        kin: lanes that may share a record, shape (L,) (``physical.lengths``); None: none.
     """
     lanes_of, laws, inverse, packed, mu, tabled, per, N, r = group
 
@@ -298,7 +304,7 @@ def physical_lanes(
         carry = (dx, dv, reg)  # where each record ended: the kernel runs it on from there
         return chunk(joined(rows, call(idx, xf, vf, n, carry)), carry, idx)
 
-    spans = physical.lengths(advance, x0, v0, per, mu, r, settings, extend, settle)
+    spans = physical.lengths(advance, x0, v0, per, mu, r, settings, extend, settle, kin)
     verdicts: dict[int, list[tuple]] = {}
     rows: dict[int, list[int]] = {}
     for s in spans:  # one verdict and one gather of strobes per kernel call
@@ -312,12 +318,15 @@ def physical_lanes(
         got = last_strobes(out, rows[key], x_only)
         strobes.update({(key, j): w for j, w in zip(rows[key], got, strict=True)})
     points = []
+    records: dict[tuple[int, int], int] = {}  # each record of the call, numbered
     for s, number in zip(spans, numbers, strict=True):
         out, j, _, _ = s.keep
         n = out[0].shape[1]
         before = s.transient - (n if s.transient_reason == "diverged" else 0)
-        points.append(lane_point(out, j, number, verdicts[id(out)][j], strobes[(id(out), j)],
-                                 before + int(out[7][j]), x_only))  # fmt: skip
+        bp = lane_point(out, j, number, verdicts[id(out)][j], strobes[(id(out), j)],
+                        before + int(out[7][j]), x_only)  # fmt: skip
+        bp._record = records.setdefault((id(out), j), len(records))
+        points.append(bp)
     return points
 
 
@@ -374,7 +383,9 @@ def simulate_batch_with(
     lanes = [(i, s) for i in range(len(points)) for s in starts]
     S = len(starts)
     numbers = [*(j for _ in points for j in range(S)), *range(len(more))]
-    per_lane = _run_lanes(points, plans, [*lanes, *more], settings, numbers, x_only)
+    # as two calls: each own start on its own (simulate's numbers), the basin starts one set
+    sets = [*(j for _ in points for j in range(S)), *(S for _ in more)]
+    per_lane = _run_lanes(points, plans, [*lanes, *more], settings, numbers, x_only, sets)
     worst = []
     for i in range(len(points)):
         block = per_lane[i * S : (i + 1) * S]

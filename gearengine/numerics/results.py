@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field
+from pydantic import Field, PrivateAttr
 
 from gearengine.model.answers import FiniteAnswer
 from gearengine.signals.nolds_check import NoldsResult
@@ -283,3 +283,7 @@ class BatchPoint(FiniteAnswer):
     force_min: float | None = Field(
         None, description="Smallest dimensionless mesh force over the record; null if diverged."
     )
+    _record: int | None = PrivateAttr(None)
+    """Which record of its kernel call the numbers are (``batch.physical_lanes``: the starts of
+    a point joined to one cycle share one), None for a record of its own: estimates from one
+    record are one estimate (``attractors``' LLE statistics)."""
