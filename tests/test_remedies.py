@@ -26,7 +26,7 @@ from gearengine.gate.remedies.compute import remedies
 from gearengine.gate.remedies.levers import iso1328_class
 from gearengine.gate.remedies.request import Lever, RemediesRequest
 from gearengine.gate.remedies.results import RemediesResult, Remedy
-from gearengine.gate.remedies.search import _narrow, _search, envelope_points
+from gearengine.gate.remedies.search import _bisect, _gallop, _narrow, _search, envelope_points
 from gearengine.gate.resolution import REFINE_DEPTH, Resolution
 from gearengine.model.design import ACCURACY_FIELD, Design
 from gearengine.model.standards import iso1328
@@ -168,6 +168,52 @@ def test_bisection_reports_a_non_monotone_response() -> None:
     _, monotone, bracket = _search(lambda v: (v >= 0.6, 0, 4), lever, 5, _narrow(1e-3, lever), 40)
     assert monotone and bracket is not None and bracket[1] == pytest.approx(0.6, rel=2e-3)
     assert _search(lambda v: (False, 3, 4), lever, 5, _narrow(1e-3, lever), 40)[2] is None
+
+
+@pytest.mark.parametrize("switch", [0.0705, 0.21, 0.47, 0.93])
+def test_galloping_from_the_failing_end_gives_bisections_bracket_with_fewer_passes(
+    switch: float,
+) -> None:
+    """A failing envelope check stops at its first failure, a passing one runs every point:
+    probes climbing from the failing end (d, 2d, 4d, ... of the bracket) then bisection give
+    the bracket bisection gives for a lever that switches once, with fewer passing checks the
+    nearer the switch is to the failing end; a far end that fails too gives none."""
+    lever = Lever(path="mesh.damping_ratio", start=0.0, end=1.0)
+    width = _narrow(0.02, lever)
+    runs: dict[str, list[float]] = {"bisect": [], "gallop": []}
+
+    def counted(name: str):  # type: ignore[no-untyped-def]
+        def passes(v: float) -> bool:
+            runs[name].append(v)
+            return v >= switch
+
+        return passes
+
+    assert _gallop(counted("gallop"), 0.05, 1.0, width, 12) == _bisect(
+        counted("bisect"), 0.05, 1.0, width, 12
+    )
+    passed = {k: sum(v >= switch for v in vs) for k, vs in runs.items()}
+    assert passed["gallop"] <= passed["bisect"]
+    if switch < 0.1:  # bisection passes at 0.525, 0.2875, 0.169, 0.109, 0.0797 on its way
+        assert passed["bisect"] - passed["gallop"] == 4
+    assert _gallop(lambda v: False, 0.05, 1.0, width, 12, known=False) is None
+
+
+def test_a_value_failing_the_finer_grid_is_searched_on_from_it_by_galloping() -> None:
+    """The value found on the grid fails the 2x finer grid: the search goes on from it toward
+    the next sample that passed, without running that sample's (passing) finer check first
+    when a value below it passes."""
+    lever = Lever(path="mesh.damping_ratio", start=0.0, end=1.0)
+    verified: list[float] = []
+
+    def verify(v: float) -> bool:
+        verified.append(v)
+        return v >= 0.33
+
+    _, monotone, bracket = _search(lambda v: (v >= 0.3, 0, 4), lever, 5, _narrow(0.02, lever),
+                                   12, passes_at=lambda v: v >= 0.3, verify=verify)  # fmt: skip
+    assert monotone and bracket is not None and 0.33 <= bracket[1] <= 0.34
+    assert 0.5 not in verified and sum(v >= 0.33 for v in verified) <= 3
 
 
 @pytest.mark.parametrize(

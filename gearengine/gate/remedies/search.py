@@ -100,18 +100,22 @@ def _search(test: Callable[[float], tuple[bool, int, int]], lever: Lever, sample
         return shown, False, None
     j = passes.index(True)
     monotone = j > 0 and all(passes[j:])
+    narrow = _bisect if passes_at is None else _gallop
     if j == 0:
         fail, good = lever.at(0.0), lever.at(0.0)
     else:
         step = passes_at or (lambda v: test(v)[0])
-        fail, good = _bisect(step, lever.at(ts[j - 1]), lever.at(ts[j]), width, max_steps)
+        fail, good = narrow(step, lever.at(ts[j - 1]), lever.at(ts[j]), width, max_steps)
     if verify is None or verify(good):
         return shown, monotone, (fail, good)
-    later = [lever.at(t) for t, ok in zip(ts[j:], passes[j:], strict=True) if ok]
-    fail, good = good, next((v for v in later if v != good and verify(v)), None)
-    if good is None:
-        return shown, monotone, None
-    return shown, monotone, _bisect(verify, fail, good, width, max_steps)
+    fail = good  # it fails ``verify``: on from it toward the next samples that passed
+    for end in (lever.at(t) for t, ok in zip(ts[j:], passes[j:], strict=True) if ok):
+        if end != fail:
+            bracket = _gallop(verify, fail, end, width, max_steps, known=False)
+            if bracket is not None:
+                return shown, monotone, bracket
+            fail = end
+    return shown, monotone, None
 
 
 def _bisect(passes: Callable[[float], bool], fail: float, good: float,
@@ -127,6 +131,32 @@ def _bisect(passes: Callable[[float], bool], fail: float, good: float,
         else:
             fail = mid
     return fail, good
+
+
+def _gallop(passes: Callable[[float], bool], fail: float, good: float,
+            width: Callable[[float, float], bool], max_steps: int, known: bool = True,
+            ) -> tuple[float, float] | None:  # fmt: skip
+    """``_bisect``'s bracket, its probes taken from the failing end, for a test whose failure is
+    cheap and whose pass is not (a failing envelope check stops at its first failing point, a
+    passing one runs every point). Bisection's halvings toward ``fail`` while every step passes
+    are m_1 = (fail + good) / 2, m_2 = (fail + m_1) / 2, ... down to the first m_K that ``width``
+    accepts with ``fail``; they are probed upward from m_K (galloping search; Bentley & Yao,
+    Inf. Proc. Lett. 5, 1976) to the first that passes, m_i, and bisection goes on from
+    [m_i+1, m_i], the bracket it reaches itself when the test switches once between them. So
+    a lever that switches once gets bisection's bracket, bit for bit, and a switch near the
+    failing end (the usual case: the value found on the coarser grid, or the last failing
+    sample) costs one passing check instead of one per halving. ``known`` False: ``good`` is
+    not known to pass and is tried last (None when it fails too)."""
+    halvings = [good]
+    while not width(fail, halvings[-1]) and len(halvings) <= max_steps:
+        halvings.append(0.5 * (fail + halvings[-1]))
+    for k in range(len(halvings) - 1, 0, -1):
+        if passes(halvings[k]):
+            return _bisect(passes, fail, halvings[k], width, max_steps)
+        fail = halvings[k]
+    if not known and not passes(good):
+        return None
+    return _bisect(passes, fail, good, width, max_steps)
 
 
 def _narrow(rtol: float, lever: Lever) -> Callable[[float, float], bool]:
