@@ -297,3 +297,29 @@ def test_a_design_validated_again_keeps_its_readings_and_the_run_up_says_them(
             "--direction", "up"]  # fmt: skip
     assert main(argv) == 0
     assert f"note: {said}" in capsys.readouterr().out
+
+
+def test_a_text_is_read_by_pint_once_and_noted_every_time_it_is_read(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A design validated again for every envelope point reads the same texts: pint reads a
+    text once per process, while each read still gets its note (a respelled unit, a bare
+    number) and its range check."""
+    from gearengine.model.units import quantities
+
+    kind = quantities.QUANTITIES["torque"]
+    quantities._text_readings.clear()
+    read: list[str] = []
+    first = quantities._text_reading
+    monkeypatch.setattr(quantities, "_text_reading",
+                        lambda text, k: read.append(text) or first(text, k))  # fmt: skip
+    for _ in range(2):
+        with quantities.readings() as notes:
+            assert quantities.parse_quantity("40 Nm", kind) == pytest.approx(40.0)
+            assert quantities.parse_quantity("12", kind) == 12.0
+        assert notes[0] == "torque '40 Nm' read as '40 N*m'" and "bare number 12" in notes[1]
+    assert read == ["40 N*m", "12"]
+    assert quantities.parse_quantity("2 m", quantities.QUANTITIES["length"]) == 2.0
+    with pytest.raises(ValueError):  # the same text read, out of a module's range
+        quantities.parse_quantity("2 m", quantities.QUANTITIES["module"])
+    assert read[-1] == "2 m" and read.count("2 m") == 1

@@ -223,7 +223,6 @@ def parse_quantity(
     ``field`` (``_bare``), or, ``unit_required``, refused naming the units meant (a field whose
     answer has no place for the note), except inside ``si_numbers``.
     """
-    ureg = registry()
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
         raise ValueError(f"give a number in {kind.unit} or a string with a unit, e.g. "
                          f"{kind.example!r}")  # fmt: skip
@@ -234,35 +233,59 @@ def parse_quantity(
                 f"separators, e.g. {kind.example!r} (digits split by a comma or a "
                 "space are read as neither a decimal nor a thousands mark)"
             )
-        value = _respelled(value, kind)
-        try:
-            quantity = ureg.Quantity(value.strip())
-        except Exception as exc:
-            raise ValueError(f"cannot read {value!r} as a quantity ({exc}); write e.g. "
-                             f"{kind.example!r}") from None  # fmt: skip
-        if isinstance(quantity, ureg.Quantity) and str(quantity.units) in SHARES:
-            raise ValueError(
-                f"{value!r} is a share, not {kind.a_name}: give a unit of dimension "
-                f"{kind.dimensionality}, e.g. {kind.example!r} (a share of a nominal value is "
-                "read only where one is meant: a torque fluctuation amplitude in % of the mean "
-                "torque)"
-            )
-        if not isinstance(quantity, ureg.Quantity) or str(quantity.units) == "dimensionless":
-            magnitude = float(getattr(quantity, "magnitude", quantity))
-            return _bare(magnitude, value, kind, allow_zero, field, unit_required)
-        if quantity.dimensionless and kind.unit not in ("rad",):
-            quantity = ureg.Quantity(quantity.magnitude, kind.unit)
-        if quantity.dimensionality != kind.dimensionality:
-            raise ValueError(
-                f"{value!r} has the unit {quantity.units:~} ({quantity.dimensionality}); "
-                f"{kind.a_name} needs a unit of dimension {kind.dimensionality}, e.g. "
-                f"{kind.example!r}"
-            )
-        _angle_given(quantity, value, kind)
-        si = float(quantity.to(kind.unit).magnitude)
-    else:
-        return _bare(float(value), value, kind, allow_zero, field, unit_required)
-    return _plausible(si, value, kind, allow_zero)
+        value = _respelled(value, kind)  # noted in the readings each time it is read
+        key = (value, kind.unit)
+        got = _text_readings.get(key)
+        if got is None:
+            got = _text_reading(value, kind)
+            if len(_text_readings) >= TEXT_READINGS:
+                _text_readings.pop(next(iter(_text_readings)), None)
+            _text_readings[key] = got
+        bare, magnitude, text = got
+        if bare:
+            return _bare(magnitude, text, kind, allow_zero, field, unit_required)
+        return _plausible(magnitude, text, kind, allow_zero)
+    return _bare(float(value), value, kind, allow_zero, field, unit_required)
+
+
+TEXT_READINGS = 4096
+"""Quantity texts whose reading this process keeps (``parse_quantity``): ``design_with``
+validates a whole design again for every envelope point and lever value, its texts ("2.5
+mm", "20 N*m") the same each time, and pint's parse of one costs ~10-50 us (~4 s of the CPU
+of a remedies search over every default lever). A text that is refused is never kept."""
+_text_readings: dict[tuple, tuple[bool, float, str]] = {}
+
+
+def _text_reading(value: str, kind: QuantityKind) -> tuple[bool, float, str]:
+    """(bare, magnitude, text) of the quantity text ``value`` (respelled: ``_respelled``) for
+    ``kind``: a number with no unit (bare: its magnitude, to be noted by ``_bare``), else its
+    value in the kind's SI unit (to be range-checked by ``_plausible``). Raises ValueError
+    naming the unit given and the dimension expected."""
+    ureg = registry()
+    try:
+        quantity = ureg.Quantity(value.strip())
+    except Exception as exc:
+        raise ValueError(f"cannot read {value!r} as a quantity ({exc}); write e.g. "
+                         f"{kind.example!r}") from None  # fmt: skip
+    if isinstance(quantity, ureg.Quantity) and str(quantity.units) in SHARES:
+        raise ValueError(
+            f"{value!r} is a share, not {kind.a_name}: give a unit of dimension "
+            f"{kind.dimensionality}, e.g. {kind.example!r} (a share of a nominal value is "
+            "read only where one is meant: a torque fluctuation amplitude in % of the mean "
+            "torque)"
+        )
+    if not isinstance(quantity, ureg.Quantity) or str(quantity.units) == "dimensionless":
+        return True, float(getattr(quantity, "magnitude", quantity)), value
+    if quantity.dimensionless and kind.unit not in ("rad",):
+        quantity = ureg.Quantity(quantity.magnitude, kind.unit)
+    if quantity.dimensionality != kind.dimensionality:
+        raise ValueError(
+            f"{value!r} has the unit {quantity.units:~} ({quantity.dimensionality}); "
+            f"{kind.a_name} needs a unit of dimension {kind.dimensionality}, e.g. "
+            f"{kind.example!r}"
+        )
+    _angle_given(quantity, value, kind)
+    return False, float(quantity.to(kind.unit).magnitude), value
 
 
 ANGULAR_RATES = frozenset({"rad/s", "rad/s^2"})

@@ -122,7 +122,7 @@ def kink_step(
     two columns of the monodromy matrix with it."""
     K0, F0 = excitation_at(t, kc, fm, fc)
     x1, v1, dx1, dv1 = _rk4_region(reg, alpha, twomu, kc, fm, fc, K0, F0, t, h, x, v, dx, dv)
-    return kink_split(reg, alpha, twomu, kc, fm, fc, t, h, x, v, dx, dv, x1, v1, dx1, dv1)
+    return kink_split(reg, alpha, twomu, kc, fm, fc, t, K0, F0, h, x, v, dx, dv, x1, v1, dx1, dv1)
 
 
 @njit(**JIT_OPTIONS)
@@ -134,6 +134,8 @@ def kink_split(
     fm: float | np.ndarray,
     fc: np.ndarray,
     t: float,
+    K0: float,
+    F0: float,
     h: float,
     x: float,
     v: float,
@@ -145,16 +147,18 @@ def kink_split(
     dv1: float,
 ) -> tuple[float, float, float, float, int]:  # pragma: no cover - compiled
     """``kink_step`` given its first attempt (x1, v1, dx1, dv1), the whole step h from t in
-    region ``reg`` (from ``_rk4_region``, or ``rk4_region_kf`` with a forcing table): the step
-    is accepted if no sample of its Hermite interpolant leaves the region, else split at the
-    crossing, the substeps evaluating the forcing at their times."""
+    region ``reg`` (from ``_rk4_region``, or ``rk4_region_kf`` with a forcing table), and the
+    forcing (K0, F0) at t (``excitation_at``'s, or the table's, the same bits): the step is
+    accepted if no sample of its Hermite interpolant leaves the region, else split at the
+    crossing, the substeps evaluating the forcing at their times (a step near a kink that
+    crosses none, the most of them, evaluates none)."""
     rem = h
     tc = t
     for it in range(16):
         if not rem > 0.0:
             return x, v, dx, dv, reg
-        K0, F0 = excitation_at(tc, kc, fm, fc)  # the forcing at the substep's start
         if it > 0:
+            K0, F0 = excitation_at(tc, kc, fm, fc)  # the forcing at the substep's start
             x1, v1, dx1, dv1 = _rk4_region(
                 reg, alpha, twomu, kc, fm, fc, K0, F0, tc, rem, x, v, dx, dv
             )
@@ -293,8 +297,9 @@ def run_kink(
                     reg, alpha, twomu, K0, F0, K1, F1, K2, F2, h, x, v, dx, dv
                 )
                 x, v, dx, dv, reg = kink_split(
-                    reg, alpha, twomu, kc, fm, fc, j * h, h, x, v, dx, dv, x1, v1, dx1, dv1
-                )
+                    reg, alpha, twomu, kc, fm, fc, j * h, K0, F0, h, x, v, dx, dv, x1, v1,
+                    dx1, dv1,
+                )  # fmt: skip
             else:
                 x, v, dx, dv, reg = kink_step(
                     reg, alpha, twomu, kc, fm, fc, n * T + j * h, h, x, v, dx, dv

@@ -146,7 +146,7 @@ def _kink_steps(
             )  # fmt: skip
             x, v, DX[lane], DV[lane], reg = kink_split(
                 REG[lane], al, twomu, kc[q, :, : nk[q]], fm[q], fc[q, :, : nf[q]],
-                j * h, h, x, v, dx, dv, x1, v1, dx1, dv1,
+                j * h, Kl[j0, lane], Fl[j0, lane], h, x, v, dx, dv, x1, v1, dx1, dv1,
             )  # fmt: skip
             X[lane] = x
             V[lane] = v
