@@ -21,6 +21,7 @@ import pytest
 from pydantic import ValidationError
 
 from gearengine.gate.envelope import EnvelopeReport, check_envelope
+from gearengine.gate.remedies import search
 from gearengine.gate.remedies.compute import answer as answer_words
 from gearengine.gate.remedies.compute import remedies
 from gearengine.gate.remedies.levers import iso1328_class
@@ -456,6 +457,35 @@ def test_no_melnikov_guarantee_where_the_criterion_allows_chaos_between_grid_poi
     said = _melnikov_said(69, passed=True, between=[12, 405])
     assert "guarantee against" not in said
     assert "still at 12 of the 405 points of the 2x finer grid between them" in said
+
+
+def test_a_melnikov_bisection_step_stops_at_the_first_point_allowing_chaos(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A bisection step needs pass or fail only: it agrees with the full count and, tried
+    first at a point where the criterion allows chaos, evaluates that point alone."""
+    doc = json.loads((ROOT / "examples" / "remedies-z23-67.json").read_text())
+    envelope = {"speed": "1000:6000", "speed_points": 4, "torque": "5:60", "torque_points": 3}
+    request = RemediesRequest.model_validate({"design": doc["design"], "envelope": envelope})
+    points, design = envelope_points(request), request.design
+    calls: list[dict] = []
+    one = search.melnikov_allows
+    judged = []
+    for ratio in (0.05, 0.1, 0.3):
+        values = {"mesh.damping_ratio": ratio}
+        allowed, _ = search.melnikov_failures(design, points, values)
+        first = search.melnikov_first_allowing(design, points, values)
+        assert (first is None) == (allowed == 0)
+        judged.append(first is None)
+        if first is not None:
+            monkeypatch.setattr(
+                search, "melnikov_allows", lambda d, v: calls.append(v) or one(d, v)
+            )
+            assert search.melnikov_first_allowing(design, points, values, first) == first
+            assert len(calls) == 1
+            monkeypatch.undo()
+            calls.clear()
+    assert judged[0] is False and judged[-1] is True
 
 
 def test_a_class_bound_written_rounded_is_that_class() -> None:

@@ -74,23 +74,43 @@ def melnikov_failures(design: Design, points: list[dict[str, float]],
     envelope ``points`` of ``design`` with the fields ``values`` set (SI): each point's
     ``chaos_possible``, as the sweep's ``melnikov_chaos_possible`` (of a train, its mesh-mode
     reduction's: ``melnikov_point``)."""
-    judged = [melnikov_point(design_model(design_with(design, {**values, **p}))[0])
-              for p in points]  # fmt: skip
-    verdicts = [None if j is None else chaos_possible(j) for j in judged]
+    verdicts = [melnikov_allows(design, {**values, **p}) for p in points]
     return sum(v is True for v in verdicts), sum(v is None for v in verdicts)
+
+
+def melnikov_first_allowing(design: Design, points: list[dict[str, float]],
+                            values: dict[str, float], first: int = 0) -> int | None:  # fmt: skip
+    """The index of an envelope point where the Melnikov criterion allows chaos for ``design``
+    with the fields ``values`` set (``points[first]`` tried first, then the others in order,
+    up to the first that allows it), None where it allows it at none: ``melnikov_failures``'s
+    pass or fail alone, for a bisection step."""
+    for k in [first, *(k for k in range(len(points)) if k != first)]:
+        if melnikov_allows(design, {**values, **points[k]}) is True:
+            return k
+    return None
+
+
+def melnikov_allows(design: Design, values: dict[str, float]) -> bool | None:
+    """``chaos_possible`` of ``design`` with the fields ``values`` set (SI): True where the
+    Melnikov criterion allows chaos, None where it does not apply."""
+    judged = melnikov_point(design_model(design_with(design, values))[0])
+    return None if judged is None else chaos_possible(judged)
 
 
 def _search(test: Callable[[float], tuple[bool, int, int]], lever: Lever, samples: int,
             width: Callable[[float, float], bool], max_steps: int,
             passes_at: Callable[[float], bool] | None = None,
             verify: Callable[[float], bool] | None = None,
+            narrow: Callable[..., tuple[float, float] | None] | None = None,
             ) -> tuple[list[Sample], bool, tuple[float, float] | None]:  # fmt: skip
     """Bracket samples of v(t), monotone on them?, and [last failing, first passing] value (SI)
     after bisection (None when no sample passes, or none passes ``verify``).
     ``test(v) -> (passed, failing points, points)`` runs the samples; ``passes_at(v)`` (default: the
     test's pass) each bisection step, where only pass or fail is needed. With ``verify`` the
     value found must pass it too (a finer grid): if not, the search goes on from it toward the
-    far end with ``verify`` as its test, and the bracket returned is ``verify``'s."""
+    far end with ``verify`` as its test, and the bracket returned is ``verify``'s. ``narrow``
+    narrows the samples' bracket: ``_bisect`` (default), or ``_gallop`` for a test whose
+    failure is cheaper than its pass; ``verify``'s is ``_gallop``."""
     ts = [k / (samples - 1) for k in range(samples)]
     results = [test(lever.at(t)) for t in ts]
     shown = [Sample(value=lever.shown(lever.at(t)), passed=r[0], failing_points=r[1],
@@ -100,7 +120,7 @@ def _search(test: Callable[[float], tuple[bool, int, int]], lever: Lever, sample
         return shown, False, None
     j = passes.index(True)
     monotone = j > 0 and all(passes[j:])
-    narrow = _bisect if passes_at is None else _gallop
+    narrow = narrow or _bisect
     if j == 0:
         fail, good = lever.at(0.0), lever.at(0.0)
     else:
@@ -322,6 +342,15 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
         possible, _ = melnikov_failures(request.design, points, {lever.path: value})
         return possible == 0, possible, len(points)
 
+    allowed_at = [0]  # the envelope point where the criterion allowed chaos last
+
+    def melnikov_rules_out(value: float) -> bool:
+        """``melnikov``'s pass or fail alone (a bisection step), the point that allowed chaos
+        at the last failing value tried first."""
+        k = melnikov_first_allowing(request.design, points, {lever.path: value}, allowed_at[0])
+        allowed_at[0] = allowed_at[0] if k is None else k
+        return k is None
+
     searched = [f"{lever.shown(v):g}{lever.suffix}" for v in (lever.start, lever.end)]
     remedies: list[Remedy] = []
     unreachable: list[Unreachable] = []
@@ -331,9 +360,10 @@ def lever_outcome(request: RemediesRequest, lever: Lever, baseline: EnvelopeRepo
     ):
         shown, monotone, bracket = _search(
             test, lever, samples, _narrow(rtol, lever), steps,
-            passes_at=passes_at if bound == "numerical" else None,
+            passes_at=passes_at if bound == "numerical" else melnikov_rules_out,
             verify=(lambda v: passes_at(snapped(v), finer=True)) if bound == "numerical"
             else None,
+            narrow=_gallop if bound == "numerical" else _bisect,
         )  # fmt: skip
         if bracket is None:
             far = run(lever.end) if bound == "numerical" else None
