@@ -156,7 +156,9 @@ def test_diverging_run_stops_where_it_leaves_the_bound() -> None:
 
 
 @pytest.mark.parametrize(
-    "point", [paper(0.2, we=1.0), paper(0.3, we=0.5, model="piecewise")], ids=["cubic", "piecewise"]
+    "point",
+    [paper(0.2, we=1.0), paper(0.32, we=0.55, model="piecewise")],
+    ids=["cubic", "piecewise"],
 )
 def test_a_record_run_on_is_the_longer_record_run_at_once(
     point: GearParams, monkeypatch: pytest.MonkeyPatch

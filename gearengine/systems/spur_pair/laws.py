@@ -168,7 +168,7 @@ LAWS: dict[str, BacklashLaw] = {
     "piecewise": BacklashLaw(
         "piecewise", 1, lambda m, x: fh_piecewise(x, m.alpha), _piecewise_fit,
         "piecewise linear (Eq. 8)", run_kink,
-        "rk4 split at the kinks |x| = 1 (Illinois regula falsi)", lanes_piecewise,
+        "rk4 split at the kinks |x| = 1 (Newton from the Hermite root)", lanes_piecewise,
     ),
 }  # fmt: skip
 """Backlash laws by name (the ``backlash.model`` field)."""

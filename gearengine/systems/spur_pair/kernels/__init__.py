@@ -10,10 +10,11 @@ The three run kernels share one output layout (see ``run_rk4``); ``monodromy`` i
   t = n T0 + j h (no drift). Cubic law, or the piecewise law of Eq. (8) stepped straight across
   the kinks (first-order accurate there; kept for comparison with ``run_kink``).
 * ``run_kink``: piecewise law of Eq. (8) with every RK4 step split at the switching times
-  |x| = 1 (port of ``gear_ref.c --kink``, general alpha): a crossing is detected from a cubic
-  Hermite interpolant of x over the substep, located by Illinois regula falsi on RK4 substeps to
-  ~1e-13 h, and integration restarts there with the new region's field. The field is continuous
-  across |x| = 1, so the tangent vector needs no saltation jump. Forcing at absolute time.
+  |x| = 1 (``gear_ref.c --kink``'s splitting, general alpha): a crossing is detected from a
+  cubic Hermite interpolant of x over the substep, located by Newton on RK4 substeps from the
+  interpolant's root (Illinois regula falsi where Newton leaves the bracket) to ~1e-13 h, and
+  integration restarts there with the new region's field. The field is continuous across
+  |x| = 1, so the tangent vector needs no saltation jump. Forcing at absolute time.
 * ``monodromy``: the flow over n intervals T0 and its 2x2 Jacobian (the monodromy matrix), for
   Newton shooting and Floquet multipliers (``numerics.floquet``); both laws, same RK4 arithmetic.
 * ``run_batch``: cubic law only; many parameter points ("lanes") in lock-step, struct of arrays,

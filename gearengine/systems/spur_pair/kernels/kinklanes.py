@@ -176,7 +176,7 @@ KINK = LaneLaw(
     its region keeps the step, by selects, not branches. A lane whose bound touches a switching
     point |x| = 1 keeps its state in that loop; a second loop, entered only when some lane is
     near a kink, retakes its step with ``rk4_region_kf`` and hands it to ``kink.kink_split``
-    (the crossing test, the regula falsi and the substeps of the scalar kernel, forcing at the
+    (the crossing test, the Newton iterates and the substeps of the scalar kernel, forcing at the
     time within the period). So each run has the numbers of ``run_kink(..., use_table=True)``
     bit for bit, while the steps far from the kinks cost what the cubic lanes' cost. The forcing
     rows are indexed in place (``Kl[2j, lane]``), not taken as row views: a view's reference

@@ -66,12 +66,12 @@ def monodromy(
     variational matrix, i.e. two tangent vectors started at (1, 0) and (0, 1).
 
     Piecewise law (law 1): every step goes through ``kink_step``, which splits the step at the
-    switching times |x| = 1 (RK4 on each side, crossing located by regula falsi). It advances
-    one tangent vector, so it is called once per column of Phi from the same state and region;
-    the state path is identical in both calls. No saltation matrix is needed at the switching
-    times: the backlash law of Eq. (8) is continuous (only its slope jumps, from alpha to 1),
-    so the vector field of Eq. (9) is continuous across |x| = 1 and the flow's Jacobian is
-    continuous across the switching surface. The saltation matrix
+    switching times |x| = 1 (RK4 on each side, crossing located by Newton from the Hermite
+    root). It advances one tangent vector, so it is called once per column of Phi from the
+    same state and region; the state path is identical in both calls. No saltation matrix is
+    needed at the switching times: the backlash law of Eq. (8) is continuous (only its slope
+    jumps, from alpha to 1), so the vector field of Eq. (9) is continuous across |x| = 1 and
+    the flow's Jacobian is continuous across the switching surface. The saltation matrix
     S = I + (f+ - f-) n^T / (n^T f-) is the identity when f+ = f- at the switching point; a
     jump correction is needed only when the vector field itself jumps (impacts, friction);
     di Bernardo et al., Piecewise-smooth Dynamical Systems, Springer 2008, ch. 2.
