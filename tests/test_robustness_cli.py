@@ -500,16 +500,17 @@ def test_samples_auto_says_before_computing_that_the_budget_cannot_prove_a_limit
     at 99.3 %, the round of 1,024, which the budget could not hold at every point, and nothing
     said so before (third new-user review). ``unreachable`` says it from the work alone."""
     from gearengine.studies.robustness.sequential import unreachable
-    from gearengine.studies.robustness.study import checked, robustness_work
+    from gearengine.studies.robustness.study import checked, point_work, robustness_work
 
     axes = [{"parameter": "speed", "start": "2000 rpm", "stop": "5000 rpm", "num": 3}]
     request = checked(RobustnessRequest.model_validate({"design": DESIGN, "axes": axes,
                                                         "samples": 64}))  # fmt: skip
     per_sample = robustness_work(request.model_copy(update={"samples": 1}))
-    said = unreachable(request, {"chaotic": 0.01}, 600 * per_sample)
+    unit = point_work(request)
+    said = unreachable(unit, {"chaotic": 0.01}, 600 * per_sample)
     assert said is not None
     assert said.startswith("a point with no events needs 561 samples to prove P(chaotic) <= 0.01 "
                            "at 99.3 % (the round of 1024 samples)")  # fmt: skip
     assert "holds 600 samples at each of the 3 points" in said
-    assert unreachable(request, {"chaotic": 0.01}, 1024 * per_sample) is None
-    assert unreachable(request, {"chaotic": 0.05}, 600 * per_sample) is None  # 110: round 128
+    assert unreachable(unit, {"chaotic": 0.01}, 1024 * per_sample) is None
+    assert unreachable(unit, {"chaotic": 0.05}, 600 * per_sample) is None  # 110: round 128

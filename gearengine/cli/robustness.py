@@ -42,7 +42,7 @@ from gearengine.studies.robustness.sequential import (
     sequential,
     unreachable,
 )
-from gearengine.studies.robustness.study import RobustnessRequest, checked, run_local
+from gearengine.studies.robustness.study import RobustnessRequest, checked, point_work, run_local
 from gearengine.studies.robustness.tolerances import samples_to_prove
 from gearengine.studies.sweep.points import PhysicalValue
 
@@ -209,12 +209,13 @@ def gate_study(request: RobustnessRequest, limits: dict[str, float], auto: bool
     if not auto:
         return run_study(request), ONE_LOOK, []
     budget = jobs.job_step_budget()
-    short = unreachable(request, limits, budget)
+    unit = point_work(request)  # a sample's RK4 steps at each point, converted once for both
+    short = unreachable(unit, limits, budget)
     notes = [] if short is None else [f"--samples auto: {short}"]
     for note in notes:
         print(note, file=sys.stderr)
     tick = progress(time.monotonic(), "robustness", "points decided")
-    out = sequential(request, limits, budget, workers=os.cpu_count() or 1, progress=tick)
+    out = sequential(request, unit, limits, budget, workers=os.cpu_count() or 1, progress=tick)
     rounds = ", ".join(str(n) for n in out.rounds)
     notes.append(f"--samples auto: {out.stopped} (rounds of {rounds} samples, {out.steps} RK4 "
                  f"steps of a budget of {budget}); each look decides at "

@@ -16,7 +16,6 @@ from gearengine.studies.robustness.sequential import (
     Verdict,
     combined,
     decision_interval,
-    verdict,
 )
 from gearengine.studies.robustness.tolerances import probability
 from gearengine.studies.sweep.points import PhysicalValue
@@ -142,51 +141,47 @@ def unfollowed(point: RobustnessPoint, name: str, limit: float,
             f"{high:.3g} > {limit:g}")  # fmt: skip
 
 
-def verdict_reasons(point: RobustnessPoint, limits: dict[str, float],
-                    confidence: float = ONE_LOOK) -> list[str]:  # fmt: skip
-    """The limits a point does not prove, in words: over (its lower bound above the limit) or
-    undecided (the interval holds the limit); the intervals the verdict read, at ``confidence``
-    (``sequential.decision_interval``), named (a fixed count's 95 % too)."""
-    at = at_confidence(confidence)
-    why = []
-    for name, limit in limits.items():
-        prob = point.probabilities[name]
-        ci = decision_interval(prob, confidence)
-        if ci is None:
-            why.append(f"P({name}) undecided: no samples")
-        elif ci[0] > limit:
-            why.append(f"P({name}) lower bound{at} {ci[0]:.3g} > {limit:g} "
-                       f"({prob.count}/{prob.samples} samples)")  # fmt: skip
-        elif ci[1] > limit:
-            why.append(f"P({name}) undecided: upper bound{at} {ci[1]:.3g} > {limit:g} "
-                       f"({prob.count}/{prob.samples} samples)")  # fmt: skip
-        elif (diverged := unfollowed(point, name, limit, confidence)) is not None:
-            why.append(diverged)
-    return why
+def read_limit(point: RobustnessPoint, name: str, limit: float,
+               confidence: float = ONE_LOOK) -> tuple[LimitVerdict, str | None]:  # fmt: skip
+    """One limit at a point, read once: its verdict and, where the limit is not proved, why in
+    words: over (the lower bound above the limit), undecided (the interval holds the limit, or
+    no samples) or undecided by the diverged samples (``unfollowed``: a pass proved on the
+    followed samples alone). The interval is the one the verdict read, at ``confidence``
+    (``sequential.decision_interval``), and the words name it (a fixed count's 95 % too): the
+    verdict and its words come from one reading and cannot disagree."""
+    prob = point.probabilities[name]
+    ci = decision_interval(prob, confidence)
+    at, counted = at_confidence(confidence), f"({prob.count}/{prob.samples} samples)"
+    said: Verdict = "undecided"
+    if ci is None:
+        why: str | None = f"P({name}) undecided: no samples"
+    elif ci[0] > limit:
+        said, why = "fail", f"P({name}) lower bound{at} {ci[0]:.3g} > {limit:g} {counted}"
+    elif ci[1] > limit:
+        why = f"P({name}) undecided: upper bound{at} {ci[1]:.3g} > {limit:g} {counted}"
+    else:
+        why = unfollowed(point, name, limit, confidence)
+        said = "pass" if why is None else "undecided"
+    read = LimitVerdict(limit=limit, verdict=said, count=prob.count, samples=prob.samples,
+                        interval=ci, confidence=confidence)  # fmt: skip
+    return read, why
 
 
 def point_verdict(point: RobustnessPoint, limits: dict[str, float], confidence: float,
                   starts: int, units: dict[str, str] | None,
                   own: dict[str, PhysicalValue] | None = None) -> PointVerdict:  # fmt: skip
-    """One point's verdict under ``limits`` at ``confidence``: each limit's
-    (``sequential.verdict``), a pass undecided where diverged samples could break it
-    (``unfollowed``), combined once (``sequential.combined``), its values in ``units``
-    (the result's ``shown_units``, else ``display_unit``); a study without axes named by
-    ``own`` (the design's speed and torque) instead of an empty point."""
-    reasons = verdict_reasons(point, limits, confidence)
-    read = {}
+    """One point's verdict under ``limits`` at ``confidence``: each limit's (``read_limit``),
+    combined once (``sequential.combined``: a pass proved on the followed samples alone, not
+    on the diverged ones, is undecided), its values in ``units`` (the result's
+    ``shown_units``, else ``display_unit``); a study without axes named by ``own`` (the
+    design's speed and torque) instead of an empty point."""
+    read, reasons = {}, []
     for name, limit in limits.items():
-        prob = point.probabilities[name]
-        followed = unfollowed(point, name, limit, confidence) is None
-        said = verdict(point, {name: limit}, confidence) if followed else "undecided"
-        read[name] = LimitVerdict(
-            limit=limit, verdict=said, count=prob.count, samples=prob.samples,
-            interval=decision_interval(prob, confidence), confidence=confidence,
-        )  # fmt: skip
+        read[name], why = read_limit(point, name, limit, confidence)
+        if why is not None:
+            reasons.append(why)
     shown = {k: PhysicalValue(value=v, unit=(units or {}).get(k) or display_unit(k)[0])
              for k, v in point.shown.items()} or dict(own or {})  # fmt: skip
-    # from the limits' verdicts as read: a pass proved on the followed samples alone, not on
-    # the diverged ones, is undecided
     overall = combined(r.verdict for r in read.values())
     return PointVerdict(point=shown, verdict=overall, reasons=reasons, limits=read,
                         samples=point.samples, starts_per_sample=starts)  # fmt: skip

@@ -126,6 +126,7 @@ def gate_runups(sweep: SweepRequest, rate_rpm_s: float) -> GateRunups:
     level's torque, as the validated ``Design`` it is, not as a document to read again."""
     design = sweep.design
     assert design is not None
+    levels = torque_levels(sweep)
     axis = next((a for a in sweep.axes if a.parameter == SPEED), None)
     grid = [] if axis is None else axis.values(design)
     if axis is None or axis.num < 2 or not grid[0] < grid[-1]:
@@ -138,7 +139,6 @@ def gate_runups(sweep: SweepRequest, rate_rpm_s: float) -> GateRunups:
                        rate_rpm_s * CHAOS_SECONDS / 2),
         "ensemble": {"size": GATE_ENSEMBLE},
     }  # fmt: skip
-    levels = torque_levels(sweep)
     requests = [validated_runup({"design": design if not level else design.model_copy(
                     update={"torque": level["torque"].value}), **ramp})
                 for level in levels]  # fmt: skip

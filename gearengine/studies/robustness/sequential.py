@@ -32,7 +32,6 @@ from gearengine.studies.robustness.study import (
     MAX_SAMPLES,
     RobustnessRequest,
     assemble,
-    point_work,
     robustness_work,
 )
 from gearengine.studies.robustness.tolerances import clopper_pearson, samples_to_prove
@@ -114,13 +113,14 @@ def point_request(request: RobustnessRequest, values: dict[str, float], samples:
     return request.model_copy(update={"axes": axes, "samples": samples, "sensitivity": False})
 
 
-def unreachable(request: RobustnessRequest, limits: dict[str, float], budget: int,
+def unreachable(unit: list[int], limits: dict[str, float], budget: int,
                 first: int = FIRST_SAMPLES, most: int = MAX_SAMPLES) -> str | None:  # fmt: skip
     """Why ``sequential`` cannot prove every limit at a point with no events within ``budget``
-    RK4 steps at every point of ``request``: the round that reaches the samples needed at the
-    looks' confidence (561 for 1 % at 99.3 %, reached at the round of 1,024) against the
-    samples a point the budget holds at all points; None when it can. Said before computing
-    (a review's 256-sample study ended with 104 of 115 points undecided, unsaid until then)."""
+    RK4 steps at every point, a sample taking ``unit`` steps at each (``point_work``): the
+    round that reaches the samples needed at the looks' confidence (561 for 1 % at 99.3 %,
+    reached at the round of 1,024) against the samples a point the budget holds at all points;
+    None when it can. Said before computing (a review's 256-sample study ended with 104 of 115
+    points undecided, unsaid until then)."""
     confidence = decision_confidence(first, most)
     need = {name: samples_to_prove(limit, confidence) for name, limit in limits.items()}
     name, n = max(need.items(), key=lambda kv: kv[1] or 0)
@@ -128,7 +128,6 @@ def unreachable(request: RobustnessRequest, limits: dict[str, float], budget: in
         return None
     rounds = [first << k for k in range(looks(first, most))]
     reach = next((r for r in rounds if r >= n), None)
-    unit = point_work(request)
     held = budget // max(1, sum(unit))
     if reach is not None and held >= reach:
         return None
@@ -148,15 +147,15 @@ def first_round_steps(request: RobustnessRequest, first: int = FIRST_SAMPLES) ->
 
 
 def sequential(
-    request: RobustnessRequest, limits: dict[str, float], budget: int, workers: int = 1,
-    most: int = MAX_SAMPLES, first: int = FIRST_SAMPLES,
+    request: RobustnessRequest, unit: list[int], limits: dict[str, float], budget: int,
+    workers: int = 1, most: int = MAX_SAMPLES, first: int = FIRST_SAMPLES,
     progress: Callable[[int, int], None] | None = None,
 ) -> SequentialResult:  # fmt: skip
     """Sample each point of ``request`` until ``limits`` decide it (see the module), within
-    ``budget`` RK4 steps in all and ``most`` samples a point; ``workers`` threads."""
+    ``budget`` RK4 steps in all, a sample taking ``unit`` steps at each point (``point_work``,
+    as ``unreachable`` read them), and ``most`` samples a point; ``workers`` threads."""
     points = request.points() or [{}]
     confidence = decision_confidence(first, most)
-    unit = point_work(request)
     chunks: list[list[str]] = [[] for _ in points]
     answers: list[RobustnessPoint | None] = [None] * len(points)
     verdicts: list[Verdict] = ["undecided"] * len(points)

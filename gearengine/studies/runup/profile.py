@@ -161,8 +161,26 @@ def _segment(
     return Segment(t0, t1, w0, w1, branch, n_blocks, steps, tau_block / steps)
 
 
+def profile_segments(request: RunupRequest, forcing: RampForcing, limit: float) -> list[Segment]:
+    """The profile of ``request`` as segments (``_segment``, RK4 steps at most ``limit``
+    [tau]): the settling at the start speed (``settle_periods``), then one segment between
+    each two knots, up or down as the speed goes (a flat stretch keeps the branch before)."""
+    assert request.design is not None
+    knots = request.knots()
+    segments: list[Segment] = []
+    if request.settle_periods > 0:
+        w = knots[0][1]
+        settle = request.settle_periods * 2.0 * math.pi / (request.design.driver.teeth * w)
+        segments.append(_segment(request, forcing, limit, -settle, 0.0, w, w, None))
+    branch: Branch = "up" if knots[-1][1] >= knots[0][1] else "down"
+    for (t0, w0), (t1, w1) in itertools.pairwise(knots):
+        branch = "up" if w1 > w0 else ("down" if w1 < w0 else branch)
+        segments.append(_segment(request, forcing, limit, t0, t1, w0, w1, branch))
+    return segments
+
+
 def runup_plan(request: RunupRequest) -> RunupPlan:
-    """Segments, forcing and mean force of a run-up.
+    """Segments (``profile_segments``), forcing and mean force of a run-up.
 
     Raises ValueError (message starting with the field) when a torque ramp changes more than
     the mean force (a load-dependent ISO 6336 stiffness).
@@ -172,6 +190,7 @@ def runup_plan(request: RunupRequest) -> RunupPlan:
     params = conv.params
     omega_n = 1.0 / conv.time_scale_s
     forcing = ramp_forcing(params, design.speed, omega_n)
+    segments = profile_segments(request, forcing, system.step_limit())
     f0 = params.mean_force
     f1 = f0
     if request.to_torque is not None:
@@ -184,17 +203,6 @@ def runup_plan(request: RunupRequest) -> RunupPlan:
     rb = float(conv.derived["base_radius_driven"].value)  # type: ignore[arg-type]
     ib = float(conv.derived["inertia_driven"].value)  # type: ignore[arg-type]
     force_scale = in_si("mesh_force", 1.0, conv.scales)  # N per unit force, b k_m
-    knots = request.knots()
-    limit = system.step_limit()
-    segments: list[Segment] = []
-    if request.settle_periods > 0:
-        w = knots[0][1]
-        settle = request.settle_periods * 2.0 * math.pi / (design.driver.teeth * w)
-        segments.append(_segment(request, forcing, limit, -settle, 0.0, w, w, None))
-    branch: Branch = "up" if knots[-1][1] >= knots[0][1] else "down"
-    for (t0, w0), (t1, w1) in itertools.pairwise(knots):
-        branch = "up" if w1 > w0 else ("down" if w1 < w0 else branch)
-        segments.append(_segment(request, forcing, limit, t0, t1, w0, w1, branch))
     return RunupPlan(
         system=system,
         conversion=conv,
@@ -202,7 +210,7 @@ def runup_plan(request: RunupRequest) -> RunupPlan:
         forcing=forcing,
         mean_force=(f0, f1),
         inertia_force=ib * (ra / rb) / rb / force_scale,
-        duration=knots[-1][0],
+        duration=segments[-1].t1,
     )
 
 
