@@ -260,7 +260,8 @@ def test_a_chunk_runs_its_start_and_basin_starts_in_one_kernel_call(
     batch._plans.clear()
     calls: list[int] = []
     run = batch._run_lanes
-    monkeypatch.setattr(batch, "_run_lanes", lambda *a: calls.append(len(a[2])) or run(*a))
+    monkeypatch.setattr(batch, "_run_lanes",
+                        lambda *a, **k: calls.append(len(a[2])) or run(*a, **k))  # fmt: skip
     points = compute_chunk(request, 0, 3)
     assert calls == [3 * (1 + 4)]  # one call: 3 points x (own start + 4 basin starts)
     assert batch._table.cache_info().misses == 3 and len(batch._plans) == 3  # one a speed

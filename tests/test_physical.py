@@ -15,7 +15,7 @@ from gearengine.analysis import AnalysisRequest, analyze
 from gearengine.gate.envelope import ENVELOPE_SETTINGS
 from gearengine.model.params import GearParams
 from gearengine.numerics import physical
-from gearengine.numerics.batch import _run_lanes, run_lanes, simulate_batch, step_plans
+from gearengine.numerics.batch import run_lanes, simulate_batch
 from gearengine.numerics.physical import DAMPING_TIMES, RECORD_MESH
 from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import SimulationSettings
@@ -207,9 +207,8 @@ def test_starts_of_one_point_on_one_cycle_share_one_record() -> None:
     settings = SimulationSettings.model_validate(ENVELOPE_SETTINGS)
     point = ci_request(4000).params
     lanes = [(0, (x, v)) for x in (-1.5, 0.0, 1.5) for v in (-0.5, 0.5)]
-    shared = run_lanes([point], lanes, settings)
-    plans = step_plans([point], settings.steps_per_period)
-    own = _run_lanes([point], plans, lanes, settings, range(6), sets=range(6))
+    shared = run_lanes([point], lanes, settings, sets=[0] * len(lanes))
+    own = run_lanes([point], lanes, settings)  # no sets: every start records its own
     assert len({b._record for b in shared}) == 2 and len({b._record for b in own}) == 6
     assert {b.impact_regime for b in shared} == {"single_sided", "no_impact"}
     for s, o in zip(shared, own, strict=True):
@@ -231,7 +230,7 @@ def test_a_record_that_misses_its_cycle_leaves_the_starts_joined_to_it_their_own
     settings = SimulationSettings.model_validate(ENVELOPE_SETTINGS)
     point = ci_request(3000).params
     lanes = [(0, (x, 0.0)) for x in (-1.0, 0.0, 1.0)]
-    assert len({b._record for b in run_lanes([point], lanes, settings)}) == 1
+    assert len({b._record for b in run_lanes([point], lanes, settings, sets=[0, 0, 0])}) == 1
     missed: list[int] = []
     detect = physical.detect_period
 
@@ -242,7 +241,7 @@ def test_a_record_that_misses_its_cycle_leaves_the_starts_joined_to_it_their_own
         return None
 
     monkeypatch.setattr(physical, "detect_period", once_missing)
-    got = run_lanes([point], lanes, settings)
+    got = run_lanes([point], lanes, settings, sets=[0, 0, 0])
     assert missed and len({b._record for b in got}) == 3
     assert {(b.classification, b.period) for b in got[1:]} == {("periodic", 1)}
 
@@ -256,11 +255,10 @@ def test_starts_that_share_a_record_are_one_estimate_of_the_attractors_lle() -> 
     settings = SimulationSettings.model_validate(ENVELOPE_SETTINGS)
     point = ci_request(3000).params
     lanes = [(0, (x, 0.0)) for x in (-1.0, 0.0, 1.0)]
-    shared = run_lanes([point], lanes, settings)
+    shared = run_lanes([point], lanes, settings, sets=[0] * len(lanes))
     a = _attractor([(s, b) for (_, s), b in zip(lanes, shared, strict=True)], 3, None)
     assert (a.lle, a.lle_stderr, a.count) == (shared[0].lle, shared[0].lle_stderr, 3)
-    plans = step_plans([point], settings.steps_per_period)
-    own = _run_lanes([point], plans, lanes, settings, range(3), sets=range(3))
+    own = run_lanes([point], lanes, settings)
     b = _attractor([(s, p) for (_, s), p in zip(lanes, own, strict=True)], 3, None)
     errs = [p.lle_stderr for p in own]
     assert b.lle_stderr == pytest.approx(math.sqrt(sum(e * e for e in errs)) / 3)

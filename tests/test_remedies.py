@@ -198,6 +198,11 @@ def test_galloping_from_the_failing_end_gives_bisections_bracket_with_fewer_pass
     if switch < 0.1:  # bisection passes at 0.525, 0.2875, 0.169, 0.109, 0.0797 on its way
         assert passed["bisect"] - passed["gallop"] == 4
     assert _gallop(lambda v: False, 0.05, 1.0, width, 12, known=False) is None
+    for steps in (3, 5):  # the step cap reached before the width: bisection's bracket still
+        never = lambda a, b: False  # noqa: E731
+        assert _gallop(counted("gallop"), 0.05, 1.0, never, steps) == _bisect(
+            counted("bisect"), 0.05, 1.0, never, steps
+        )
 
 
 def test_a_value_failing_the_finer_grid_is_searched_on_from_it_by_galloping() -> None:

@@ -176,10 +176,10 @@ def _attractor(
     one record, ``BatchPoint._record``, are one estimate), DTE, force and impacts the largest
     seen."""
     start, rep = members[0]
-    records: set[int] = set()
+    records: set[tuple[str, int]] = set()
     estimates = []  # one member per record, in start order
     for _, bp in members:
-        key = id(bp) if bp._record is None else bp._record
+        key = ("own", id(bp)) if bp._record is None else ("shared", bp._record)
         if key not in records:
             records.add(key)
             estimates.append(bp)
@@ -286,7 +286,8 @@ def _lanes_attractors(
     basins = settings.basins or BasinSettings()
     starts = [basin_starts(basins, sc) for sc in scales]
     lanes = [(i, s) for i, ss in enumerate(starts) for s in ss]
-    return _grouped(plans, settings, scales, starts, run_lanes(points, lanes, settings, plans))
+    runs = run_lanes(points, lanes, settings, plans, sets=[0] * len(lanes))  # basin starts
+    return _grouped(plans, settings, scales, starts, runs)
 
 
 def verdicts_and_attractors(

@@ -127,6 +127,7 @@ def run_lanes(
     lanes: Sequence[Lane],
     settings: SimulationSettings | None = None,
     plans: list[StepPlan] | None = None,
+    sets: Sequence[int] | None = None,
 ) -> list[BatchPoint]:
     """The verdict of every lane: the one door of ensembles into the kernels.
 
@@ -139,7 +140,7 @@ def run_lanes(
     ``settings.adaptive`` a lane may stop early (``kernels.adaptive``: settled periodic orbits,
     and chaotic or quasi-periodic ones once their LLE's stderr is within the settings'
     tolerances); otherwise, and in the single kernels, the numbers equal those of ``simulate``
-    for the same point and start.
+    for the same point and start, unless ``sets`` lets starts share a record.
 
     Args:
         points: the parameter points, shape (P,).
@@ -147,6 +148,10 @@ def run_lanes(
         settings: periods, steps and adaptive stopping shared by all lanes (their starts are
             ignored: each lane carries its own).
         plans: the points' ``step_plans`` when the caller has them (made here otherwise).
+        sets: the set of starts of each lane, shape (L,): lanes of one point and set that
+            settle on one cycle in physical time share one record (``physical.lengths``'
+            ``kin``: a point's basin starts, whose attractors are what is asked); None: every
+            lane records its own, as independent samples must.
 
     Returns:
         One ``BatchPoint`` per lane, in order, shape (L,); its ``start_index`` is the lane's
@@ -154,7 +159,7 @@ def run_lanes(
     """
     settings = settings or SimulationSettings()
     plans = step_plans(points, settings.steps_per_period) if plans is None else plans
-    return _run_lanes(points, plans, lanes, settings, range(len(lanes)))
+    return _run_lanes(points, plans, lanes, settings, range(len(lanes)), sets=sets)
 
 
 def _run_lanes(
@@ -171,7 +176,7 @@ def _run_lanes(
     the lock-step lanes keep the x of their last strobes alone (``lanes.last_strobes``).
     ``sets``: the set of starts of each lane, shape (L,) (a point's own starts and its basin
     starts, run together as they would run apart); the lanes of one point and set settling on
-    one cycle share a record (``physical.lengths``' ``kin``). None: one set."""
+    one cycle share a record (``physical.lengths``' ``kin``). None: none share."""
     results: list[BatchPoint | None] = [None] * len(lanes)
     groups: dict[tuple[str, int, float], list[int]] = {}
     systems: dict[tuple, list[int]] = {}
@@ -211,7 +216,7 @@ def _run_lanes(
         if physical.applies(settings, plans[members[0]], 0.0):
             group = (lanes_of, laws, inverse, packed, mu, tabled, per, N, r)
             mine = [numbers[k] for k in ks]
-            kin = inverse if sets is None else np.array([sets[k] for k in ks]) * len(ks) + inverse
+            kin = None if sets is None else np.array([sets[k] for k in ks]) * len(ks) + inverse
             got = physical_lanes(group, x0, v0, settings, mine, x_only, kin)
             for k, point in zip(ks, got, strict=True):
                 results[k] = point
@@ -375,7 +380,9 @@ def simulate_batch_with(
     """``simulate_batch`` of ``points`` and ``run_lanes`` of ``more`` lanes of the same points
     (a chunk's basin starts), in one call of the kernels: one forcing table a point and one
     pass of the lock-step chunks for both. The same numbers as two calls: a lane's run does
-    not depend on the lanes beside it; ``x_only`` as ``simulate_batch``'s."""
+    not depend on other points, nor on the other set (each own start records its own; the
+    basin starts of a point may share records among themselves); ``x_only`` as
+    ``simulate_batch``'s."""
     starts = settings.starts()
     plans = step_plans(points, settings.steps_per_period)
     for plan in plans:

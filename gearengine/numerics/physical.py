@@ -172,6 +172,8 @@ class Lengths:
     record_reason: str = ""
     keep: Any = None
     period: int | None = None
+    record_period: int | None = None
+    """The period its record found (``detect_period``), None when it found none."""
     joined: int | None = None
     """The lane whose record is this one's (``kin``: a start of the same point and set that
     settled on the same cycle), None when the lane records its own."""
@@ -223,9 +225,10 @@ def lengths(
 
 
 def _confirmed(leader: Lengths) -> bool:
-    """The record of a settled lane found its period (the cycle it settled on, which the lanes
+    """The record of a settled lane found the period it settled with (the cycle the lanes
     joined to it share); otherwise they record their own."""
-    return leader.transient_reason == "settled" and leader.record_reason == "period"
+    return (leader.transient_reason == "settled" and leader.record_reason == "period"
+            and leader.record_period == leader.period)  # fmt: skip
 
 
 def _settle(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, mu: np.ndarray,
@@ -270,7 +273,7 @@ def _settle(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, 
             active[lane] = False
             if kin is not None:
                 known = cycles.setdefault(int(kin[lane]), [])
-                same = (k for k, q, c, z in known if q == p and same_cycle(c, cycle, max(z, size)))
+                same = (k for k, q, c, z in known if q == p and _same_cycle(c, cycle, max(z, size)))
                 s.joined = next(same, None)
                 if s.joined is None:
                     known.append((lane, p, cycle, size))
@@ -312,7 +315,7 @@ def _periods(history: list[tuple[np.ndarray, Chunk]], lanes: np.ndarray, ran: in
     return found
 
 
-def same_cycle(a: np.ndarray, b: np.ndarray, size: float) -> bool:
+def _same_cycle(a: np.ndarray, b: np.ndarray, size: float) -> bool:
     """True when the cycles a and b (strobes (p, 2), any phase) are one: every strobe of each
     within the period test's ``REL_TOL`` x ``size`` of a strobe of the other."""
     d = np.hypot(a[:, None, 0] - b[None, :, 0], a[:, None, 1] - b[None, :, 1])
@@ -393,7 +396,8 @@ def _next(c: Chunk, j: int, n: int, T0: float, s: Lengths, settings: SimulationS
     length, or -1 (move the record into the transient and record again)."""
     cap = settings.record_periods
     size = attractor_size(float(c.xmin[j]), float(c.xmax[j]))
-    if detect_period(c.xs[j], c.vs[j], size) is not None:
+    s.record_period = detect_period(c.xs[j], c.vs[j], size)
+    if s.record_period is not None:
         s.record_reason = "period"
         return None
     est = benettin(c.logs[j], T0)

@@ -284,6 +284,7 @@ class BatchPoint(FiniteAnswer):
         None, description="Smallest dimensionless mesh force over the record; null if diverged."
     )
     _record: int | None = PrivateAttr(None)
-    """Which record of its kernel call the numbers are (``batch.physical_lanes``: the starts of
-    a point joined to one cycle share one), None for a record of its own: estimates from one
-    record are one estimate (``attractors``' LLE statistics)."""
+    """Which record of its kernel call the numbers are (``batch.physical_lanes`` numbers every
+    record; the basin starts of a point joined to one cycle share one), None outside physical
+    time: estimates from one record are one estimate (``attractors``' LLE statistics). The
+    numbers are per call, and all of a point's lanes are in one call."""

@@ -170,13 +170,14 @@ def _gallop(passes: Callable[[float], bool], fail: float, good: float,
     halvings = [good]
     while not width(fail, halvings[-1]) and len(halvings) <= max_steps:
         halvings.append(0.5 * (fail + halvings[-1]))
-    for k in range(len(halvings) - 1, 0, -1):
-        if passes(halvings[k]):
-            return _bisect(passes, fail, halvings[k], width, max_steps)
+    last = len(halvings) - 1
+    for k in range(last, 0, -1):
+        if passes(halvings[k]):  # bisection's steps 1..k passed, step k + 1 (if any) failed
+            return _bisect(passes, fail, halvings[k], width, max_steps - k - (k < last))
         fail = halvings[k]
     if not known and not passes(good):
         return None
-    return _bisect(passes, fail, good, width, max_steps)
+    return _bisect(passes, fail, good, width, max_steps - (last >= 1))
 
 
 def _narrow(rtol: float, lever: Lever) -> Callable[[float, float], bool]:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 import re
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
@@ -238,9 +239,10 @@ def parse_quantity(
         got = _text_readings.get(key)
         if got is None:
             got = _text_reading(value, kind)
-            if len(_text_readings) >= TEXT_READINGS:
-                _text_readings.pop(next(iter(_text_readings)), None)
-            _text_readings[key] = got
+            with _text_readings_lock:  # threads of one process read designs at once
+                if len(_text_readings) >= TEXT_READINGS:
+                    _text_readings.pop(next(iter(_text_readings)), None)
+                _text_readings[key] = got
         bare, magnitude, text = got
         if bare:
             return _bare(magnitude, text, kind, allow_zero, field, unit_required)
@@ -254,6 +256,7 @@ validates a whole design again for every envelope point and lever value, its tex
 mm", "20 N*m") the same each time, and pint's parse of one costs ~10-50 us (~4 s of the CPU
 of a remedies search over every default lever). A text that is refused is never kept."""
 _text_readings: dict[tuple, tuple[bool, float, str]] = {}
+_text_readings_lock = threading.Lock()
 
 
 def _text_reading(value: str, kind: QuantityKind) -> tuple[bool, float, str]:
