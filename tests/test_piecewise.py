@@ -147,20 +147,3 @@ def test_a_point_the_regula_falsi_lost_is_dop853s_periodic_orbit() -> None:
     period, _, final = scipy_run(point, 2, 4, tuple(b.poincare[-1]))  # on from its strobe
     assert period == 1  # DOP853 stays on it: the orbit, to RK4's error at 128 steps a mesh period
     assert list(final[:2]) == pytest.approx(b.poincare[-1], abs=1e-4)
-
-
-@pytest.mark.parametrize(("slope", "curve", "lo", "root"), [(0.2, -1.0, 0.125, 0.2),
-                                                            (0.8, -8.0, 0.0, 0.1)])  # fmt: skip
-def test_the_hermite_crossing_finds_where_x_leaves_its_region(
-    slope: float, curve: float, lo: float, root: float
-) -> None:
-    """x(theta) = 1 + slope theta + curve theta^2 (a quadratic: its cubic Hermite interpolant
-    over [0, 1] is itself) leaves the region x > 1 at ``root``, bracketed by the samples at
-    ``lo`` and ``lo`` + 1/8. From inside, and from a substep that starts on the kink (x = 1,
-    where the step after a crossing starts) with a re-exit in its first eighth: the initial
-    guess must not be pulled to theta = 0, where x = 1 too."""
-    from gearengine.systems.spur_pair.kernels.kink import _hermite_crossing
-
-    x1, v1 = 1.0 + slope + curve, slope + 2.0 * curve
-    th = _hermite_crossing(1.0, slope, x1, v1, 1.0, lo, lo + 0.125, 1.0)
-    assert th == pytest.approx(root, abs=1e-12)

@@ -111,28 +111,25 @@ NEWTON_SUBSTEPS = 4
 
 @njit(**JIT_OPTIONS)
 def _hermite_crossing(
-    x: float, vr: float, x1: float, v1r: float, b: float, lo: float, hi: float, side: float
+    x: float, vr: float, x1: float, v1r: float, b: float, lo: float, hi: float
 ) -> float:  # pragma: no cover - compiled
     """The theta in [lo, hi] where the cubic Hermite interpolant of x over a substep (ends x,
-    x1; slopes vr, v1r per unit theta) leaves its region through b, bracketed by its samples
-    at lo (inside: side (x - b) > 0, or on b where a substep starts at a crossing) and hi
-    (outside): safeguarded Newton on the polynomial (no forcing evaluated)."""
+    x1; slopes vr, v1r per unit theta) crosses b, bracketed by its samples at lo and hi:
+    safeguarded Newton on the polynomial (no forcing evaluated)."""
     h_lo = _hermite(x, vr, x1, v1r, lo) - b
     h_hi = _hermite(x, vr, x1, v1r, hi) - b
-    th = lo + (hi - lo) * h_lo / (h_lo - h_hi) if side * h_lo > 0.0 else 0.5 * (lo + hi)
+    th = lo + (hi - lo) * h_lo / (h_lo - h_hi) if h_lo != h_hi else 0.5 * (lo + hi)
     for _ in range(8):
         f = _hermite(x, vr, x1, v1r, th) - b
-        if f == 0.0:
-            return th
-        if side * f > 0.0:
-            lo = th
+        if (f > 0.0) == (h_lo > 0.0):
+            lo, h_lo = th, f
         else:
             hi = th
         s2 = th * th
         d = (6 * s2 - 6 * th) * x + (3 * s2 - 4 * th + 1) * vr + (6 * th - 6 * s2) * x1
         d += (3 * s2 - 2 * th) * v1r
         nxt = th - f / d if d != 0.0 else 0.5 * (lo + hi)
-        th = nxt if lo <= nxt <= hi else 0.5 * (lo + hi)  # Newton, or bisection outside
+        th = nxt if lo < nxt < hi else 0.5 * (lo + hi)
     return th
 
 
@@ -234,8 +231,7 @@ def kink_split(
         # Newton on theta from the Hermite interpolant's crossing, the slope the velocity of
         # the RK4 substep to theta: one substep lands within ~1e-9 of the root, a second
         # confirms it (the bracketing regula falsi below took ~6.5)
-        side = float(reg) if reg != 0 else -b  # side (x - b) > 0 inside the region
-        th = _hermite_crossing(x, rem * v, x1, rem * v1, b, lo, hi, side)
+        th = _hermite_crossing(x, rem * v, x1, rem * v1, b, lo, hi)
         crossed = False
         xth, vth, dxth, dvth = x, v, dx, dv
         for _n in range(NEWTON_SUBSTEPS):
@@ -257,6 +253,7 @@ def kink_split(
             v, dx, dv = vth, dxth, dvth
         else:  # a grazing excursion, or Newton left the bracket: bracket and regula falsi
             # g(theta) = side (x(theta) - b) > 0 inside the current region
+            side = float(reg) if reg != 0 else -b
             xlo = x
             if lo > 0.0:
                 xlo = _rk4_region(
