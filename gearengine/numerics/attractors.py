@@ -40,7 +40,7 @@ from gearengine.numerics.results import Attractor, BasinCounts, BatchPoint
 from gearengine.numerics.runs import integrate
 from gearengine.numerics.settings import BasinSettings, SimulationSettings
 from gearengine.signals.classify import severity
-from gearengine.signals.periodicity import SIZE_FLOOR
+from gearengine.signals.periodicity import SIZE_FLOOR, same_cycle
 from gearengine.systems.base import StepPlan, System
 
 ORBIT_TOL = 1e-2
@@ -99,13 +99,7 @@ def same_orbit(a: BatchPoint, b: BatchPoint) -> bool:
     """True when the periodic starts ``a`` and ``b`` settled on one orbit (see module doc)."""
     if a.period != b.period:
         return False
-    tol = ORBIT_TOL * max(_size(a), _size(b))
-    oa, ob = _orbit(a), _orbit(b)
-    if oa.shape[1] == 2:
-        d = np.hypot(oa[:, None, 0] - ob[None, :, 0], oa[:, None, 1] - ob[None, :, 1])
-    else:
-        d = np.linalg.norm(oa[:, None, :] - ob[None, :, :], axis=2)
-    return bool((d.min(axis=1) < tol).all() and (d.min(axis=0) < tol).all())
+    return same_cycle(_orbit(a), _orbit(b), ORBIT_TOL * max(_size(a), _size(b)))
 
 
 def same_cloud(a: BatchPoint, b: BatchPoint) -> bool:

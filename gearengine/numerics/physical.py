@@ -80,7 +80,7 @@ from gearengine.numerics.results import RunLength
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.signals.classify import LLE_FLOOR
 from gearengine.signals.lyapunov import BLOCKS, benettin
-from gearengine.signals.periodicity import REL_TOL, attractor_size, detect_period
+from gearengine.signals.periodicity import REL_TOL, attractor_size, detect_period, same_cycle
 from gearengine.systems.base import StepPlan
 
 DAMPING_TIMES = 10.0
@@ -273,7 +273,8 @@ def _settle(advance: Advance, x: np.ndarray, v: np.ndarray, period: np.ndarray, 
             active[lane] = False
             if kin is not None:
                 known = cycles.setdefault(int(kin[lane]), [])
-                same = (k for k, q, c, z in known if q == p and _same_cycle(c, cycle, max(z, size)))
+                same = (k for k, q, c, z in known
+                        if q == p and same_cycle(c, cycle, REL_TOL * max(z, size)))  # fmt: skip
                 s.joined = next(same, None)
                 if s.joined is None:
                     known.append((lane, p, cycle, size))
@@ -313,14 +314,6 @@ def _periods(history: list[tuple[np.ndarray, Chunk]], lanes: np.ndarray, ran: in
         if p is not None and _converged(w, p, size):
             found.append((lane, p, w[-p:], size))
     return found
-
-
-def _same_cycle(a: np.ndarray, b: np.ndarray, size: float) -> bool:
-    """True when the cycles a and b (strobes (p, 2), any phase) are one: every strobe of each
-    within the period test's ``REL_TOL`` x ``size`` of a strobe of the other."""
-    d = np.hypot(a[:, None, 0] - b[None, :, 0], a[:, None, 1] - b[None, :, 1])
-    tol = REL_TOL * size
-    return bool((d.min(axis=1) < tol).all() and (d.min(axis=0) < tol).all())
 
 
 def _converged(window: np.ndarray, p: int, size: float) -> bool:

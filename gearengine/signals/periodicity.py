@@ -70,3 +70,14 @@ def _smallest_period(
         if every:
             return n
     return 0
+
+
+def same_cycle(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
+    """True when the cycles ``a`` and ``b`` (strobes, shapes (p, n) and (q, n), any phase) are
+    one set: every strobe of each within ``tol`` of a strobe of the other (Euclidean; hypot
+    for n = 2)."""
+    if a.shape[1] == 2:
+        d = np.hypot(a[:, None, 0] - b[None, :, 0], a[:, None, 1] - b[None, :, 1])
+    else:
+        d = np.linalg.norm(a[:, None, :] - b[None, :, :], axis=2)
+    return bool((d.min(axis=1) < tol).all() and (d.min(axis=0) < tol).all())
