@@ -251,20 +251,15 @@ def tolerance_derived(design: Design) -> dict[str, Derived]:
     return out
 
 
-def operating_pressure_angle(design: Design) -> float:
-    """alpha_wt [rad] of the pair (``Design.operating_pressure_angle``)."""
-    return design.operating_pressure_angle()
-
-
 def half_backlash_band(design: Design, j_min: float, j_max: float) -> tuple[float, float]:
     """(b_min, b_max) [m] of a circumferential backlash band [m] of this pair."""
-    return backlash.half_backlash_band(j_min, j_max, operating_pressure_angle(design))
+    return backlash.half_backlash_band(j_min, j_max, design.operating_pressure_angle())
 
 
 def convert_design(design: Design) -> DesignConversion:
     """The dimensionless parameters of ``design`` (Eq. 7-9) with the scales and derivations."""
     data, derived, notes = physical_data(design)
-    conv = to_dimensionless(data)
+    conv, gain = to_dimensionless(data), torque_gain(data)
     notes += [n for n in conv.notes if n.startswith(("base-radius", "sum of |k_r|"))]
     m = conv.equivalent_mass
     for role, r, inertia in (
@@ -304,7 +299,7 @@ def convert_design(design: Design) -> DesignConversion:
         half_backlash_m=data.half_backlash,
         mesh_stiffness_n_per_m=data.mesh_stiffness,
         static_force_n=conv.params.mean_force * force_scale,
-        torque_gain=torque_gain(data),
+        torque_gain=gain,
         notes=notes,
     )
 

@@ -21,11 +21,11 @@ def design_model(design: Design) -> tuple[GearParams | System, DesignConversion]
     """(what the numerics run, the conversion whose scales read its answers) for ``design``:
     (the pair's ``GearParams``, its conversion), or with a train (its ``TrainSystem``, the
     conversion of its equivalent pair, I_a = I_m + I_p, I_b = I_g + I_l)."""
-    if design.train is None:
-        conversion = convert_design(design)
-        return conversion.params, conversion
-    model, pair = train_of(design)
-    return train_system(model, pair), pair
+    if design.train is not None:
+        model, pair = train_of(design)
+        return train_system(model, pair), pair
+    conversion = convert_design(design)
+    return conversion.params, conversion
 
 
 def params_of(model: GearParams | System) -> GearParams:
