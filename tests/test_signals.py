@@ -142,3 +142,20 @@ def test_summary_states_the_verdict_and_its_evidence() -> None:
     r = signal(logistic(3.5), 1.0)
     assert r.summary.startswith(reading.WORDS["periodic"] + ": the average over 1 fundamental")
     assert r.evidence and r.evidence[0] in r.summary
+
+
+def test_same_cycle_matches_a_cycle_at_any_phase_and_nothing_less() -> None:
+    """``same_cycle`` is a set test: a period-2 cycle strobed from its other point is itself; a
+    fixed point on one of its strobes, or a cycle moved by more than ``tol``, is not; the
+    n-dimensional branch (a train's state) answers as the n = 2 one does."""
+    from gearengine.signals.periodicity import same_cycle
+
+    cycle = np.array([[0.8, -0.1], [-0.3, 0.4]])
+    assert same_cycle(cycle, cycle[::-1], 1e-6)  # strobed half a cycle later
+    assert not same_cycle(cycle, cycle[:1], 1e-6)  # the other strobe has no partner
+    assert not same_cycle(cycle[:1], cycle, 1e-6)  # the set test runs both ways
+    moved = cycle + np.array([0.0, 2e-6])
+    assert same_cycle(cycle, moved, 3e-6) and not same_cycle(cycle, moved, 1e-6)
+    lifted = np.hstack([cycle, np.array([[0.2], [0.5]])])  # n = 3: the norm branch
+    assert same_cycle(lifted, lifted[::-1], 1e-6)
+    assert not same_cycle(lifted, lifted + np.array([0.0, 0.0, 1e-3]), 1e-6)

@@ -323,3 +323,24 @@ def test_a_text_is_read_by_pint_once_and_noted_every_time_it_is_read(
     with pytest.raises(ValueError):  # the same text read, out of a module's range
         quantities.parse_quantity("2 m", quantities.QUANTITIES["module"])
     assert read[-1] == "2 m" and read.count("2 m") == 1
+
+
+def test_the_kept_readings_are_bounded_oldest_out_and_refusals_never_kept(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Past ``TEXT_READINGS`` texts the oldest reading is let go (insertion order), the same
+    value still comes back for it, read by pint again; a text pint refuses is not kept."""
+    from gearengine.model.units import quantities
+
+    kind = quantities.QUANTITIES["torque"]
+    quantities._text_readings.clear()
+    monkeypatch.setattr(quantities, "TEXT_READINGS", 2)
+    for text in ("10 N*m", "20 N*m", "30 N*m"):
+        quantities.parse_quantity(text, kind)
+    assert [k[0] for k in quantities._text_readings] == ["20 N*m", "30 N*m"]
+    assert quantities.parse_quantity("10 N*m", kind) == pytest.approx(10.0)
+    assert [k[0] for k in quantities._text_readings] == ["30 N*m", "10 N*m"]
+    with pytest.raises(ValueError, match="dimension"):
+        quantities.parse_quantity("3 kg", kind)
+    assert [k[0] for k in quantities._text_readings] == ["30 N*m", "10 N*m"]
+    quantities._text_readings.clear()
