@@ -147,3 +147,28 @@ def test_a_point_the_regula_falsi_lost_is_dop853s_periodic_orbit() -> None:
     period, _, final = scipy_run(point, 2, 4, tuple(b.poincare[-1]))  # on from its strobe
     assert period == 1  # DOP853 stays on it: the orbit, to RK4's error at 128 steps a mesh period
     assert list(final[:2]) == pytest.approx(b.poincare[-1], abs=1e-4)
+
+
+@pytest.mark.parametrize(("x", "v", "reg"), [(0.995, 0.8, 0), (1.004, -0.6, 1), (-0.99, -1.1, 0)])
+def test_the_regula_falsi_fallback_finds_newtons_crossing(x: float, v: float, reg: int) -> None:
+    """A step across a kink, split by Newton from the Hermite root (the compiled kernel) and by
+    the bracketing regula falsi alone (``NEWTON_SUBSTEPS`` 0, the fallback a grazing excursion
+    or a Newton iterate out of its bracket takes; run as Python): the same crossing, the same
+    state and tangent after it, in the region the motion enters."""
+    from gearengine.systems.spur_pair.kernels import kink
+    from gearengine.systems.spur_pair.kernels.phase import excitation_at
+
+    params = paper(0.25, model="piecewise", alpha=0.3)
+    kc, fm, fc = packed_forcing(params)
+    alpha, twomu, t, h = params.backlash.alpha, 2.0 * params.damping, 0.7, 0.05
+    newton = kink.kink_step(reg, alpha, twomu, kc, fm, fc, t, h, x, v, 1.0, 0.0)
+    assert newton[4] != reg  # the step crossed
+    K0, F0 = excitation_at(t, kc, fm, fc)
+    first = kink._rk4_region(reg, alpha, twomu, kc, fm, fc, K0, F0, t, h, x, v, 1.0, 0.0)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(kink, "NEWTON_SUBSTEPS", 0)
+        falsi = kink.kink_split.py_func(reg, alpha, twomu, kc, fm, fc, t, K0, F0, h, x, v, 1.0,
+                                        0.0, *first)  # fmt: skip
+    assert abs(newton[3] - first[3]) > 1e-3  # the unsplit step's tangent is another
+    assert falsi[4] == newton[4]
+    assert falsi[:4] == pytest.approx(newton[:4], rel=1e-10, abs=1e-12)
