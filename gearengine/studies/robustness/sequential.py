@@ -32,7 +32,6 @@ from gearengine.studies.robustness.study import (
     MAX_SAMPLES,
     RobustnessRequest,
     assemble,
-    robustness_work,
 )
 from gearengine.studies.robustness.tolerances import clopper_pearson, samples_to_prove
 from gearengine.studies.sweep.axes import axis_unit
@@ -139,11 +138,6 @@ def unreachable(unit: list[int], limits: dict[str, float], budget: int,
             f"holds {held} samples at each of the {points} point{'s' if points != 1 else ''}: "
             "points without events will end undecided (fewer points, a looser limit, or a "
             "larger budget decide them)")  # fmt: skip
-
-
-def first_round_steps(request: RobustnessRequest, first: int = FIRST_SAMPLES) -> int:
-    """RK4 steps of the first round: ``first`` samples at every point."""
-    return robustness_work(request.model_copy(update={"samples": first, "sensitivity": False}))
 
 
 def sequential(

@@ -129,12 +129,15 @@ def variables(design: Design) -> list[Variable]:
     """The toleranced fields of ``design`` in order: accuracy, backlash, then by path.
 
     Raises ``InputError`` (naming the field) for an unknown path, a distribution outside
-    the field's physical bounds, sd <= 0, or an ISO 1328 input outside its range.
+    the field's physical bounds, sd <= 0, or an ISO 1328 input outside its range; the fields
+    by path are read first (on the base design, each through its field's unit), then the
+    standards' tolerances.
     """
     tol = design.tolerances
     if tol is None:
         raise tolerance_error("", "the design has no tolerances")
     base, out = base_design(design), []
+    fields = [_variable(base, path, dist) for path, dist in tol.fields().items()]
     if tol.accuracy is not None:
         grade = tol.accuracy.tolerance_class
         try:
@@ -153,8 +156,7 @@ def variables(design: Design) -> list[Variable]:
         )
         label = f"backlash (band {band})"
         out.append(Variable(BACKLASH_FIELD, words, stats.uniform(lo, hi - lo).ppf, label))
-    for path, dist in tol.fields().items():
-        out.append(_variable(base, path, dist))
+    out += fields
     if not out:
         raise tolerance_error("", "give at least one tolerance")
     return out
