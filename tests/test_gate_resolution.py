@@ -148,14 +148,14 @@ def test_refined_levels_say_where_they_were_checked_and_each_is_a_junit_case() -
     from xml.etree import ElementTree
 
     from gearengine.gate.envelope import EnvelopeReport, envelope_report
-    from gearengine.gate.envelope_text import refined_levels, windows_summary
+    from gearengine.gate.envelope_text import windows_summary
 
     golden = EnvelopeReport.model_validate_json((ROOT / "tests/golden/check-envelope.json")
                                                 .read_text())  # fmt: skip
     report = envelope_report(golden.sweep, Rules(fail_on=["diverged"]), golden.refined,
                              golden.resolution)  # fmt: skip
     assert report.passed and len(report.windows) == 5
-    lines = windows_summary(report.windows, refined=refined_levels(report))
+    lines = windows_summary(report.windows, report=report)
     for line, torque in zip(lines[1:4], ("4.375", "6.75", "9.125"), strict=True):
         assert line.startswith(f"windows at torque {torque} N*m (refined level, checked at ")
     assert "(refined level" not in lines[0] + lines[4]

@@ -599,3 +599,24 @@ def test_the_gates_run_up_bins_resolve_its_chaos_rule(tmp_path: Path) -> None:
           "--speed-points", "2", "--runup", "2000", "--json", str(report)])  # fmt: skip
     ran = json.loads(report.read_text())["runup"]
     assert ran["bin_rpm"] == 2000 * CHAOS_SECONDS / 2 == 50.0
+
+
+def test_a_torque_ramp_ends_at_the_design_converted_at_its_end_torque() -> None:
+    """A torque ramp's plan ends at the mean force of the design converted at ``to_torque`` (an
+    operating point at that torque, as a sweep's grid point reads it: ``point_params``); a
+    design whose ISO 6336 stiffness depends on the load is refused, naming to_torque."""
+    from gearengine.studies.runup.profile import runup_plan
+    from gearengine.studies.sweep.axes import point_params
+
+    ramp = {"from_speed": "4300 rpm", "to_speed": "4500 rpm", "rate": "4000 rpm/s",
+            "to_torque": "60 N*m"}  # fmt: skip
+    r = validated_runup(_request(**ramp))
+    assert r.params is not None and r.to_torque is not None
+    f0, f1 = runup_plan(r).mean_force
+    end = point_params(r.params, r.design, {"torque": r.to_torque})
+    assert (f0, f1) == (r.params.mean_force, end.mean_force)
+    assert f1 == pytest.approx(1.5 * f0, rel=1e-12)  # 60 against the design's 40 N*m
+    iso = json.loads((ROOT / "examples" / "design-geometry.json").read_text())["design"]
+    with pytest.raises(ValidationError, match="to_torque") as refused:
+        validated_runup({"design": iso, **ramp, "to_torque": "90 N*m"})
+    assert "depends on the load" in str(refused.value)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Hashable, Sequence
 
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -115,18 +115,20 @@ def check_or_failures(request: SweepRequest, rules: Rules, refine: int = REFINE_
         return any(tuple(g[k] for g, k in zip(grids, ix, strict=True)) in wanted
                    for ix in plan.chunk(i).points)  # fmt: skip
 
+    fails, near, kind = _judges(rules)
     text = request.model_dump_json()
     outputs = [""] * plan.n_chunks()
     for i in sorted(range(plan.n_chunks()), key=lambda i: not expected(i)):
         outputs[i] = jobs.compute_chunk_json("sweep", text, i, size)
         points = [SweepPoint.model_validate(p) for p in points_of_chunk(outputs[i])]
-        failing = [p for p in points if attractor_failures(p, rules)]
+        failing = [p for p in points if fails(p)]
         if failing:
             return failing
     result = job.assemble(request, outputs)
     assert isinstance(result, SweepResult)
-    added = _refined(request, result, rules, refine, stop=True, first=first)
-    failing = [p for p in added if attractor_failures(p, rules)]
+    grid = [p for p in result.points if p.branch != "down"]
+    added = refine_points(request, grid, fails, near, refine, kind=kind, stop=fails, first=first)
+    failing = [p for p in added if fails(p)]
     return failing or envelope_report(result, rules, added, resolution(request, refine, len(added)))
 
 
@@ -158,11 +160,10 @@ def fails_toward(request: SweepRequest, rules: Rules, refine: int,
         cell = [dict(zip(names, x, strict=True)) for x in itertools.product(*spans)]
         corners += [c for c in cell if c not in corners]
     points = points_at(request, corners)
-    fails = lambda p: bool(attractor_failures(p, rules))  # noqa: E731
+    fails, near, kind = _judges(rules)
     if any(fails(p) for p in points):
         return True
-    found = refine_points(request, points, fails, lambda p: near_limit(p, rules), refine,
-                          kind=lambda p: attractor_set(p, rules), stop=fails, first=at,
+    found = refine_points(request, points, fails, near, refine, kind=kind, stop=fails, first=at,
                           levels=False)  # fmt: skip
     return any(fails(p) for p in found)
 
@@ -173,27 +174,20 @@ def refined_report(request: SweepRequest, result: SweepResult, rules: Rules,
     """The report of an envelope sweep's ``result`` (computed here or on a server), refined
     between its grid points in this process as ``check_envelope`` says, built once: the grid
     fails when one of its points does (``refine_failing`` False then leaves it unrefined)."""
-    grid_fails = not refine_failing and any(
-        attractor_failures(p, rules) for p in result.points if p.branch != "down"
-    )
-    depth = 0 if grid_fails else max(refine, 0)
-    added = _refined(request, result, rules, depth, workers)
+    grid = [p for p in result.points if p.branch != "down"]
+    fails, near, kind = _judges(rules)
+    depth = 0 if not refine_failing and any(fails(p) for p in grid) else max(refine, 0)
+    added = refine_points(request, grid, fails, near, depth, workers, kind)
     return envelope_report(result, rules, added, resolution(request, depth, len(added)))
 
 
-def _refined(request: SweepRequest, result: SweepResult, rules: Rules, depth: int,
-             workers: int = 1, stop: bool = False, first: Sequence[dict[str, float]] = ()
-             ) -> list[SweepPoint]:  # fmt: skip
-    """The points ``gate.resolution.refine`` inserts ``depth`` times between the grid points of
-    ``result``; ``stop``: to the first batch with a failing point (the points of ``first``
-    first), where only pass or fail is needed."""
-    if depth <= 0:
-        return []
-    fails = lambda p: bool(attractor_failures(p, rules))  # noqa: E731
-    return refine_points(request, [p for p in result.points if p.branch != "down"], fails,
-                         lambda p: near_limit(p, rules), depth, workers,
-                         lambda p: attractor_set(p, rules), fails if stop else None,
-                         first)  # fmt: skip
+def _judges(rules: Rules) -> tuple[Callable[[SweepPoint], bool], Callable[[SweepPoint], bool],
+                                   Callable[[SweepPoint], Hashable]]:  # fmt: skip
+    """What the refinement (``gate.resolution.refine``) reads of a point under ``rules``: does
+    it fail (``attractor_failures``), is it near a limit (``near_limit``), and its attractor
+    set (``attractor_set``), for the report, a bisection step and ``fails_toward`` alike."""
+    return (lambda p: bool(attractor_failures(p, rules)), lambda p: near_limit(p, rules),
+            lambda p: attractor_set(p, rules))  # fmt: skip
 
 
 class FailingWindow(BaseModel):

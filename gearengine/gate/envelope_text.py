@@ -36,8 +36,7 @@ def report_lines(report: EnvelopeReport, design: Design | None = None) -> list[s
     if report.runup is not None:
         lines.append(f"  run-ups: {report.runup.text()}")
     lines += [f"  {window_text(w)}" for w in report.failures]
-    return lines + [f"  {line}" for line in windows_summary(report.windows, short,
-                                                          refined_levels(report))]  # fmt: skip
+    return lines + [f"  {line}" for line in windows_summary(report.windows, short, report)]
 
 
 def rules_text(rules: Rules) -> str:
@@ -92,14 +91,15 @@ def refined_levels(report: EnvelopeReport) -> dict[str, str]:
 
 
 def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit",
-                    refined: dict[str, str] | None = None) -> list[str]:  # fmt: skip
+                    report: EnvelopeReport | None = None) -> list[str]:  # fmt: skip
     """Per level of the other axis, the impact and Melnikov windows in rpm, pass or fail:
     "windows at torque 40 N*m: tooth separation 500-1100 rpm; Melnikov:
     chaos possible nowhere" ("teeth always in contact" only where no point diverged: a
     diverged point has no contact verdict); ``reason`` says why Melnikov does not apply where
-    it does not (``not_judged_reason``); ``refined`` (``refined_levels``) says over which
-    speeds a level refined between the grid's was checked: "windows at torque 8.44 N*m
-    (refined level, checked at 3 speeds in 4636-4864 rpm): ..."."""
+    it does not (``not_judged_reason``); ``report`` (whose windows these are) says over which
+    speeds a level refined between the grid's was checked (``refined_levels``): "windows at
+    torque 8.44 N*m (refined level, checked at 3 speeds in 4636-4864 rpm): ..."."""
+    refined = {} if report is None else refined_levels(report)
     out = []
     for w in windows:
         parts = [f"{CONTACT_LABELS[k]} {spans_text(v)}" for k, v in w.contact.items()]
@@ -110,9 +110,10 @@ def windows_summary(windows: list[SpeedWindows], reason: str = "above T_crit",
         if w.melnikov_not_applicable:
             na = f"not applicable at {spans_text(w.melnikov_not_applicable)} ({reason})"
             melnikov = f"{melnikov}, {na}" if w.melnikov else na
-        where = f" at {level_text(w.level)}" if w.level else ""
-        if refined and level_text(w.level) in refined:
-            where += f" ({refined[level_text(w.level)]})"
+        level = level_text(w.level)
+        where = f" at {level}" if w.level else ""
+        if level in refined:
+            where += f" ({refined[level]})"
         out.append(f"windows{where}: {contact or 'teeth always in contact'}; "
                    f"Melnikov: {melnikov}")  # fmt: skip
     return out

@@ -29,12 +29,13 @@ from pydantic import ValidationError
 from pydantic_core import InitErrorDetails
 
 from gearengine.model.errors import Problems
+from gearengine.model.fields import design_with
 from gearengine.model.params import GearParams
 from gearengine.model.reduction import DesignConversion
 from gearengine.model.units import RPM, in_si
 from gearengine.studies.runup.request import MAX_RUNUP_STEPS, RunupRequest, request_errors
-from gearengine.studies.sweep.axes import point_params
 from gearengine.systems.base import System
+from gearengine.systems.designs import design_model, params_of
 from gearengine.systems.spur_pair.forcing import packed_forcing
 
 BLOCKS_PER_BIN = 4
@@ -194,7 +195,7 @@ def runup_plan(request: RunupRequest) -> RunupPlan:
     f0 = params.mean_force
     f1 = f0
     if request.to_torque is not None:
-        end = point_params(params, design, {"torque": request.to_torque})
+        end = params_of(design_model(design_with(design, {"torque": request.to_torque}))[0])
         if end.model_copy(update={"mean_force": f0}) != params:
             raise ValueError("to_torque: this design's mesh stiffness depends on the load "
                              "(iso6336); a torque ramp needs mesh.stiffness in N/m")  # fmt: skip
