@@ -29,7 +29,7 @@ import math
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, Field, field_validator
+from pydantic import BaseModel, Field, PrivateAttr, field_validator, model_validator
 from pydantic_core import InitErrorDetails
 
 from gearengine.homoclinic.thresholds import chaos_possible
@@ -125,9 +125,27 @@ class RobustnessRequest(BaseModel):
     def _over_light(cls, given: object) -> object:
         return over_light(given)
 
+    _variables: list[Variable] | InputError | None = PrivateAttr(None)
+
+    @model_validator(mode="after")
+    def _carry_variables(self) -> RobustnessRequest:
+        """Read the toleranced fields once, when the request is validated (the row count, every
+        chunk's sample rows and the assembly read them; each read validated the design's
+        tolerance values again): the variables, or the ``InputError`` refusing one, which
+        ``request_errors`` names beside the request's other problems."""
+        try:
+            self._variables = variables(self.design)
+        except InputError as exc:
+            self._variables = exc
+        return self
+
     def variables(self) -> list[Variable]:
-        """The toleranced fields (``studies.robustness.tolerances.variables``)."""
-        return variables(self.design)
+        """The toleranced fields (``studies.robustness.tolerances.variables``), read when the
+        request was validated; raises the ``InputError`` that refused one."""
+        if isinstance(self._variables, InputError):
+            raise self._variables
+        assert self._variables is not None
+        return self._variables
 
     def unit_rows(self) -> np.ndarray:
         """Every run's point of the unit cube, shape (rows, D)."""
