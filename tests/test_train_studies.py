@@ -17,11 +17,12 @@ from pydantic import ValidationError
 import gearengine
 from gearengine.analysis import AnalysisRequest
 from gearengine.gate.envelope import check_envelope
-from gearengine.gate.envelope_text import not_judged_reason, windows_summary
+from gearengine.gate.envelope_text import windows_summary
 from gearengine.gate.remedies.compute import remedies
 from gearengine.gate.remedies.request import RemediesRequest as RemediesRequest_
 from gearengine.gate.remedies.search import verify_depth
 from gearengine.gate.rules import Rules, attractor_failures
+from gearengine.homoclinic.train_reduction import not_judged_reason
 from gearengine.model.design import Design
 from gearengine.model.train import EXAMPLE_TRAIN
 from gearengine.numerics.runs import work

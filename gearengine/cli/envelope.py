@@ -47,6 +47,7 @@ from gearengine.gate.envelope_text import report_lines
 from gearengine.gate.junit import envelope_junit
 from gearengine.gate.resolution import GRID_POINTS
 from gearengine.gate.rules import Rules
+from gearengine.homoclinic.train_reduction import not_judged_reason
 from gearengine.jsonio import dumps
 from gearengine.numerics.settings import SimulationSettings
 from gearengine.studies import jobs
@@ -239,7 +240,8 @@ def cmd_envelope(args: argparse.Namespace, doc: object, rules: Rules) -> int:
         report = gate_envelope(report, runups)
     if request.design is not None and request.design.tolerances is not None:
         report = report.model_copy(update={"notes": [*report.notes, NOMINAL_ONLY]})
-    for line in report_lines(report, request.design):
+    why = not_judged_reason(request.design)  # why Melnikov judges no point where it does not
+    for line in report_lines(report, why):
         print(line)
     if args.json:
         Path(args.json).write_text(dumps(report))

@@ -6,25 +6,21 @@ the failing windows, and per level of the other axis the impact and Melnikov win
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 from gearengine.gate.envelope import EnvelopeReport, level_text, window_text
 from gearengine.gate.rules import Rules
+from gearengine.homoclinic.train_reduction import ABOVE_T_CRIT
 from gearengine.model.units import POINT_OUTPUTS
 from gearengine.numerics.attractors import IMPACT_TEXT
 from gearengine.studies.sweep.points import SpeedWindows
 from gearengine.studies.sweep.windows import SPEED
 
-if TYPE_CHECKING:
-    from gearengine.model.design import Design
 
-
-def report_lines(report: EnvelopeReport, design: Design | None = None) -> list[str]:
+def report_lines(report: EnvelopeReport, why: tuple[str, str] = ABOVE_T_CRIT) -> list[str]:
     """PASS or FAIL, then the notes, what was checked, one line per failing window (rpm and
-    N m) and each level's windows; ``design`` says why Melnikov judges no point where it does
-    not (``not_judged_reason``)."""
+    N m) and each level's windows; ``why`` says why Melnikov judges no point where it does not
+    (``homoclinic.train_reduction.not_judged_reason`` of the design: short, whole)."""
     verdict = "PASS" if report.passed else "FAIL"
-    short, reason = not_judged_reason(design)
+    short, reason = why
     lines = [f"{verdict}: {report.failing_points} of {report.points} operating points break "
              f"the rules ({rules_text(report.rules)})"]  # fmt: skip
     if "melnikov" in report.rules.fail_on and report.melnikov_not_judged:
@@ -51,25 +47,6 @@ def rules_text(rules: Rules) -> str:
     if rules.min_basin is not None:
         parts.append(f"--min-basin {rules.min_basin:g}")
     return ", ".join(parts)
-
-
-def not_judged_reason(design: Design | None) -> tuple[str, str]:
-    """Why the Melnikov criterion judges no point of ``design``'s envelope where it does not,
-    (in a window's words, in the report's): above the critical torque of the pair, or of a
-    train's mesh-mode reduction (``homoclinic.train_reduction``), or, for a train whose mesh no
-    single mode carries, at every point (no one-mode reduction). The gate's axes (speed and
-    torque) leave a train's modes as they are, so the design decides it."""
-    if design is None or design.train is None:
-        return "above T_crit", "the criterion does not apply above the critical torque"
-    from gearengine.homoclinic.train_reduction import SHARE_THRESHOLD, melnikov_point
-    from gearengine.systems.designs import design_model
-
-    if melnikov_point(design_model(design)[0]) is not None:
-        return ("above the mesh-mode reduction's T_crit",
-                "the criterion of the train's mesh-mode reduction does not apply above its "
-                "critical torque")  # fmt: skip
-    share = f"no single mode of the train holds {SHARE_THRESHOLD:.0%} of the mesh strain energy"
-    return share, f"{share}: the one-degree-of-freedom criterion has no reduction to judge"
 
 
 def refined_levels(report: EnvelopeReport) -> dict[str, str]:

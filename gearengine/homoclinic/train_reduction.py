@@ -26,8 +26,10 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from gearengine.homoclinic.schemas import MelnikovResult
 from gearengine.homoclinic.verdict import melnikov
+from gearengine.model.design import Design
 from gearengine.model.params import CubicBacklash, Excitation, GearParams, Harmonic
 from gearengine.systems.base import System
+from gearengine.systems.designs import design_model
 from gearengine.systems.gear_train.system import TrainSystem
 from gearengine.systems.spur_pair.laws import melnikov_cubic
 
@@ -121,3 +123,23 @@ def melnikov_point(model: GearParams | System) -> GearParams | None:
         return model.params
     phi, s, share = mesh_mode(model)
     return reduced_params(model, phi, s, share) if share >= SHARE_THRESHOLD else None
+
+
+ABOVE_T_CRIT = ("above T_crit", "the criterion does not apply above the critical torque")
+"""Why the pair's criterion judges no point where it does not (``not_judged_reason``)."""
+
+
+def not_judged_reason(design: Design | None) -> tuple[str, str]:
+    """Why the Melnikov criterion judges no point of ``design``'s operating envelope where it
+    does not (in a window's words, in a report's): above the critical torque of the pair
+    (``ABOVE_T_CRIT``), or of a train's mesh-mode reduction, or, for a train whose mesh no
+    single mode carries, at every point (no one-mode reduction, ``melnikov_point``). Speed
+    and torque leave a train's modes as they are, so the design decides it."""
+    if design is None or design.train is None:
+        return ABOVE_T_CRIT
+    if melnikov_point(design_model(design)[0]) is not None:
+        return ("above the mesh-mode reduction's T_crit",
+                "the criterion of the train's mesh-mode reduction does not apply above its "
+                "critical torque")  # fmt: skip
+    share = f"no single mode of the train holds {SHARE_THRESHOLD:.0%} of the mesh strain energy"
+    return share, f"{share}: the one-degree-of-freedom criterion has no reduction to judge"
